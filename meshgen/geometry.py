@@ -1,0 +1,151 @@
+"""Derived dimensions of a cylindrical worm gear pair (90 deg shaft angle), SI units.
+
+Sources: DIN 3975-1 / ISO 1122-1 for the names and the basic relations; seed 003
+(`../shared/seeds/003_a94382a6f782276d.txt`) for the involute helicoid parameters r_b and p.
+
+Relations (m_x axial module, m_n normal module, z1 starts, z2 wheel teeth, gamma lead angle at d1):
+
+    m_n   = m_x cos(gamma)
+    q     = d1 / m_x = z1 / tan(gamma)                  (diameter quotient)
+    d1    = q m_x,  d2 = z2 m_x,  a = (d1 + d2) / 2     (reference diameters, centre distance)
+    p_x   = pi m_x (axial pitch),  p_z = z1 p_x (lead),  p = p_z / (2 pi) = r1 tan(gamma)   (helix parameter, seed 003)
+    tan(alpha_x) = tan(alpha_n) / cos(gamma)            (axial pressure angle at d1)
+    cos(gamma_b) = cos(gamma) cos(alpha_n),  r_b = p / tan(gamma_b)   (ZI base cylinder, seed 003)
+    h_a = addendum_coef m_x,  h_f = dedendum_coef m_x,  c = h_f - h_a  (tip clearance)
+    r_a1 = r1 + h_a, r_f1 = r1 - h_f (worm tip/root); r_a2 = r2 + h_a, r_f2 = r2 - h_f (wheel throat tip/root)
+    wheel tip surface: torus about the worm axis, tube radius a - r_a2 = r1 - h_a (the "throat")
+    wheel root surface: torus about the worm axis, tube radius a - r_f2 = r1 + h_f
+    r_e2 = r_a2 + m_x / 2  (outside radius of the wheel rim; DIN 3975 guide d_e2 <= d_a2 + 2 m for z1 = 1)
+    b2 = 0.75 d_a1 (z1 <= 3), 0.67 d_a1 (z1 >= 4)  (default face width, DIN 3975 guide)
+    wheel tooth thickness on d2: s2 = p_x / 2 - j_t   (backlash j_t taken from the wheel, symmetric)
+    ratio i = z2 / z1,  meshing frequency f_m = z1 n1 / 60
+
+Hand: right-hand worms have p > 0; a left-hand worm is the mirror image (p -> -p, seed 003).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+
+from wormsim.scenario import Gear, ScenarioError
+from wormsim.units import DEG, MM
+
+
+@dataclass(frozen=True)
+class GearGeometry:
+    profile: str            # "ZI" | "ZA"
+    hand: int               # +1 right, -1 left
+    z1: int
+    z2: int
+    m_x: float              # axial module, m
+    m_n: float              # normal module, m
+    gamma: float            # lead angle at d1, rad
+    alpha_n: float          # normal pressure angle, rad
+    alpha_x: float          # axial pressure angle, rad
+    q: float                # diameter quotient
+    d1: float
+    d2: float
+    a: float                # centre distance, m
+    p_x: float              # axial pitch, m
+    lead: float             # p_z, m
+    p: float                # helix parameter lead / 2 pi (signed by hand), m/rad
+    gamma_b: float          # base lead angle (ZI), rad
+    r_b: float              # base radius (ZI), m
+    h_a: float
+    h_f: float
+    r_a1: float
+    r_f1: float
+    r_a2: float
+    r_f2: float
+    r_e2: float             # wheel outside (rim) radius
+    throat_radius: float    # tube radius of the wheel tip torus, a - r_a2
+    root_torus_radius: float  # tube radius of the wheel root torus, a - r_f2
+    face_width: float       # b2, m
+    worm_length: float      # b1, m
+    backlash: float         # circumferential at d2, m
+    wheel_tooth_thickness: float  # s2 on d2 (arc), m
+    ratio: float            # z2 / z1
+
+    @property
+    def r1(self) -> float:
+        return self.d1 / 2
+
+    @property
+    def r2(self) -> float:
+        return self.d2 / 2
+
+    def mesh_frequency_hz(self, worm_speed_rpm: float) -> float:
+        """f_m = z1 n1 / 60 (seed 001)."""
+        return self.z1 * abs(worm_speed_rpm) / 60.0
+
+    def as_dict_mm_deg(self) -> dict:
+        """For printing: lengths in mm, angles in deg, names carrying the unit."""
+        out = {}
+        angles = {"gamma", "alpha_n", "alpha_x", "gamma_b"}
+        plain = {"profile", "hand", "z1", "z2", "q", "ratio"}
+        for k, v in asdict(self).items():
+            if k in plain:
+                out[k] = v
+            elif k in angles:
+                out[f"{k}_deg"] = v / DEG
+            elif k == "p":
+                out["p_mm_per_rad"] = v / MM
+            else:
+                out[f"{k}_mm"] = v / MM
+        return out
+
+
+def derive(gear: Gear) -> GearGeometry:
+    """All derived quantities from a validated `gear:` block. Raises ScenarioError on impossible data."""
+    z1, z2 = gear.worm_starts, gear.wheel_teeth
+    alpha_n = gear.normal_pressure_angle_deg * DEG
+    if gear.lead_angle_deg is not None:
+        gamma = gear.lead_angle_deg * DEG
+        q = z1 / math.tan(gamma)
+    else:
+        q = gear.diameter_quotient
+        gamma = math.atan(z1 / q)
+        if not (0 < gamma < 45 * DEG):
+            raise ScenarioError(f"gear.diameter_quotient = {q}: gives lead angle {gamma / DEG:.2f} deg; allowed (0, 45) deg")
+    if gear.axial_module_mm is not None:
+        m_x = gear.axial_module_mm * MM
+    else:
+        m_x = gear.normal_module_mm * MM / math.cos(gamma)
+    m_n = m_x * math.cos(gamma)
+    d1, d2 = q * m_x, z2 * m_x
+    r1, r2 = d1 / 2, d2 / 2
+    a = r1 + r2
+    p_x = math.pi * m_x
+    lead = z1 * p_x
+    hand = 1 if gear.hand == "right" else -1
+    p = hand * lead / (2 * math.pi)
+    alpha_x = math.atan(math.tan(alpha_n) / math.cos(gamma))
+    gamma_b = math.acos(math.cos(gamma) * math.cos(alpha_n))
+    r_b = abs(p) / math.tan(gamma_b)
+    h_a, h_f = gear.addendum_coef * m_x, gear.dedendum_coef * m_x
+    r_a1, r_f1 = r1 + h_a, r1 - h_f
+    r_a2, r_f2 = r2 + h_a, r2 - h_f
+    if r_f1 <= 0.2 * r1:
+        raise ScenarioError(
+            f"gear: worm root radius {r_f1 / MM:.3f} mm is too small for reference radius {r1 / MM:.3f} mm "
+            f"(diameter quotient q = {q:.2f}); use a lead angle giving q >= {2.5 * gear.dedendum_coef:.1f}")
+    r_e2 = r_a2 + 0.5 * m_x
+    b2 = gear.face_width_mm * MM if gear.face_width_mm is not None else (0.75 if z1 <= 3 else 0.67) * 2 * r_a1
+    if b2 >= 2 * (a - r_f1) * 0.999 or b2 > 2 * r_a1 * 1.2:
+        raise ScenarioError(
+            f"gear.face_width_mm = {b2 / MM:.3f}: too wide for this worm; allowed up to {1.2 * 2 * r_a1 / MM:.3f} mm "
+            f"(1.2 x worm tip diameter)")
+    # threaded length: cover every point of the wheel rim that can reach the worm tip cylinder, plus one pitch
+    reach = r_e2 ** 2 - (a - r_a1) ** 2
+    b1 = gear.worm_length_mm * MM if gear.worm_length_mm is not None else 2 * math.sqrt(max(reach, 0.0)) + p_x
+    s2 = p_x / 2 - gear.backlash_mm * MM
+    if s2 <= 0.1 * p_x:
+        raise ScenarioError(
+            f"gear.backlash_mm = {gear.backlash_mm}: leaves a wheel tooth of {s2 / MM:.3f} mm on d2; "
+            f"allowed below {0.4 * p_x / MM:.3f} mm (0.4 axial pitch)")
+    return GearGeometry(
+        profile=gear.profile, hand=hand, z1=z1, z2=z2, m_x=m_x, m_n=m_n, gamma=gamma, alpha_n=alpha_n,
+        alpha_x=alpha_x, q=q, d1=d1, d2=d2, a=a, p_x=p_x, lead=lead, p=p, gamma_b=gamma_b, r_b=r_b,
+        h_a=h_a, h_f=h_f, r_a1=r_a1, r_f1=r_f1, r_a2=r_a2, r_f2=r_f2, r_e2=r_e2,
+        throat_radius=a - r_a2, root_torus_radius=a - r_f2, face_width=b2, worm_length=b1,
+        backlash=gear.backlash_mm * MM, wheel_tooth_thickness=s2, ratio=z2 / z1)

@@ -1,0 +1,138 @@
+"""`wormsim` console script (INTERFACE.md): run, mesh, model, bench, schema, check.
+
+Exit codes: 0 ok, 2 invalid input (the message names the field), 3 the simulation failed
+(with a diagnosis), 1 an internal error (a bug: rerun with --debug for the traceback).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import traceback
+from pathlib import Path
+
+from wormsim.errors import ScenarioError, SimulationError
+
+EXIT_OK, EXIT_INTERNAL, EXIT_INPUT, EXIT_SIM = 0, 1, 2, 3
+
+
+def _add_scenario_args(p: argparse.ArgumentParser, out_required: bool = True) -> None:
+    p.add_argument("scenario", help="scenario YAML file")
+    p.add_argument("--out", required=out_required, help="output directory")
+    p.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
+                   help="override a field by its dotted path, e.g. gear.wheel_teeth=41 (repeatable)")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    ap = argparse.ArgumentParser(prog="wormsim", description="Worm gear drive dynamics with real tooth contact.")
+    ap.add_argument("--debug", action="store_true", help="show tracebacks of internal errors")
+    sub = ap.add_subparsers(dest="command", required=True)
+    p = sub.add_parser("run", help="run one scenario: summary.json, timeseries.npz, recording.rrd, report.png")
+    _add_scenario_args(p)
+    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p = sub.add_parser("mesh", help="geometry only: worm.stl, wheel.stl, assembly.json, recording.rrd")
+    _add_scenario_args(p)
+    p = sub.add_parser("model", help="write a standalone MJCF (model.xml + mesh assets) for MuJoCo's viewer")
+    _add_scenario_args(p)
+    p = sub.add_parser("bench", help="speed-accuracy benchmark: bench.json and bench.png")
+    p.add_argument("--quick", action="store_true", help="CI-sized subset")
+    p.add_argument("--out", required=True)
+    p = sub.add_parser("schema", help="print the scenario JSON schema (for editors)")
+    p.add_argument("--out", help="write to this file instead of stdout")
+    p = sub.add_parser("check", help="validate a scenario and print it with defaults filled in")
+    _add_scenario_args(p, out_required=False)
+    return ap
+
+
+def _cmd_run(args) -> int:
+    from wormsim.run import run_scenario
+    from wormsim.scenario import load_scenario
+
+    sc = load_scenario(args.scenario, args.overrides)
+    summary = run_scenario(sc, args.out, progress=False if args.no_progress else None)
+    out = Path(args.out)
+    keys = [k for k in summary if k not in ("status", "message")]
+    width = max(len(k) for k in keys)
+    for k in keys:
+        v = summary[k]
+        print(f"  {k:<{width}}  {v:.6g}" if isinstance(v, float) else f"  {k:<{width}}  {v}")
+    print(f"wrote {out / 'summary.json'}, {out / 'timeseries.npz'}, {out / 'report.png'}")
+    print(f"recording: {out / 'recording.rrd'}  (view with: rerun {out / 'recording.rrd'})")
+    return EXIT_OK
+
+
+def _cmd_mesh(args) -> int:
+    from meshgen.export import write_mesh_outputs
+    from wormsim.scenario import load_scenario
+
+    sc = load_scenario(args.scenario, args.overrides)
+    write_mesh_outputs(sc, args.out)
+    return EXIT_OK
+
+
+def _cmd_model(args) -> int:
+    from wormsim.model import write_model
+    from wormsim.scenario import load_scenario
+
+    sc = load_scenario(args.scenario, args.overrides)
+    path = write_model(sc, args.out)
+    print(f"wrote {path}  (open with: python -m mujoco.viewer --mjcf {path})")
+    return EXIT_OK
+
+
+def _cmd_bench(args) -> int:
+    from wormsim.bench import run_bench
+
+    run_bench(quick=args.quick, out_dir=args.out)
+    return EXIT_OK
+
+
+def _cmd_schema(args) -> int:
+    from wormsim.scenario import json_schema
+
+    text = json.dumps(json_schema(), indent=2)
+    if args.out:
+        Path(args.out).write_text(text + "\n")
+    else:
+        print(text)
+    return EXIT_OK
+
+
+def _cmd_check(args) -> int:
+    import yaml
+
+    from wormsim.scenario import load_scenario
+
+    sc = load_scenario(args.scenario, args.overrides)
+    print(yaml.safe_dump(sc.model_dump(mode="json", exclude_none=True), sort_keys=False), end="")
+    return EXIT_OK
+
+
+COMMANDS = {"run": _cmd_run, "mesh": _cmd_mesh, "model": _cmd_model, "bench": _cmd_bench,
+            "schema": _cmd_schema, "check": _cmd_check}
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    try:
+        return COMMANDS[args.command](args)
+    except ScenarioError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return EXIT_INPUT
+    except SimulationError as exc:
+        print(f"simulation failed: {exc}", file=sys.stderr)
+        return EXIT_SIM
+    except KeyboardInterrupt:
+        print("interrupted", file=sys.stderr)
+        return 130
+    except Exception as exc:  # a bug, not a user error
+        if args.debug:
+            traceback.print_exc()
+        else:
+            print(f"internal error: {exc.__class__.__name__}: {exc} (rerun with --debug for the traceback)",
+                  file=sys.stderr)
+        return EXIT_INTERNAL
+
+
+if __name__ == "__main__":
+    sys.exit(main())

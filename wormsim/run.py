@@ -1,0 +1,63 @@
+"""Run one scenario end to end: simulate at the requested fidelity, then write the time series,
+report.png, recording.rrd and summary.json atomically (wormsim.output)."""
+from __future__ import annotations
+
+import importlib
+import time
+from pathlib import Path
+
+import numpy as np
+
+from wormsim.errors import SimulationError
+from wormsim.output import ResultDir
+from wormsim.progress import Progress
+from wormsim.result import Result
+from wormsim.scenario import Scenario
+
+# model name -> module with simulate(scenario, progress) -> Result, write_report(result, path),
+# write_recording(result, path)
+MODEL_MODULES = {
+    "wedge": "wormsim.wedge",
+    "contact3d": "wormsim.simulate",
+    "torsional": "wormsim.torsional",
+}
+
+
+def model_module(name: str):
+    return importlib.import_module(MODEL_MODULES[name])
+
+
+def simulate(scenario: Scenario, progress: Progress | None = None) -> Result:
+    """Simulate only (no files): for tests and the benchmark."""
+    return model_module(scenario.model).simulate(scenario, progress=progress)
+
+
+def run_scenario(scenario: Scenario, out_dir: str | Path, progress: bool | None = None) -> dict:
+    """Simulate and write DIR/{summary.json, timeseries.npz, report.png, recording.rrd}.
+
+    Returns the summary. Raises SimulationError after writing a "failed" summary.
+    """
+    mod = model_module(scenario.model)
+    rd = ResultDir(out_dir)
+    base = {"model": scenario.model, "scenario": scenario.name}
+    t0 = time.perf_counter()
+    try:
+        with Progress(scenario.simulation.duration_s, label=f"{scenario.name} ({scenario.model})", enabled=progress) as bar:
+            res = mod.simulate(scenario, progress=bar)
+        wall = time.perf_counter() - t0
+        np.savez_compressed(rd.path("timeseries.npz"), **res.series)
+        mod.write_report(res, rd.path("report.png"))
+        mod.write_recording(res, rd.path("recording.rrd"))
+    except SimulationError as exc:
+        rd.fail({"status": "failed", "message": str(exc), **base,
+                 "wall_time_s": time.perf_counter() - t0, "sim_time_s": None, "steps": None})
+        raise
+    except BaseException as exc:  # never leave a result that looks complete
+        rd.fail({"status": "failed", "message": f"internal error: {exc.__class__.__name__}: {exc}", **base,
+                 "wall_time_s": time.perf_counter() - t0, "sim_time_s": None, "steps": None})
+        raise
+    summary = {"status": "ok", "message": "", **base, "wall_time_s": wall,
+               "sim_time_s": res.sim_time_s, "steps": res.steps, **res.summary}
+    rd.commit(summary)
+    return summary
+
