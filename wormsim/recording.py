@@ -1,0 +1,84 @@
+"""Rerun recordings (.rrd) of a run: time series on a simulated-time timeline, meshes, transforms.
+
+Every fidelity level writes its recording through these helpers, so all recordings share one layout:
+
+    /series/<name>            scalar time series (units in the name), timeline "sim_time" (seconds)
+    /assembly/worm, /assembly/wheel   meshes (contact3d, meshgen) placed by Transform3D
+    /assembly/contacts        contact points and force arrows (contact3d)
+
+Open a recording with `rerun DIR/recording.rrd`.
+"""
+from __future__ import annotations
+
+import os
+from contextlib import contextmanager
+from pathlib import Path
+
+import numpy as np
+import rerun as rr
+
+TIMELINE = "sim_time"
+APP_ID = "wormsim"
+
+
+@contextmanager
+def recording(path: str | Path, name: str):
+    """A RecordingStream that saves to `path` (written to a temp file, renamed on success)."""
+    path = Path(path)
+    tmp = path.with_name(f".{path.name}.tmp{os.getpid()}")
+    rec = rr.RecordingStream(APP_ID, recording_id=name, send_properties=False)
+    rec.save(str(tmp))
+    try:
+        yield rec
+        rec.flush()
+        rec.disconnect()
+        os.replace(tmp, path)
+    finally:
+        if tmp.exists():
+            tmp.unlink()
+
+
+def log_series(rec: rr.RecordingStream, t_s: np.ndarray, series: dict[str, np.ndarray],
+               prefix: str = "series") -> None:
+    """Log every 1-D numeric array of len(t_s) in `series` as a scalar plot on the sim-time timeline.
+
+    Multi-column arrays (N, k) become k plots named `<name>/<i>`. Non-numeric or mismatched arrays
+    are skipped (they belong elsewhere).
+    """
+    t_s = np.asarray(t_s, dtype=float)
+    times = rr.TimeColumn(TIMELINE, duration=t_s)
+    for name, values in series.items():
+        arr = np.asarray(values)
+        if name == "t_s" or arr.shape[:1] != t_s.shape or not np.issubdtype(arr.dtype, np.number):
+            continue
+        cols = arr.reshape(len(t_s), -1).astype(float)
+        for i in range(cols.shape[1]):
+            path = f"{prefix}/{name}" if cols.shape[1] == 1 else f"{prefix}/{name}/{i}"
+            rr.send_columns(path, indexes=[times], columns=rr.Scalars.columns(scalars=cols[:, i]), recording=rec)
+
+
+def log_mesh(rec: rr.RecordingStream, path: str, vertices: np.ndarray, faces: np.ndarray,
+             color=(180, 180, 190), static: bool = True) -> None:
+    """A triangle mesh (metres) with vertex normals, logged once (static) under `path`."""
+    import trimesh
+
+    mesh = trimesh.Trimesh(vertices=vertices, faces=faces, process=False)
+    rr.log(path, rr.Mesh3D(vertex_positions=mesh.vertices, triangle_indices=mesh.faces,
+                           vertex_normals=mesh.vertex_normals, albedo_factor=list(color)),
+           static=static, recording=rec)
+
+
+def log_transforms(rec: rr.RecordingStream, path: str, t_s: np.ndarray, matrices: np.ndarray) -> None:
+    """A moving frame: 4x4 homogeneous transforms (N, 4, 4) of `path` on the sim-time timeline."""
+    t_s = np.asarray(t_s, dtype=float)
+    mats = np.asarray(matrices, dtype=float)
+    rr.send_columns(
+        path, indexes=[rr.TimeColumn(TIMELINE, duration=t_s)],
+        columns=rr.Transform3D.columns(translation=mats[:, :3, 3], mat3x3=mats[:, :3, :3]),
+        recording=rec)
+
+
+def save_series_recording(path: str | Path, name: str, t_s: np.ndarray, series: dict[str, np.ndarray]) -> None:
+    """Convenience: a recording holding only time series."""
+    with recording(path, name) as rec:
+        log_series(rec, t_s, series)
