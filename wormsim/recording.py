@@ -82,3 +82,10 @@ def save_series_recording(path: str | Path, name: str, t_s: np.ndarray, series: 
     """Convenience: a recording holding only time series."""
     with recording(path, name) as rec:
         log_series(rec, t_s, series)
+
+
+def recorded_entities(path: str | Path) -> set[str]:
+    """Entity paths stored in an .rrd file (read back with rerun's RrdReader): for tests and checks."""
+    from rerun.chunk import RrdReader
+
+    return set(RrdReader(str(path)).store().schema().entity_paths())
