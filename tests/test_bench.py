@@ -1,0 +1,27 @@
+"""Benchmark bookkeeping: relative errors, Pareto front, the chart (the speed numbers themselves are
+never asserted)."""
+import numpy as np
+
+from wormsim.bench import ERROR_KEYS, pareto_front, plot_bench, relative_errors
+
+
+def test_relative_errors_only_where_defined():
+    e = relative_errors({"ratio": 53.053, "efficiency": 0.6, "mesh_frequency_hz": None},
+                        {"ratio": 53.0, "efficiency": 0.0, "mesh_frequency_hz": 0.6})
+    assert abs(e["ratio"] - 0.001) < 1e-12
+    assert e["efficiency"] is None and e["mesh_frequency_hz"] is None
+    assert set(e) == set(ERROR_KEYS)
+
+
+def test_pareto_front_keeps_only_undominated_points():
+    cost = np.array([1.0, 2.0, 3.0, 2.5, 0.5])
+    err = np.array([0.1, 0.05, 0.01, 0.2, 0.5])
+    assert pareto_front(cost, err).tolist() == [True, True, True, False, True]
+
+
+def test_chart_is_written(tmp_path):
+    recs = [{"scenario": "s", "model": m, "status": "ok", "wall_s_per_sim_s": w, "reference": False,
+             "finer": False, "error": {k: e for k in ERROR_KEYS}}
+            for m, w, e in [("contact3d", 1.0, 0.01), ("contact3d", 0.3, 0.05), ("torsional", 1e-3, 0.02)]]
+    plot_bench(recs, tmp_path / "bench.png")
+    assert (tmp_path / "bench.png").read_bytes()[:4] == b"\x89PNG"

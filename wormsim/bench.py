@@ -1,0 +1,199 @@
+"""`wormsim bench`: speed against accuracy of the fidelity levels (INTERFACE.md, bench.json).
+
+For each seed scenario, each fidelity level runs across its resolutions and timesteps. Per run:
+
+    wall_s            median wall time of `repeats` runs in this process (after one warm-up for caches)
+    realtime_factor   sim_s / wall_s
+    error[key]        |value - reference| / |reference| for key in ERROR_KEYS, against the converged
+                      reference: the finest contact3d run of that scenario. The reference itself is checked
+                      against a finer run (`reference_check` in bench_meta.json).
+
+Outputs, written atomically: bench.json (list of records), bench_meta.json (machine, reference
+check, notes), bench.png (error against wall time per simulated second, log axes, one curve per
+level, Pareto front marked).
+"""
+from __future__ import annotations
+
+import importlib.util
+import os
+import platform
+import statistics
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from wormsim.output import write_json_atomic
+from wormsim.scenario import load_scenario
+
+ROOT = Path(__file__).resolve().parents[1]
+SCENARIOS = ROOT / "scenarios"
+ERROR_KEYS = ("ratio", "tangential_force_mean_n", "tangential_force_p2p_n", "mesh_frequency_hz", "efficiency")
+
+
+@dataclass(frozen=True)
+class BenchCase:
+    scenario: str                 # stem of scenarios/<stem>.yaml
+    model: str                    # fidelity level
+    resolution: dict              # free-form description of the level's resolution
+    timestep_s: float | None
+    overrides: tuple[str, ...] = field(default_factory=tuple)
+    reference: bool = False       # the converged reference of its scenario
+    finer: bool = False           # the finer run that checks the reference
+
+
+def _level_available(model: str) -> bool:
+    from wormsim.run import MODEL_MODULES
+
+    return importlib.util.find_spec(MODEL_MODULES[model]) is not None
+
+
+def bench_cases(quick: bool) -> list[BenchCase]:
+    """The grid. quick: the seat motor only, short, coarse-to-medium (CI-sized)."""
+    plan = {
+        # scenario: (sim duration for the bench, timesteps to sweep)
+        "seat_motor": (2.0 if quick else 20.0, (2e-4, 1e-4) if quick else (4e-4, 2e-4, 1e-4, 5e-5)),
+        "screw_jack": (0.2, (5e-5, 2e-5, 1e-5)),
+        "involute_41": (0.3, (5e-5, 2e-5, 1e-5)),
+    }
+    if quick:
+        plan = {"seat_motor": plan["seat_motor"]}
+    out: list[BenchCase] = []
+    for name, (dur, steps) in plan.items():
+        common = (f"simulation.duration_s={dur}",)
+        levels = ("coarse", "medium") if quick else ("coarse", "medium", "fine")
+        if _level_available("contact3d"):
+            for lvl in levels:
+                for dt in steps:
+                    out.append(BenchCase(name, "contact3d", {"level": lvl}, dt,
+                                         common + (f"simulation.resolution={lvl}", f"simulation.timestep_s={dt}")))
+            out.append(BenchCase(name, "contact3d", {"level": levels[-1]}, steps[-1],
+                                 common + (f"simulation.resolution={levels[-1]}", f"simulation.timestep_s={steps[-1]}"),
+                                 reference=True))
+            out.append(BenchCase(name, "contact3d", {"level": levels[-1]}, steps[-1] / 2,
+                                 common + (f"simulation.resolution={levels[-1]}", f"simulation.timestep_s={steps[-1] / 2}"),
+                                 finer=True))
+        if _level_available("torsional"):
+            for dt in steps:
+                out.append(BenchCase(name, "torsional", {"level": "mesh-stiffness table"}, dt,
+                                     common + ("model=torsional", f"simulation.timestep_s={dt}")))
+    return out
+
+
+def relative_errors(summary: dict, reference: dict) -> dict:
+    """|x - x_ref| / |x_ref| for each ERROR_KEYS entry both summaries hold (None where undefined)."""
+    err = {}
+    for k in ERROR_KEYS:
+        x, r = summary.get(k), reference.get(k)
+        if x is None or r is None or not np.isfinite(x) or not np.isfinite(r) or r == 0:
+            err[k] = None
+        else:
+            err[k] = abs(x - r) / abs(r)
+    return err
+
+
+def pareto_front(cost: np.ndarray, error: np.ndarray) -> np.ndarray:
+    """Mask of points not dominated by another (lower-or-equal cost AND error, one strictly lower)."""
+    cost, error = np.asarray(cost, float), np.asarray(error, float)
+    keep = np.ones(len(cost), bool)
+    for i in range(len(cost)):
+        dominated = (cost <= cost[i]) & (error <= error[i]) & ((cost < cost[i]) | (error < error[i]))
+        keep[i] = not dominated.any()
+    return keep
+
+
+def machine_info() -> dict:
+    return {"platform": platform.platform(), "python": platform.python_version(),
+            "processor": platform.processor() or platform.machine(), "cpu_count": os.cpu_count()}
+
+
+def _run_case(case: BenchCase, repeats: int) -> tuple[dict, float, float]:
+    from wormsim.run import simulate
+
+    sc = load_scenario(SCENARIOS / f"{case.scenario}.yaml", list(case.overrides))
+    walls, res = [], None
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        res = simulate(sc)
+        walls.append(time.perf_counter() - t0)
+    return res.summary, statistics.median(walls), res.sim_time_s
+
+
+def run_bench(quick: bool, out_dir: str | Path, repeats: int | None = None) -> list[dict]:
+    from wormsim.errors import SimulationError
+
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    repeats = repeats or (1 if quick else 3)
+    records, summaries, notes = [], {}, []
+    for case in bench_cases(quick):
+        try:
+            summary, wall, sim_s = _run_case(case, repeats)
+        except SimulationError as exc:
+            notes.append(f"{case.scenario} {case.model} {case.resolution} dt={case.timestep_s}: failed: {exc}")
+            records.append({"scenario": case.scenario, "model": case.model, "resolution": case.resolution,
+                            "timestep_s": case.timestep_s, "wall_s": None, "sim_s": None, "realtime_factor": None,
+                            "status": "failed", "message": str(exc), "error": {}})
+            continue
+        rec = {"scenario": case.scenario, "model": case.model, "resolution": case.resolution,
+               "timestep_s": summary.get("timestep_s", case.timestep_s), "wall_s": wall, "sim_s": sim_s,
+               "realtime_factor": sim_s / wall if wall > 0 else None,
+               "wall_s_per_sim_s": wall / sim_s if sim_s else None, "status": "ok",
+               "reference": case.reference, "finer": case.finer, "error": {}}
+        summaries[id(rec)] = summary
+        records.append(rec)
+    meta = {"machine": machine_info(), "quick": quick, "repeats": repeats, "reference_check": {}, "notes": notes}
+    for scen in {r["scenario"] for r in records}:
+        ref = next((r for r in records if r["scenario"] == scen and r.get("reference") and r["status"] == "ok"), None)
+        if ref is None:
+            notes.append(f"{scen}: no converged reference run; errors left empty")
+            continue
+        ref_sum = summaries[id(ref)]
+        for r in records:
+            if r["scenario"] == scen and r["status"] == "ok":
+                r["error"] = relative_errors(summaries[id(r)], ref_sum)
+        finer = next((r for r in records if r["scenario"] == scen and r.get("finer") and r["status"] == "ok"), None)
+        if finer is not None:
+            meta["reference_check"][scen] = finer["error"]
+    write_json_atomic(out / "bench.json", records)
+    write_json_atomic(out / "bench_meta.json", meta)
+    plot_bench(records, out / "bench.png")
+    return records
+
+
+def plot_bench(records: list[dict], path: Path, key: str = "tangential_force_mean_n") -> None:
+    """Error of `key` (and the worst of ERROR_KEYS) against wall time per simulated second, log-log."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    ok = [r for r in records if r["status"] == "ok" and r.get("wall_s_per_sim_s") and not r.get("finer")]
+    fig, axes = plt.subplots(1, 2, figsize=(12, 4.8), constrained_layout=True)
+    for ax, mode in zip(axes, (key, "worst")):
+        pts = []
+        for r in ok:
+            errs = [v for v in r["error"].values() if v is not None]
+            e = r["error"].get(key) if mode == key else (max(errs) if errs else None)
+            if e is None or r.get("reference"):
+                continue
+            pts.append((r["wall_s_per_sim_s"], max(e, 1e-6), f"{r['scenario']}/{r['model']}"))
+        for label in sorted({p[2] for p in pts}):
+            sel = sorted((p for p in pts if p[2] == label), key=lambda p: p[0])
+            ax.plot([p[0] for p in sel], [p[1] for p in sel], "o-", label=label, alpha=0.8)
+        if pts:
+            c, e = np.array([p[0] for p in pts]), np.array([p[1] for p in pts])
+            m = pareto_front(c, e)
+            order = np.argsort(c[m])
+            ax.plot(c[m][order], e[m][order], "k--", lw=1.5, label="Pareto front")
+        ax.set_xscale("log"); ax.set_yscale("log")
+        ax.set_xlabel("wall time per simulated second [s/s]")
+        ax.set_ylabel(f"relative error of {mode}" if mode == key else "worst relative error of " + ", ".join(ERROR_KEYS[:2]) + ", ...")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=7)
+    fig.suptitle("wormsim bench: accuracy against speed (errors vs the finest contact3d run)")
+    tmp = path.with_name(f".{path.name}.tmp.png")
+    fig.savefig(tmp, dpi=110)
+    plt.close(fig)
+    os.replace(tmp, path)
