@@ -138,16 +138,23 @@ class WedgeMotor(_Strict):
     peak_force_n: float = Field(2178.0, gt=0)
     synchronous_speed_m_s: float = Field(7.85, gt=0)
     peak_force_speed_m_s: float = Field(6.5, gt=0)
+    nominal_force_n: float = Field(
+        990.0, gt=0, description="rated force Ft1 = M_n / R1 for the dynamic factor Kd1; seed 000: 2178 N / (Mmax/Mn = 2.2)")
+    nominal_speed_m_s: float = Field(
+        7.59, gt=0, description="rated speed n_n R1 (Ft2 uses rho there); seed 000: 2900 rpm at R1 = 25 mm")
 
     @model_validator(mode="after")
     def _order(self) -> "WedgeMotor":
         if self.peak_force_speed_m_s >= self.synchronous_speed_m_s:
             raise ValueError("peak_force_speed_m_s must be below synchronous_speed_m_s")
+        if self.nominal_speed_m_s >= self.synchronous_speed_m_s:
+            raise ValueError("nominal_speed_m_s must be below synchronous_speed_m_s")
         return self
 
 
 class WedgeLoad(_Strict):
     force_n: float = Field(-5000.0, gt=-1e7, lt=1e7, description="F2 on the driven body (negative resists)")
+    initial_force_n: float = Field(0.0, gt=-1e7, lt=1e7, description="F2 before start_s; STEP to force_n over ramp_s")
     start_s: NonNegFloat = 0.0
     ramp_s: NonNegFloat = 0.0
 
