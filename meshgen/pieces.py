@@ -1,0 +1,302 @@
+"""Convex collision pieces of the worm and of one wheel tooth, the gear set, its cache.
+
+MuJoCo collides a mesh geom as its convex hull, so every piece here IS a convex hull:
+- worm: per start, the thread ridge cut into helical segments of 2 pi / worm_segments_per_turn: the hull of the
+  exact axial ridge profile (both flanks sampled at profile_points radii from r_f1 - 0.1 m_x to the tip r_a1)
+  at the two bounding worm angles; segments at the ends are clipped by the planes z = +-b1/2. The core is a
+  cylinder of radius worm_core_radius_m = r_f1 (a collision cylinder/capsule stands in for it).
+- wheel: tooth 0 cut into wheel_slabs slabs across the face width: the hull of the two exact flank sections
+  (profile_points radii from the root torus to the throat tip, plus the tip arc) at the slab's bounding
+  zeta planes.
+The hull of a slice replaces each flank between two sections by chords: the deviation is measured against the
+exact flanks on the ACTIVE flank (worm: r from the wheel throat a - r_a2 to r_a1; wheel: from the worm tip's
+reach rho = a - sqrt(r_a1^2 - zeta^2) to the wheel tip, conjugate points only; the undercut zone, cut by the
+hob tip edge, is concave across the profile so the hull bridges it: reported apart as "wheel_undercut_zone") as the signed distance of dense exact flank points
+from the union of pieces (negative: the flank lies inside a piece, the piece bulges out; positive: a gap):
+piece_error_um = {"worm"|"wheel": {"max": max |d|, "rms": rms d, "min_signed": .., "max_signed": ..}}.
+"""
+from __future__ import annotations
+
+import functools
+import hashlib
+import json
+import math
+import os
+import pickle
+import tempfile
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+import trimesh
+
+from meshgen import meshes, wheel, worm
+from meshgen.geometry import GearGeometry
+
+CODE_VERSION = "meshgen-1"
+
+
+@dataclass(frozen=True)
+class Resolution:
+    worm_segments_per_turn: int
+    wheel_slabs: int          # slabs across the face width per wheel tooth
+    profile_points: int       # samples along the tooth profile (each flank)
+
+
+RESOLUTIONS: dict[str, Resolution] = {
+    "coarse": Resolution(24, 3, 6),
+    "medium": Resolution(48, 5, 8),
+    "fine": Resolution(96, 9, 12),
+}
+
+
+@dataclass
+class GearSet:
+    geometry: GearGeometry
+    resolution: Resolution
+    worm_pieces: list[trimesh.Trimesh]
+    wheel_tooth_pieces: list[trimesh.Trimesh]
+    tooth_angle_rad: Callable[[int], float]
+    worm_visual: trimesh.Trimesh
+    wheel_visual: trimesh.Trimesh
+    worm_core_radius_m: float
+    piece_error_um: dict
+    undercut_fraction: float = 0.0
+    info: dict = field(default_factory=dict)
+
+
+# ----------------------------------------------------------------------------- pieces
+
+def _hull(points: np.ndarray) -> trimesh.Trimesh:
+    """Convex hull as a watertight, outward-oriented mesh (scipy/qhull; trimesh's hull may drop sliver faces)."""
+    from scipy.spatial import ConvexHull
+
+    pts = np.asarray(points, float)
+    h = ConvexHull(pts)
+    used = np.unique(h.simplices)
+    remap = np.full(len(pts), -1)
+    remap[used] = np.arange(len(used))
+    faces = remap[h.simplices]
+    V = pts[used]
+    n = np.cross(V[faces[:, 1]] - V[faces[:, 0]], V[faces[:, 2]] - V[faces[:, 0]])
+    flip = np.einsum("ij,ij->i", n, h.equations[:, :3]) < 0
+    faces[flip] = faces[flip][:, ::-1]
+    return trimesh.Trimesh(V, faces, process=False)
+
+
+def _clip_convex(points: np.ndarray, zmin: float, zmax: float) -> np.ndarray | None:
+    """Vertices of hull(points) intersected with the slab zmin <= z <= zmax (convex stays convex):
+    the hull's vertices inside plus the intersections of its edges with the two planes."""
+    h = _hull(points)
+    V = np.asarray(h.vertices)
+    E = np.asarray(h.edges_unique)
+    keep = [V[(V[:, 2] >= zmin) & (V[:, 2] <= zmax)]]
+    for z0 in (zmin, zmax):
+        za, zb = V[E[:, 0], 2], V[E[:, 1], 2]
+        cross = (za - z0) * (zb - z0) < 0
+        t = (z0 - za[cross]) / (zb[cross] - za[cross])
+        keep.append(V[E[cross, 0]] + t[:, None] * (V[E[cross, 1]] - V[E[cross, 0]]))
+    pts = np.concatenate(keep)
+    scale = max(float(np.ptp(pts, axis=0).max()), 1e-12)
+    _, first = np.unique(np.round(pts / (1e-7 * scale)).astype(np.int64), axis=0, return_index=True)
+    pts = pts[np.sort(first)]
+    if len(pts) < 4 or np.ptp(pts[:, 2]) <= 0:
+        return None
+    return pts
+
+
+def worm_piece_points(g: GearGeometry, res: Resolution, start: int, phi0: float, phi1: float):
+    r_in = g.r_f1 - 0.1 * g.m_x
+    prof = worm.ridge_profile(g, res.profile_points, r_in)
+    r, u = prof[:, 0], prof[:, 1]
+    pts = []
+    for phi in (phi0, phi1):
+        pts.append(np.stack([r * np.cos(phi), r * np.sin(phi), g.p * phi + start * g.p_x + u], -1))
+    return np.concatenate(pts)
+
+
+def worm_segment_angles(g: GearGeometry, res: Resolution, start: int):
+    """Segment boundaries (worm angles) covering the thread centre z in [-b1/2 - p_x, b1/2 + p_x]."""
+    half = g.worm_length / 2 + g.p_x
+    ph = sorted([(-half - start * g.p_x) / g.p, (half - start * g.p_x) / g.p])
+    d = 2 * math.pi / res.worm_segments_per_turn
+    k0, k1 = math.floor(ph[0] / d), math.ceil(ph[1] / d)
+    return np.arange(k0, k1 + 1) * d
+
+
+def build_worm_pieces(g: GearGeometry, res: Resolution) -> list[trimesh.Trimesh]:
+    half = g.worm_length / 2
+    out = []
+    for n in range(g.z1):
+        phis = worm_segment_angles(g, res, n)
+        for a, b in zip(phis[:-1], phis[1:]):
+            pts = worm_piece_points(g, res, n, a, b)
+            z = pts[:, 2]
+            if z.max() <= -half or z.min() >= half:
+                continue
+            if z.min() < -half or z.max() > half:
+                pts = _clip_convex(pts, -half, half)
+                if pts is None:
+                    continue
+            out.append(_hull(pts))
+    vmax = max(h.volume for h in out)
+    return [h for h in out if h.volume > 1e-3 * vmax]   # drop end slivers of the clipping
+
+
+def wheel_slab_sections(g: GearGeometry, res: Resolution, zeta: np.ndarray, n_tip: int = 3):
+    """Points of the tooth-0 section(s) at the given zeta values: (len(zeta), m, 3)."""
+    s = np.linspace(0.0, 1.0, res.profile_points)
+    lo, hi = wheel.root_rho(g, zeta), wheel.tip_rho(g, zeta)
+    R = lo[:, None] + s[None, :] * (hi - lo)[:, None]
+    Z = np.broadcast_to(zeta[:, None], R.shape)
+    pa, pb = wheel.tooth_flanks(g, R, Z)
+    w = np.linspace(0.0, 1.0, n_tip + 2)[1:-1]
+    tip_psi = pa[:, -1:] + w[None, :] * (pb[:, -1:] - pa[:, -1:])
+    rho = np.concatenate([R, R, np.broadcast_to(hi[:, None], tip_psi.shape)], axis=1)
+    psi = np.concatenate([pa, pb, tip_psi], axis=1)
+    zz = np.broadcast_to(zeta[:, None], rho.shape)
+    return np.stack([rho * np.cos(psi), rho * np.sin(psi), zz], -1)
+
+
+def build_wheel_tooth_pieces(g: GearGeometry, res: Resolution) -> list[trimesh.Trimesh]:
+    sub = SLAB_SUBSECTIONS
+    zeta = np.linspace(-g.face_width / 2, g.face_width / 2, sub * res.wheel_slabs + 1)
+    S = wheel_slab_sections(g, res, zeta)
+    return [_hull(S[sub * j: sub * (j + 1) + 1].reshape(-1, 3)) for j in range(res.wheel_slabs)]
+
+
+SLAB_SUBSECTIONS = 4   # exact sections per slab that its hull spans (2 ends + 3 inside)
+
+
+# ----------------------------------------------------------------------------- error of the pieces
+
+def _plane_sets(pieces):
+    out = []
+    for p in pieces:
+        n = np.asarray(p.face_normals)
+        d = np.einsum("ij,ij->i", n, np.asarray(p.triangles_center))
+        out.append((n, d))
+    return out
+
+
+def union_signed_distance(pieces, pts: np.ndarray) -> np.ndarray:
+    """Signed distance of points from the union of convex pieces (max over face planes, min over pieces).
+
+    Exact inside a piece and where the nearest feature is a face; a lower bound near edges outside.
+    """
+    best = np.full(len(pts), np.inf)
+    for n, d in _plane_sets(pieces):
+        sd = (pts @ n.T - d[None, :]).max(axis=1)
+        best = np.minimum(best, sd)
+    return best
+
+
+def _stats(d: np.ndarray) -> dict:
+    d_um = d * 1e6
+    return {"max": float(np.max(np.abs(d_um))), "rms": float(np.sqrt(np.mean(d_um ** 2))),
+            "min_signed": float(d_um.min()), "max_signed": float(d_um.max()), "n_points": int(len(d_um))}
+
+
+def worm_active_flank_points(g: GearGeometry, phi0: float, phi1: float, n_r: int = 25, n_phi: int = 41):
+    r = np.linspace(g.throat_radius, g.r_a1, n_r)
+    phi = np.linspace(phi0, phi1, n_phi)
+    R, PHI = np.meshgrid(r, phi, indexing="ij")
+    return np.concatenate([worm.flank_points(g, R, PHI, s).reshape(-1, 3) for s in (-1, 1)])
+
+
+def wheel_active_flank_points(g: GearGeometry, n_rho: int = 25, n_zeta: int = 61):
+    zeta = np.linspace(-g.face_width / 2, g.face_width / 2, n_zeta)
+    lo = g.a - np.sqrt(np.maximum(g.r_a1 ** 2 - zeta ** 2, 0.0))
+    hi = wheel.tip_rho(g, zeta)
+    lo = np.minimum(lo, hi)
+    s = np.linspace(0.0, 1.0, n_rho)
+    R = lo[None, :] + s[:, None] * (hi - lo)[None, :]
+    Z = np.broadcast_to(zeta[None, :], R.shape)
+    pa, pb = wheel.tooth_flanks(g, R, Z)
+    ia = wheel.space_flank(g, R, Z, +1).interior
+    ib = wheel.space_flank(g, R, Z, -1).interior
+    pts = [np.stack([R * np.cos(p), R * np.sin(p), Z], -1).reshape(-1, 3) for p in (pa, pb)]
+    return np.concatenate(pts), np.concatenate([ia.ravel(), ib.ravel()])
+
+
+def measure_piece_error(g: GearGeometry, res: Resolution, worm_pieces, wheel_pieces) -> dict:
+    # worm: one turn of start 0 around the middle, away from the clipped ends
+    d = 2 * math.pi / res.worm_segments_per_turn
+    pts = worm_active_flank_points(g, -math.pi, math.pi - 1e-12, n_phi=4 * res.worm_segments_per_turn + 1)
+    near = [p for p in worm_pieces if abs(p.centroid[2]) < abs(g.p) * (math.pi + 2 * d) + g.p_x]
+    dw = union_signed_distance(near, pts)
+    pts, conj = wheel_active_flank_points(g, n_zeta=8 * res.wheel_slabs + 1)
+    dh = union_signed_distance(wheel_pieces, pts)
+    out = {"worm": _stats(dw), "wheel": _stats(dh[conj])}
+    if not conj.all():
+        out["wheel_undercut_zone"] = _stats(dh[~conj])
+    return out
+
+
+# ----------------------------------------------------------------------------- gear set + cache
+
+def cache_dir() -> Path:
+    return Path(os.environ.get("WORMSIM_CACHE", Path.home() / ".cache" / "wormsim"))
+
+
+def cache_key(g: GearGeometry, res: Resolution) -> str:
+    blob = json.dumps({"g": asdict(g), "r": asdict(res), "v": CODE_VERSION}, sort_keys=True, default=float)
+    return hashlib.sha256(blob.encode()).hexdigest()[:24]
+
+
+def _pack(m: trimesh.Trimesh):
+    return (np.asarray(m.vertices, float), np.asarray(m.faces, np.int64))
+
+
+def _unpack(t) -> trimesh.Trimesh:
+    return trimesh.Trimesh(t[0], t[1], process=False)
+
+
+def _generate(g: GearGeometry, res: Resolution) -> dict:
+    worm.check_worm(g, wheel.hob_radius(g))
+    wheel.check_wheel(g)
+    wp = build_worm_pieces(g, res)
+    hp = build_wheel_tooth_pieces(g, res)
+    err = measure_piece_error(g, res, wp, hp)
+    return {
+        "worm_pieces": [_pack(m) for m in wp],
+        "wheel_tooth_pieces": [_pack(m) for m in hp],
+        "worm_visual": _pack(meshes.worm_mesh(g)),
+        "wheel_visual": _pack(meshes.wheel_mesh(g)),
+        "piece_error_um": err,
+        "undercut_fraction": wheel.undercut_fraction(g),
+    }
+
+
+def build_gear_set(geometry: GearGeometry, resolution: Resolution | str = "medium", use_cache: bool = True) -> GearSet:
+    """Generate (or load from the cache) the gear set. Raises ScenarioError for undercut / pointed teeth."""
+    res = RESOLUTIONS[resolution] if isinstance(resolution, str) else resolution
+    g = geometry
+    path = cache_dir() / f"gearset-{cache_key(g, res)}.pkl"
+    data = None
+    if use_cache and path.exists():
+        try:
+            with open(path, "rb") as fh:
+                data = pickle.load(fh)
+        except Exception:
+            data = None
+    if data is None:
+        data = _generate(g, res)
+        if use_cache:
+            try:
+                path.parent.mkdir(parents=True, exist_ok=True)
+                fd, tmp = tempfile.mkstemp(prefix=".gearset-", dir=path.parent)
+                with os.fdopen(fd, "wb") as fh:
+                    pickle.dump(data, fh, protocol=pickle.HIGHEST_PROTOCOL)
+                os.replace(tmp, path)
+            except OSError:
+                pass
+    return GearSet(
+        geometry=g, resolution=res,
+        worm_pieces=[_unpack(t) for t in data["worm_pieces"]],
+        wheel_tooth_pieces=[_unpack(t) for t in data["wheel_tooth_pieces"]],
+        tooth_angle_rad=functools.partial(wheel.tooth_angle, g),
+        worm_visual=_unpack(data["worm_visual"]), wheel_visual=_unpack(data["wheel_visual"]),
+        worm_core_radius_m=g.r_f1, piece_error_um=data["piece_error_um"],
+        undercut_fraction=data["undercut_fraction"])
