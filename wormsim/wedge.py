@@ -364,7 +364,7 @@ def _assemble(segs: list[dict], p: WedgeParams, steps: int, name: str) -> Result
         "self_locking": bool(rho0 > g),
         "stalled": bool(np.max(np.abs(x1)) == 0.0),
         "locked_at_end": bool(code[-1] == 0),
-        "min_speed_m_s": float(np.min(v1)), "max_speed_m_s": float(np.max(v1)),
+        "x1_end_m": float(x1[-1]), "min_speed_m_s": float(np.min(v1)), "max_speed_m_s": float(np.max(v1)),
         "regimes": regimes,
         "regime_timeline": [{"regime": r, "start_s": t0, "end_s": t1} for r, t0, t1 in timeline],
         "monitor": p.monitor,
