@@ -34,7 +34,7 @@ import trimesh
 from meshgen import meshes, wheel, worm
 from meshgen.geometry import GearGeometry
 
-CODE_VERSION = "meshgen-1"
+CODE_VERSION = "meshgen-3"
 
 
 @dataclass(frozen=True)
@@ -45,9 +45,9 @@ class Resolution:
 
 
 RESOLUTIONS: dict[str, Resolution] = {
-    "coarse": Resolution(24, 3, 6),
-    "medium": Resolution(48, 5, 8),
-    "fine": Resolution(96, 9, 12),
+    "coarse": Resolution(24, 4, 6),
+    "medium": Resolution(48, 8, 8),
+    "fine": Resolution(96, 16, 12),
 }
 
 
@@ -144,26 +144,65 @@ def build_worm_pieces(g: GearGeometry, res: Resolution) -> list[trimesh.Trimesh]
     return [h for h in out if h.volume > 1e-3 * vmax]   # drop end slivers of the clipping
 
 
-def wheel_slab_sections(g: GearGeometry, res: Resolution, zeta: np.ndarray, n_tip: int = 3):
-    """Points of the tooth-0 section(s) at the given zeta values: (len(zeta), m, 3)."""
-    s = np.linspace(0.0, 1.0, res.profile_points)
+def conjugate_junction_rho(g: GearGeometry, zeta: np.ndarray, n_grid: int = 48, n_bisect: int = 30) -> np.ndarray:
+    """Per zeta: the lowest radius above which BOTH flanks of tooth 0 are conjugate (envelope points), i.e. the
+    top of the root fillet / undercut cut by the hob tip edge; the root radius where there is none."""
     lo, hi = wheel.root_rho(g, zeta), wheel.tip_rho(g, zeta)
+    s = np.linspace(0.0, 1.0, n_grid)
     R = lo[:, None] + s[None, :] * (hi - lo)[:, None]
     Z = np.broadcast_to(zeta[:, None], R.shape)
+    conj = wheel.space_flank(g, R, Z, +1).interior & wheel.space_flank(g, R, Z, -1).interior
+    # index of the first grid point from which every point above is conjugate
+    bad_above = np.flip(np.cumsum(np.flip(~conj, axis=1), axis=1), axis=1) > 0
+    k = np.argmin(bad_above, axis=1)
+    k = np.where(bad_above[:, -1], n_grid - 1, k)
+    a = R[np.arange(len(zeta)), np.maximum(k - 1, 0)]
+    b = R[np.arange(len(zeta)), k]
+    none = k == 0
+    for _ in range(n_bisect):
+        m = 0.5 * (a + b)
+        ok = wheel.space_flank(g, m, zeta, +1).interior & wheel.space_flank(g, m, zeta, -1).interior
+        b = np.where(ok, m, b)
+        a = np.where(ok, a, m)
+    return np.where(none, lo, b)
+
+
+def wheel_slab_sections(g: GearGeometry, res: Resolution, zeta: np.ndarray, rho_lo, rho_hi, n_tip: int = 3,
+                        tip: bool = True):
+    """Points of tooth-0 sections at the given zeta values, both flanks from rho_lo to rho_hi (arrays over zeta),
+    plus n_tip points across the tip arc when tip: (len(zeta), m, 3)."""
+    s = np.linspace(0.0, 1.0, res.profile_points)
+    R = rho_lo[:, None] + s[None, :] * (rho_hi - rho_lo)[:, None]
+    Z = np.broadcast_to(zeta[:, None], R.shape)
     pa, pb = wheel.tooth_flanks(g, R, Z)
-    w = np.linspace(0.0, 1.0, n_tip + 2)[1:-1]
-    tip_psi = pa[:, -1:] + w[None, :] * (pb[:, -1:] - pa[:, -1:])
-    rho = np.concatenate([R, R, np.broadcast_to(hi[:, None], tip_psi.shape)], axis=1)
-    psi = np.concatenate([pa, pb, tip_psi], axis=1)
+    rho, psi = [R, R], [pa, pb]
+    if tip:
+        w = np.linspace(0.0, 1.0, n_tip + 2)[1:-1]
+        psi.append(pa[:, -1:] + w[None, :] * (pb[:, -1:] - pa[:, -1:]))
+        rho.append(np.broadcast_to(rho_hi[:, None], psi[-1].shape))
+    rho, psi = np.concatenate(rho, axis=1), np.concatenate(psi, axis=1)
     zz = np.broadcast_to(zeta[:, None], rho.shape)
     return np.stack([rho * np.cos(psi), rho * np.sin(psi), zz], -1)
 
 
 def build_wheel_tooth_pieces(g: GearGeometry, res: Resolution) -> list[trimesh.Trimesh]:
+    """Slabs across the face width; where the hob tip edge cut a root fillet / undercut (concave), each slab is
+    split at the conjugate junction radius so that no hull bridges the concave kink of the working flank."""
     sub = SLAB_SUBSECTIONS
     zeta = np.linspace(-g.face_width / 2, g.face_width / 2, sub * res.wheel_slabs + 1)
-    S = wheel_slab_sections(g, res, zeta)
-    return [_hull(S[sub * j: sub * (j + 1) + 1].reshape(-1, 3)) for j in range(res.wheel_slabs)]
+    root, tip = wheel.root_rho(g, zeta), wheel.tip_rho(g, zeta)
+    junc = conjugate_junction_rho(g, zeta)
+    upper = wheel_slab_sections(g, res, zeta, junc, tip)
+    has_fillet = junc > root + 1e-6 * g.m_x
+    lower = wheel_slab_sections(g, Resolution(0, 0, max(3, res.profile_points // 2)), zeta, root,
+                                np.maximum(junc, root), tip=False)
+    out = []
+    for j in range(res.wheel_slabs):
+        sl = slice(sub * j, sub * (j + 1) + 1)
+        out.append(_hull(upper[sl].reshape(-1, 3)))
+        if has_fillet[sl].any():
+            out.append(_hull(lower[sl].reshape(-1, 3)))
+    return out
 
 
 SLAB_SUBSECTIONS = 4   # exact sections per slab that its hull spans (2 ends + 3 inside)
