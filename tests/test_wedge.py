@@ -260,6 +260,19 @@ def test_the_mov_scenarios_exist():
     assert {"mov_1", "mov_2", "mov_3", "mov_4", "mov_5", "mov_1_from_rest"} <= names
 
 
+def test_early_seat_stalls_and_locks_with_s1_at_the_static_wedge_limit():
+    res = wedge.simulate(load_scenario(ROOT / "scenarios" / "mov_3_early_seat.yaml"))
+    s, sm = res.series, res.summary
+    assert sm["regimes"] == ["tractive", "locked"] and sm["locked_at_end"] and not sm["stalled"]
+    t_stop = sm["regime_timeline"][1]["start_s"]
+    assert sm["S1_peak_time_s"] == pytest.approx(t_stop, abs=1e-9)
+    # just before the stop x1' -> 0, rho -> rho(0): S1 = psi1(rho0) S2 with S2 = F2 - m2 tan g x1''
+    rho0 = math.radians(1 / 0.088)
+    a = (F1_REST - (-15000.0) * -math.tan(G + rho0)) / (11.8 + 100 * math.tan(G + rho0) * math.tan(G))
+    assert sm["S1_peak_n"] == pytest.approx(F1_REST - 11.8 * a, rel=1e-6)
+    np.testing.assert_allclose(s["S1_n"][s["t_s"] > t_stop + 1e-6], F1_REST, rtol=1e-12)
+
+
 @pytest.mark.parametrize("path", MOV, ids=[f.stem for f in MOV])
 def test_every_mov_scenario_runs_and_writes_all_files(path, tmp_path):
     summary = run_scenario(load_scenario(path), tmp_path, progress=False)
