@@ -1,0 +1,182 @@
+"""Tooth-contact law of contact3d: the scenario's `contact:` block (ADAMS IMPACT K, e, C, d and friction)
+mapped onto MuJoCo's soft contact constraints (solref / solimp), and the friction coefficient mu(Vs).
+
+MuJoCo (modeling.rst "Solver parameters", computation "Soft constraints") computes a contact's normal
+force from the constraint-space dynamics  a1 + d (b v + k r) = (1 - d) a0  with impedance d
+(solimp), reference stiffness k and damping b (solref). In the direct (negative) solref format
+(-S, -B) with constant impedance d = solimp[0] = solimp[1]:  d k = S, d b = B.  The regulariser is
+R = (1 - d) / d * A_hat, where A_hat is MuJoCo's approximate constraint-space inverse mass of the row
+(for a contact: body_invweight0[worm, 0] + body_invweight0[wheel, 0]). At static equilibrium
+(qacc = 0) the primal optimality of the constraint solve gives, per row,
+
+    f = R^-1 a_ref = -(k / R) r = -S / ((1 - d) A_hat) * r        (a linear spring, exactly)
+
+and in motion f = -S/((1-d) A_hat) r - B/((1-d) A_hat) v - R^-1 a1: the same spring and damper plus
+an added mass 1/R = d / ((1 - d) A_hat) in the contact normal, which is small for small d. So we set
+A_hat ourselves (model.body_invweight0, see wormsim.model) and choose
+
+    S = k_c (1 - d) A_hat,    B = c_c (1 - d) A_hat                                     (1)
+
+for a wanted linear stiffness k_c (N/m) and damping c_c (N s/m) per MuJoCo contact.
+
+ADAMS IMPACT is F = K delta^e + STEP(delta, 0, 0, d_max, C) delta_dot. MuJoCo's contact is linear in
+the penetration, so the exponent e cannot be represented. We read `contact.stiffness_n_per_m` as
+the linear (secant) stiffness of one tooth pair at its working load, in N/m as the key says: that is
+what seed 001 derives it as (K = pi L E* / 4, Hertz line contact, N/mm), and reading seed 001's
+K = 1.47e7 with e = 1.5 in SI as N/m^1.5 would give a 2 mm penetration at the 1.3 kN tooth load of a
+0.7 mm module gear. The exponent is reported, not used. Damping C is the full (delta >= d_max)
+value; it is capped at critical damping of one tooth pair against the mesh's effective mass (ADAMS's
+C of seeds 001/002 is 100x over-critical for these masses and would need a timestep below 1e-7 s
+in an explicit spring; the cap is reported as `contact_damping_used_n_s_per_m`).
+
+A tooth pair touches along a line; the convex collision pieces turn it into several point contacts
+(one per worm-piece/wheel-piece pair). Each MuJoCo contact gets k_c = K / n_ref, with n_ref the
+number of wheel-tooth pieces across the face width per flank (`contacts_per_pair`), so a pair whose
+line contact spans the face carries K.
+
+Defaults when `stiffness_n_per_m` is absent: Hertz line contact of seed 001, K = pi L E* / 4 with
+L = wheel face width b2 and 1/E* = (1 - nu1^2)/E1 + (1 - nu2^2)/E2. Default damping: 10 % of critical.
+
+Friction: MuJoCo has one Coulomb coefficient per contact (elliptic cone). We set it every few steps
+from the sliding speed Vs = omega1 r1 / cos(gamma) (seed 000):
+  friction: mu                           constant
+  friction_static/_dynamic: mu(Vs) = STEP(|Vs|, 0, mu_s, v_t, mu_d)   (ADAMS-style cubic blend over
+                                          the transition velocity v_t = contact.transition_velocity_m_s)
+  friction_group: mu(Vs) = tan(rho(Vs)), rho of seed 000 (wormsim.friction)
+  none given: mu = 0.05 (lubricated steel/bronze, DEFAULT_FRICTION).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from wormsim.scenario import Contact, Materials
+from wormsim.units import GPA, step
+
+DEFAULT_FRICTION = 0.05
+DEFAULT_DAMPING_RATIO = 0.1
+MAX_DAMPING_RATIO = 1.0
+IMPEDANCE = 0.01            # d: added mass in the contact normal is d/(1-d) = 1 % of the mesh's effective mass
+
+
+@dataclass(frozen=True)
+class ContactLaw:
+    """Numbers of the mapping (1); SI units."""
+
+    pair_stiffness_n_per_m: float       # K, one tooth pair (linear, secant)
+    stiffness_source: str               # "scenario" | "hertz"
+    exponent: float                     # ADAMS e (reported, not representable)
+    contacts_per_pair: int              # n_ref
+    contact_stiffness_n_per_m: float    # k_c = K / n_ref
+    contact_damping_requested_n_s_per_m: float
+    contact_damping_n_s_per_m: float    # c_c used (capped at critical)
+    effective_mass_kg: float            # 1 / A_hat: mesh effective mass at a contact's normal
+    inv_mass_hat: float                 # A_hat (1/kg)
+    impedance: float                    # d
+    solref: tuple[float, float]         # (-S, -B)
+    solimp: tuple[float, float, float, float, float]
+
+    def natural_frequency_rad_s(self, contacts: int) -> float:
+        """omega = sqrt(n k_c A_hat): mesh mode with `contacts` contacts in parallel."""
+        return math.sqrt(contacts * self.contact_stiffness_n_per_m * self.inv_mass_hat)
+
+    def stable_timestep_s(self, contacts: int) -> float:
+        """Explicit (semi-implicit Euler) limit of the spring-damper in the contact normal:
+        h < 2 / omega * (sqrt(1 + zeta^2) - zeta), zeta = c / (2 sqrt(k m)) (per contact, in parallel)."""
+        w = self.natural_frequency_rad_s(contacts)
+        zeta = self.damping_ratio * math.sqrt(contacts / self.contacts_per_pair)
+        return 2.0 / w * (math.sqrt(1 + zeta * zeta) - zeta)
+
+    @property
+    def damping_ratio(self) -> float:
+        """zeta of one tooth pair (n_ref contacts) against the mesh's effective mass."""
+        return self.contact_damping_n_s_per_m * self.contacts_per_pair / (
+            2 * math.sqrt(self.pair_stiffness_n_per_m * self.effective_mass_kg))
+
+    def as_dict(self) -> dict:
+        return asdict(self)
+
+
+def effective_modulus_pa(materials: Materials) -> float:
+    """E* with 1/E* = (1 - nu1^2)/E1 + (1 - nu2^2)/E2 (Hertz; seeds 001, 002)."""
+    w, g = materials.worm, materials.wheel
+    return 1.0 / ((1 - w.poisson_ratio ** 2) / (w.youngs_modulus_gpa * GPA)
+                  + (1 - g.poisson_ratio ** 2) / (g.youngs_modulus_gpa * GPA))
+
+
+def hertz_line_stiffness_n_per_m(materials: Materials, contact_length_m: float) -> float:
+    """K = pi L E* / 4 (seed 001, Hertz line contact of two cylinders)."""
+    return math.pi * contact_length_m * effective_modulus_pa(materials) / 4.0
+
+
+def contact_law(contact: Contact, materials: Materials, face_width_m: float, contacts_per_pair: int,
+                inv_mass_hat: float) -> ContactLaw:
+    """Map the scenario's contact block onto per-contact solref/solimp by (1).
+
+    `inv_mass_hat` is A_hat = 1 / m_eff, the constraint-space inverse mass the model assigns to every
+    worm-wheel contact (wormsim.model sets body_invweight0 so that it holds).
+    """
+    if contact.stiffness_n_per_m is not None:
+        k_pair, source = contact.stiffness_n_per_m, "scenario"
+    else:
+        k_pair, source = hertz_line_stiffness_n_per_m(materials, face_width_m), "hertz"
+    n_ref = max(int(contacts_per_pair), 1)
+    k_c = k_pair / n_ref
+    m_eff = 1.0 / inv_mass_hat
+    c_crit = 2.0 * math.sqrt(k_pair * m_eff) / n_ref      # per contact: critical damping of one pair
+    if contact.damping_n_s_per_m is not None:
+        c_req = contact.damping_n_s_per_m / n_ref
+    else:
+        c_req = DEFAULT_DAMPING_RATIO * c_crit
+    c_c = min(c_req, MAX_DAMPING_RATIO * c_crit)
+    d = IMPEDANCE
+    s = k_c * (1 - d) * inv_mass_hat
+    b = c_c * (1 - d) * inv_mass_hat
+    return ContactLaw(
+        pair_stiffness_n_per_m=k_pair, stiffness_source=source, exponent=contact.exponent,
+        contacts_per_pair=n_ref, contact_stiffness_n_per_m=k_c,
+        contact_damping_requested_n_s_per_m=c_req, contact_damping_n_s_per_m=c_c,
+        effective_mass_kg=m_eff, inv_mass_hat=inv_mass_hat, impedance=d,
+        solref=(-s, -b), solimp=(d, d, 0.001, 0.5, 2.0))
+
+
+# ----------------------------------------------------------------------------- friction
+
+def friction_mode(contact: Contact) -> str:
+    if contact.friction_group is not None:
+        return f"group {contact.friction_group} (seed 000 rho(Vs))"
+    if contact.friction_static is not None:
+        return (f"static {contact.friction_static} -> dynamic {contact.friction_dynamic} "
+                f"over {contact.transition_velocity_m_s} m/s")
+    if contact.friction is not None:
+        return f"constant {contact.friction}"
+    return f"default constant {DEFAULT_FRICTION}"
+
+
+def friction_coefficient(contact: Contact, sliding_speed_m_s) -> float | np.ndarray:
+    """mu(Vs): see the module docstring. Vectorised over Vs."""
+    vs = np.abs(np.asarray(sliding_speed_m_s, dtype=float))
+    if contact.friction_group is not None:
+        from wormsim.friction import mu_from_rho, rho_rad
+
+        out = mu_from_rho(rho_rad(vs, group=contact.friction_group))
+    elif contact.friction_static is not None:
+        out = step(vs, 0.0, contact.friction_static, contact.transition_velocity_m_s, contact.friction_dynamic)
+    elif contact.friction is not None:
+        out = np.full_like(vs, contact.friction)
+    else:
+        out = np.full_like(vs, DEFAULT_FRICTION)
+    return float(out) if np.ndim(out) == 0 else out
+
+
+def efficiency_theory(lead_angle_rad: float, normal_pressure_angle_rad: float, mu: float,
+                      backdriving: bool = False) -> float:
+    """Wedge efficiencies with the virtual friction angle rho' = atan(mu / cos(alpha_n)) (DIN 3975):
+    forward eta = tan(g) / tan(g + rho'), backward eta' = tan(g - rho') / tan(g) (0 when self-locking)."""
+    rho = math.atan(mu / math.cos(normal_pressure_angle_rad))
+    g = lead_angle_rad
+    if backdriving:
+        return max(math.tan(g - rho) / math.tan(g), 0.0)
+    return math.tan(g) / math.tan(g + rho)

@@ -1,0 +1,128 @@
+"""Summary metrics of a contact3d run (INTERFACE.md keys), from its time series.
+
+- steady window: starts after the last ramp (drive.ramp_s, load.start_s + load.ramp_s) plus settling,
+  the first time from which a one-mesh-period moving mean of the driven shaft's speed stays within
+  2 % of the mean of the run's last half; then trimmed from the start to a whole number of mesh periods
+  (when at least one fits), so periodic fluctuation does not bias the means;
+- ratio = mean |worm speed| / mean |wheel speed| over the window; theory z2 / z1;
+- meshing frequency: dominant peak of the FFT of the tangential force over the window (mean and linear
+  trend removed, Hann window, DC bin excluded), refined by Gaussian (log-parabolic) interpolation of
+  the peak's three bins; bin width 1 / T_window reported as `mesh_frequency_resolution_hz`; theory
+  z1 n1 / 60 with n1 the mean worm speed;
+- forces: means and peak-to-peak (max - min) over the window, magnitudes of the means;
+- efficiency = output power / input power over the window = mean(-T_load w_load) / mean(T_drive w_drive);
+  theory tan(g) / tan(g + rho') (or tan(g - rho') / tan(g) back-driving), rho' = atan(mu / cos(alpha_n)),
+  mu the mean friction coefficient applied over the window.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from wormsim.contact import efficiency_theory
+
+
+def steady_window(t: np.ndarray, speed: np.ndarray, t_start: float, period_s: float) -> tuple[int, int]:
+    """Indices [i0, i1) of the steady window (see the module docstring)."""
+    n = len(t)
+    i_ramp = int(np.searchsorted(t, t_start))
+    if n - i_ramp < 8:
+        return max(0, n - 8), n
+    dt = (t[-1] - t[0]) / max(n - 1, 1)
+    half = speed[max(i_ramp, n // 2):]
+    ref = float(np.mean(np.abs(half))) if len(half) else 0.0
+    w = max(1, int(round(period_s / dt))) if period_s > 0 else 1
+    w = min(w, max(1, (n - i_ramp) // 4))
+    mm = np.convolve(np.abs(speed), np.ones(w) / w, mode="same")
+    bad = np.abs(mm[i_ramp:] - ref) > 0.02 * max(ref, 1e-12)
+    # first index after which no moving mean is outside the band (ignore the last half-window edge)
+    edge = max(1, w // 2)
+    bad[-edge:] = False
+    idx = np.nonzero(bad)[0]
+    i0 = i_ramp + (int(idx[-1]) + 1 if len(idx) else 0)
+    i0 = min(i0, n - max(8, (n - i_ramp) // 4))
+    i1 = n
+    if period_s > 0:
+        span = t[i1 - 1] - t[i0]
+        periods = math.floor(span / period_s)
+        if periods >= 1:
+            i0 = int(np.searchsorted(t, t[i1 - 1] - periods * period_s))
+    return i0, i1
+
+
+def dominant_frequency(t: np.ndarray, x: np.ndarray) -> tuple[float, float, np.ndarray, np.ndarray]:
+    """(f_peak_hz, resolution_hz, freqs, amplitude spectrum) of x(t) on a uniform grid: linear trend
+    removed, Hann window, DC bin excluded, Gaussian interpolation of the peak bin."""
+    n = len(x)
+    if n < 8:
+        return float("nan"), float("nan"), np.zeros(0), np.zeros(0)
+    dt = (t[-1] - t[0]) / (n - 1)
+    tt = t - t[0]
+    coef = np.polyfit(tt, x, 1)
+    y = (x - np.polyval(coef, tt)) * np.hanning(n)
+    spec = np.abs(np.fft.rfft(y)) * 2 / max(np.hanning(n).sum(), 1e-12)
+    freqs = np.fft.rfftfreq(n, dt)
+    df = 1.0 / (n * dt)
+    k = 1 + int(np.argmax(spec[1:]))
+    f = freqs[k]
+    if 1 <= k < len(spec) - 1 and spec[k - 1] > 0 and spec[k] > 0 and spec[k + 1] > 0:
+        a, b, c = np.log(spec[k - 1]), np.log(spec[k]), np.log(spec[k + 1])
+        den = a - 2 * b + c
+        if den < 0:
+            f = freqs[k] + 0.5 * (a - c) / den * df
+    return float(f), float(df), freqs, spec
+
+
+def contact3d_summary(S: dict, scenario, bm) -> dict:
+    geo = bm.geometry
+    t = S["t_s"]
+    drv, load = scenario.drive, scenario.load
+    w1 = np.abs(S["worm_speed_rpm"])
+    w2 = np.abs(S["wheel_speed_rpm"])
+    n1_guess = float(np.mean(w1[len(w1) // 2:])) if len(w1) else 0.0
+    f_mesh_guess = geo.z1 * n1_guess / 60.0
+    period = 1.0 / f_mesh_guess if f_mesh_guess > 0 else 0.0
+    ramp_end = max(drv.ramp_s, load.start_s + load.ramp_s)
+    driven = w2 if drv.on == "worm" else w1
+    i0, i1 = steady_window(t, driven, ramp_end, period)
+    sl = slice(i0, i1)
+    n1 = float(np.mean(w1[sl]))
+    n2 = float(np.mean(w2[sl]))
+    f_peak, df, _, _ = dominant_frequency(t[sl], S["tangential_force_n"][sl])
+    ft = S["tangential_force_n"][sl]
+    w1s = S["worm_speed_rpm"][sl] * (2 * math.pi / 60)
+    w2s = S["wheel_speed_rpm"][sl] * (2 * math.pi / 60)
+    T1, T2 = S["worm_torque_nm"][sl], S["wheel_torque_nm"][sl]
+    p1, p2 = float(np.mean(T1 * w1s)), float(np.mean(T2 * w2s))
+    if drv.on == "worm":
+        eff = -p2 / p1 if p1 > 0 else float("nan")
+    else:
+        eff = -p1 / p2 if p2 > 0 else float("nan")
+    mu = float(np.mean(S["friction_coefficient"][sl]))
+    eta_th = efficiency_theory(geo.gamma, geo.alpha_n, mu, backdriving=drv.on == "wheel")
+    return {
+        "ratio": n1 / n2 if n2 > 0 else float("inf"),
+        "ratio_theory": geo.ratio,
+        "mesh_frequency_hz": f_peak,
+        "mesh_frequency_theory_hz": geo.z1 * n1 / 60.0,
+        "mesh_frequency_resolution_hz": df,
+        "tangential_force_mean_n": abs(float(np.mean(ft))),
+        "tangential_force_p2p_n": float(np.ptp(ft)) if len(ft) else float("nan"),
+        "tangential_force_theory_n": abs(load.torque_nm) / geo.r2 if load.on == "wheel" else float("nan"),
+        "radial_force_mean_n": abs(float(np.mean(S["radial_force_n"][sl]))),
+        "axial_force_mean_n": abs(float(np.mean(S["axial_force_n"][sl]))),
+        "worm_torque_mean_nm": abs(float(np.mean(T1))),
+        "wheel_torque_mean_nm": abs(float(np.mean(T2))),
+        "worm_speed_mean_rpm": n1,
+        "wheel_speed_mean_rpm": n2,
+        "efficiency": eff,
+        "efficiency_theory": eta_th,
+        "friction_coefficient_mean": mu,
+        "steady_window_s": [float(t[i0]), float(t[i1 - 1])],
+        "contacts_mean": float(np.mean(S["contacts"][sl])),
+        "teeth_in_contact_mean": float(np.mean(S["teeth_in_contact"][sl])),
+        "max_penetration_um": float(np.max(S["max_penetration_m"][sl]) * 1e6),
+        "transmission_error_p2p_urad": float(np.ptp(S["transmission_error_rad"][sl]) * 1e6),
+        "wheel_speed_fluctuation": float(np.ptp(w2[sl]) / n2) if n2 > 0 else float("nan"),
+    }

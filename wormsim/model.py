@@ -1,0 +1,357 @@
+"""The contact3d MuJoCo model: worm + wheel on one hinge each, coupled only through tooth contact.
+
+Built with mujoco.MjSpec from the template `models/worm_pair.xml` (see models/README.md):
+
+- bodies in the assembly frame of INTERFACE.md (wheel axis z through the origin, worm axis parallel
+  to x at y = -a), placed by meshgen.assembly; one hinge each, no gear or equality constraint;
+- collision geoms: meshgen's convex pieces (meshgen.pieces). All worm pieces; for the wheel only an
+  ACTIVE WINDOW of `window_teeth` tooth slots around the line of centres, which wormsim.simulate
+  re-poses by whole pitches as the wheel turns (tooth k lives in slot k mod W), so the cost does not
+  grow with z2. Contype/conaffinity let worm pieces meet wheel pieces only;
+- visual-only geoms: the smooth watertight meshes (whole worm, whole wheel);
+- inertias: axial moments of the visual meshes times the materials' densities (trimesh mass
+  properties; a solid cylinder r_f..r_a as a fallback if a mesh is not watertight);
+- drive: speed -> `velocity` actuator (kv chosen for a 0.1 % speed droop at the expected torque, integrated
+  implicitly by implicitfast), torque -> `motor`; the command follows ADAMS STEP over drive.ramp_s;
+- load: `motor` on the other shaft, resisting (sign opposite to the expected motion), STEP from
+  load.start_s over load.ramp_s;
+- contact law: wormsim.contact (solref/solimp per collision geom; body_invweight0 set to A_hat).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import mujoco
+import numpy as np
+
+from meshgen.geometry import GearGeometry, derive
+from wormsim.contact import ContactLaw, contact_law, efficiency_theory, friction_coefficient
+from wormsim.scenario import Scenario, ScenarioError
+from wormsim.units import rpm_to_rad_s
+
+TEMPLATE = Path(__file__).resolve().parent.parent / "models" / "worm_pair.xml"
+SPEED_DROOP = 1e-3          # velocity servo: kv = T_expected / (SPEED_DROOP * omega_cmd)
+
+
+@dataclass
+class BuiltModel:
+    """A compiled model and what the runner needs to drive, re-pose and read it."""
+
+    model: mujoco.MjModel
+    spec: mujoco.MjSpec
+    geometry: GearGeometry
+    law: ContactLaw
+    worm_body: int
+    wheel_body: int
+    worm_dof: int
+    wheel_dof: int
+    drive_actuator: int
+    load_actuator: int
+    worm_geoms: np.ndarray              # collision geom ids
+    wheel_slot_geoms: np.ndarray        # (W, n_pieces) collision geom ids
+    slot_base_pos: np.ndarray           # (W, n_pieces, 3): geom_pos with the tooth at angle 0
+    slot_base_quat: np.ndarray          # (W, n_pieces, 4)
+    window_teeth: int
+    tooth0_angle_rad: float             # angle of tooth 0's centre in the wheel frame at theta2 = 0
+    direction: int                      # +1/-1: expected sign of (load shaft speed) / (drive command)
+    drive_sign: int                     # sign of the drive command
+    pieces: object = None               # meshgen GearSet
+    meta: dict = field(default_factory=dict)
+
+
+# ----------------------------------------------------------------------------- geometry helpers
+
+def gear_set(scenario: Scenario):
+    from meshgen.pieces import build_gear_set
+
+    geo = derive(scenario.gear)
+    return geo, build_gear_set(geo, resolution=scenario.simulation.resolution)
+
+
+def _assembly(geo: GearGeometry, part: str, theta: float) -> np.ndarray:
+    import inspect
+
+    from meshgen import assembly
+
+    fn = getattr(assembly, f"{part}_to_assembly")
+    n = len(inspect.signature(fn).parameters)
+    return np.asarray(fn(theta) if n == 1 else fn(theta, geo), dtype=float)
+
+
+def _mat2quat(R: np.ndarray) -> np.ndarray:
+    q = np.zeros(4)
+    mujoco.mju_mat2Quat(q, np.ascontiguousarray(R, dtype=float).ravel())
+    return q
+
+
+def _axial_inertia(mesh, density: float, r_in: float, r_out: float, length: float) -> tuple[float, float]:
+    """(mass, I_zz) about the part's axis z: mesh volume integrals if watertight, else a hollow cylinder."""
+    if mesh is not None and getattr(mesh, "is_watertight", False) and mesh.volume > 0:
+        m = mesh.copy()
+        m.density = density
+        mp = m.mass_properties
+        return float(mp["mass"]), float(mp["inertia"][2, 2] + mp["mass"] * 0.0)
+    mass = density * math.pi * (r_out ** 2 - r_in ** 2) * length
+    return mass, 0.5 * mass * (r_out ** 2 + r_in ** 2)
+
+
+def mesh_arms(geo: GearGeometry) -> tuple[float, float]:
+    """Moment arms of a unit normal force at the pitch point about the worm and wheel axes:
+    worm r1 cos(alpha_n) sin(gamma), wheel r2 cos(alpha_n) cos(gamma) (normal direction of the
+    flank at the pitch point, DIN 3975 force components)."""
+    ca = math.cos(geo.alpha_n)
+    return geo.r1 * ca * math.sin(geo.gamma), geo.r2 * ca * math.cos(geo.gamma)
+
+
+def expected_direction(scenario: Scenario, geo: GearGeometry) -> int:
+    """+1/-1: sign of the driven shaft's speed per sign of the drive command. INTERFACE.md: a positive
+    worm rotation drives the wheel positive for a right-hand worm (and back-driving the same way)."""
+    return geo.hand
+
+
+def window_size(geo: GearGeometry) -> int:
+    """Wheel teeth with collision: those the threaded length can reach, plus one each side."""
+    reach = min(geo.worm_length / 2, geo.r_e2)
+    half = math.asin(min(reach / geo.r_e2, 1.0)) * geo.z2 / (2 * math.pi)
+    return int(min(geo.z2, 2 * math.ceil(half) + 2))
+
+
+def window_teeth_at(theta2: float, z2: int, window: int, tooth0_angle: float) -> np.ndarray:
+    """Unwrapped tooth indices k of the window at wheel angle theta2: the W teeth nearest the line of
+    centres (angle -pi/2 in the assembly frame), tooth k at angle tooth0 + 2 pi k / z2 + theta2."""
+    pitch = 2 * math.pi / z2
+    c = math.floor((-math.pi / 2 - tooth0_angle - theta2) / pitch)
+    h = window // 2
+    return np.arange(c - h + 1, c - h + 1 + window)
+
+
+# ----------------------------------------------------------------------------- build
+
+def build_model(scenario: Scenario, gs=None) -> BuiltModel:
+    if scenario.gear is None or scenario.drive is None:
+        raise ScenarioError("model: contact3d needs gear: and drive: blocks")
+    geo, gs = (derive(scenario.gear), gs) if gs is not None else gear_set(scenario)
+    mats = scenario.materials
+    spec = mujoco.MjSpec.from_file(str(TEMPLATE))
+    spec.modelname = scenario.name
+
+    # inertias from densities
+    m1, I1 = _axial_inertia(gs.worm_visual, mats.worm.density_kg_m3, 0.0, geo.r1, geo.worm_length)
+    m2, I2 = _axial_inertia(gs.wheel_visual, mats.wheel.density_kg_m3, 0.0, geo.r2, geo.face_width)
+    arm1, arm2 = mesh_arms(geo)
+    inv_mass_hat = arm1 ** 2 / I1 + arm2 ** 2 / I2
+    slabs = max(1, _slabs_per_flank(gs))
+    law = contact_law(scenario.contact, mats, geo.face_width, slabs, inv_mass_hat)
+    mu0 = float(friction_coefficient(scenario.contact, 0.0))
+
+    worm_b, wheel_b = spec.body("worm"), spec.body("wheel")
+    Tw = _assembly(geo, "worm", 0.0)
+    Tg = _assembly(geo, "wheel", 0.0)
+    if not np.allclose(Tg, np.eye(4), atol=1e-12):
+        raise RuntimeError("meshgen.assembly: the wheel frame must coincide with the assembly frame at theta2 = 0")
+    worm_b.pos = Tw[:3, 3]
+    worm_b.quat = _mat2quat(Tw[:3, :3])
+    for body, mass, izz in ((worm_b, m1, I1), (wheel_b, m2, I2)):
+        body.explicitinertial = True
+        body.mass = mass
+        body.ipos = [0, 0, 0]
+        body.inertia = [izz / 2 + 1e-12, izz / 2 + 1e-12, izz]
+
+    def add_mesh(name, mesh):
+        me = spec.add_mesh()
+        me.name = name
+        me.uservert = np.asarray(mesh.vertices, dtype=np.float32).ravel()
+        me.userface = np.asarray(mesh.faces, dtype=np.int32).ravel()
+        me.inertia = mujoco.mjtMeshInertia.mjMESH_INERTIA_CONVEX
+        return me
+
+    def set_contact(g):
+        g.solref = law.solref
+        g.solimp = law.solimp
+        g.friction = [mu0, 0.0, 0.0]
+        g.margin = 0.0
+
+    add_mesh("worm_visual", gs.worm_visual)
+    add_mesh("wheel_visual", gs.wheel_visual)
+    for b, name, rgba in ((worm_b, "worm_visual", (0.55, 0.6, 0.7, 1)), (wheel_b, "wheel_visual", (0.85, 0.65, 0.3, 1))):
+        g = b.add_geom(default=spec.find_default("visual"))
+        g.name, g.meshname, g.rgba = name, name, rgba
+    worm_names = []
+    for i, piece in enumerate(gs.worm_pieces):
+        add_mesh(f"worm_piece_{i}", piece)
+        g = worm_b.add_geom(default=spec.find_default("worm_collision"))
+        g.name = g.meshname = f"worm_piece_{i}"
+        set_contact(g)
+        worm_names.append(g.name)
+    for j, piece in enumerate(gs.wheel_tooth_pieces):
+        add_mesh(f"tooth_piece_{j}", piece)
+    W = window_size(geo)
+    tooth0 = _tooth0_angle(gs)
+    ks = window_teeth_at(0.0, geo.z2, W, tooth0)
+    slot_names = [[None] * len(gs.wheel_tooth_pieces) for _ in range(W)]
+    for k in ks:
+        s = int(k % W)
+        ang = 2 * math.pi * k / geo.z2
+        for j in range(len(gs.wheel_tooth_pieces)):
+            g = wheel_b.add_geom(default=spec.find_default("wheel_collision"))
+            g.name = f"slot{s}_piece{j}"
+            g.meshname = f"tooth_piece_{j}"
+            g.quat = [math.cos(ang / 2), 0, 0, math.sin(ang / 2)]
+            set_contact(g)
+            slot_names[s][j] = g.name
+
+    # drive and load
+    drv, load = scenario.drive, scenario.load
+    direction = expected_direction(scenario, geo)
+    drive_joint = f"{drv.on}_hinge"
+    load_joint = f"{load.on}_hinge"
+    a = spec.add_actuator()
+    a.name, a.target, a.trntype = "drive", drive_joint, mujoco.mjtTrn.mjTRN_JOINT
+    meta = {"worm_mass_kg": m1, "wheel_mass_kg": m2, "worm_inertia_kg_m2": I1, "wheel_inertia_kg_m2": I2,
+            "window_teeth": W, "worm_pieces": len(gs.worm_pieces), "tooth_pieces": len(gs.wheel_tooth_pieces)}
+    if drv.speed_rpm is not None:
+        w_cmd = abs(rpm_to_rad_s(drv.speed_rpm))
+        eta = efficiency_theory(geo.gamma, geo.alpha_n, float(friction_coefficient(scenario.contact, 1.0)),
+                                backdriving=drv.on == "wheel")
+        if drv.on == "worm":
+            t_exp = abs(load.torque_nm) / geo.ratio / max(eta, 0.05)
+        else:
+            t_exp = abs(load.torque_nm) * geo.ratio / max(eta, 0.05)
+        t_exp = max(t_exp, 1e-3)
+        kv = t_exp / (SPEED_DROOP * max(w_cmd, 1e-3))
+        a.set_to_velocity(kv=kv)
+        meta["drive_kv_nm_s"] = kv
+        drive_sign = int(np.sign(drv.speed_rpm)) or 1
+    else:
+        a.set_to_motor()
+        drive_sign = int(np.sign(drv.torque_nm)) or 1
+    a.ctrllimited = False
+    lo = spec.add_actuator()
+    lo.name, lo.target, lo.trntype = "load", load_joint, mujoco.mjtTrn.mjTRN_JOINT
+    lo.set_to_motor()
+    lo.ctrllimited = False
+
+    o = spec.option
+    o.timestep = default_timestep(law) if scenario.simulation.timestep_s is None else scenario.simulation.timestep_s
+    o.integrator = {"implicitfast": mujoco.mjtIntegrator.mjINT_IMPLICITFAST, "rk4": mujoco.mjtIntegrator.mjINT_RK4,
+                    "euler": mujoco.mjtIntegrator.mjINT_EULER, "implicit": mujoco.mjtIntegrator.mjINT_IMPLICIT,
+                    "discrete": mujoco.mjtIntegrator.mjINT_DISCRETE}[scenario.simulation.integrator]
+
+    model = spec.compile()
+    _set_inv_mass_hat(model, law, arm1 ** 2 / I1, arm2 ** 2 / I2)
+    geom_id = lambda n: mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, n)  # noqa: E731
+    slot_geoms = np.array([[geom_id(n) for n in row] for row in slot_names], dtype=int)
+    base_pos = np.zeros(slot_geoms.shape + (3,))
+    base_quat = np.zeros(slot_geoms.shape + (4,))
+    for k in ks:
+        s = int(k % W)
+        ang = 2 * math.pi * k / geo.z2
+        qinv = np.array([math.cos(-ang / 2), 0, 0, math.sin(-ang / 2)])
+        Rinv = _rotz(-ang)
+        for j, gid in enumerate(slot_geoms[s]):
+            base_pos[s, j] = Rinv @ model.geom_pos[gid]
+            mujoco.mju_mulQuat(base_quat[s, j], qinv, model.geom_quat[gid].copy())
+    jid = lambda n: mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, n)  # noqa: E731
+    return BuiltModel(
+        model=model, spec=spec, geometry=geo, law=law,
+        worm_body=mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "worm"),
+        wheel_body=mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "wheel"),
+        worm_dof=int(model.jnt_dofadr[jid("worm_hinge")]), wheel_dof=int(model.jnt_dofadr[jid("wheel_hinge")]),
+        drive_actuator=mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, "drive"),
+        load_actuator=mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, "load"),
+        worm_geoms=np.array([geom_id(n) for n in worm_names], dtype=int),
+        wheel_slot_geoms=slot_geoms, slot_base_pos=base_pos, slot_base_quat=base_quat,
+        window_teeth=W, tooth0_angle_rad=tooth0, direction=direction, drive_sign=drive_sign, pieces=gs, meta=meta)
+
+
+def _slabs_per_flank(gs) -> int:
+    """n_ref: wheel-tooth pieces across the face width on one flank (meshgen may split a tooth
+    into flank pieces; a piece spanning both flanks counts once per flank)."""
+    res = getattr(gs, "resolution", None)
+    if getattr(res, "wheel_slabs", None):
+        return int(res.wheel_slabs)
+    zs = [round(float(np.mean(p.vertices[:, 2])), 9) for p in gs.wheel_tooth_pieces]
+    return len(set(zs))
+
+
+def _tooth0_angle(gs) -> float:
+    """Angle of tooth 0's centre (mean of its pieces' centroids) in the wheel frame."""
+    c = np.mean([p.centroid for p in gs.wheel_tooth_pieces], axis=0)
+    return math.atan2(c[1], c[0])
+
+
+def _rotz(a: float) -> np.ndarray:
+    c, s = math.cos(a), math.sin(a)
+    return np.array([[c, -s, 0], [s, c, 0], [0, 0, 1.0]])
+
+
+def _set_inv_mass_hat(model: mujoco.MjModel, law: ContactLaw, a_worm: float, a_wheel: float) -> None:
+    """Make MuJoCo's diagonal approximation of a worm-wheel contact row equal A_hat (wormsim.contact (1))."""
+    wb = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "worm")
+    gb = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "wheel")
+    model.body_invweight0[wb, 0] = a_worm
+    model.body_invweight0[gb, 0] = a_wheel
+    assert abs(a_worm + a_wheel - law.inv_mass_hat) <= 1e-9 * law.inv_mass_hat
+
+
+def repose_window(bm: BuiltModel, theta2: float, current: np.ndarray | None = None) -> np.ndarray:
+    """Place the window slots on the W teeth nearest the line of centres; returns the tooth indices."""
+    ks = window_teeth_at(theta2, bm.geometry.z2, bm.window_teeth, bm.tooth0_angle_rad)
+    if current is not None and np.array_equal(ks, current):
+        return current
+    m = bm.model
+    for k in ks:
+        s = int(k % bm.window_teeth)
+        if current is not None and k in current:
+            continue
+        ang = 2 * math.pi * k / bm.geometry.z2
+        R = _rotz(ang)
+        q = np.array([math.cos(ang / 2), 0, 0, math.sin(ang / 2)])
+        for j, gid in enumerate(bm.wheel_slot_geoms[s]):
+            m.geom_pos[gid] = R @ bm.slot_base_pos[s, j]
+            out = np.zeros(4)
+            mujoco.mju_mulQuat(out, q, bm.slot_base_quat[s, j])
+            m.geom_quat[gid] = out
+    return ks
+
+
+def default_timestep(law: ContactLaw, contacts: int | None = None) -> float:
+    """A quarter of the explicit stability limit with `contacts` (default 3 pairs' worth) in parallel,
+    rounded down to 1-2-5 steps."""
+    n = contacts if contacts is not None else 3 * law.contacts_per_pair
+    h = 0.25 * law.stable_timestep_s(n)
+    e = math.floor(math.log10(h))
+    for mant in (5, 2, 1):
+        if mant * 10 ** e <= h:
+            return mant * 10 ** e
+    return 10 ** e
+
+
+# ----------------------------------------------------------------------------- standalone MJCF
+
+def write_model(scenario: Scenario, out_dir: str | Path) -> Path:
+    """DIR/model.xml + DIR/meshes/*.stl: opens with `python -m mujoco.viewer --mjcf DIR/model.xml`.
+
+    The standalone file holds the collision window at t = 0 (the viewer does not re-pose it) and
+    MuJoCo recomputes body_invweight0 on load, so its contact stiffness differs from a wormsim run's.
+    """
+    out = Path(out_dir)
+    (out / "meshes").mkdir(parents=True, exist_ok=True)
+    bm = build_model(scenario)
+    spec = bm.spec
+    import trimesh
+
+    for me in spec.meshes:
+        v = np.asarray(me.uservert, dtype=float).reshape(-1, 3)
+        f = np.asarray(me.userface, dtype=int).reshape(-1, 3)
+        trimesh.Trimesh(v, f, process=False).export(out / "meshes" / f"{me.name}.stl")
+        me.uservert = []
+        me.userface = []
+        me.file = f"{me.name}.stl"
+    spec.meshdir = "meshes"
+    path = out / "model.xml"
+    path.write_text(spec.to_xml())
+    mujoco.MjModel.from_xml_path(str(path))      # fail here, not in the user's viewer
+    return path

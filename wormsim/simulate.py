@@ -1,0 +1,252 @@
+"""contact3d runner: steps the MuJoCo model of wormsim.model, reads the tooth forces, guards the run.
+
+`simulate(scenario, progress) -> Result` (the interface of wormsim.run). The loop advances the model in
+chunks of `record_every` steps with mujoco.mj_step(nstep=...) (controls are held over a chunk: the
+STEP ramps are smooth on that scale); after each chunk it
+
+- re-poses the wheel's collision window by whole pitches (wormsim.model.repose_window),
+- sets the friction coefficient mu(Vs) from the sliding speed Vs = |omega1| r1 / cos(gamma),
+- records shaft angles/speeds/torques and the tooth forces: for every worm-wheel contact the force
+  of the elliptic-cone constraint rows (normal, two tangents: what mj_contactForce returns) turned into
+  the assembly frame and summed ON THE WHEEL: tangential force F_t = M_z / r2 (the wheel torque of the
+  contact forces reduced to the reference radius, DIN 3975 F_t2 = 2 T2 / d2), radial F_r = sum F . e_r
+  (outward, at each contact point), axial F_a = sum F . e_z; the number of contacts and of wheel teeth
+  touching; contact points in the frame of wheel tooth 0 (for the contact pattern),
+- checks the guards: non-finite state or MuJoCo's bad-qacc warning (divergence), penetration beyond
+  `penetration_limit_m`, the transmission error passing half a pitch (teeth jumped), a speed-driven
+  drive stuck below half its command (locked). Each raises SimulationError with what to change.
+"""
+from __future__ import annotations
+
+import math
+import time
+
+import mujoco
+import numpy as np
+
+from wormsim.contact import efficiency_theory, friction_coefficient, friction_mode
+from wormsim.errors import SimulationError
+from wormsim.model import BuiltModel, build_model, repose_window
+from wormsim.result import Result
+from wormsim.scenario import Scenario
+from wormsim.units import rad_s_to_rpm, rpm_to_rad_s, step
+
+MAX_POINTS = 48             # contact points kept per sample (for the pattern and the recording)
+TARGET_SAMPLES = 20000      # automatic record_every aims at about this many samples per run
+
+
+def _record_every(scenario: Scenario, dt: float, n_steps: int) -> int:
+    sim = scenario.simulation
+    if "record_every" in sim.model_fields_set:
+        return sim.record_every
+    return max(1, n_steps // TARGET_SAMPLES)
+
+
+def commands(scenario: Scenario, t: np.ndarray, direction: int) -> tuple[np.ndarray, np.ndarray]:
+    """Drive command (rad/s or N m) and load torque (N m, on the load shaft) at times t: ADAMS STEP.
+
+    The load resists: its sign is opposite to the load shaft's expected motion, which is
+    `direction` * sign(drive command) (wormsim.model.expected_direction)."""
+    drv, load = scenario.drive, scenario.load
+    target = rpm_to_rad_s(drv.speed_rpm) if drv.speed_rpm is not None else drv.torque_nm
+    drive = step(t, 0.0, 0.0, drv.ramp_s, target)
+    s = (np.sign(target) or 1.0) * direction
+    load_t = step(t, load.start_s, 0.0, load.start_s + load.ramp_s, -s * load.torque_nm)
+    return np.atleast_1d(drive), np.atleast_1d(load_t)
+
+
+def penetration_limit_m(bm: BuiltModel) -> float:
+    """Largest allowed penetration: 40 % of the axial module (beyond it teeth are about to skip)."""
+    return 0.4 * bm.geometry.m_x
+
+
+def tooth_forces(bm: BuiltModel, d: mujoco.MjData, window_ks: np.ndarray):
+    """Contact forces on the wheel: (F_t, F_r, F_a, n_contacts, n_teeth, max_pen, points_tooth0 (n,3),
+    forces (n,3) world, points world (n,3))."""
+    n = d.ncon
+    if n == 0:
+        z = np.zeros((0, 3))
+        return 0.0, 0.0, 0.0, 0, 0, 0.0, z, z, z
+    con = d.contact
+    adr = np.asarray(con.efc_address[:n])
+    ok = adr >= 0
+    geom = np.asarray(con.geom[:n])[ok]
+    adr = adr[ok]
+    frame = np.asarray(con.frame[:n])[ok].reshape(-1, 3, 3)
+    pos = np.asarray(con.pos[:n])[ok]
+    dist = np.asarray(con.dist[:n])[ok]
+    f = np.stack([d.efc_force[adr], d.efc_force[adr + 1], d.efc_force[adr + 2]], axis=1)
+    F = np.einsum("ni,nij->nj", f, frame)              # force on geom2, world frame
+    wheel_is_2 = bm.model.geom_bodyid[geom[:, 1]] == bm.wheel_body
+    F = np.where(wheel_is_2[:, None], F, -F)           # force on the wheel
+    r_xy = pos[:, :2]
+    rad = np.linalg.norm(r_xy, axis=1)
+    e_r = r_xy / np.maximum(rad, 1e-12)[:, None]
+    mz = r_xy[:, 0] * F[:, 1] - r_xy[:, 1] * F[:, 0]
+    f_t = float(mz.sum() / bm.geometry.r2)
+    f_r = float(np.sum(F[:, 0] * e_r[:, 0] + F[:, 1] * e_r[:, 1]))
+    f_a = float(F[:, 2].sum())
+    wheel_geom = np.where(wheel_is_2, geom[:, 1], geom[:, 0])
+    # tooth index of each contact: slot -> tooth in the current window
+    W = bm.window_teeth
+    slot_of = _slot_lookup(bm)
+    slots = slot_of[wheel_geom]
+    by_slot = {int(k % W): int(k) for k in window_ks}
+    ks = np.array([by_slot.get(int(s), 0) for s in slots])
+    n_teeth = len(set(ks.tolist()))
+    # contact points in tooth-0 frame: undo wheel rotation and tooth angle
+    th2 = float(d.qpos[bm.model.jnt_qposadr[bm.model.dof_jntid[bm.wheel_dof]]])
+    ang = -(th2 + 2 * math.pi * ks / bm.geometry.z2)
+    c, s = np.cos(ang), np.sin(ang)
+    p0 = np.stack([c * pos[:, 0] - s * pos[:, 1], s * pos[:, 0] + c * pos[:, 1], pos[:, 2]], axis=1)
+    return f_t, f_r, f_a, len(adr), n_teeth, float(max(0.0, -dist.min())), p0, F, pos
+
+
+_SLOT_CACHE: dict[int, np.ndarray] = {}
+
+
+def _slot_lookup(bm: BuiltModel) -> np.ndarray:
+    key = id(bm)
+    if key not in _SLOT_CACHE:
+        lut = np.full(bm.model.ngeom, -1, dtype=int)
+        for s, row in enumerate(bm.wheel_slot_geoms):
+            lut[row] = s
+        _SLOT_CACHE.clear()
+        _SLOT_CACHE[key] = lut
+    return _SLOT_CACHE[key]
+
+
+def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
+    m = bm.model
+    d = mujoco.MjData(m)
+    geo = bm.geometry
+    dt = float(m.opt.timestep)
+    duration = scenario.simulation.duration_s
+    n_steps = int(round(duration / dt))
+    rec = _record_every(scenario, dt, n_steps)
+    n_rec = n_steps // rec
+    drv = scenario.drive
+    qa_worm = int(m.jnt_qposadr[m.dof_jntid[bm.worm_dof]])
+    qa_wheel = int(m.jnt_qposadr[m.dof_jntid[bm.wheel_dof]])
+    coll = np.concatenate([bm.worm_geoms, bm.wheel_slot_geoms.ravel()])
+    pen_lim = penetration_limit_m(bm)
+    pitch_angle = 2 * math.pi / geo.z2
+    sign_cmd = bm.drive_sign
+    ramp_end = max(drv.ramp_s, scenario.load.start_s + scenario.load.ramp_s)
+    dt_limit = bm.law.stable_timestep_s(3 * bm.law.contacts_per_pair)
+
+    names = ["t_s", "worm_angle_rad", "wheel_angle_rad", "worm_speed_rpm", "wheel_speed_rpm",
+             "worm_torque_nm", "wheel_torque_nm", "drive_command", "tangential_force_n", "radial_force_n",
+             "axial_force_n", "contacts", "teeth_in_contact", "max_penetration_m", "friction_coefficient",
+             "transmission_error_rad"]
+    S = {k: np.zeros(n_rec) for k in names}
+    pts = np.full((n_rec, MAX_POINTS, 3), np.nan, dtype=np.float32)
+    pts_world = np.full((n_rec, MAX_POINTS, 3), np.nan, dtype=np.float32)
+    forces = np.full((n_rec, MAX_POINTS, 3), np.nan, dtype=np.float32)
+
+    window = repose_window(bm, 0.0)
+    mujoco.mj_forward(m, d)
+    locked_since = None
+    t_wall = time.perf_counter()
+    worm_is_drive = drv.on == "worm"
+    for i in range(n_rec):
+        t_mid = (i * rec + 0.5 * rec) * dt
+        cmd, load_t = commands(scenario, np.array([t_mid]), bm.direction)
+        d.ctrl[bm.drive_actuator] = cmd[0]
+        d.ctrl[bm.load_actuator] = load_t[0]
+        mujoco.mj_step(m, d, nstep=rec)
+        th1, th2 = float(d.qpos[qa_worm]), float(d.qpos[qa_wheel])
+        w1, w2 = float(d.qvel[bm.worm_dof]), float(d.qvel[bm.wheel_dof])
+        t = float(d.time)
+        # guards
+        if not (np.isfinite(d.qpos).all() and np.isfinite(d.qvel).all()) or d.warning[mujoco.mjtWarning.mjWARN_BADQACC].number:
+            raise SimulationError(
+                f"diverged at t = {t:.4g} s: timestep {dt:.3g} s against the contact's stable limit ~{dt_limit:.2g} s "
+                f"(contact stiffness {bm.law.pair_stiffness_n_per_m:.3g} N/m per tooth pair); set "
+                f"simulation.timestep_s <= {0.25 * dt_limit:.2g} or lower contact.stiffness_n_per_m")
+        te = th2 - bm.direction * th1 / geo.ratio
+        if abs(te) > 0.5 * pitch_angle:
+            raise SimulationError(
+                f"teeth jumped a pitch at t = {t:.4g} s (transmission error {te / pitch_angle:.2f} pitch): the contact "
+                f"is too soft or too slow to resolve for this load/timestep; timestep {dt:.3g} s (stable limit "
+                f"~{dt_limit:.2g} s), stiffness {bm.law.pair_stiffness_n_per_m:.3g} N/m: lower simulation.timestep_s, "
+                f"raise contact.stiffness_n_per_m or lower load.torque_nm")
+        window = repose_window(bm, th2, window)
+        vs = abs(w1) * geo.r1 / math.cos(geo.gamma)
+        mu = float(friction_coefficient(scenario.contact, vs))
+        m.geom_friction[coll, 0] = mu
+        f_t, f_r, f_a, ncon, nteeth, pen, p0, F, pw = tooth_forces(bm, d, window)
+        if pen > pen_lim:
+            raise SimulationError(
+                f"penetration {pen * 1e6:.1f} um at t = {t:.4g} s exceeds the tolerance {pen_lim * 1e6:.1f} um "
+                f"(0.4 m_x): contact too soft for the load or timestep {dt:.3g} s too large (stable limit "
+                f"~{dt_limit:.2g} s); raise contact.stiffness_n_per_m or lower simulation.timestep_s")
+        if drv.speed_rpm is not None and t > ramp_end + 0.02:
+            w_drive = w1 if worm_is_drive else w2
+            if abs(w_drive) < 0.5 * abs(cmd[0]):
+                locked_since = t if locked_since is None else locked_since
+                if t - locked_since > max(0.05, 20 * rec * dt):
+                    raise SimulationError(
+                        f"the drive locked at t = {t:.4g} s: {rad_s_to_rpm(w_drive):.3g} rpm against a command of "
+                        f"{rad_s_to_rpm(cmd[0]):.3g} rpm; the mesh is jammed (check gear.backlash_mm, the load "
+                        f"torque {scenario.load.torque_nm} N m and the friction)")
+            else:
+                locked_since = None
+        act = d.actuator_force
+        tq_drive, tq_load = float(act[bm.drive_actuator]), float(act[bm.load_actuator])
+        S["t_s"][i] = t
+        S["worm_angle_rad"][i], S["wheel_angle_rad"][i] = th1, th2
+        S["worm_speed_rpm"][i], S["wheel_speed_rpm"][i] = rad_s_to_rpm(w1), rad_s_to_rpm(w2)
+        S["worm_torque_nm"][i] = tq_drive if worm_is_drive else tq_load
+        S["wheel_torque_nm"][i] = tq_load if worm_is_drive else tq_drive
+        S["drive_command"][i] = cmd[0]
+        S["tangential_force_n"][i], S["radial_force_n"][i], S["axial_force_n"][i] = f_t, f_r, f_a
+        S["contacts"][i], S["teeth_in_contact"][i] = ncon, nteeth
+        S["max_penetration_m"][i] = pen
+        S["friction_coefficient"][i] = mu
+        S["transmission_error_rad"][i] = te
+        k = min(len(p0), MAX_POINTS)
+        pts[i, :k], forces[i, :k], pts_world[i, :k] = p0[:k], F[:k], pw[:k]
+        if progress is not None:
+            progress.update(t)
+    wall = time.perf_counter() - t_wall
+    from wormsim.metrics import contact3d_summary
+
+    summary = contact3d_summary(S, scenario, bm)
+    summary.update({
+        "timestep_s": dt, "timestep_stable_limit_s": dt_limit, "resolution": scenario.simulation.resolution,
+        "integrator": scenario.simulation.integrator, "record_every": rec,
+        "contact_pair_stiffness_n_per_m": bm.law.pair_stiffness_n_per_m,
+        "contact_stiffness_source": bm.law.stiffness_source,
+        "contact_exponent_reported": bm.law.exponent,
+        "contacts_per_pair_ref": bm.law.contacts_per_pair,
+        "contact_damping_requested_n_s_per_m": bm.law.contact_damping_requested_n_s_per_m * bm.law.contacts_per_pair,
+        "contact_damping_used_n_s_per_m": bm.law.contact_damping_n_s_per_m * bm.law.contacts_per_pair,
+        "contact_damping_ratio": bm.law.damping_ratio,
+        "friction": friction_mode(scenario.contact),
+        "window_teeth": bm.window_teeth, "collision_geoms": int(len(coll)),
+        "step_wall_us": 1e6 * wall / max(n_rec * rec, 1),
+        "piece_error_um": getattr(bm.pieces, "piece_error_um", None),
+    })
+    return Result(model="contact3d", summary=summary, series=S, steps=n_rec * rec, sim_time_s=float(d.time),
+                  extra={"points_tooth0": pts, "points_world": pts_world, "forces_world": forces, "built": bm})
+
+
+def simulate(scenario: Scenario, progress=None) -> Result:
+    bm = build_model(scenario)
+    return run_model(bm, scenario, progress)
+
+
+def write_report(result: Result, path) -> None:
+    from wormsim.report3d import write_report as _w
+
+    _w(result, path)
+
+
+def write_recording(result: Result, path) -> None:
+    from wormsim.report3d import write_recording as _w
+
+    _w(result, path)
+
+
+__all__ = ["simulate", "write_report", "write_recording", "run_model", "efficiency_theory"]
