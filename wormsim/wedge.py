@@ -231,7 +231,6 @@ def simulate(scenario, progress=None) -> Result:
 
 def simulate_params(p: WedgeParams, progress=None, name: str = "wedge") -> Result:
     T, g = p.duration_s, p.gamma_rad
-    tan_g = math.tan(g)
     rho0 = rho_static(p)
     grid = np.linspace(0.0, T, GRID_POINTS)
     stops = _breakpoints(p) + [T]
