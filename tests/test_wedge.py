@@ -111,7 +111,10 @@ def test_efficiency_forward_is_power_ratio_and_closed_form():
     p_out = -s["S2_n"][-1] * s["v2_m_s"][-1]
     assert p_out / p_in == pytest.approx(math.tan(G) / math.tan(G + rho), rel=1e-6)
     assert sm["efficiency_forward"] == pytest.approx(math.tan(G) / math.tan(G + rho), rel=1e-12)
-    assert sm["efficiency_backward"] == pytest.approx(math.tan(G - rho) / math.tan(G), rel=1e-12)
+    # group III self-locks at standstill (rho(0) = 11.4 deg > gamma): no back-driving from rest (INTERFACE.md),
+    # while a pair already sliding at the steady speed back-drives with tan(g - rho) / tan g
+    assert sm["self_locking"] and sm["efficiency_backward"] == 0.0
+    assert sm["efficiency_backward_sliding"] == pytest.approx(math.tan(G - rho) / math.tan(G), rel=1e-12)
 
 
 def test_efficiency_backward_is_power_ratio_and_closed_form():

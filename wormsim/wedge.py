@@ -173,6 +173,17 @@ def efficiencies(gamma: float, rho: float) -> dict:
     }
 
 
+def _summary_efficiencies(gamma: float, rho_sliding: float, rho_static: float) -> dict:
+    """summary.json efficiencies (INTERFACE.md). efficiency_backward is 0 when the pair self-locks at
+    standstill (rho(0) > gamma: it cannot be back-driven from rest); the back-driving efficiency of a
+    pair that is already sliding at the steady speed is efficiency_backward_sliding."""
+    e = efficiencies(gamma, rho_sliding)
+    e["efficiency_backward_sliding"] = e["efficiency_backward"]
+    if rho_static > gamma:
+        e["efficiency_backward"] = 0.0
+    return e
+
+
 def rated_forces_n(p: WedgeParams) -> tuple[float, float]:
     """Ft1 = the motor's rated force; Ft2 = Ft1 / tan(g + rho(Vs_n)) (static wedge relation, rated speed)."""
     rho_n = rho_of_speed(p.nominal_speed_m_s, p)
@@ -358,7 +369,7 @@ def _assemble(segs: list[dict], p: WedgeParams, steps: int, name: str) -> Result
         "S1_steady_n": _time_mean(t, S1, t_ss), "S2_steady_n": _time_mean(t, S2, t_ss),
         "Kd1": abs(float(S1[i1])) / Ft1, "Kd2": abs(float(S2[i2])) / Ft2,
         "Ft1_n": Ft1, "Ft2_n": Ft2,
-        **efficiencies(g, rho_ss),
+        **_summary_efficiencies(g, rho_ss, rho0),
         "rho_steady_deg": rho_ss / DEG, "rho_static_deg": rho0 / DEG, "lead_angle_deg": g / DEG,
         "self_locking": bool(rho0 > g),
         "stalled": bool(np.max(np.abs(x1)) == 0.0),
