@@ -6,7 +6,9 @@
   (when at least one fits), so periodic fluctuation does not bias the means;
 - ratio = mean |worm speed| / mean |wheel speed| over the window; theory z2 / z1;
 - meshing frequency: dominant peak of the FFT of the tangential force over the window (mean and linear
-  trend removed, Hann window, DC bin excluded), refined by Gaussian (log-parabolic) interpolation of
+  trend removed, Hann window, DC bin excluded), searched below half the piece-passing frequency
+  (worm segments per turn x worm speed: the facets of the convex pieces excite the force there; the
+  full-band peak is reported as `force_peak_full_band_hz`), refined by Gaussian (log-parabolic) interpolation of
   the peak's three bins; bin width 1 / T_window reported as `mesh_frequency_resolution_hz`; theory
   z1 n1 / 60 with n1 the mean worm speed;
 - forces: means and peak-to-peak (max - min) over the window, magnitudes of the means;
@@ -51,9 +53,11 @@ def steady_window(t: np.ndarray, speed: np.ndarray, t_start: float, period_s: fl
     return i0, i1
 
 
-def dominant_frequency(t: np.ndarray, x: np.ndarray) -> tuple[float, float, np.ndarray, np.ndarray]:
+def dominant_frequency(t: np.ndarray, x: np.ndarray, f_max_hz: float = float("inf")
+                       ) -> tuple[float, float, np.ndarray, np.ndarray]:
     """(f_peak_hz, resolution_hz, freqs, amplitude spectrum) of x(t) on a uniform grid: linear trend
-    removed, Hann window, DC bin excluded, Gaussian interpolation of the peak bin."""
+    removed, Hann window, DC bin excluded, peak searched below f_max_hz, Gaussian interpolation of the
+    peak bin."""
     n = len(x)
     if n < 8:
         return float("nan"), float("nan"), np.zeros(0), np.zeros(0)
@@ -64,7 +68,8 @@ def dominant_frequency(t: np.ndarray, x: np.ndarray) -> tuple[float, float, np.n
     spec = np.abs(np.fft.rfft(y)) * 2 / max(np.hanning(n).sum(), 1e-12)
     freqs = np.fft.rfftfreq(n, dt)
     df = 1.0 / (n * dt)
-    k = 1 + int(np.argmax(spec[1:]))
+    top = max(2, int(np.searchsorted(freqs, f_max_hz, side="right")))
+    k = 1 + int(np.argmax(spec[1:top]))
     f = freqs[k]
     if 1 <= k < len(spec) - 1 and spec[k - 1] > 0 and spec[k] > 0 and spec[k + 1] > 0:
         a, b, c = np.log(spec[k - 1]), np.log(spec[k]), np.log(spec[k + 1])
@@ -89,7 +94,11 @@ def contact3d_summary(S: dict, scenario, bm) -> dict:
     sl = slice(i0, i1)
     n1 = float(np.mean(w1[sl]))
     n2 = float(np.mean(w2[sl]))
-    f_peak, df, _, _ = dominant_frequency(t[sl], S["tangential_force_n"][sl])
+    # the convex pieces' facets excite the force at (segments per turn) x (worm speed): search below half that
+    segs = getattr(getattr(bm.pieces, "resolution", None), "worm_segments_per_turn", None)
+    f_max = 0.5 * segs * n1 / 60.0 if segs else float("inf")
+    f_peak, df, _, _ = dominant_frequency(t[sl], S["tangential_force_n"][sl], f_max)
+    f_full, _, _, _ = dominant_frequency(t[sl], S["tangential_force_n"][sl])
     ft = S["tangential_force_n"][sl]
     w1s = S["worm_speed_rpm"][sl] * (2 * math.pi / 60)
     w2s = S["wheel_speed_rpm"][sl] * (2 * math.pi / 60)
@@ -107,6 +116,8 @@ def contact3d_summary(S: dict, scenario, bm) -> dict:
         "mesh_frequency_hz": f_peak,
         "mesh_frequency_theory_hz": geo.z1 * n1 / 60.0,
         "mesh_frequency_resolution_hz": df,
+        "mesh_frequency_search_max_hz": f_max,
+        "force_peak_full_band_hz": f_full,
         "tangential_force_mean_n": abs(float(np.mean(ft))),
         "tangential_force_p2p_n": float(np.ptp(ft)) if len(ft) else float("nan"),
         "tangential_force_theory_n": abs(load.torque_nm) / geo.r2 if load.on == "wheel" else float("nan"),

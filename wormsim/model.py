@@ -318,10 +318,10 @@ def repose_window(bm: BuiltModel, theta2: float, current: np.ndarray | None = No
 
 
 def default_timestep(law: ContactLaw, contacts: int | None = None) -> float:
-    """A quarter of the explicit stability limit with `contacts` (default 3 pairs' worth) in parallel,
+    """0.4 x the explicit stability limit with `contacts` (default 3 pairs' worth) in parallel,
     rounded down to 1-2-5 steps."""
     n = contacts if contacts is not None else 3 * law.contacts_per_pair
-    h = 0.25 * law.stable_timestep_s(n)
+    h = 0.4 * law.stable_timestep_s(n)
     e = math.floor(math.log10(h))
     for mant in (5, 2, 1):
         if mant * 10 ** e <= h:

@@ -214,7 +214,7 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
 
     summary = contact3d_summary(S, scenario, bm)
     summary.update({
-        "timestep_s": dt, "timestep_stable_limit_s": dt_limit, "resolution": scenario.simulation.resolution,
+        "scenario": scenario.name, "timestep_s": dt, "timestep_stable_limit_s": dt_limit, "resolution": scenario.simulation.resolution,
         "integrator": scenario.simulation.integrator, "record_every": rec,
         "contact_pair_stiffness_n_per_m": bm.law.pair_stiffness_n_per_m,
         "contact_stiffness_source": bm.law.stiffness_source,

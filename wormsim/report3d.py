@@ -1,0 +1,114 @@
+"""report.png and recording.rrd of a contact3d run.
+
+report.png: tooth forces on the wheel (tangential, radial, axial) with the steady window shaded; shaft
+speeds; the FFT amplitude spectrum of the tangential force over the steady window with the theoretical
+meshing frequency marked; the contact pattern on a wheel tooth (contact points of the steady window,
+mapped into the frame of tooth 0: axial position across the face against radius, coloured by force).
+
+recording.rrd (wormsim.recording layout): /series/* time series on the sim_time timeline; the worm and
+wheel meshes under /assembly/worm and /assembly/wheel moved by their 4x4 transforms; contact points
+(/assembly/contacts/points) and force arrows on the wheel (/assembly/contacts/forces, 1 mm per
+`ARROW_N_PER_MM` newtons) at up to MAX_FRAMES instants.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from wormsim.result import Result
+
+MAX_FRAMES = 1500
+ARROW_N_PER_MM = None      # chosen per run: the mean tooth force maps to 5 mm
+
+
+def write_report(result: Result, path) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from wormsim.metrics import dominant_frequency
+
+    S, s = result.series, result.summary
+    t = S["t_s"]
+    w0, w1 = s["steady_window_s"]
+    sl = (t >= w0) & (t <= w1)
+    fig, ax = plt.subplots(2, 2, figsize=(13, 8.5))
+    a = ax[0, 0]
+    for k, lab in (("tangential_force_n", "tangential"), ("radial_force_n", "radial"), ("axial_force_n", "axial")):
+        a.plot(t, S[k], lw=0.6, label=lab)
+    a.axvspan(w0, w1, color="0.9", zorder=-1, label="steady window")
+    if np.isfinite(s.get("tangential_force_theory_n", float("nan"))):
+        a.axhline(s["tangential_force_theory_n"], color="k", ls="--", lw=0.8, label="T_load / r2")
+    a.set(xlabel="time [s]", ylabel="force on the wheel [N]", title="tooth forces (wheel frame)")
+    a.legend(fontsize=8)
+    a = ax[0, 1]
+    a.plot(t, np.abs(S["worm_speed_rpm"]) / s["ratio_theory"], lw=0.6, label="worm / (z2/z1)")
+    a.plot(t, np.abs(S["wheel_speed_rpm"]), lw=0.6, label="wheel")
+    a.axvspan(w0, w1, color="0.9", zorder=-1)
+    a.set(xlabel="time [s]", ylabel="speed [rpm]",
+          title=f"speeds: ratio {s['ratio']:.4g} (theory {s['ratio_theory']:.4g}), efficiency {s['efficiency']:.3f} "
+                f"(theory {s['efficiency_theory']:.3f})")
+    a.legend(fontsize=8)
+    a = ax[1, 0]
+    _, df, fr, sp = dominant_frequency(t[sl], S["tangential_force_n"][sl])
+    if len(fr):
+        a.semilogy(fr[1:], np.maximum(sp[1:], 1e-9), lw=0.7)
+        a.axvline(s["mesh_frequency_theory_hz"], color="r", ls="--", lw=0.8, label=f"z1 n1/60 = {s['mesh_frequency_theory_hz']:.4g} Hz")
+        a.axvline(s["mesh_frequency_hz"], color="g", ls=":", lw=1.0, label=f"peak {s['mesh_frequency_hz']:.4g} Hz (bin {df:.3g} Hz)")
+        a.set_xlim(0, min(fr[-1], 10 * max(s["mesh_frequency_theory_hz"], df)))
+    a.set(xlabel="frequency [Hz]", ylabel="|F_t| amplitude [N]", title="spectrum of the tangential force (Hann)")
+    a.legend(fontsize=8)
+    a = ax[1, 1]
+    P = result.extra.get("points_tooth0")
+    F = result.extra.get("forces_world")
+    if P is not None and sl.any():
+        p = P[sl].reshape(-1, 3)
+        f = np.linalg.norm(F[sl].reshape(-1, 3), axis=1)
+        ok = np.isfinite(p[:, 0])
+        r = np.hypot(p[ok, 0], p[ok, 1]) * 1e3
+        sc = a.scatter(p[ok, 2] * 1e3, r, c=f[ok], s=3, cmap="viridis")
+        fig.colorbar(sc, ax=a, label="contact force [N]")
+        geo = result.extra["built"].geometry
+        for rr_, lab in ((geo.r2, "r2"), (geo.r_a2, "r_a2"), (geo.r_f2, "r_f2")):
+            a.axhline(rr_ * 1e3, color="0.5", lw=0.6, ls="--")
+            a.text(-geo.face_width / 2 * 1e3, rr_ * 1e3, lab, fontsize=7, va="bottom")
+        a.set_xlim(-0.6 * geo.face_width * 1e3, 0.6 * geo.face_width * 1e3)
+    a.set(xlabel="across the face (wheel z) [mm]", ylabel="radius [mm]", title="contact pattern on a wheel tooth")
+    fig.suptitle(f"{result.summary.get('scenario', '')} contact3d: dt {s['timestep_s']:.3g} s, resolution "
+                 f"{s['resolution']}, steady window {w0:.3g}-{w1:.3g} s")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def write_recording(result: Result, path) -> None:
+    import rerun as rr
+
+    from wormsim.model import _assembly
+    from wormsim.recording import log_mesh, log_series, log_transforms, recording
+
+    bm = result.extra["built"]
+    geo = bm.geometry
+    S = result.series
+    t = S["t_s"]
+    with recording(path, f"contact3d-{result.summary.get('scenario', 'run')}") as rec:
+        log_series(rec, t, {k: v for k, v in S.items() if k != "drive_command"})
+        gs = bm.pieces
+        log_mesh(rec, "assembly/worm/mesh", gs.worm_visual.vertices, gs.worm_visual.faces, color=(150, 160, 180))
+        log_mesh(rec, "assembly/wheel/mesh", gs.wheel_visual.vertices, gs.wheel_visual.faces, color=(220, 165, 80))
+        idx = np.unique(np.linspace(0, len(t) - 1, min(len(t), MAX_FRAMES)).astype(int))
+        Tw = np.stack([_assembly(geo, "worm", float(a)) for a in S["worm_angle_rad"][idx]])
+        Tg = np.stack([_assembly(geo, "wheel", float(a)) for a in S["wheel_angle_rad"][idx]])
+        log_transforms(rec, "assembly/worm", t[idx], Tw)
+        log_transforms(rec, "assembly/wheel", t[idx], Tg)
+        P, F = result.extra["points_world"], result.extra["forces_world"]
+        fmean = np.nanmean(np.linalg.norm(F.reshape(-1, 3), axis=1)) if np.isfinite(F).any() else 1.0
+        scale = 5e-3 / max(fmean, 1e-9)           # mean contact force -> 5 mm arrow
+        for i in idx:
+            ok = np.isfinite(P[i, :, 0])
+            rr.set_time("sim_time", duration=float(t[i]), recording=rec)
+            rr.log("assembly/contacts/points", rr.Points3D(P[i, ok], radii=2e-4, colors=(230, 40, 40)), recording=rec)
+            rr.log("assembly/contacts/forces", rr.Arrows3D(origins=P[i, ok], vectors=F[i, ok] * scale,
+                                                           colors=(40, 200, 40)), recording=rec)
