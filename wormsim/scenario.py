@@ -38,7 +38,7 @@ class Gear(_Strict):
     """Worm gear data (DIN 3975 / ISO 1122 names). Exactly one module and one of lead angle / q."""
 
     profile: Literal["ZI", "ZA"] = Field("ZI", description="ZI: involute helicoid (seed 003); ZA: straight-sided axial profile")
-    hand: Literal["right", "left"] = "right"
+    hand: Literal["right", "left"] = Field("right", description="thread hand of the worm")
     worm_starts: int = Field(1, ge=1, le=8, description="z1")
     wheel_teeth: int = Field(..., ge=10, le=200, description="z2")
     normal_module_mm: float | None = Field(None, gt=0, le=50)
@@ -103,10 +103,10 @@ class Contact(_Strict):
 
 
 class Drive(_Strict):
-    on: Literal["worm", "wheel"] = "worm"
-    speed_rpm: float | None = Field(None, gt=-100000, lt=100000)
-    torque_nm: float | None = Field(None, gt=-1e6, lt=1e6)
-    ramp_s: NonNegFloat = 0.0
+    on: Literal["worm", "wheel"] = Field("worm", description="driven shaft (wheel = back-driving)")
+    speed_rpm: float | None = Field(None, gt=-100000, lt=100000, description="speed-controlled drive, STEP ramp from 0 over ramp_s")
+    torque_nm: float | None = Field(None, gt=-1e6, lt=1e6, description="torque drive, same STEP ramp")
+    ramp_s: NonNegFloat = Field(0.0, description="STEP ramp time of the drive")
 
     @model_validator(mode="after")
     def _one_of(self) -> "Drive":
@@ -116,10 +116,10 @@ class Drive(_Strict):
 
 
 class Load(_Strict):
-    on: Literal["worm", "wheel"] = "wheel"
+    on: Literal["worm", "wheel"] = Field("wheel", description="loaded shaft (the other one)")
     torque_nm: float = Field(0.0, gt=-1e6, lt=1e6, description="resisting torque")
-    start_s: NonNegFloat = 0.0
-    ramp_s: NonNegFloat = 0.0
+    start_s: NonNegFloat = Field(0.0, description="STEP ramp of the load starts here")
+    ramp_s: NonNegFloat = Field(0.0, description="STEP ramp time of the load")
 
 
 class Simulation(_Strict):
@@ -184,9 +184,10 @@ class Wedge(_Strict):
 # ----------------------------------------------------------------------------- scenario
 
 class Scenario(_Strict):
-    name: str = Field(..., pattern=r"^[a-z0-9_-]+$")
-    description: str = ""
-    model: Literal["contact3d", "torsional", "wedge"] = "contact3d"
+    name: str = Field(..., pattern=r"^[a-z0-9_-]+$", description="case name, used in outputs")
+    description: str = Field("", description="free text")
+    model: Literal["contact3d", "torsional", "wedge"] = Field(
+        "contact3d", description="fidelity level: 3D tooth contact (MuJoCo), 2-DOF torsional, or 1-DOF wedge (seed 000)")
     gear: Gear | None = None
     materials: Materials = Materials()
     contact: Contact = Contact()

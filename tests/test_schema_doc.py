@@ -1,0 +1,10 @@
+"""docs/scenario.md is generated from the schema and must be current."""
+from pathlib import Path
+
+from wormsim.schema_doc import markdown
+
+DOC = Path(__file__).resolve().parents[1] / "docs" / "scenario.md"
+
+
+def test_scenario_reference_is_up_to_date():
+    assert DOC.read_text() == markdown(), "regenerate: python -m wormsim.schema_doc > docs/scenario.md"

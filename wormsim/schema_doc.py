@@ -1,0 +1,77 @@
+"""Markdown reference of the scenario schema, generated from the pydantic models (docs/scenario.md).
+
+`python -m wormsim.schema_doc > docs/scenario.md` regenerates it; tests/test_schema_doc.py fails when
+the committed file is out of date, so the documentation cannot drift from the code.
+"""
+from __future__ import annotations
+
+import typing
+
+from pydantic import BaseModel
+from pydantic_core import PydanticUndefined
+
+from wormsim import scenario as S
+
+BLOCKS = [("(top level)", S.Scenario), ("gear", S.Gear), ("materials.worm / materials.wheel", S.Material),
+          ("contact", S.Contact), ("drive", S.Drive), ("load", S.Load), ("simulation", S.Simulation),
+          ("wedge", S.Wedge), ("wedge.motor", S.WedgeMotor), ("wedge.load", S.WedgeLoad)]
+
+
+def _type_name(ann) -> str:
+    origin = typing.get_origin(ann)
+    if origin is typing.Literal:
+        return " \\| ".join(f"`{a}`" for a in typing.get_args(ann))
+    if origin in (typing.Union, getattr(__import__("types"), "UnionType", None)):
+        parts = [a for a in typing.get_args(ann) if a is not type(None)]
+        return " \\| ".join(_type_name(a) for a in parts)
+    if origin is typing.Annotated:
+        return _type_name(typing.get_args(ann)[0])
+    if isinstance(ann, type) and issubclass(ann, BaseModel):
+        return "block"
+    return getattr(ann, "__name__", str(ann))
+
+
+def _bounds(field) -> str:
+    out = []
+    for m in field.metadata:
+        for attr, sym in (("gt", ">"), ("ge", ">="), ("lt", "<"), ("le", "<=")):
+            v = getattr(m, attr, None)
+            if v is not None:
+                out.append(f"{sym} {v:g}" if isinstance(v, (int, float)) else f"{sym} {v}")
+        if getattr(m, "pattern", None):
+            out.append(f"matches `{m.pattern}`")
+    return ", ".join(out)
+
+
+def _default(field) -> str:
+    if field.is_required():
+        return "**required**"
+    d = field.default
+    if d is PydanticUndefined or isinstance(d, BaseModel):
+        return "see block"
+    return "-" if d is None else f"`{d}`"
+
+
+def markdown() -> str:
+    lines = ["# Scenario file reference", "",
+             "Generated from `wormsim/scenario.py` by `python -m wormsim.schema_doc`; do not edit by hand.",
+             "Units are in the key names. Unknown keys are errors. `wormsim schema` prints the same as JSON schema.", ""]
+    for title, model in BLOCKS:
+        lines += [f"## `{title}`", ""]
+        if model.__doc__:
+            lines += [" ".join(model.__doc__.split()), ""]
+        lines += ["| key | type | default | allowed | meaning |", "| --- | --- | --- | --- | --- |"]
+        for name, f in model.model_fields.items():
+            desc = (f.description or "").replace("|", "\\|")
+            lines.append(f"| `{name}` | {_type_name(f.annotation)} | {_default(f)} | {_bounds(f)} | {desc} |")
+        lines.append("")
+    lines += ["Cross-field rules: exactly one of `gear.normal_module_mm` / `gear.axial_module_mm`; exactly one of",
+              "`gear.lead_angle_deg` / `gear.diameter_quotient`; `gear.dedendum_coef` > `gear.addendum_coef`; one of",
+              "`contact.friction` / `contact.friction_group` / `contact.friction_static` + `contact.friction_dynamic`",
+              "(dynamic <= static); exactly one of `drive.speed_rpm` / `drive.torque_nm`; `drive.on` != `load.on`;",
+              "`model: wedge` needs a `wedge:` block, the other models need `gear:` and `drive:`.", ""]
+    return "\n".join(lines)
+
+
+if __name__ == "__main__":
+    print(markdown(), end="")
