@@ -34,7 +34,7 @@ import trimesh
 from meshgen import meshes, wheel, worm
 from meshgen.geometry import GearGeometry
 
-CODE_VERSION = "meshgen-3"
+CODE_VERSION = "meshgen-5"
 
 
 @dataclass(frozen=True)
@@ -144,14 +144,16 @@ def build_worm_pieces(g: GearGeometry, res: Resolution) -> list[trimesh.Trimesh]
     return [h for h in out if h.volume > 1e-3 * vmax]   # drop end slivers of the clipping
 
 
-def conjugate_junction_rho(g: GearGeometry, zeta: np.ndarray, n_grid: int = 48, n_bisect: int = 30) -> np.ndarray:
-    """Per zeta: the lowest radius above which BOTH flanks of tooth 0 are conjugate (envelope points), i.e. the
-    top of the root fillet / undercut cut by the hob tip edge; the root radius where there is none."""
+def conjugate_junction_rho(g: GearGeometry, zeta: np.ndarray, side: int, n_grid: int = 48,
+                           n_bisect: int = 30) -> np.ndarray:
+    """Per zeta: the lowest radius above which the flank of tooth space 0 on `side` (+1: psi_+, the tooth-0
+    flank A; -1: psi_-, flank B of tooth 0 by periodicity) is conjugate (envelope points), i.e. the top of the
+    root fillet / undercut cut by the hob tip edge; the root radius where there is none."""
     lo, hi = wheel.root_rho(g, zeta), wheel.tip_rho(g, zeta)
     s = np.linspace(0.0, 1.0, n_grid)
     R = lo[:, None] + s[None, :] * (hi - lo)[:, None]
     Z = np.broadcast_to(zeta[:, None], R.shape)
-    conj = wheel.space_flank(g, R, Z, +1).interior & wheel.space_flank(g, R, Z, -1).interior
+    conj = wheel.space_flank(g, R, Z, side).interior
     # index of the first grid point from which every point above is conjugate
     bad_above = np.flip(np.cumsum(np.flip(~conj, axis=1), axis=1), axis=1) > 0
     k = np.argmin(bad_above, axis=1)
@@ -161,41 +163,58 @@ def conjugate_junction_rho(g: GearGeometry, zeta: np.ndarray, n_grid: int = 48, 
     none = k == 0
     for _ in range(n_bisect):
         m = 0.5 * (a + b)
-        ok = wheel.space_flank(g, m, zeta, +1).interior & wheel.space_flank(g, m, zeta, -1).interior
+        ok = wheel.space_flank(g, m, zeta, side).interior
         b = np.where(ok, m, b)
         a = np.where(ok, a, m)
     return np.where(none, lo, b)
 
 
-def wheel_slab_sections(g: GearGeometry, res: Resolution, zeta: np.ndarray, rho_lo, rho_hi, n_tip: int = 3,
-                        tip: bool = True):
-    """Points of tooth-0 sections at the given zeta values, both flanks from rho_lo to rho_hi (arrays over zeta),
-    plus n_tip points across the tip arc when tip: (len(zeta), m, 3)."""
-    s = np.linspace(0.0, 1.0, res.profile_points)
-    R = rho_lo[:, None] + s[None, :] * (rho_hi - rho_lo)[:, None]
-    Z = np.broadcast_to(zeta[:, None], R.shape)
-    pa, pb = wheel.tooth_flanks(g, R, Z)
-    rho, psi = [R, R], [pa, pb]
+def wheel_slab_sections(g: GearGeometry, n_profile: int, zeta: np.ndarray, lo_a, hi_a, lo_b, hi_b,
+                        n_tip: int = 3, tip: bool = True):
+    """Points of tooth-0 sections at the given zeta values: flank A (psi_a) from lo_a to hi_a, flank B from lo_b
+    to hi_b (radius arrays over zeta), plus n_tip points across the tip arc when tip: (len(zeta), m, 3)."""
+    s = np.linspace(0.0, 1.0, n_profile)
+    Z = np.broadcast_to(zeta[:, None], (len(zeta), n_profile))
+    Ra = lo_a[:, None] + s[None, :] * (hi_a - lo_a)[:, None]
+    Rb = lo_b[:, None] + s[None, :] * (hi_b - lo_b)[:, None]
+    pa, _ = wheel.tooth_flanks(g, Ra, Z, which="a")
+    _, pb = wheel.tooth_flanks(g, Rb, Z, which="b")
+    rho, psi = [Ra, Rb], [pa, pb]
     if tip:
         w = np.linspace(0.0, 1.0, n_tip + 2)[1:-1]
         psi.append(pa[:, -1:] + w[None, :] * (pb[:, -1:] - pa[:, -1:]))
-        rho.append(np.broadcast_to(rho_hi[:, None], psi[-1].shape))
+        rho.append(np.broadcast_to(hi_a[:, None], psi[-1].shape))
     rho, psi = np.concatenate(rho, axis=1), np.concatenate(psi, axis=1)
+    zz = np.broadcast_to(zeta[:, None], rho.shape)
+    return np.stack([rho * np.cos(psi), rho * np.sin(psi), zz], -1)
+
+
+def _fillet_core_sections(g: GearGeometry, zeta, root, top, n: int = 16):
+    """Conservative core of the tooth below the conjugate flanks, per section: the annular sector
+    root <= rho <= top, max psi_a <= psi <= min psi_b over that radius range (inside the exact tooth, so the hull
+    never bulges into the concave root fillet / undercut where the worm tip passes). (len(zeta), 4, 3)."""
+    s = np.linspace(0.0, 1.0, n)
+    R = root[:, None] + s[None, :] * (top - root)[:, None]
+    Z = np.broadcast_to(zeta[:, None], R.shape)
+    pa, pb = wheel.tooth_flanks(g, R, Z)
+    lo, hi = pa.max(axis=1), pb.min(axis=1)
+    rho = np.stack([root, root, top, top], axis=1)
+    psi = np.stack([lo, hi, lo, hi], axis=1)
     zz = np.broadcast_to(zeta[:, None], rho.shape)
     return np.stack([rho * np.cos(psi), rho * np.sin(psi), zz], -1)
 
 
 def build_wheel_tooth_pieces(g: GearGeometry, res: Resolution) -> list[trimesh.Trimesh]:
     """Slabs across the face width; where the hob tip edge cut a root fillet / undercut (concave), each slab is
-    split at the conjugate junction radius so that no hull bridges the concave kink of the working flank."""
+    split at each flank's conjugate junction radius, so that no hull bridges the concave kink of a working flank:
+    an upper piece (both conjugate flanks + tip) and a lower, conservative core piece (_fillet_core_sections)."""
     sub = SLAB_SUBSECTIONS
     zeta = np.linspace(-g.face_width / 2, g.face_width / 2, sub * res.wheel_slabs + 1)
     root, tip = wheel.root_rho(g, zeta), wheel.tip_rho(g, zeta)
-    junc = conjugate_junction_rho(g, zeta)
-    upper = wheel_slab_sections(g, res, zeta, junc, tip)
-    has_fillet = junc > root + 1e-6 * g.m_x
-    lower = wheel_slab_sections(g, Resolution(0, 0, max(3, res.profile_points // 2)), zeta, root,
-                                np.maximum(junc, root), tip=False)
+    ja, jb = conjugate_junction_rho(g, zeta, +1), conjugate_junction_rho(g, zeta, -1)
+    upper = wheel_slab_sections(g, res.profile_points, zeta, ja, tip, jb, tip)
+    has_fillet = (ja > root + 1e-6 * g.m_x) | (jb > root + 1e-6 * g.m_x)
+    lower = _fillet_core_sections(g, zeta, root, np.minimum(ja, jb))
     out = []
     for j in range(res.wheel_slabs):
         sl = slice(sub * j, sub * (j + 1) + 1)

@@ -121,15 +121,15 @@ def space_flank(g: GearGeometry, rho, zeta, side: int, n_grid: int = 48, n_newto
     return FlankSolution(psi.reshape(shape), beta.reshape(shape), interior.reshape(shape))
 
 
-def tooth_flanks(g: GearGeometry, rho, zeta):
+def tooth_flanks(g: GearGeometry, rho, zeta, which: str = "ab"):
     """Flank angles of wheel tooth 0 (between space 0 and space 1), backlash applied.
 
     Returns (psi_a, psi_b): psi_a = psi_+ of space 0 + j/(2 r2) (flank facing -psi), psi_b = psi_- of space 0
     + 2 pi / z2 - j/(2 r2). By the tooth symmetry psi_b(rho, zeta) = -pi + 2 pi/z2 - psi_a(rho, -zeta).
     """
     dj = g.backlash / (2 * g.r2)
-    a = space_flank(g, rho, zeta, +1).psi + dj
-    b = space_flank(g, rho, zeta, -1).psi + 2 * math.pi / g.z2 - dj
+    a = space_flank(g, rho, zeta, +1).psi + dj if "a" in which else None
+    b = space_flank(g, rho, zeta, -1).psi + 2 * math.pi / g.z2 - dj if "b" in which else None
     return a, b
 
 
