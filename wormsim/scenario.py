@@ -128,6 +128,8 @@ class Simulation(_Strict):
     resolution: Literal["coarse", "medium", "fine"] = Field("medium", description="collision decomposition level (contact3d)")
     integrator: Literal["implicitfast", "rk4", "euler", "implicit", "discrete"] = "implicitfast"
     record_every: int = Field(1, ge=1, le=100000, description="store every n-th step in the time series")
+    mesh_stiffness_samples: int = Field(
+        64, ge=8, le=4096, description="torsional: k(theta) samples per mesh cycle (tooth contact analysis)")
 
 
 # ----------------------------------------------------------------------------- wedge (seed 000)
