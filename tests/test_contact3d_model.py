@@ -1,0 +1,94 @@
+"""The contact3d MuJoCo model: standalone MJCF, contact filtering, collision window, guards."""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import mujoco
+import numpy as np
+import pytest
+
+from wormsim.errors import SimulationError
+from wormsim.model import build_model, repose_window, write_model
+from wormsim.scenario import load_scenario
+from wormsim.simulate import simulate
+
+SCEN = Path(__file__).resolve().parent.parent / "scenarios"
+COARSE = ["simulation.resolution=coarse"]
+
+
+@pytest.fixture(scope="module")
+def seat():
+    return build_model(load_scenario(SCEN / "seat_motor.yaml", COARSE))
+
+
+def test_only_tooth_contact_couples_the_shafts(seat):
+    m = seat.model
+    assert m.neq == 0 and m.ntendon == 0 and m.njnt == 2
+    ct, ca = m.geom_contype, m.geom_conaffinity
+    worm, wheel = seat.worm_geoms, seat.wheel_slot_geoms.ravel()
+    # worm-worm and wheel-wheel never collide; worm-wheel does; visual geoms never
+    assert not np.any((ct[worm][:, None] & ca[worm][None]) | (ct[worm][None] & ca[worm][:, None]))
+    assert not np.any((ct[wheel][:, None] & ca[wheel][None]) | (ct[wheel][None] & ca[wheel][:, None]))
+    assert np.all((ct[worm][:, None] & ca[wheel][None]) | (ct[wheel][None] & ca[worm][:, None]))
+    vis = [i for i in range(m.ngeom) if i not in set(worm) | set(wheel)]
+    assert np.all(ct[vis] == 0) and np.all(ca[vis] == 0)
+
+
+def test_window_cost_does_not_grow_with_tooth_count():
+    n = []
+    for z2 in (40, 120):
+        bm = build_model(load_scenario(SCEN / "involute_41.yaml",
+                                       COARSE + [f"gear.wheel_teeth={z2}", "gear.worm_length_mm=120"]))
+        n.append((bm.window_teeth, bm.wheel_slot_geoms.size))
+    assert n[0] == n[1]
+
+
+def test_window_repose_places_the_tooth_k_pieces(seat):
+    m = seat.model
+    theta2 = 7.3 * 2 * math.pi / seat.geometry.z2
+    ks = repose_window(seat, theta2)
+    k = ks[len(ks) // 2]
+    s = int(k % seat.window_teeth)
+    d = mujoco.MjData(m)
+    mujoco.mj_kinematics(m, d)
+    gid = seat.wheel_slot_geoms[s, 0]
+    ang = 2 * math.pi * k / seat.geometry.z2
+    piece = seat.pieces.wheel_tooth_pieces[0]
+    c, sn = math.cos(ang), math.sin(ang)
+    want = np.array([[c, -sn, 0], [sn, c, 0], [0, 0, 1]]) @ piece.vertices.T
+    # the compiled mesh is recentred: compare the hull's centre of mass
+    got_centre = d.geom_xpos[gid]
+    assert np.linalg.norm(got_centre - piece.copy().apply_transform(
+        np.block([[np.array([[c, -sn, 0], [sn, c, 0], [0, 0, 1]]), np.zeros((3, 1))], [np.zeros((1, 3)), 1]])
+    ).center_mass) < 1e-6
+    assert want.shape[0] == 3
+    repose_window(seat, 0.0)
+
+
+def test_write_model_is_standalone(tmp_path):
+    sc = load_scenario(SCEN / "seat_motor.yaml", COARSE)
+    path = write_model(sc, tmp_path / "m")
+    m = mujoco.MjModel.from_xml_path(str(path))
+    assert m.nu == 2 and m.njnt == 2 and (tmp_path / "m" / "meshes").is_dir()
+
+
+def test_too_large_timestep_stops_with_a_diagnosis():
+    sc = load_scenario(SCEN / "seat_motor.yaml", COARSE + ["simulation.timestep_s=2e-4", "simulation.duration_s=0.05",
+                                                           "drive.speed_rpm=1800", "drive.ramp_s=0.01", "load.ramp_s=0.01"])
+    with pytest.raises(SimulationError, match=r"timestep"):
+        simulate(sc)
+
+
+def test_self_locking_worm_creeps_under_1_percent_of_frictionless():
+    """rho' = atan(0.1 / cos 10 deg) = 5.8 deg > gamma = 4.79 deg: a torque on the wheel must not turn the
+    free worm; without friction the same torque spins it up."""
+    base = ["drive.on=wheel", "drive.torque_nm=12", "drive.speed_rpm=null", "drive.ramp_s=0.002", "load.on=worm",
+            "load.torque_nm=0", "load.ramp_s=0", "simulation.duration_s=0.01", "simulation.resolution=coarse",
+            "contact.friction_static=null", "contact.friction_dynamic=null"]
+    speeds = {}
+    for mu in (0.1, 0.0):
+        res = simulate(load_scenario(SCEN / "seat_motor.yaml", base + [f"contact.friction={mu}"]))
+        speeds[mu] = abs(res.series["worm_speed_rpm"][-1])
+    assert speeds[0.0] > 10.0
+    assert speeds[0.1] < 0.01 * speeds[0.0], speeds
