@@ -1,0 +1,540 @@
+"""The `torsional` fidelity level: worm and wheel rotations as 2 DOF coupled by a mesh force element
+(seed 002's class of model, I theta'' + C theta' + K(t) theta = T(t)), with the wedge friction law.
+
+Coordinates theta1 (worm), theta2 (wheel) about their own axes (meshgen.assembly: positive worm rotation drives
+the wheel positive for a right-hand worm, theta2 = hand theta1 z1 / z2 for the rigid conjugate pair).
+
+Mesh deflection. The wheel lag angle (transmission error with the opposite sign of contact3d's)
+
+    e = hand (z1 / z2) theta1 - theta2,    e' = hand (z1 / z2) omega1 - omega2
+
+measures how far the worm leads the wheel. Conjugate flanks with circumferential backlash j (taken from the
+wheel tooth, j / 2 per side, meshgen.wheel) leave an angular gap g = j / (2 r2) each side, so the flank the
+worm pushes in forward drive (side +1) touches for e > g and the opposite flank (side -1) for e < -g;
+in between, no force. The penetration along the line of action is delta = arm0 (|e| - g), arm0 = r2 cos(alpha_n)
+cos(gamma) (wormsim.mesh_stiffness: k(theta1) is computed there, once, from the generated flanks).
+
+Mesh torque on the wheel (ADAMS IMPACT form with e = 1, damping blended in over the penetration depth d_max
+like IMPACT's STEP, never pulling):
+
+    T2m = side max(0, K_theta,side(theta1) (|e| - g) + C_theta(theta1) STEP(delta, 0, 0, d_max, 1) side e')
+
+C_theta = c arm0^2 K_theta / K_theta,mean: the line-of-action damping c (contact.damping_n_s_per_m, capped at the
+critical damping of the mesh mode; default 10 % of it, as wormsim.contact does for contact3d) scaled with the
+number of pairs engaged.
+
+Friction: the wedge law (seed 000, DIN 3975 / Niemann-Winter worm gear forces) with the virtual friction angle
+rho' = atan(mu / cos alpha_n), mu = mu(Vs) of wormsim.contact (constant, static/dynamic STEP blend over the
+transition velocity v_t, or seed 000's rho(Vs) groups), Vs = omega1 r1 / cos(gamma) (signed). The torque the
+mesh takes from the worm is
+
+    T1m = hand (T2m / r2) r1 tan(gamma + s rho'),   s = sign(T2m) hand tanh(Vs / v_t)
+
+s = +1 is tractive (the worm drives: T2m omega2 > 0, eta = tan g / tan(g + rho')), s = -1 back-driving
+(tan(g - rho') / tan g), and tanh the smooth transition through Vs = 0 (v_t = contact.transition_velocity_m_s).
+Without friction T1m omega1 = T2m omega2 (power balance, p = r1 tan g = r2 z1 / z2). Self-locking comes out:
+for rho' > gamma a wheel torque makes tan(gamma - s rho') = 0 at Vs = v_t atanh(gamma / rho'), a creep of the
+order of v_t.
+
+Equations of motion:
+
+    I1 omega1' = T_drive,1 + T_load,1 - T1m,     I2 omega2' = T2m + T_drive,2 + T_load,2
+
+Drive: speed-controlled -> a stiff servo on speed T = kv (omega_cmd(t) - omega), kv for a 0.1 % droop at the
+expected torque (as contact3d's MuJoCo velocity actuator, wormsim.model); torque -> T(t). Both follow ADAMS
+STEP over drive.ramp_s; the load resists the expected motion, STEP from load.start_s over load.ramp_s
+(as wormsim.simulate.commands).
+
+Inertias: analytic solid cylinders (not the meshes): worm radius r1 over the threaded length b1, wheel radius
+r2 over the face width b2, from the materials' densities: I = m r^2 / 2, m = density pi r^2 L.
+
+Forces reported on the wheel (DIN 3975 / DIN 3996 force components, Niemann-Winter Maschinenelemente III):
+with the normal force F_n and friction mu F_n, F_t2 = F_n (cos a_n cos g - mu sin g), F_r = F_n sin a_n,
+F_a2 = F_t1 = F_n (cos a_n sin g + mu cos g); with mu = tan(rho') cos(a_n) this is
+
+    F_t2 = T2m / r2,   F_a2 = F_t2 tan(g + s rho'),   F_r = |F_t2| tan(a_n) cos(rho') / cos(g + s rho').
+
+Integration: fixed-step backward Euler with Newton iterations (integrate_backward_euler): the mesh mode, the
+servo and the friction regularisation are many decades faster than the motion (stiff); the implicit step
+follows the motion and the quasi-static mesh force at steps of one k(theta) sample's worth of worm rotation
+(default_timestep) and damps the kHz modes. scipy solve_ivp (LSODA, BDF, Radau; `simulate(..., method=)`)
+resolves them and serves as the accuracy reference; it is 20-500x slower (docs/torsional.md).
+Summary keys and their computation: those of contact3d (wormsim.metrics: steady window, FFT peak), except
+that mesh_frequency_hz is the FFT peak of the transmission error, not of the tangential force (see
+torsional_summary; the force's peak is reported as force_peak_full_band_hz).
+"""
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+from meshgen.geometry import GearGeometry, derive
+from wormsim.contact import (DEFAULT_DAMPING_RATIO, MAX_DAMPING_RATIO, effective_modulus_pa, efficiency_theory,
+                             friction_coefficient, friction_mode)
+from wormsim.errors import SimulationError
+from wormsim.mesh_stiffness import MeshStiffness, mesh_stiffness, per_length_stiffness
+from wormsim.result import Result
+from wormsim.scenario import Scenario
+from wormsim.units import rad_s_to_rpm, rpm_to_rad_s, step
+
+SPEED_DROOP = 1e-3          # speed servo: kv = T_expected / (SPEED_DROOP * omega_cmd) (as wormsim.model)
+MAX_SAMPLES = 20000
+SAMPLES_PER_MESH_PERIOD = 64
+RTOL, ATOL_ANGLE = 1e-7, 1e-10
+
+
+def inertias(scenario: Scenario, g: GearGeometry) -> tuple[float, float]:
+    """(I1, I2) in kg m^2: solid cylinders (module docstring)."""
+    mats = scenario.materials
+    m1 = mats.worm.density_kg_m3 * math.pi * g.r1 ** 2 * g.worm_length
+    m2 = mats.wheel.density_kg_m3 * math.pi * g.r2 ** 2 * g.face_width
+    return 0.5 * m1 * g.r1 ** 2, 0.5 * m2 * g.r2 ** 2
+
+
+def _mu_scalar(contact):
+    """A float-only mu(Vs) equal to wormsim.contact.friction_coefficient (fast inside the ODE right-hand side)."""
+    if contact.friction_group is not None or (contact.friction is None and contact.friction_static is None):
+        mu_c = None if contact.friction_group is not None else float(friction_coefficient(contact, 0.0))
+        if mu_c is not None:
+            return lambda vs: mu_c
+        from wormsim.friction import GROUPS
+        from wormsim.units import DEG
+        a, b, c = GROUPS[contact.friction_group]
+        return lambda vs: math.tan(DEG / (a * abs(vs) ** b + c))
+    if contact.friction is not None:
+        mu_c = float(contact.friction)
+        return lambda vs: mu_c
+    ms, md, vt = contact.friction_static, contact.friction_dynamic, contact.transition_velocity_m_s
+
+    def mu(vs):
+        x = abs(vs) / vt
+        if x >= 1.0:
+            return md
+        return ms + (md - ms) * x * x * (3.0 - 2.0 * x)
+    return mu
+
+
+class _Mesh:
+    """The force element (module docstring); scalar call for the ODE, array call for the outputs."""
+
+    def __init__(self, scenario: Scenario, g: GearGeometry, ms: MeshStiffness, I1: float, I2: float):
+        c = scenario.contact
+        self.g, self.ms = g, ms
+        self.hz = g.hand * g.z1 / g.z2
+        self.gap = g.backlash / (2 * g.r2)
+        self.arm0 = ms.arm0_m
+        self.N = ms.samples
+        self.period = ms.period_rad
+        self.kf = ms.k_theta_fwd_nm_per_rad.tolist()
+        self.kr = ms.k_theta_rev_nm_per_rad.tolist()
+        self.k_mean = float(np.mean(ms.k_theta_fwd_nm_per_rad))
+        # damping along the line of action: requested, capped at critical of the mesh mode
+        k_lin = self.k_mean / self.arm0 ** 2
+        m_eff = 1.0 / (self.arm0 ** 2 / I2 + (self.hz * self.arm0) ** 2 / I1)   # mesh mode mass on the line of action
+        self.c_crit = 2.0 * math.sqrt(k_lin * m_eff)
+        c_req = c.damping_n_s_per_m if c.damping_n_s_per_m is not None else DEFAULT_DAMPING_RATIO * self.c_crit
+        self.c_req = c_req
+        self.c_lin = min(c_req, MAX_DAMPING_RATIO * self.c_crit)
+        self.c_theta_per_k = self.c_lin * self.arm0 ** 2 / self.k_mean
+        self.d_max = c.penetration_depth_m
+        self.vt = c.transition_velocity_m_s
+        self.mu = _mu_scalar(c)
+        self.cos_an = math.cos(g.alpha_n)
+        self.omega_mesh = math.sqrt(self.k_mean * (1.0 / I2 + self.hz ** 2 / I1))
+
+    def k_at(self, th1: float, table: list) -> float:
+        x = (th1 % self.period) / self.period * self.N
+        i = int(x)
+        f = x - i
+        return table[i % self.N] * (1.0 - f) + table[(i + 1) % self.N] * f
+
+    def torques(self, th1: float, w1: float, th2: float, w2: float) -> tuple[float, float]:
+        """(T2m on the wheel, T1m taken from the worm), N m."""
+        e = self.hz * th1 - th2
+        de = self.hz * w1 - w2
+        if e > self.gap:
+            side, dlt, ddlt, K = 1.0, e - self.gap, de, self.k_at(th1, self.kf)
+        elif e < -self.gap:
+            side, dlt, ddlt, K = -1.0, -e - self.gap, -de, self.k_at(th1, self.kr)
+        else:
+            return 0.0, 0.0
+        pen = self.arm0 * dlt
+        x = pen / self.d_max
+        blend = 1.0 if x >= 1.0 else x * x * (3.0 - 2.0 * x)
+        T = K * dlt + self.c_theta_per_k * K * blend * ddlt
+        if T <= 0.0:
+            return 0.0, 0.0
+        T2m = side * T
+        g = self.g
+        vs = w1 * g.r1 / math.cos(g.gamma)
+        rho = math.atan(self.mu(vs) / self.cos_an)
+        s = side * g.hand * math.tanh(vs / self.vt)
+        T1m = g.hand * (T2m / g.r2) * g.r1 * math.tan(g.gamma + s * rho)
+        return T2m, T1m
+
+    def outputs(self, th1, w1, th2, w2) -> dict:
+        """Vectorised over samples: forces on the wheel and the mesh state."""
+        g = self.g
+        n = len(th1)
+        T2m, T1m = np.zeros(n), np.zeros(n)
+        for i in range(n):
+            T2m[i], T1m[i] = self.torques(th1[i], w1[i], th2[i], w2[i])
+        e = self.hz * th1 - th2
+        vs = w1 * g.r1 / math.cos(g.gamma)
+        mu = np.asarray(friction_coefficient_vec(self.mu, vs))
+        rho = np.arctan(mu / self.cos_an)
+        s = np.sign(T2m) * g.hand * np.tanh(vs / self.vt)
+        ft = T2m / g.r2
+        phase = np.mod(th1, self.period) / self.period * self.N
+        kf = np.interp(phase, np.arange(self.N + 1), self.kf + self.kf[:1])
+        kr = np.interp(phase, np.arange(self.N + 1), self.kr + self.kr[:1])
+        k = np.where(e >= 0, kf, kr) / self.arm0 ** 2
+        return {
+            "tangential_force_n": ft,
+            "axial_force_n": ft * np.tan(g.gamma + s * rho),
+            "radial_force_n": np.abs(ft) * math.tan(g.alpha_n) * np.cos(s * rho) / np.cos(g.gamma + s * rho),
+            "mesh_torque_worm_nm": T1m,
+            "friction_coefficient": mu,
+            "transmission_error_rad": -e,
+            "mesh_deflection_m": self.arm0 * np.maximum(np.abs(e) - self.gap, 0.0),
+            "mesh_stiffness_n_per_m": k,
+        }
+
+
+def friction_coefficient_vec(mu_scalar, vs: np.ndarray) -> np.ndarray:
+    return np.array([mu_scalar(float(v)) for v in vs])
+
+
+def _commands(scenario: Scenario, g: GearGeometry):
+    """Drive command (rad/s or N m) and load torque (N m) as functions of t: ADAMS STEP; the load resists the
+    expected motion, sign(command) * hand (as wormsim.simulate.commands with wormsim.model.expected_direction)."""
+    drv, load = scenario.drive, scenario.load
+    target = rpm_to_rad_s(drv.speed_rpm) if drv.speed_rpm is not None else drv.torque_nm
+    s = (math.copysign(1.0, target) if target != 0 else 1.0) * g.hand
+    t_load = -s * load.torque_nm
+    rd, l0, l1 = drv.ramp_s, load.start_s, load.start_s + load.ramp_s
+
+    def drive(t: float) -> float:
+        return _step_scalar(t, 0.0, 0.0, rd, target)
+
+    def load_t(t: float) -> float:
+        return _step_scalar(t, l0, 0.0, l1, t_load)
+    return drive, load_t, target
+
+
+def _step_scalar(t: float, t0: float, h0: float, t1: float, h1: float) -> float:
+    """wormsim.units.step (ADAMS STEP) for floats, without numpy (inside the ODE right-hand side)."""
+    if t1 <= t0:
+        return h1 if t >= t0 else h0
+    x = (t - t0) / (t1 - t0)
+    x = 0.0 if x < 0.0 else (1.0 if x > 1.0 else x)
+    return h0 + (h1 - h0) * x * x * (3.0 - 2.0 * x)
+
+
+def _servo_gain(scenario: Scenario, g: GearGeometry) -> float:
+    """kv = T_expected / (SPEED_DROOP omega_cmd), T_expected from the wedge efficiency (as wormsim.model)."""
+    drv, load = scenario.drive, scenario.load
+    w_cmd = abs(rpm_to_rad_s(drv.speed_rpm))
+    eta = efficiency_theory(g.gamma, g.alpha_n, float(friction_coefficient(scenario.contact, 1.0)),
+                            backdriving=drv.on == "wheel")
+    t_exp = abs(load.torque_nm) / g.ratio / max(eta, 0.05) if drv.on == "worm" else abs(load.torque_nm) * g.ratio / max(eta, 0.05)
+    return max(t_exp, 1e-3) / (SPEED_DROOP * max(w_cmd, 1e-3))
+
+
+def default_timestep(g: GearGeometry, ms: MeshStiffness, w1_full_rad_s: float, duration_s: float) -> float:
+    """One k(theta) sample's worth of worm rotation at full speed, period / (N omega1), rounded down to 1-2-5,
+    and at least duration / MAX_SAMPLES."""
+    h = ms.period_rad / ms.samples / max(w1_full_rad_s, 1e-9)
+    h = min(h, duration_s / 50)
+    e = math.floor(math.log10(h))
+    h = next(m * 10 ** e for m in (5, 2, 1) if m * 10 ** e <= h)
+    return max(h, duration_s / MAX_SAMPLES)
+
+
+def integrate_backward_euler(acc, duration: float, h: float, max_iter: int = 30):
+    """Fixed-step backward (implicit) Euler, L-stable (Hairer & Wanner, Solving ODEs II, IV.3), for
+    theta_i' = omega_i, omega_i' = a_i(t, theta1, omega1, theta2, omega2):
+
+        y_{n+1} = y_n + h f(t_{n+1}, y_{n+1}),
+
+    solved by Newton's method from the predictor 2 y_n - y_{n-1}, with a forward-difference Jacobian of (a1, a2)
+    recomputed each iteration (the mesh force is piecewise smooth: backlash, contact onset); the 4x4 Newton
+    system is reduced to 2x2 in the speed updates (d theta_i = r_theta_i + h d omega_i) and solved by Cramer's
+    rule, all in floats. Converged when every update is below TOL + 1e-10 |y|. A step whose iteration does not
+    converge is split in two (recursively, down to h / 1024). It steps over the mesh and servo modes (kHz) and
+    damps them: it follows the motion and the quasi-static mesh force.
+    Returns (t, Y (4, n + 1), evaluations of acc)."""
+    n = int(math.floor(duration / h + 1e-9))
+    t = np.arange(n + 1) * h
+    Y = np.zeros((4, n + 1))
+    FD_TH, FD_W = 1e-10, 1e-7
+    TOL_TH, TOL_W = 1e-13, 1e-10
+    nfev = 0
+
+    def solve_step(y0, yp, t1, hh, depth):
+        nonlocal nfev
+        p1, v1, p2, v2 = y0
+        x1, u1, x2, u2 = yp
+        for _ in range(max_iter):
+            a1, a2 = acc(t1, x1, u1, x2, u2)
+            d = FD_TH + 1e-9 * abs(x1); b1, b2 = acc(t1, x1 + d, u1, x2, u2); j10, j30 = (b1 - a1) / d, (b2 - a2) / d
+            d = FD_W + 1e-9 * abs(u1); b1, b2 = acc(t1, x1, u1 + d, x2, u2); j11, j31 = (b1 - a1) / d, (b2 - a2) / d
+            d = FD_TH + 1e-9 * abs(x2); b1, b2 = acc(t1, x1, u1, x2 + d, u2); j12, j32 = (b1 - a1) / d, (b2 - a2) / d
+            d = FD_W + 1e-9 * abs(u2); b1, b2 = acc(t1, x1, u1, x2, u2 + d); j13, j33 = (b1 - a1) / d, (b2 - a2) / d
+            nfev += 5
+            r0, r1 = p1 + hh * u1 - x1, v1 + hh * a1 - u1
+            r2, r3 = p2 + hh * u2 - x2, v2 + hh * a2 - u2
+            # (I - hJ) d = r with d_theta_i = r_theta_i + h d_omega_i  ->  2x2 in (d_omega1, d_omega2)
+            m00 = 1.0 - hh * j11 - hh * hh * j10
+            m01 = -hh * j13 - hh * hh * j12
+            m10 = -hh * j31 - hh * hh * j30
+            m11 = 1.0 - hh * j33 - hh * hh * j32
+            q0 = r1 + hh * (j10 * r0 + j12 * r2)
+            q1 = r3 + hh * (j30 * r0 + j32 * r2)
+            det = m00 * m11 - m01 * m10
+            dw1 = (q0 * m11 - m01 * q1) / det
+            dw2 = (m00 * q1 - m10 * q0) / det
+            dp1, dp2 = r0 + hh * dw1, r2 + hh * dw2
+            x1, u1, x2, u2 = x1 + dp1, u1 + dw1, x2 + dp2, u2 + dw2
+            if not math.isfinite(x1 + u1 + x2 + u2):
+                break
+            if (abs(dp1) <= TOL_TH + 1e-10 * abs(x1) and abs(dp2) <= TOL_TH + 1e-10 * abs(x2)
+                    and abs(dw1) <= TOL_W + 1e-10 * abs(u1) and abs(dw2) <= TOL_W + 1e-10 * abs(u2)):
+                return (x1, u1, x2, u2)
+        if depth >= 10:
+            raise SimulationError(
+                f"torsional: implicit step did not converge at t = {t1:.4g} s even at timestep {hh:.3g} s")
+        ym = solve_step(y0, y0, t1 - hh / 2, hh / 2, depth + 1)
+        return solve_step(ym, ym, t1, hh / 2, depth + 1)
+
+    y_prev = y = (0.0, 0.0, 0.0, 0.0)
+    for i in range(n):
+        pred = tuple(2 * a - b for a, b in zip(y, y_prev))
+        y_prev, y = y, solve_step(y, pred, t[i + 1], h, 0)
+        Y[:, i + 1] = y
+    return t, Y, nfev
+
+
+def _integrate_scipy(rhs, duration: float, h: float, ms: MeshStiffness, w1_full: float, method: str):
+    """scipy solve_ivp LSODA (error-controlled, resolves the mesh vibration): the accuracy reference."""
+    n = int(math.floor(duration / h + 1e-9))
+    t_eval = np.arange(n + 1) * h
+    max_step = min(ms.period_rad / ms.samples / max(w1_full, 1e-9), duration / 20)
+    atol = np.array([ATOL_ANGLE, ATOL_ANGLE * 1e3, ATOL_ANGLE, ATOL_ANGLE * 1e3])
+    sol = solve_ivp(rhs, (0.0, duration), [0.0, 0.0, 0.0, 0.0], method=method, t_eval=t_eval,
+                    rtol=RTOL, atol=atol, max_step=max_step)
+    if sol.status != 0:
+        raise SimulationError(f"torsional integration (LSODA) failed at t = {sol.t[-1]:.4g} s: {sol.message}")
+    return sol.t, sol.y, sol.nfev
+
+
+def simulate(scenario: Scenario, progress=None, method: str = "implicit") -> Result:
+    """method: "implicit" (default, fixed-step backward Euler) or "lsoda" (scipy, error-controlled)."""
+    g = derive(scenario.gear)
+    kp, src = per_length_stiffness(scenario.contact.stiffness_n_per_m, g.face_width,
+                                   effective_modulus_pa(scenario.materials))
+    ms = mesh_stiffness(g, kp, src, scenario.simulation.mesh_stiffness_samples)
+    I1, I2 = inertias(scenario, g)
+    mesh = _Mesh(scenario, g, ms, I1, I2)
+    drv = scenario.drive
+    drive_f, load_f, target = _commands(scenario, g)
+    speed_driven = drv.speed_rpm is not None
+    kv = _servo_gain(scenario, g) if speed_driven else 0.0
+    worm_drive = drv.on == "worm"
+
+    def shaft_torques(t, w1, w2):
+        cmd = drive_f(t)
+        td = kv * (cmd - (w1 if worm_drive else w2)) if speed_driven else cmd
+        tl = load_f(t)
+        return (td, tl) if worm_drive else (tl, td)
+
+    def acc(t, th1, w1, th2, w2):
+        T2m, T1m = mesh.torques(th1, w1, th2, w2)
+        t1, t2 = shaft_torques(t, w1, w2)
+        return (t1 - T1m) / I1, (T2m + t2) / I2
+
+    def rhs(t, y):
+        a1, a2 = acc(t, *y)
+        return (y[1], a1, y[3], a2)
+
+    duration = scenario.simulation.duration_s
+    w_full = abs(target) if speed_driven else 2 * math.pi
+    w1_full = w_full * (g.ratio if (speed_driven and not worm_drive) else 1.0)
+    h = scenario.simulation.timestep_s or default_timestep(g, ms, w1_full, duration)
+    t_wall = time.perf_counter()
+    if method in ("LSODA", "BDF", "Radau"):
+        t, Y, nfev = _integrate_scipy(rhs, duration, h, ms, w1_full, method)
+    else:
+        t, Y, nfev = integrate_backward_euler(acc, duration, h)
+    wall = time.perf_counter() - t_wall
+    if progress is not None:
+        progress.update(duration)
+    th1, w1, th2, w2 = Y
+    if not np.all(np.isfinite(Y)):
+        raise SimulationError(
+            f"torsional integration diverged (timestep {h:.3g} s); lower simulation.timestep_s")
+    out = mesh.outputs(th1, w1, th2, w2)
+    _guards(scenario, g, t, w1, w2, out, drive_f, target)
+    cmd = np.array([drive_f(x) for x in t])
+    tq = np.array([shaft_torques(ti, a, b) for ti, a, b in zip(t, w1, w2)])
+    S = {
+        "t_s": t, "worm_angle_rad": th1, "wheel_angle_rad": th2,
+        "worm_speed_rpm": rad_s_to_rpm(w1), "wheel_speed_rpm": rad_s_to_rpm(w2),
+        "worm_torque_nm": tq[:, 0], "wheel_torque_nm": tq[:, 1], "drive_command": cmd,
+        "teeth_in_contact": np.where(out["mesh_deflection_m"] > 0, np.interp(
+            np.mod(th1, ms.period_rad) / ms.period_rad * ms.samples, np.arange(ms.samples + 1),
+            np.append(ms.teeth_fwd, ms.teeth_fwd[0])), 0.0),
+        **out,
+    }
+    summary = torsional_summary(S, scenario, g, ms)
+    summary.update({
+        "scenario": scenario.name, "timestep_s": h,
+        "solver": "backward Euler (fixed step, Newton)" if method != "lsoda" else f"scipy LSODA rtol {RTOL}",
+        "solver_rhs_evaluations": int(nfev),
+        "solve_wall_s": wall, "mesh_stiffness_wall_s": None,
+        "worm_inertia_kg_m2": I1, "wheel_inertia_kg_m2": I2, "inertia_source": "solid cylinders r1 x b1, r2 x b2",
+        "mesh_natural_frequency_hz": mesh.omega_mesh / (2 * math.pi),
+        "contact_damping_requested_n_s_per_m": mesh.c_req, "contact_damping_used_n_s_per_m": mesh.c_lin,
+        "contact_damping_ratio": mesh.c_lin / mesh.c_crit, "drive_kv_nm_s": kv if speed_driven else None,
+        "backlash_angle_rad": 2 * mesh.gap, "friction": friction_mode(scenario.contact),
+        **ms.summary(),
+    })
+    return Result(model="torsional", summary=summary, series=S, steps=len(t) - 1, sim_time_s=float(t[-1]),
+                  extra={"mesh_stiffness": ms})
+
+
+def _guards(scenario, g, t, w1, w2, out, drive_f, target) -> None:
+    """Teeth would skip (deflection past 0.4 m_x, contact3d's penetration limit); a speed-driven drive stuck
+    below half its command for 0.05 s after the ramps (locked: self-locking back-drive or jam)."""
+    dmax = float(np.max(out["mesh_deflection_m"]))
+    if dmax > 0.4 * g.m_x:
+        i = int(np.argmax(out["mesh_deflection_m"] > 0.4 * g.m_x))
+        raise SimulationError(
+            f"mesh deflection {dmax * 1e6:.1f} um at t = {t[i]:.4g} s exceeds 0.4 m_x = {0.4 * g.m_x * 1e6:.1f} um: "
+            f"the teeth would skip; raise contact.stiffness_n_per_m or lower load.torque_nm")
+    drv, load = scenario.drive, scenario.load
+    if drv.speed_rpm is None:
+        return
+    ramp_end = max(drv.ramp_s, load.start_s + load.ramp_s) + 0.02
+    w_drive = w1 if drv.on == "worm" else w2
+    cmd = np.array([drive_f(x) for x in t])
+    bad = (t > ramp_end) & (np.abs(w_drive) < 0.5 * np.abs(cmd))
+    if bad.any():
+        i0 = int(np.argmax(bad))
+        run = np.nonzero(~bad[i0:])[0]
+        i1 = i0 + (int(run[0]) if len(run) else len(bad) - i0) - 1
+        if t[i1] - t[i0] >= 0.05 or (not len(run) and t[-1] - t[i0] > 0):
+            raise SimulationError(
+                f"the drive locked at t = {t[i0]:.4g} s: {rad_s_to_rpm(float(w_drive[i0])):.3g} rpm against a "
+                f"command of {rad_s_to_rpm(float(cmd[i0])):.3g} rpm (self-locking: the wheel cannot drive the worm "
+                f"when rho' > gamma; or the load {load.torque_nm} N m is too high)")
+
+
+def torsional_summary(S: dict, scenario: Scenario, g: GearGeometry, ms: MeshStiffness) -> dict:
+    """contact3d's summary keys, computed as wormsim.metrics computes them (steady window, FFT peak)."""
+    from wormsim.metrics import dominant_frequency, steady_window
+
+    t = S["t_s"]
+    drv, load = scenario.drive, scenario.load
+    w1 = np.abs(S["worm_speed_rpm"])
+    w2 = np.abs(S["wheel_speed_rpm"])
+    n1_guess = float(np.mean(w1[len(w1) // 2:])) if len(w1) else 0.0
+    f_guess = g.z1 * n1_guess / 60.0
+    period = 1.0 / f_guess if f_guess > 0 else 0.0
+    ramp_end = max(drv.ramp_s, load.start_s + load.ramp_s)
+    i0, i1 = steady_window(t, w2 if drv.on == "worm" else w1, ramp_end, period)
+    sl = slice(i0, i1)
+    n1, n2 = float(np.mean(w1[sl])), float(np.mean(w2[sl]))
+    ft = S["tangential_force_n"][sl]
+    # the mesh force element's tangential force is quasi-static: its fluctuation is the inertial part, the 2nd
+    # time derivative of the transmission error, which weights the harmonics of k(theta)'s tooth-entry kinks by
+    # n^2 and puts the force's peak on a harmonic; the meshing frequency is taken from the transmission error
+    f_peak, df, _, _ = dominant_frequency(t[sl], S["transmission_error_rad"][sl])
+    f_force, _, _, _ = dominant_frequency(t[sl], ft)
+    rpm = 2 * math.pi / 60
+    T1, T2 = S["worm_torque_nm"][sl], S["wheel_torque_nm"][sl]
+    p1 = float(np.mean(T1 * S["worm_speed_rpm"][sl] * rpm))
+    p2 = float(np.mean(T2 * S["wheel_speed_rpm"][sl] * rpm))
+    if drv.on == "worm":
+        eff = -p2 / p1 if p1 > 0 else float("nan")
+    else:
+        eff = -p1 / p2 if p2 > 0 else float("nan")
+    mu = float(np.mean(S["friction_coefficient"][sl]))
+    return {
+        "ratio": n1 / n2 if n2 > 0 else float("inf"),
+        "ratio_theory": g.ratio,
+        "mesh_frequency_hz": f_peak,
+        "mesh_frequency_theory_hz": g.z1 * n1 / 60.0,
+        "mesh_frequency_resolution_hz": df,
+        "mesh_frequency_source": "transmission error",
+        "force_peak_full_band_hz": f_force,
+        "tangential_force_mean_n": abs(float(np.mean(ft))),
+        "tangential_force_p2p_n": float(np.ptp(ft)) if len(ft) else float("nan"),
+        "tangential_force_theory_n": abs(load.torque_nm) / g.r2 if load.on == "wheel" else float("nan"),
+        "radial_force_mean_n": abs(float(np.mean(S["radial_force_n"][sl]))),
+        "axial_force_mean_n": abs(float(np.mean(S["axial_force_n"][sl]))),
+        "worm_torque_mean_nm": abs(float(np.mean(T1))),
+        "wheel_torque_mean_nm": abs(float(np.mean(T2))),
+        "worm_speed_mean_rpm": n1,
+        "wheel_speed_mean_rpm": n2,
+        "efficiency": eff,
+        "efficiency_theory": efficiency_theory(g.gamma, g.alpha_n, mu, backdriving=drv.on == "wheel"),
+        "friction_coefficient_mean": mu,
+        "steady_window_s": [float(t[i0]), float(t[i1 - 1])],
+        "transmission_error_p2p_urad": float(np.ptp(S["transmission_error_rad"][sl]) * 1e6),
+        "mesh_deflection_mean_um": float(np.mean(S["mesh_deflection_m"][sl]) * 1e6),
+        "wheel_speed_fluctuation": float(np.ptp(w2[sl]) / n2) if n2 > 0 else float("nan"),
+    }
+
+
+# ----------------------------------------------------------------------------- report, recording
+
+def write_report(result: Result, path) -> None:
+    """report.png: speeds, forces, transmission error, and k(theta) over one mesh cycle."""
+    import os
+    from pathlib import Path
+
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    S, sm = result.series, result.summary
+    ms: MeshStiffness = result.extra["mesh_stiffness"]
+    t = S["t_s"]
+    fig, ax = plt.subplots(2, 2, figsize=(12, 7), constrained_layout=True)
+    a = ax[0, 0]
+    a.plot(t, S["worm_speed_rpm"], label="worm")
+    a.plot(t, S["wheel_speed_rpm"] * sm["ratio_theory"], "--", label="wheel x ratio")
+    a.set_xlabel("t [s]"); a.set_ylabel("speed [rpm]"); a.legend(); a.set_title("shaft speeds")
+    a = ax[0, 1]
+    for k in ("tangential_force_n", "radial_force_n", "axial_force_n"):
+        a.plot(t, S[k], label=k.replace("_n", " [N]"))
+    w0, w1 = sm["steady_window_s"]
+    a.axvspan(w0, w1, color="0.9", zorder=-1, label="steady window")
+    a.set_xlabel("t [s]"); a.legend(fontsize=8); a.set_title("forces on the wheel")
+    a = ax[1, 0]
+    a.plot(t, S["transmission_error_rad"] * 1e6)
+    a.set_xlabel("t [s]"); a.set_ylabel("transmission error [urad]"); a.set_title("theta2 - hand theta1 z1/z2")
+    a = ax[1, 1]
+    deg = np.degrees(ms.theta1_rad)
+    a.plot(deg, ms.k_mesh_fwd_n_per_m, "o-", ms=3, label="flank side +1 (forward)")
+    a.plot(deg, ms.k_mesh_rev_n_per_m, "s--", ms=3, label="flank side -1")
+    a.set_xlabel("worm angle in the mesh cycle [deg]"); a.set_ylabel("k on the line of action [N/m]")
+    a.set_title(f"mesh stiffness (TCA, {ms.samples} samples)"); a.legend(fontsize=8)
+    fig.suptitle(f"{sm.get('scenario', '')} (torsional): ratio {sm['ratio']:.4g}, F_t {sm['tangential_force_mean_n']:.4g} N, "
+                 f"efficiency {sm['efficiency']:.3f}")
+    path = Path(path)
+    tmp = path.with_name(f".{path.name}.tmp.png")
+    fig.savefig(tmp, dpi=100)
+    plt.close(fig)
+    os.replace(tmp, path)
+
+
+def write_recording(result: Result, path) -> None:
+    from wormsim.recording import save_series_recording
+
+    save_series_recording(path, result.summary.get("scenario", "torsional"), result.series["t_s"], result.series)
