@@ -25,3 +25,23 @@ def test_chart_is_written(tmp_path):
             for m, w, e in [("contact3d", 1.0, 0.01), ("contact3d", 0.3, 0.05), ("torsional", 1e-3, 0.02)]]
     plot_bench(recs, tmp_path / "bench.png")
     assert (tmp_path / "bench.png").read_bytes()[:4] == b"\x89PNG"
+
+
+def test_quick_bench_torsional_level_writes_files_and_records(tmp_path):
+    """run_bench(quick=True) restricted to the torsional level (contact3d's quick grid is minutes, not CI-sized):
+    the files and each record's keys (speed is measured, never asserted)."""
+    import json
+
+    from wormsim.bench import run_bench
+
+    recs = run_bench(quick=True, out_dir=tmp_path, levels=("torsional",))
+    assert recs and all(r["model"] == "torsional" for r in recs)
+    on_disk = json.loads((tmp_path / "bench.json").read_text())
+    assert len(on_disk) == len(recs)
+    for r in on_disk:
+        for k in ("scenario", "model", "resolution", "timestep_s", "wall_s", "sim_s", "realtime_factor", "error"):
+            assert k in r, k
+        assert r["status"] == "ok" and r["sim_s"] > 0 and r["realtime_factor"] > 0 and r["timestep_s"] > 0
+        assert r["resolution"]["mesh_stiffness_samples"] in (16, 64)
+    assert (tmp_path / "bench.png").read_bytes()[:4] == b"\x89PNG"
+    assert "machine" in json.loads((tmp_path / "bench_meta.json").read_text())

@@ -49,8 +49,8 @@ def _level_available(model: str) -> bool:
     return importlib.util.find_spec(MODEL_MODULES[model]) is not None
 
 
-def bench_cases(quick: bool) -> list[BenchCase]:
-    """The grid. quick: the seat motor only, short, coarse-to-medium (CI-sized)."""
+def bench_cases(quick: bool, levels: tuple[str, ...] | None = None) -> list[BenchCase]:
+    """The grid. quick: the seat motor only, short, coarse-to-medium (CI-sized). levels: only these models."""
     plan = {
         # scenario: (sim duration for the bench, timesteps to sweep)
         "seat_motor": (2.0 if quick else 20.0, (2e-4, 1e-4) if quick else (4e-4, 2e-4, 1e-4, 5e-5)),
@@ -75,9 +75,13 @@ def bench_cases(quick: bool) -> list[BenchCase]:
                                  common + (f"simulation.resolution={levels[-1]}", f"simulation.timestep_s={steps[-1] / 2}"),
                                  finer=True))
         if _level_available("torsional"):
-            for dt in steps:
-                out.append(BenchCase(name, "torsional", {"level": "mesh-stiffness table"}, dt,
-                                     common + ("model=torsional", f"simulation.timestep_s={dt}")))
+            # resolution = k(theta) samples per mesh cycle; the default timestep is one sample's worth of worm
+            # rotation at full speed (wormsim.torsional.default_timestep), so this sweeps both
+            for n in ((16, 64) if quick else (16, 32, 64, 128, 256)):
+                out.append(BenchCase(name, "torsional", {"level": "mesh-stiffness table", "mesh_stiffness_samples": n},
+                                     None, common + ("model=torsional", f"simulation.mesh_stiffness_samples={n}")))
+    if levels is not None:
+        out = [c for c in out if c.model in levels]
     return out
 
 
@@ -120,14 +124,15 @@ def _run_case(case: BenchCase, repeats: int) -> tuple[dict, float, float]:
     return res.summary, statistics.median(walls), res.sim_time_s
 
 
-def run_bench(quick: bool, out_dir: str | Path, repeats: int | None = None) -> list[dict]:
+def run_bench(quick: bool, out_dir: str | Path, repeats: int | None = None,
+              levels: tuple[str, ...] | None = None) -> list[dict]:
     from wormsim.errors import SimulationError
 
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     repeats = repeats or (1 if quick else 3)
     records, summaries, notes = [], {}, []
-    for case in bench_cases(quick):
+    for case in bench_cases(quick, levels):
         try:
             summary, wall, sim_s = _run_case(case, repeats)
         except SimulationError as exc:

@@ -208,6 +208,17 @@ def compute(g: GearGeometry, stiffness_per_length: float, source: str, samples: 
         samples=samples)
 
 
+def stiffness_at(g: GearGeometry, stiffness_per_length: float, theta1_rad, side: int = 1) -> np.ndarray:
+    """K_theta (N m/rad) of flank `side` at arbitrary worm angles (4), without the table: for checks."""
+    import contourpy
+
+    fld = _flank_field(g, side)
+    gen = contourpy.contour_generator(z=fld.c, name="serial", corner_mask=True)
+    th = np.atleast_1d(np.asarray(theta1_rad, float))
+    return np.array([stiffness_per_length * _lines_at(fld, gen, g.hand * t1 * g.z1 / g.z2, 2 * math.pi / g.z2)[0]
+                     for t1 in th])
+
+
 def _cache_key(g: GearGeometry, kp: float, source: str, samples: int) -> str:
     blob = json.dumps({"g": asdict(g), "kp": kp, "src": source, "n": samples, "v": CODE_VERSION,
                        "grid": (GRID_ZETA, GRID_S)}, sort_keys=True, default=str)

@@ -409,15 +409,25 @@ def simulate(scenario: Scenario, progress=None, method: str = "implicit") -> Res
 def _guards(scenario, g, t, w1, w2, out, drive_f, target) -> None:
     """Teeth would skip (deflection past 0.4 m_x, contact3d's penetration limit); a speed-driven drive stuck
     below half its command for 0.05 s after the ramps (locked: self-locking back-drive or jam)."""
+    drv, load = scenario.drive, scenario.load
+    if drv.speed_rpm is not None:
+        _locked_guard(scenario, t, w1, w2, drive_f)
     dmax = float(np.max(out["mesh_deflection_m"]))
     if dmax > 0.4 * g.m_x:
         i = int(np.argmax(out["mesh_deflection_m"] > 0.4 * g.m_x))
+        why = "raise contact.stiffness_n_per_m or lower load.torque_nm"
+        vs = abs(float(w1[i])) * g.r1 / math.cos(g.gamma)
+        if drv.on == "wheel" and vs < 10 * scenario.contact.transition_velocity_m_s:
+            rho = math.atan(float(out["friction_coefficient"][i]) / math.cos(g.alpha_n))
+            why = (f"the pair is self-locking (rho' = {math.degrees(rho):.2f} deg > gamma = {math.degrees(g.gamma):.2f} "
+                   f"deg): the wheel cannot drive the worm, which creeps at Vs = {vs * 1e3:.2g} mm/s")
         raise SimulationError(
             f"mesh deflection {dmax * 1e6:.1f} um at t = {t[i]:.4g} s exceeds 0.4 m_x = {0.4 * g.m_x * 1e6:.1f} um: "
-            f"the teeth would skip; raise contact.stiffness_n_per_m or lower load.torque_nm")
+            f"the teeth would skip; {why}")
+
+
+def _locked_guard(scenario, t, w1, w2, drive_f) -> None:
     drv, load = scenario.drive, scenario.load
-    if drv.speed_rpm is None:
-        return
     ramp_end = max(drv.ramp_s, load.start_s + load.ramp_s) + 0.02
     w_drive = w1 if drv.on == "worm" else w2
     cmd = np.array([drive_f(x) for x in t])
