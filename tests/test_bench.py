@@ -34,7 +34,7 @@ def test_quick_bench_torsional_level_writes_files_and_records(tmp_path):
 
     from wormsim.bench import run_bench
 
-    recs = run_bench(quick=True, out_dir=tmp_path, levels=("torsional",))
+    recs = run_bench(quick=True, out_dir=tmp_path, models=("torsional",))
     assert recs and all(r["model"] == "torsional" for r in recs)
     on_disk = json.loads((tmp_path / "bench.json").read_text())
     assert len(on_disk) == len(recs)

@@ -49,8 +49,8 @@ def _level_available(model: str) -> bool:
     return importlib.util.find_spec(MODEL_MODULES[model]) is not None
 
 
-def bench_cases(quick: bool, levels: tuple[str, ...] | None = None) -> list[BenchCase]:
-    """The grid. quick: the seat motor only, short, coarse-to-medium (CI-sized). levels: only these models."""
+def bench_cases(quick: bool, models: tuple[str, ...] | None = None) -> list[BenchCase]:
+    """The grid. quick: the seat motor only, short, coarse-to-medium (CI-sized). models: only these levels."""
     plan = {
         # scenario: (sim duration for the bench, timesteps to sweep)
         "seat_motor": (2.0 if quick else 20.0, (2e-4, 1e-4) if quick else (4e-4, 2e-4, 1e-4, 5e-5)),
@@ -80,8 +80,8 @@ def bench_cases(quick: bool, levels: tuple[str, ...] | None = None) -> list[Benc
             for n in ((16, 64) if quick else (16, 32, 64, 128, 256)):
                 out.append(BenchCase(name, "torsional", {"level": "mesh-stiffness table", "mesh_stiffness_samples": n},
                                      None, common + ("model=torsional", f"simulation.mesh_stiffness_samples={n}")))
-    if levels is not None:
-        out = [c for c in out if c.model in levels]
+    if models is not None:
+        out = [c for c in out if c.model in models]
     return out
 
 
@@ -125,14 +125,14 @@ def _run_case(case: BenchCase, repeats: int) -> tuple[dict, float, float]:
 
 
 def run_bench(quick: bool, out_dir: str | Path, repeats: int | None = None,
-              levels: tuple[str, ...] | None = None) -> list[dict]:
+              models: tuple[str, ...] | None = None) -> list[dict]:
     from wormsim.errors import SimulationError
 
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     repeats = repeats or (1 if quick else 3)
     records, summaries, notes = [], {}, []
-    for case in bench_cases(quick, levels):
+    for case in bench_cases(quick, models):
         try:
             summary, wall, sim_s = _run_case(case, repeats)
         except SimulationError as exc:
