@@ -25,6 +25,7 @@ def _write_stl_atomic(mesh, path: Path) -> None:
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
     with os.fdopen(fd, "wb") as fh:
         mesh.export(fh, file_type="stl")
+    os.chmod(tmp, 0o644)
     os.replace(tmp, path)
 
 
@@ -74,6 +75,7 @@ def write_mesh_outputs(scenario, out_dir) -> dict:
     }
     _recording(out / "recording.rrd", scenario.name, g, gs)
     write_json_atomic(out / "assembly.json", data)
+    os.chmod(out / "assembly.json", 0o644)
     width = max(len(k) for k in derived)
     for k, v in derived.items():
         print(f"  {k:<{width}}  {v:.6g}" if isinstance(v, float) else f"  {k:<{width}}  {v}")

@@ -88,8 +88,16 @@ def _to_manifold(m: trimesh.Trimesh) -> mf.Manifold:
 
 
 def _from_manifold(man: mf.Manifold) -> trimesh.Trimesh:
+    """Mesh of a manifold: vertices kept apart per input mesh are joined through manifold3d's own merge vectors
+    (merge_from_vert -> merge_to_vert), never by a distance tolerance (booleans can leave sub-10-nm triangles)."""
     mesh = man.to_mesh64()
-    return trimesh.Trimesh(np.asarray(mesh.vert_properties)[:, :3] / MM_PER_M, np.asarray(mesh.tri_verts), process=True)
+    V = np.asarray(mesh.vert_properties)[:, :3] / MM_PER_M
+    F = np.asarray(mesh.tri_verts).astype(np.int64)
+    remap = np.arange(len(V))
+    remap[np.asarray(mesh.merge_from_vert, dtype=np.int64)] = np.asarray(mesh.merge_to_vert, dtype=np.int64)
+    out = trimesh.Trimesh(V, remap[F], process=False)
+    out.remove_unreferenced_vertices()
+    return out
 
 
 def wheel_mesh(g: GearGeometry, n_zeta: int = 17, n_rho: int = 12, n_w: int = 4, segments: int = 720) -> trimesh.Trimesh:
