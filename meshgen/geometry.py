@@ -16,7 +16,8 @@ Relations (m_x axial module, m_n normal module, z1 starts, z2 wheel teeth, gamma
     wheel tip surface: torus about the worm axis, tube radius a - r_a2 = r1 - h_a (the "throat")
     wheel root surface: torus about the worm axis, tube radius a - r_f2 = r1 + h_f
     r_e2 = r_a2 + m_x / 2  (outside radius of the wheel rim; DIN 3975 guide d_e2 <= d_a2 + 2 m for z1 = 1)
-    b2 = 0.75 d_a1 (z1 <= 3), 0.67 d_a1 (z1 >= 4)  (default face width, DIN 3975 guide)
+    b2 = 0.75 d_a1 (z1 <= 3), 0.67 d_a1 (z1 >= 4)  (default face width, DIN 3975 guide);
+    b2 <= 2 sqrt((a - r_f2)^2 - (a - r_e2 + 0.1 (h_a + h_f))^2)  (tooth depth left at the face edges, meshgen)
     wheel tooth thickness on d2: s2 = p_x / 2 - j_t   (backlash j_t taken from the wheel, symmetric)
     ratio i = z2 / z1,  meshing frequency f_m = z1 n1 / 60
 
@@ -135,6 +136,14 @@ def derive(gear: Gear) -> GearGeometry:
         raise ScenarioError(
             f"gear.face_width_mm = {b2 / MM:.3f}: too wide for this worm; allowed up to {1.2 * 2 * r_a1 / MM:.3f} mm "
             f"(1.2 x worm tip diameter)")
+    # the wheel root torus (tube radius a - r_f2) rises towards the face edges; the tooth must keep at least
+    # 0.1 of its full depth h_a + h_f under the rim radius r_e2 at zeta = +-b2/2
+    R_root, edge = a - r_f2, a - r_e2 + 0.1 * (h_a + h_f)
+    b2_max = 2 * math.sqrt(max(R_root ** 2 - edge ** 2, 0.0))
+    if b2 > b2_max:
+        raise ScenarioError(
+            f"gear.face_width_mm = {b2 / MM:.3f}: the wheel root torus leaves no tooth at the face edges; "
+            f"allowed up to {b2_max / MM:.3f} mm")
     # threaded length: cover every point of the wheel rim that can reach the worm tip cylinder, plus one pitch
     reach = r_e2 ** 2 - (a - r_a1) ** 2
     b1 = gear.worm_length_mm * MM if gear.worm_length_mm is not None else 2 * math.sqrt(max(reach, 0.0)) + p_x
