@@ -8,7 +8,8 @@
 - meshing frequency: dominant peak of the FFT of the tangential force over the window (mean and linear
   trend removed, Hann window, DC bin excluded), searched below half the piece-passing frequency
   (worm segments per turn x worm speed: the facets of the convex pieces excite the force there; the
-  full-band peak is reported as `force_peak_full_band_hz`), refined by Gaussian (log-parabolic) interpolation of
+  full-band peak is reported as `force_peak_full_band_hz`; the same search on the radial force as
+  `mesh_frequency_radial_hz`), refined by Gaussian (log-parabolic) interpolation of
   the peak's three bins; bin width 1 / T_window reported as `mesh_frequency_resolution_hz`; theory
   z1 n1 / 60 with n1 the mean worm speed;
 - forces: means and peak-to-peak (max - min) over the window, magnitudes of the means;
@@ -99,6 +100,7 @@ def contact3d_summary(S: dict, scenario, bm) -> dict:
     f_max = 0.5 * segs * n1 / 60.0 if segs else float("inf")
     f_peak, df, _, _ = dominant_frequency(t[sl], S["tangential_force_n"][sl], f_max)
     f_full, _, _, _ = dominant_frequency(t[sl], S["tangential_force_n"][sl])
+    f_rad, _, _, _ = dominant_frequency(t[sl], S["radial_force_n"][sl], f_max)
     ft = S["tangential_force_n"][sl]
     w1s = S["worm_speed_rpm"][sl] * (2 * math.pi / 60)
     w2s = S["wheel_speed_rpm"][sl] * (2 * math.pi / 60)
@@ -118,6 +120,7 @@ def contact3d_summary(S: dict, scenario, bm) -> dict:
         "mesh_frequency_resolution_hz": df,
         "mesh_frequency_search_max_hz": f_max,
         "force_peak_full_band_hz": f_full,
+        "mesh_frequency_radial_hz": f_rad,
         "tangential_force_mean_n": abs(float(np.mean(ft))),
         "tangential_force_p2p_n": float(np.ptp(ft)) if len(ft) else float("nan"),
         "tangential_force_theory_n": abs(load.torque_nm) / geo.r2 if load.on == "wheel" else float("nan"),

@@ -51,8 +51,7 @@ class BuiltModel:
     load_actuator: int
     worm_geoms: np.ndarray              # collision geom ids
     wheel_slot_geoms: np.ndarray        # (W, n_pieces) collision geom ids
-    slot_base_pos: np.ndarray           # (W, n_pieces, 3): geom_pos with the tooth at angle 0
-    slot_base_quat: np.ndarray          # (W, n_pieces, 4)
+    slot_bodies: np.ndarray             # (W,) body ids of the window slots (children of the wheel)
     window_teeth: int
     tooth0_angle_rad: float             # angle of tooth 0's centre in the wheel frame at theta2 = 0
     direction: int                      # +1/-1: expected sign of (load shaft speed) / (drive command)
@@ -194,11 +193,18 @@ def build_model(scenario: Scenario, gs=None) -> BuiltModel:
     for k in ks:
         s = int(k % W)
         ang = 2 * math.pi * k / geo.z2
+        # one rigid child body per slot (no joint): re-posing a slot moves its body, so MuJoCo's per-body
+        # bounding-volume hierarchy (built at compile time in the body frame) stays valid
+        sb = wheel_b.add_body()
+        sb.name = f"slot{s}"
+        sb.quat = [math.cos(ang / 2), 0, 0, math.sin(ang / 2)]
+        sb.explicitinertial = True
+        sb.mass = 1e-9
+        sb.inertia = [1e-15, 1e-15, 1e-15]
         for j in range(len(gs.wheel_tooth_pieces)):
-            g = wheel_b.add_geom(default=spec.find_default("wheel_collision"))
+            g = sb.add_geom(default=spec.find_default("wheel_collision"))
             g.name = f"slot{s}_piece{j}"
             g.meshname = f"tooth_piece_{j}"
-            g.quat = [math.cos(ang / 2), 0, 0, math.sin(ang / 2)]
             set_contact(g)
             slot_names[s][j] = g.name
 
@@ -240,19 +246,10 @@ def build_model(scenario: Scenario, gs=None) -> BuiltModel:
                     "discrete": mujoco.mjtIntegrator.mjINT_DISCRETE}[scenario.simulation.integrator]
 
     model = spec.compile()
-    _set_inv_mass_hat(model, law, arm1 ** 2 / I1, arm2 ** 2 / I2)
     geom_id = lambda n: mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, n)  # noqa: E731
     slot_geoms = np.array([[geom_id(n) for n in row] for row in slot_names], dtype=int)
-    base_pos = np.zeros(slot_geoms.shape + (3,))
-    base_quat = np.zeros(slot_geoms.shape + (4,))
-    for k in ks:
-        s = int(k % W)
-        ang = 2 * math.pi * k / geo.z2
-        qinv = np.array([math.cos(-ang / 2), 0, 0, math.sin(-ang / 2)])
-        Rinv = _rotz(-ang)
-        for j, gid in enumerate(slot_geoms[s]):
-            base_pos[s, j] = Rinv @ model.geom_pos[gid]
-            mujoco.mju_mulQuat(base_quat[s, j], qinv, model.geom_quat[gid].copy())
+    slot_bodies = np.array([mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, f"slot{i}") for i in range(W)])
+    _set_inv_mass_hat(model, law, arm1 ** 2 / I1, arm2 ** 2 / I2, slot_bodies)
     jid = lambda n: mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, n)  # noqa: E731
     return BuiltModel(
         model=model, spec=spec, geometry=geo, law=law,
@@ -262,7 +259,7 @@ def build_model(scenario: Scenario, gs=None) -> BuiltModel:
         drive_actuator=mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, "drive"),
         load_actuator=mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, "load"),
         worm_geoms=np.array([geom_id(n) for n in worm_names], dtype=int),
-        wheel_slot_geoms=slot_geoms, slot_base_pos=base_pos, slot_base_quat=base_quat,
+        wheel_slot_geoms=slot_geoms, slot_bodies=slot_bodies,
         window_teeth=W, tooth0_angle_rad=tooth0, direction=direction, drive_sign=drive_sign, pieces=gs, meta=meta)
 
 
@@ -287,12 +284,15 @@ def _rotz(a: float) -> np.ndarray:
     return np.array([[c, -s, 0], [s, c, 0], [0, 0, 1.0]])
 
 
-def _set_inv_mass_hat(model: mujoco.MjModel, law: ContactLaw, a_worm: float, a_wheel: float) -> None:
-    """Make MuJoCo's diagonal approximation of a worm-wheel contact row equal A_hat (wormsim.contact (1))."""
+def _set_inv_mass_hat(model: mujoco.MjModel, law: ContactLaw, a_worm: float, a_wheel: float,
+                      slot_bodies: np.ndarray) -> None:
+    """Make MuJoCo's diagonal approximation of a worm-wheel contact row equal A_hat (wormsim.contact (1)):
+    body_invweight0[worm] + body_invweight0[slot body] = A_hat."""
     wb = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "worm")
     gb = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "wheel")
     model.body_invweight0[wb, 0] = a_worm
     model.body_invweight0[gb, 0] = a_wheel
+    model.body_invweight0[slot_bodies, 0] = a_wheel
     assert abs(a_worm + a_wheel - law.inv_mass_hat) <= 1e-9 * law.inv_mass_hat
 
 
@@ -303,17 +303,10 @@ def repose_window(bm: BuiltModel, theta2: float, current: np.ndarray | None = No
         return current
     m = bm.model
     for k in ks:
-        s = int(k % bm.window_teeth)
         if current is not None and k in current:
             continue
         ang = 2 * math.pi * k / bm.geometry.z2
-        R = _rotz(ang)
-        q = np.array([math.cos(ang / 2), 0, 0, math.sin(ang / 2)])
-        for j, gid in enumerate(bm.wheel_slot_geoms[s]):
-            m.geom_pos[gid] = R @ bm.slot_base_pos[s, j]
-            out = np.zeros(4)
-            mujoco.mju_mulQuat(out, q, bm.slot_base_quat[s, j])
-            m.geom_quat[gid] = out
+        m.body_quat[bm.slot_bodies[int(k % bm.window_teeth)]] = [math.cos(ang / 2), 0, 0, math.sin(ang / 2)]
     return ks
 
 
@@ -351,6 +344,7 @@ def write_model(scenario: Scenario, out_dir: str | Path) -> Path:
         me.userface = []
         me.file = f"{me.name}.stl"
     spec.meshdir = "meshes"
+    spec.modelfiledir = str(out.resolve())
     path = out / "model.xml"
     path.write_text(spec.to_xml())
     mujoco.MjModel.from_xml_path(str(path))      # fail here, not in the user's viewer

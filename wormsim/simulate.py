@@ -33,6 +33,7 @@ from wormsim.units import rad_s_to_rpm, rpm_to_rad_s, step
 
 MAX_POINTS = 48             # contact points kept per sample (for the pattern and the recording)
 TARGET_SAMPLES = 20000      # automatic record_every aims at about this many samples per run
+JUMP_PITCH = 0.5            # transmission error (in pitches) that counts as teeth jumping
 
 
 def _record_every(scenario: Scenario, dt: float, n_steps: int) -> int:
@@ -77,7 +78,7 @@ def tooth_forces(bm: BuiltModel, d: mujoco.MjData, window_ks: np.ndarray):
     dist = np.asarray(con.dist[:n])[ok]
     f = np.stack([d.efc_force[adr], d.efc_force[adr + 1], d.efc_force[adr + 2]], axis=1)
     F = np.einsum("ni,nij->nj", f, frame)              # force on geom2, world frame
-    wheel_is_2 = bm.model.geom_bodyid[geom[:, 1]] == bm.wheel_body
+    wheel_is_2 = bm.model.geom_bodyid[geom[:, 1]] != bm.worm_body
     F = np.where(wheel_is_2[:, None], F, -F)           # force on the wheel
     r_xy = pos[:, :2]
     rad = np.linalg.norm(r_xy, axis=1)
@@ -165,7 +166,7 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
                 f"(contact stiffness {bm.law.pair_stiffness_n_per_m:.3g} N/m per tooth pair); set "
                 f"simulation.timestep_s <= {0.25 * dt_limit:.2g} or lower contact.stiffness_n_per_m")
         te = th2 - bm.direction * th1 / geo.ratio
-        if abs(te) > 0.5 * pitch_angle:
+        if abs(te) > JUMP_PITCH * pitch_angle:
             raise SimulationError(
                 f"teeth jumped a pitch at t = {t:.4g} s (transmission error {te / pitch_angle:.2f} pitch): the contact "
                 f"is too soft or too slow to resolve for this load/timestep; timestep {dt:.3g} s (stable limit "
