@@ -196,7 +196,8 @@ def plot_bench(records: list[dict], path: Path, key: str = "tangential_force_mea
         ax.set_xlabel("wall time per simulated second [s/s]")
         ax.set_ylabel(f"relative error of {mode}" if mode == key else "worst relative error of " + ", ".join(ERROR_KEYS[:2]) + ", ...")
         ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=7)
+        if pts:
+            ax.legend(fontsize=7)
     fig.suptitle("wormsim bench: accuracy against speed (errors vs the finest contact3d run)")
     tmp = path.with_name(f".{path.name}.tmp.png")
     fig.savefig(tmp, dpi=110)
