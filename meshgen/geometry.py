@@ -17,7 +17,8 @@ Relations (m_x axial module, m_n normal module, z1 starts, z2 wheel teeth, gamma
     wheel root surface: torus about the worm axis, tube radius a - r_f2 = r1 + h_f
     r_e2 = r_a2 + m_x / 2  (outside radius of the wheel rim; DIN 3975 guide d_e2 <= d_a2 + 2 m for z1 = 1)
     b2 = 0.75 d_a1 (z1 <= 3), 0.67 d_a1 (z1 >= 4)  (default face width, DIN 3975 guide);
-    b2 <= 2 sqrt((a - r_f2)^2 - (a - r_e2 + 0.1 (h_a + h_f))^2)  (tooth depth left at the face edges, meshgen)
+    b2 <= 2 sqrt((a - r_f2)^2 - (a - r_e2 + 0.1 (h_a + h_f))^2)  (tooth depth left at the face edges, meshgen;
+          the default is clipped to it, a given face width beyond it is an input error)
     wheel tooth thickness on d2: s2 = p_x / 2 - j_t   (backlash j_t taken from the wheel, symmetric)
     ratio i = z2 / z1,  meshing frequency f_m = z1 n1 / 60
 
@@ -140,6 +141,8 @@ def derive(gear: Gear) -> GearGeometry:
     # 0.1 of its full depth h_a + h_f under the rim radius r_e2 at zeta = +-b2/2
     R_root, edge = a - r_f2, a - r_e2 + 0.1 * (h_a + h_f)
     b2_max = 2 * math.sqrt(max(R_root ** 2 - edge ** 2, 0.0))
+    if gear.face_width_mm is None:
+        b2 = min(b2, b2_max)        # the DIN guide default, clipped where the root torus would eat the edges
     if b2 > b2_max:
         raise ScenarioError(
             f"gear.face_width_mm = {b2 / MM:.3f}: the wheel root torus leaves no tooth at the face edges; "

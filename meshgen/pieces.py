@@ -34,7 +34,7 @@ import trimesh
 from meshgen import meshes, wheel, worm
 from meshgen.geometry import GearGeometry
 
-CODE_VERSION = "meshgen-6"
+CODE_VERSION = "meshgen-7"
 
 
 @dataclass(frozen=True)
@@ -241,12 +241,20 @@ def _plane_sets(pieces):
 def union_signed_distance(pieces, pts: np.ndarray) -> np.ndarray:
     """Signed distance of points from the union of convex pieces (max over face planes, min over pieces).
 
-    Exact inside a piece and where the nearest feature is a face; a lower bound near edges outside.
+    Exact inside a piece and where the nearest feature is a face; a lower bound near edges outside. Each piece
+    is evaluated only for the points in its bounding box grown by a fifth of its diagonal (farther points are
+    farther than that from it); points near no piece get +inf.
     """
+    pts = np.asarray(pts, float)
     best = np.full(len(pts), np.inf)
-    for n, d in _plane_sets(pieces):
-        sd = (pts @ n.T - d[None, :]).max(axis=1)
-        best = np.minimum(best, sd)
+    for p, (n, d) in zip(pieces, _plane_sets(pieces)):
+        lo, hi = np.asarray(p.bounds)
+        grow = 0.2 * float(np.linalg.norm(hi - lo))
+        near = np.all((pts >= lo - grow) & (pts <= hi + grow), axis=1)
+        if not near.any():
+            continue
+        sd = (pts[near] @ n.T - d[None, :]).max(axis=1)
+        best[near] = np.minimum(best[near], sd)
     return best
 
 
