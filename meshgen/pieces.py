@@ -365,4 +365,5 @@ def build_gear_set(geometry: GearGeometry, resolution: Resolution | str = "mediu
         tooth_angle_rad=functools.partial(wheel.tooth_angle, g),
         worm_visual=_unpack(data["worm_visual"]), wheel_visual=_unpack(data["wheel_visual"]),
         worm_core_radius_m=g.r_f1, piece_error_um=data["piece_error_um"],
-        undercut_fraction=data["undercut_fraction"])
+        undercut_fraction=data["undercut_fraction"],
+        info={"cache_key": cache_key(g, res), "code_version": CODE_VERSION})

@@ -181,9 +181,26 @@ def test_property_valid_gears_watertight_and_never_interfering(gear):
     assert mins.min() >= g.backlash / 2 - 2e-8 * g.m_x / 1e-3
 
 
-@settings(max_examples=8, deadline=None, derandomize=True, phases=[Phase.explicit, Phase.generate])
-@given(st.integers(10, 24), st.floats(5.0, 9.0), st.floats(1.0, 10.0))
-def test_property_undercut_data_is_a_clear_input_error(z2, alpha, m):
-    g = derive(Gear(wheel_teeth=z2, normal_pressure_angle_deg=alpha, axial_module_mm=m, diameter_quotient=10))
-    with pytest.raises(ScenarioError, match=r"gear\.(normal_pressure_angle_deg|wheel_teeth)"):
-        pieces.build_gear_set(g, "coarse", use_cache=False)
+invalid_gears = st.one_of(
+    # undercut: small pressure angle, few teeth
+    st.builds(lambda z2, alpha, m: (dict(wheel_teeth=z2, normal_pressure_angle_deg=alpha, axial_module_mm=m,
+                                         diameter_quotient=10), r"gear\.(normal_pressure_angle_deg|wheel_teeth)"),
+              st.integers(10, 24), st.floats(5.0, 9.0), st.floats(1.0, 10.0)),
+    # face width beyond what the root torus leaves
+    st.builds(lambda f, m: (dict(wheel_teeth=40, axial_module_mm=m, diameter_quotient=10,
+                                 face_width_mm=f * 2 * (m * 5 + m)), r"gear\.face_width_mm"),
+              st.floats(1.0, 1.2), st.floats(0.5, 5.0)),
+    # backlash leaving no tooth
+    st.builds(lambda b, m: (dict(wheel_teeth=40, axial_module_mm=m, diameter_quotient=10, backlash_mm=b * math.pi * m),
+                            r"gear\.backlash_mm"),
+              st.floats(0.41, 0.6), st.floats(0.5, 5.0)),
+)
+
+
+@settings(max_examples=12, deadline=None, derandomize=True, phases=[Phase.explicit, Phase.generate])
+@given(invalid_gears)
+def test_property_invalid_data_is_a_clear_input_error(case):
+    """Undercut, a too wide face or a backlash leaving no tooth: always ScenarioError naming the field."""
+    fields, pattern = case
+    with pytest.raises(ScenarioError, match=pattern):
+        pieces.build_gear_set(derive(Gear(**fields)), "coarse", use_cache=False)
