@@ -64,9 +64,9 @@ import numpy as np
 from meshgen import wheel
 from meshgen.geometry import GearGeometry
 
-CODE_VERSION = "mesh-stiffness-1"
-GRID_ZETA = 61              # TCA grid across the face width
-GRID_S = 41                 # TCA grid along the profile (worm tip reach .. wheel tip)
+CODE_VERSION = "mesh-stiffness-2"
+GRID_ZETA = 121             # TCA grid across the face width (mean k within ~1.5 % of a 241 x 161 grid)
+GRID_S = 81                 # TCA grid along the profile (worm tip reach .. wheel tip)
 
 
 @dataclass(frozen=True)
