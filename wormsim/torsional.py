@@ -19,9 +19,10 @@ like IMPACT's STEP, never pulling):
 
     T2m = side max(0, K_theta,side(theta1) (|e| - g) + C_theta(theta1) STEP(delta, 0, 0, d_max, 1) side e')
 
-C_theta = c arm0^2 K_theta / K_theta,mean: the line-of-action damping c (contact.damping_n_s_per_m, capped at the
-critical damping of the mesh mode; default 10 % of it, as wormsim.contact does for contact3d) scaled with the
-number of pairs engaged.
+C_theta = c arm0^2 K_theta / K_theta,mean: the line-of-action damping c (contact.damping_n_s_per_m, capped at
+wormsim.contact.MAX_DAMPING_RATIO (0.1) of the critical damping of the mesh mode, default DEFAULT_DAMPING_RATIO
+(0.1) of it: the constants contact3d uses) scaled with the number of pairs engaged. Seed 001's C = 5e4 N s/m is
+capped to 78 N s/m this way.
 
 Friction: the wedge law (seed 000, DIN 3975 / Niemann-Winter worm gear forces) with the virtual friction angle
 rho' = atan(mu / cos alpha_n), mu = mu(Vs) of wormsim.contact (constant, static/dynamic STEP blend over the
@@ -132,7 +133,7 @@ class _Mesh:
         self.kf = ms.k_theta_fwd_nm_per_rad.tolist()
         self.kr = ms.k_theta_rev_nm_per_rad.tolist()
         self.k_mean = float(np.mean(ms.k_theta_fwd_nm_per_rad))
-        # damping along the line of action: requested, capped at critical of the mesh mode
+        # damping along the line of action: requested, capped at MAX_DAMPING_RATIO of critical of the mesh mode
         k_lin = self.k_mean / self.arm0 ** 2
         m_eff = 1.0 / (self.arm0 ** 2 / I2 + (self.hz * self.arm0) ** 2 / I1)   # mesh mode mass on the line of action
         self.c_crit = 2.0 * math.sqrt(k_lin * m_eff)
