@@ -190,3 +190,21 @@ def test_backward_euler_agrees_with_error_controlled_lsoda():
     b = torsional.simulate(sc, method="LSODA").summary
     for k in ("tangential_force_mean_n", "efficiency", "ratio", "worm_torque_mean_nm", "radial_force_mean_n"):
         assert a[k] == pytest.approx(b[k], rel=5e-3), k
+
+
+@pytest.mark.parametrize("overrides", [("gear.hand=left",), ("gear.profile=ZA",),
+                                       ("gear.worm_starts=2", "gear.wheel_teeth=40"), ("drive.speed_rpm=-1330",)])
+def test_variants_hand_profile_starts_direction(overrides):
+    """Left hand, ZA profile, two starts, reverse drive: closed forms hold and the wheel turns as INTERFACE.md says
+    (positive worm rotation drives the wheel positive for a right-hand worm, negative for a left-hand one)."""
+    sc = scen("screw_jack", *overrides)
+    r = torsional.simulate(sc)
+    s, g = r.summary, derive(sc.gear)
+    assert abs(s["ratio"] / g.ratio - 1) < 1e-3
+    assert abs(s["tangential_force_mean_n"] * g.r2 / sc.load.torque_nm - 1) < 0.02
+    assert abs(s["efficiency"] / (math.tan(g.gamma) / math.tan(g.gamma + rho_prime(s, g))) - 1) < 0.03
+    tol = max(0.01 * s["mesh_frequency_theory_hz"], s["mesh_frequency_resolution_hz"])
+    assert abs(s["mesh_frequency_hz"] - s["mesh_frequency_theory_hz"]) <= tol
+    w1, w2 = r.series["worm_speed_rpm"][-1], r.series["wheel_speed_rpm"][-1]
+    assert np.sign(w1) == np.sign(sc.drive.speed_rpm)
+    assert np.sign(w2) == np.sign(w1) * g.hand
