@@ -4,7 +4,8 @@
   the first time from which a one-mesh-period moving mean of the driven shaft's speed stays within
   2 % of the mean of the run's last half; then trimmed from the start to a whole number of mesh periods
   (when at least one fits), so periodic fluctuation does not bias the means;
-- ratio = mean |worm speed| / mean |wheel speed| over the window; theory z2 / z1;
+- mean speeds = |angle increment| / window duration (a mean of |speed| samples would be biased by the
+  wheel's high-frequency vibration, which reverses its speed); ratio = n1 / n2; theory z2 / z1;
 - meshing frequency: dominant peak of the FFT of the tangential force over the window (mean and linear
   trend removed, Hann window, DC bin excluded), searched below half the piece-passing frequency
   (worm segments per turn x worm speed: the facets of the convex pieces excite the force there; the
@@ -34,10 +35,10 @@ def steady_window(t: np.ndarray, speed: np.ndarray, t_start: float, period_s: fl
         return max(0, n - 8), n
     dt = (t[-1] - t[0]) / max(n - 1, 1)
     half = speed[max(i_ramp, n // 2):]
-    ref = float(np.mean(np.abs(half))) if len(half) else 0.0
+    ref = abs(float(np.mean(half))) if len(half) else 0.0
     w = max(1, int(round(period_s / dt))) if period_s > 0 else 1
     w = min(w, max(1, (n - i_ramp) // 4))
-    mm = np.convolve(np.abs(speed), np.ones(w) / w, mode="same")
+    mm = np.abs(np.convolve(speed, np.ones(w) / w, mode="same"))
     bad = np.abs(mm[i_ramp:] - ref) > 0.02 * max(ref, 1e-12)
     # first index after which no moving mean is outside the band (ignore the last half-window edge)
     edge = max(1, w // 2)
@@ -84,17 +85,21 @@ def contact3d_summary(S: dict, scenario, bm) -> dict:
     geo = bm.geometry
     t = S["t_s"]
     drv, load = scenario.drive, scenario.load
-    w1 = np.abs(S["worm_speed_rpm"])
-    w2 = np.abs(S["wheel_speed_rpm"])
-    n1_guess = float(np.mean(w1[len(w1) // 2:])) if len(w1) else 0.0
+    w1 = S["worm_speed_rpm"]
+    w2 = S["wheel_speed_rpm"]
+    n1_guess = abs(float(np.mean(w1[len(w1) // 2:]))) if len(w1) else 0.0
     f_mesh_guess = geo.z1 * n1_guess / 60.0
     period = 1.0 / f_mesh_guess if f_mesh_guess > 0 else 0.0
     ramp_end = max(drv.ramp_s, load.start_s + load.ramp_s)
     driven = w2 if drv.on == "worm" else w1
     i0, i1 = steady_window(t, driven, ramp_end, period)
     sl = slice(i0, i1)
-    n1 = float(np.mean(w1[sl]))
-    n2 = float(np.mean(w2[sl]))
+    # mean speeds = angle increments over the window (exact for the sampled angles; a mean of |speed| samples
+    # would be biased by the wheel's high-frequency vibration, which reverses its speed)
+    span = t[i1 - 1] - t[i0]
+    rpm = 60.0 / (2 * math.pi)
+    n1 = abs(S["worm_angle_rad"][i1 - 1] - S["worm_angle_rad"][i0]) / span * rpm if span > 0 else float("nan")
+    n2 = abs(S["wheel_angle_rad"][i1 - 1] - S["wheel_angle_rad"][i0]) / span * rpm if span > 0 else float("nan")
     # the convex pieces' facets excite the force at (segments per turn) x (worm speed): search below half that
     segs = getattr(getattr(bm.pieces, "resolution", None), "worm_segments_per_turn", None)
     f_max = 0.5 * segs * n1 / 60.0 if segs else float("inf")
@@ -139,4 +144,5 @@ def contact3d_summary(S: dict, scenario, bm) -> dict:
         "max_penetration_um": float(np.max(S["max_penetration_m"][sl]) * 1e6),
         "transmission_error_p2p_urad": float(np.ptp(S["transmission_error_rad"][sl]) * 1e6),
         "wheel_speed_fluctuation": float(np.ptp(w2[sl]) / n2) if n2 > 0 else float("nan"),
+        "wheel_speed_std_rpm": float(np.std(w2[sl])),
     }
