@@ -1,10 +1,12 @@
 """Convex collision pieces, visual meshes, mass properties, cache, and property tests over gear data."""
 from __future__ import annotations
 
+import io
 import math
 
 import numpy as np
 import pytest
+import trimesh
 from hypothesis import HealthCheck, Phase, given, settings
 from hypothesis import strategies as st
 
@@ -173,8 +175,14 @@ valid_gears = st.builds(
 def test_property_valid_gears_watertight_and_never_interfering(gear):
     g = derive(gear)
     gs = pieces.build_gear_set(g, "coarse", use_cache=False)
-    assert gs.worm_visual.is_watertight and gs.wheel_visual.is_watertight
-    assert gs.worm_visual.volume > 0 and gs.wheel_visual.volume > 0
+    for m in (gs.worm_visual, gs.wheel_visual):
+        assert m.is_watertight and m.is_winding_consistent and m.volume > 0
+        # what an STL reader sees (it merges vertices closer than 1e-8): still the same closed solid
+        buf = io.BytesIO()
+        m.export(buf, file_type="stl")
+        buf.seek(0)
+        back = trimesh.load(buf, file_type="stl")
+        assert back.is_watertight and back.volume == pytest.approx(m.volume, rel=1e-6)   # STL is float32
     assert all(p.is_convex for p in gs.wheel_tooth_pieces)
     pts, conj = pieces.wheel_active_flank_points(g, n_rho=13, n_zeta=17)
     mins = np.array([clearance_to_worm(g, pts[conj], th)[0].min() for th in np.linspace(0, 2 * math.pi / g.z1, 9)])
