@@ -105,8 +105,28 @@ def wheel_mesh(g: GearGeometry, n_zeta: int | None = None, n_rho: int = 14, n_w:
     return m
 
 
+def stl_safe(m: trimesh.Trimesh) -> bool:
+    """True when merging vertices closer than trimesh's tolerance (what an STL reader does) keeps the mesh
+    watertight with all its faces (no sub-10-nm slivers)."""
+    c = trimesh.Trimesh(np.asarray(m.vertices), np.asarray(m.faces), process=False)
+    c.merge_vertices()
+    return bool(c.nondegenerate_faces().all() and c.is_watertight and len(c.faces) == len(m.faces))
+
+
 def worm_mesh(g: GearGeometry, segments_per_turn: int = 96, n_flank: int = 12) -> trimesh.Trimesh:
-    """Worm threads + core, trimmed to the worm length b1 (see module docstring)."""
+    """Worm threads + core, trimmed to the worm length b1 (see module docstring).
+
+    The booleans can, by chance, leave vertices nanometres apart; then the helical sampling is shifted by a
+    fraction of a segment and the worm rebuilt (at most 3 tries), so that the STL holds the same closed solid.
+    """
+    for phase in (0.0, 0.37, 0.71):
+        m = _worm_mesh(g, segments_per_turn, n_flank, phase)
+        if stl_safe(m):
+            break
+    return m
+
+
+def _worm_mesh(g: GearGeometry, segments_per_turn: int, n_flank: int, phase: float) -> trimesh.Trimesh:
     half = g.worm_length / 2
     r_in = g.r_f1 - 0.3 * g.m_x
     prof = worm.ridge_profile(g, n_flank, r_in)              # (m, 2) closed, CCW in (r, u)
@@ -116,8 +136,9 @@ def worm_mesh(g: GearGeometry, segments_per_turn: int = 96, n_flank: int = 12) -
         # thread centre z = p phi + n p_x must cover [-half - p_x, half + p_x]
         z0, z1 = -half - g.p_x, half + g.p_x
         ph = np.sort([(z0 - n * g.p_x) / g.p, (z1 - n * g.p_x) / g.p])
-        nseg = max(2, int(math.ceil((ph[1] - ph[0]) / (2 * math.pi) * segments_per_turn)))
-        phi = np.linspace(ph[0], ph[1], nseg + 1)
+        dphi = 2 * math.pi / segments_per_turn
+        nseg = max(2, int(math.ceil((ph[1] - ph[0]) / dphi)) + 1)
+        phi = ph[0] - phase * dphi + dphi * np.arange(nseg + 1)
         r, u = prof[:, 0], prof[:, 1]
         X = np.stack([r[None] * np.cos(phi[:, None]), r[None] * np.sin(phi[:, None]),
                       g.p * phi[:, None] + n * g.p_x + u[None]], axis=-1)   # (nphi, m, 3)

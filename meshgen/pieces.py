@@ -34,7 +34,7 @@ import trimesh
 from meshgen import meshes, wheel, worm
 from meshgen.geometry import GearGeometry
 
-CODE_VERSION = "meshgen-9"
+CODE_VERSION = "meshgen-10"
 
 
 @dataclass(frozen=True)
