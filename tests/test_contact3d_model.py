@@ -92,3 +92,24 @@ def test_self_locking_worm_creeps_under_1_percent_of_frictionless():
         speeds[mu] = abs(res.series["worm_speed_rpm"][-1])
     assert speeds[0.0] > 10.0
     assert speeds[0.1] < 0.01 * speeds[0.0], speeds
+
+
+def test_run_writes_summary_series_report_and_3d_recording(tmp_path):
+    """End to end through wormsim.run on a very short seat-motor demo: every INTERFACE.md contact3d key,
+    a report and a recording holding the moving meshes, contact points and force arrows."""
+    from wormsim.recording import recorded_entities
+    from wormsim.run import run_scenario
+
+    sc = load_scenario(SCEN / "seat_motor_demo.yaml", ["simulation.duration_s=0.03"])
+    summary = run_scenario(sc, tmp_path / "out", progress=False)
+    keys = ["ratio", "ratio_theory", "mesh_frequency_hz", "mesh_frequency_theory_hz", "tangential_force_mean_n",
+            "tangential_force_p2p_n", "radial_force_mean_n", "axial_force_mean_n", "worm_torque_mean_nm",
+            "wheel_torque_mean_nm", "worm_speed_mean_rpm", "wheel_speed_mean_rpm", "efficiency", "steady_window_s",
+            "efficiency_theory", "timestep_s", "resolution", "contacts_mean"]
+    assert summary["status"] == "ok" and all(k in summary for k in keys)
+    for f in ("summary.json", "timeseries.npz", "report.png", "recording.rrd"):
+        assert (tmp_path / "out" / f).stat().st_size > 0
+    ents = recorded_entities(tmp_path / "out" / "recording.rrd")
+    for e in ("/assembly/worm", "/assembly/wheel", "/assembly/worm/mesh", "/assembly/contacts/points",
+              "/assembly/contacts/forces", "/series/tangential_force_n"):
+        assert e in ents, sorted(ents)[:20]
