@@ -195,7 +195,7 @@ def test_worm_and_wheel_meshes_clearance_over_mesh_cycle(name):
     """The watertight worm and wheel MESHES, placed by meshgen.assembly at theta1 and hand theta1 z1/z2 over one
     mesh cycle (8 worm angles): manifold3d finds no intersection volume, and their minimum gap (min_gap) stays
     within 1 um below the exact flank-normal clearance (j/2) cos(alpha_n) cos(gamma) (measured: seat motor
-    23.97..24.05 um vs 24.53, screw jack 36.6 vs 37.4). Closing the backlash by turning the wheel 1.5 j/(2 r2)
+    24.42..24.49 um vs 24.53, screw jack 36.54..36.77 vs 37.40). Closing the backlash by turning the wheel 1.5 j/(2 r2)
     further makes them intersect, so the check can fail. The wheel is trimmed to the teeth near the worm."""
     g = seed_geometry(name)
     W = meshes._to_manifold(meshes.worm_mesh(g))
