@@ -8,7 +8,8 @@ import pytest
 
 from _meshgen_common import clearance_to_worm, gear_with, seed_geometry
 from meshgen import assembly, meshes, pieces, wheel, worm
-from wormsim.scenario import ScenarioError
+from meshgen.geometry import derive
+from wormsim.scenario import Gear, ScenarioError
 
 SEEDS = ["seat_motor", "involute_41", "screw_jack"]
 
@@ -220,3 +221,18 @@ def test_worm_and_wheel_meshes_clearance_over_mesh_cycle(name):
     assert max(vols) == 0.0
     assert min(gaps) >= normal - 1e-6 and min(gaps) <= normal + 1e-7
     assert (placed(0.0, 1.5 * g.backlash / (2 * g.r2)) ^ H).volume() > 0
+
+
+def test_zi_root_below_base_cylinder_generates_conjugate_wheel():
+    """ZI with the worm root inside the base cylinder (z1 3, q 6, alpha_n 25: r_b = 1.15 r_f1): the flank is
+    continued radially below r_b (worm.py); the wheel is still generated, watertight and conjugate."""
+    g = derive(Gear(worm_starts=3, diameter_quotient=6, normal_pressure_angle_deg=25, axial_module_mm=2,
+                    wheel_teeth=40, backlash_mm=0.05))
+    assert g.r_b > g.r_f1
+    r = np.linspace(g.r_f1, g.r_b, 5)
+    assert np.allclose(worm.half_thickness(g, r), worm.half_thickness(g, g.r_b), atol=1e-15)
+    m = meshes.wheel_mesh(g)
+    assert m.is_watertight and m.volume > 0
+    pts, conj = pieces.wheel_active_flank_points(g, n_rho=15, n_zeta=21)
+    mins = np.array([clearance_to_worm(g, pts[conj], th)[0].min() for th in np.linspace(0, 2 * math.pi / 3, 9)])
+    assert mins.min() >= g.backlash / 2 - 2e-8 and mins.max() <= g.backlash / 2 + 2e-6
