@@ -113,3 +113,9 @@ def test_run_writes_summary_series_report_and_3d_recording(tmp_path):
     for e in ("/assembly/worm", "/assembly/wheel", "/assembly/worm/mesh", "/assembly/contacts/points",
               "/assembly/contacts/forces", "/series/tangential_force_n"):
         assert e in ents, sorted(ents)[:20]
+
+
+def test_too_soft_contact_stops_on_penetration_with_a_diagnosis():
+    sc = load_scenario(SCEN / "seat_motor_demo.yaml", ["contact.stiffness_n_per_m=2e5", "simulation.duration_s=0.03"])
+    with pytest.raises(SimulationError, match=r"penetration .* exceeds .* raise contact.stiffness_n_per_m"):
+        simulate(sc)
