@@ -34,7 +34,7 @@ import trimesh
 from meshgen import meshes, wheel, worm
 from meshgen.geometry import GearGeometry
 
-CODE_VERSION = "meshgen-10"
+CODE_VERSION = "meshgen-11"
 
 
 @dataclass(frozen=True)
@@ -106,12 +106,15 @@ def _clip_convex(points: np.ndarray, zmin: float, zmax: float) -> np.ndarray | N
     return pts
 
 
+WORM_SUBSECTIONS = 4   # the hull of a helical segment spans SUB + 1 exact ridge sections (helix chords: gap only)
+
+
 def worm_piece_points(g: GearGeometry, res: Resolution, start: int, phi0: float, phi1: float):
     r_in = g.r_f1 - 0.1 * g.m_x
     prof = worm.ridge_profile(g, res.profile_points, r_in)
     r, u = prof[:, 0], prof[:, 1]
     pts = []
-    for phi in (phi0, phi1):
+    for phi in np.linspace(phi0, phi1, WORM_SUBSECTIONS + 1):
         pts.append(np.stack([r * np.cos(phi), r * np.sin(phi), g.p * phi + start * g.p_x + u], -1))
     return np.concatenate(pts)
 
@@ -289,7 +292,8 @@ def wheel_active_flank_points(g: GearGeometry, n_rho: int = 25, n_zeta: int = 61
 def measure_piece_error(g: GearGeometry, res: Resolution, worm_pieces, wheel_pieces) -> dict:
     # worm: one turn of start 0 around the middle, away from the clipped ends
     d = 2 * math.pi / res.worm_segments_per_turn
-    pts = worm_active_flank_points(g, -math.pi, math.pi - 1e-12, n_phi=4 * res.worm_segments_per_turn + 1)
+    # 4 samples per sub-section interval: the sections, their quarter and mid points (the chords' worst)
+    pts = worm_active_flank_points(g, -math.pi, math.pi, n_phi=4 * WORM_SUBSECTIONS * res.worm_segments_per_turn + 1)
     near = [p for p in worm_pieces if abs(p.centroid[2]) < abs(g.p) * (math.pi + 2 * d) + g.p_x]
     dw = union_signed_distance(near, pts)
     pts, conj = wheel_active_flank_points(g, n_zeta=8 * res.wheel_slabs + 1)
