@@ -1,19 +1,20 @@
-"""Convex collision pieces of the worm and of one wheel tooth, the gear set, its cache.
+"""Convex collision pieces of the worm and of one wheel tooth, the gear set, its cache (docs/geometry.md).
 
-MuJoCo collides a mesh geom as its convex hull, so every piece here IS a convex hull:
+MuJoCo collides a mesh geom as its convex hull, so every piece here IS a convex hull of exact surface points:
 - worm: per start, the thread ridge cut into helical segments of 2 pi / worm_segments_per_turn: the hull of the
-  exact axial ridge profile (both flanks sampled at profile_points radii from r_f1 - 0.1 m_x to the tip r_a1)
-  at the two bounding worm angles; segments at the ends are clipped by the planes z = +-b1/2. The core is a
-  cylinder of radius worm_core_radius_m = r_f1 (a collision cylinder/capsule stands in for it).
-- wheel: tooth 0 cut into wheel_slabs slabs across the face width: the hull of the two exact flank sections
-  (profile_points radii from the root torus to the throat tip, plus the tip arc) at the slab's bounding
-  zeta planes.
-The hull of a slice replaces each flank between two sections by chords: the deviation is measured against the
-exact flanks on the ACTIVE flank (worm: r from the wheel throat a - r_a2 to r_a1; wheel: from the worm tip's
-reach rho = a - sqrt(r_a1^2 - zeta^2) to the wheel tip, conjugate points only; the undercut zone, cut by the
-hob tip edge, is concave across the profile so the hull bridges it: reported apart as "wheel_undercut_zone") as the signed distance of dense exact flank points
-from the union of pieces (negative: the flank lies inside a piece, the piece bulges out; positive: a gap):
-piece_error_um = {"worm"|"wheel": {"max": max |d|, "rms": rms d, "min_signed": .., "max_signed": ..}}.
+  exact axial ridge profile (both flanks at profile_points radii from r_f1 - 0.1 m_x to the tip r_a1) at
+  WORM_SUBSECTIONS + 1 worm angles across the segment; segments at the ends are clipped by z = +-b1/2. The core
+  is a cylinder of radius worm_core_radius_m = r_f1 (a collision cylinder/capsule stands in for it).
+- wheel: tooth 0 cut into wheel_slabs slabs across the face width, each the hull of SLAB_SUBSECTIONS + 1 exact
+  sections; each flank's conjugate part (above the root fillet / undercut cut by the hob tip edge) forms an
+  upper piece (both flanks + tip arc), and where there is a fillet a lower, conservative core piece lies inside
+  both fillets, so that no hull bridges the concave kink of a working flank.
+Error (piece_error_um): signed distance of dense exact points of the ACTIVE flanks (worm: r from the wheel throat
+a - r_a2 to r_a1; wheel: from the worm tip's reach rho = a - sqrt(r_a1^2 - zeta^2) to the wheel tip, conjugate
+points; the fillet / undercut points apart as "wheel_undercut_zone") from the union of pieces, in micrometres;
+negative: the piece bulges beyond the flank, positive: a gap.
+piece_error_um = {"worm"|"wheel"[|"wheel_undercut_zone"]: {"max": max |d|, "rms", "min_signed", "max_signed",
+"n_points"}}.
 """
 from __future__ import annotations
 
