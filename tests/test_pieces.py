@@ -220,3 +220,35 @@ def test_property_invalid_data_is_a_clear_input_error(case):
     fields, pattern = case
     with pytest.raises(ScenarioError, match=pattern):
         pieces.build_gear_set(derive(Gear(**fields)), "coarse", use_cache=False)
+
+
+def test_collision_pieces_against_each_other_over_mesh_cycle(seat_medium):
+    """What MuJoCo sees: the convex worm pieces (middle turns) and the wheel-tooth pieces of 7 teeth, placed by
+    meshgen.assembly over one mesh cycle: no intersection volume (manifold3d), minimum gap between
+    (j/2) cos(alpha_n) cos(gamma) minus the reported wheel bulge and the exact value (measured seat motor:
+    coarse 14.35, medium 21.95, fine 23.86 um against 24.53 exact)."""
+    import manifold3d as mf
+
+    from meshgen import assembly
+
+    gs = seat_medium
+    g = gs.geometry
+    mm = 1000.0
+    worm_near = [p for p in gs.worm_pieces if abs(p.centroid[2]) < 3 * g.p_x]
+    W = mf.Manifold.compose([mf.Manifold.hull_points(np.asarray(p.vertices) * mm) for p in worm_near])
+    teeth = []
+    for k in range(-3, 4):
+        rot = assembly.wheel_to_assembly(2 * math.pi * k / g.z2)[:3, :3]
+        teeth += [mf.Manifold.hull_points(np.asarray(p.vertices) @ rot.T * mm) for p in gs.wheel_tooth_pieces]
+    H = mf.Manifold.compose(teeth)
+    normal = g.backlash / 2 * math.cos(g.alpha_n) * math.cos(g.gamma)
+    bulge = -gs.piece_error_um["wheel"]["min_signed"] * 1e-6
+    gaps = []
+    for th1 in np.linspace(0.0, 2 * math.pi / g.z1, 13)[:-1]:
+        m = np.linalg.inv(assembly.wheel_to_assembly(assembly.wheel_angle(g, th1))) @ assembly.worm_to_assembly(th1, g)
+        m[:3, 3] *= mm
+        w = W.transform(m[:3, :4])
+        assert (w ^ H).volume() == 0.0
+        gaps.append(w.min_gap(H, 3 * normal * mm) / mm)
+    assert min(gaps) >= normal - bulge - 0.5e-6
+    assert min(gaps) <= normal + 0.5e-6
