@@ -81,51 +81,54 @@ def dominant_frequency(t: np.ndarray, x: np.ndarray, f_max_hz: float = float("in
     return float(f), float(df), freqs, spec
 
 
-def contact3d_summary(S: dict, scenario, bm) -> dict:
-    geo = bm.geometry
+def window_of(S: dict, scenario, geo) -> tuple[int, int, float]:
+    """Steady window [i0, i1) of a run and the mesh period used to find and trim it."""
     t = S["t_s"]
     drv, load = scenario.drive, scenario.load
-    w1 = S["worm_speed_rpm"]
-    w2 = S["wheel_speed_rpm"]
+    w1, w2 = S["worm_speed_rpm"], S["wheel_speed_rpm"]
     n1_guess = abs(float(np.mean(w1[len(w1) // 2:]))) if len(w1) else 0.0
     f_mesh_guess = geo.z1 * n1_guess / 60.0
     period = 1.0 / f_mesh_guess if f_mesh_guess > 0 else 0.0
     ramp_end = max(drv.ramp_s, load.start_s + load.ramp_s)
-    driven = w2 if drv.on == "worm" else w1
-    i0, i1 = steady_window(t, driven, ramp_end, period)
-    sl = slice(i0, i1)
-    # mean speeds = angle increments over the window (exact for the sampled angles; a mean of |speed| samples
-    # would be biased by the wheel's high-frequency vibration, which reverses its speed)
+    i0, i1 = steady_window(t, w2 if drv.on == "worm" else w1, ramp_end, period)
+    return i0, i1, period
+
+
+def mean_speeds_rpm(S: dict, i0: int, i1: int) -> tuple[float, float]:
+    """Mean worm and wheel speeds = |angle increment| / window duration (exact for the sampled angles; a
+    mean of |speed| samples would be biased by the wheel's high-frequency vibration, which reverses it)."""
+    t = S["t_s"]
     span = t[i1 - 1] - t[i0]
+    if span <= 0:
+        return float("nan"), float("nan")
     rpm = 60.0 / (2 * math.pi)
-    n1 = abs(S["worm_angle_rad"][i1 - 1] - S["worm_angle_rad"][i0]) / span * rpm if span > 0 else float("nan")
-    n2 = abs(S["wheel_angle_rad"][i1 - 1] - S["wheel_angle_rad"][i0]) / span * rpm if span > 0 else float("nan")
-    # the convex pieces' facets excite the force at (segments per turn) x (worm speed): search below half that
-    segs = getattr(getattr(bm.pieces, "resolution", None), "worm_segments_per_turn", None)
-    f_max = 0.5 * segs * n1 / 60.0 if segs else float("inf")
-    f_peak, df, _, _ = dominant_frequency(t[sl], S["tangential_force_n"][sl], f_max)
-    f_full, _, _, _ = dominant_frequency(t[sl], S["tangential_force_n"][sl])
-    f_rad, _, _, _ = dominant_frequency(t[sl], S["radial_force_n"][sl], f_max)
+    n1 = abs(S["worm_angle_rad"][i1 - 1] - S["worm_angle_rad"][i0]) / span * rpm
+    n2 = abs(S["wheel_angle_rad"][i1 - 1] - S["wheel_angle_rad"][i0]) / span * rpm
+    return float(n1), float(n2)
+
+
+def drive_summary(S: dict, scenario, geo, i0: int, i1: int, n1: float, n2: float) -> dict:
+    """The summary keys every gear-level model shares (INTERFACE.md contact3d list, less the meshing
+    frequency, which each model takes from its own signal): ratio, forces, torques, speeds, efficiency
+    (output / input power over the window) and its theory tan(g) / tan(g + rho') (or back-driving)."""
+    t = S["t_s"]
+    drv, load = scenario.drive, scenario.load
+    sl = slice(i0, i1)
     ft = S["tangential_force_n"][sl]
-    w1s = S["worm_speed_rpm"][sl] * (2 * math.pi / 60)
-    w2s = S["wheel_speed_rpm"][sl] * (2 * math.pi / 60)
+    w = 2 * math.pi / 60
     T1, T2 = S["worm_torque_nm"][sl], S["wheel_torque_nm"][sl]
-    p1, p2 = float(np.mean(T1 * w1s)), float(np.mean(T2 * w2s))
+    p1 = float(np.mean(T1 * S["worm_speed_rpm"][sl] * w))
+    p2 = float(np.mean(T2 * S["wheel_speed_rpm"][sl] * w))
     if drv.on == "worm":
         eff = -p2 / p1 if p1 > 0 else float("nan")
     else:
         eff = -p1 / p2 if p2 > 0 else float("nan")
     mu = float(np.mean(S["friction_coefficient"][sl]))
-    eta_th = efficiency_theory(geo.gamma, geo.alpha_n, mu, backdriving=drv.on == "wheel")
+    w2 = S["wheel_speed_rpm"]
     return {
         "ratio": n1 / n2 if n2 > 0 else float("inf"),
         "ratio_theory": geo.ratio,
-        "mesh_frequency_hz": f_peak,
         "mesh_frequency_theory_hz": geo.z1 * n1 / 60.0,
-        "mesh_frequency_resolution_hz": df,
-        "mesh_frequency_search_max_hz": f_max,
-        "force_peak_full_band_hz": f_full,
-        "mesh_frequency_radial_hz": f_rad,
         "tangential_force_mean_n": abs(float(np.mean(ft))),
         "tangential_force_p2p_n": float(np.ptp(ft)) if len(ft) else float("nan"),
         "tangential_force_theory_n": abs(load.torque_nm) / geo.r2 if load.on == "wheel" else float("nan"),
@@ -136,13 +139,36 @@ def contact3d_summary(S: dict, scenario, bm) -> dict:
         "worm_speed_mean_rpm": n1,
         "wheel_speed_mean_rpm": n2,
         "efficiency": eff,
-        "efficiency_theory": eta_th,
+        "efficiency_theory": efficiency_theory(geo.gamma, geo.alpha_n, mu, backdriving=drv.on == "wheel"),
         "friction_coefficient_mean": mu,
         "steady_window_s": [float(t[i0]), float(t[i1 - 1])],
-        "contacts_mean": float(np.mean(S["contacts"][sl])),
-        "teeth_in_contact_mean": float(np.mean(S["teeth_in_contact"][sl])),
-        "max_penetration_um": float(np.max(S["max_penetration_m"][sl]) * 1e6),
         "transmission_error_p2p_urad": float(np.ptp(S["transmission_error_rad"][sl]) * 1e6),
         "wheel_speed_fluctuation": float(np.ptp(w2[sl]) / n2) if n2 > 0 else float("nan"),
         "wheel_speed_std_rpm": float(np.std(w2[sl])),
+    }
+
+
+def contact3d_summary(S: dict, scenario, bm) -> dict:
+    """drive_summary plus the meshing frequency from the tangential force and contact statistics."""
+    geo = bm.geometry
+    t = S["t_s"]
+    i0, i1, _ = window_of(S, scenario, geo)
+    sl = slice(i0, i1)
+    n1, n2 = mean_speeds_rpm(S, i0, i1)
+    # the convex pieces' facets excite the force at (segments per turn) x (worm speed): search below half that
+    segs = getattr(getattr(bm.pieces, "resolution", None), "worm_segments_per_turn", None)
+    f_max = 0.5 * segs * n1 / 60.0 if segs else float("inf")
+    f_peak, df, _, _ = dominant_frequency(t[sl], S["tangential_force_n"][sl], f_max)
+    f_full, _, _, _ = dominant_frequency(t[sl], S["tangential_force_n"][sl])
+    f_rad, _, _, _ = dominant_frequency(t[sl], S["radial_force_n"][sl], f_max)
+    return {
+        **drive_summary(S, scenario, geo, i0, i1, n1, n2),
+        "mesh_frequency_hz": f_peak,
+        "mesh_frequency_resolution_hz": df,
+        "mesh_frequency_search_max_hz": f_max,
+        "force_peak_full_band_hz": f_full,
+        "mesh_frequency_radial_hz": f_rad,
+        "contacts_mean": float(np.mean(S["contacts"][sl])),
+        "teeth_in_contact_mean": float(np.mean(S["teeth_in_contact"][sl])),
+        "max_penetration_um": float(np.max(S["max_penetration_m"][sl]) * 1e6),
     }

@@ -451,59 +451,26 @@ def _locked_guard(scenario, t, w1, w2, drive_f) -> None:
 
 
 def torsional_summary(S: dict, scenario: Scenario, g: GearGeometry, ms: MeshStiffness) -> dict:
-    """contact3d's summary keys, computed as wormsim.metrics computes them (steady window, FFT peak)."""
-    from wormsim.metrics import dominant_frequency, steady_window
+    """contact3d's summary keys, computed by the same functions (wormsim.metrics), with one difference:
+    the meshing frequency is the FFT peak of the transmission error. The mesh force element's tangential
+    force is quasi-static: its fluctuation is the inertial part, the 2nd time derivative of the
+    transmission error, which weights the harmonics of k(theta)'s tooth-entry kinks by n^2 and puts the
+    force's peak on a harmonic (reported as force_peak_full_band_hz)."""
+    from wormsim.metrics import dominant_frequency, drive_summary, mean_speeds_rpm, window_of
 
     t = S["t_s"]
-    drv, load = scenario.drive, scenario.load
-    w1 = np.abs(S["worm_speed_rpm"])
-    w2 = np.abs(S["wheel_speed_rpm"])
-    n1_guess = float(np.mean(w1[len(w1) // 2:])) if len(w1) else 0.0
-    f_guess = g.z1 * n1_guess / 60.0
-    period = 1.0 / f_guess if f_guess > 0 else 0.0
-    ramp_end = max(drv.ramp_s, load.start_s + load.ramp_s)
-    i0, i1 = steady_window(t, w2 if drv.on == "worm" else w1, ramp_end, period)
+    i0, i1, _ = window_of(S, scenario, g)
     sl = slice(i0, i1)
-    n1, n2 = float(np.mean(w1[sl])), float(np.mean(w2[sl]))
-    ft = S["tangential_force_n"][sl]
-    # the mesh force element's tangential force is quasi-static: its fluctuation is the inertial part, the 2nd
-    # time derivative of the transmission error, which weights the harmonics of k(theta)'s tooth-entry kinks by
-    # n^2 and puts the force's peak on a harmonic; the meshing frequency is taken from the transmission error
+    n1, n2 = mean_speeds_rpm(S, i0, i1)
     f_peak, df, _, _ = dominant_frequency(t[sl], S["transmission_error_rad"][sl])
-    f_force, _, _, _ = dominant_frequency(t[sl], ft)
-    rpm = 2 * math.pi / 60
-    T1, T2 = S["worm_torque_nm"][sl], S["wheel_torque_nm"][sl]
-    p1 = float(np.mean(T1 * S["worm_speed_rpm"][sl] * rpm))
-    p2 = float(np.mean(T2 * S["wheel_speed_rpm"][sl] * rpm))
-    if drv.on == "worm":
-        eff = -p2 / p1 if p1 > 0 else float("nan")
-    else:
-        eff = -p1 / p2 if p2 > 0 else float("nan")
-    mu = float(np.mean(S["friction_coefficient"][sl]))
+    f_force, _, _, _ = dominant_frequency(t[sl], S["tangential_force_n"][sl])
     return {
-        "ratio": n1 / n2 if n2 > 0 else float("inf"),
-        "ratio_theory": g.ratio,
+        **drive_summary(S, scenario, g, i0, i1, n1, n2),
         "mesh_frequency_hz": f_peak,
-        "mesh_frequency_theory_hz": g.z1 * n1 / 60.0,
         "mesh_frequency_resolution_hz": df,
         "mesh_frequency_source": "transmission error",
         "force_peak_full_band_hz": f_force,
-        "tangential_force_mean_n": abs(float(np.mean(ft))),
-        "tangential_force_p2p_n": float(np.ptp(ft)) if len(ft) else float("nan"),
-        "tangential_force_theory_n": abs(load.torque_nm) / g.r2 if load.on == "wheel" else float("nan"),
-        "radial_force_mean_n": abs(float(np.mean(S["radial_force_n"][sl]))),
-        "axial_force_mean_n": abs(float(np.mean(S["axial_force_n"][sl]))),
-        "worm_torque_mean_nm": abs(float(np.mean(T1))),
-        "wheel_torque_mean_nm": abs(float(np.mean(T2))),
-        "worm_speed_mean_rpm": n1,
-        "wheel_speed_mean_rpm": n2,
-        "efficiency": eff,
-        "efficiency_theory": efficiency_theory(g.gamma, g.alpha_n, mu, backdriving=drv.on == "wheel"),
-        "friction_coefficient_mean": mu,
-        "steady_window_s": [float(t[i0]), float(t[i1 - 1])],
-        "transmission_error_p2p_urad": float(np.ptp(S["transmission_error_rad"][sl]) * 1e6),
         "mesh_deflection_mean_um": float(np.mean(S["mesh_deflection_m"][sl]) * 1e6),
-        "wheel_speed_fluctuation": float(np.ptp(w2[sl]) / n2) if n2 > 0 else float("nan"),
     }
 
 
