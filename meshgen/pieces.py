@@ -35,7 +35,7 @@ import trimesh
 from meshgen import meshes, wheel, worm
 from meshgen.geometry import GearGeometry
 
-CODE_VERSION = "meshgen-11"
+CODE_VERSION = "meshgen-13"
 
 
 @dataclass(frozen=True)
@@ -174,15 +174,17 @@ def conjugate_junction_rho(g: GearGeometry, zeta: np.ndarray, side: int, n_grid:
 
 
 def wheel_slab_sections(g: GearGeometry, n_profile: int, zeta: np.ndarray, lo_a, hi_a, lo_b, hi_b,
-                        n_tip: int = 3, tip: bool = True):
+                        n_tip: int = 3, tip: bool = True, dpsi_a: float = 0.0, dpsi_b: float = 0.0):
     """Points of tooth-0 sections at the given zeta values: flank A (psi_a) from lo_a to hi_a, flank B from lo_b
-    to hi_b (radius arrays over zeta), plus n_tip points across the tip arc when tip: (len(zeta), m, 3)."""
+    to hi_b (radius arrays over zeta), plus n_tip points across the tip arc when tip: (len(zeta), m, 3).
+    dpsi_a, dpsi_b >= 0 move flank A / flank B into the tooth by that angle (conservative pieces)."""
     s = np.linspace(0.0, 1.0, n_profile)
     Z = np.broadcast_to(zeta[:, None], (len(zeta), n_profile))
     Ra = lo_a[:, None] + s[None, :] * (hi_a - lo_a)[:, None]
     Rb = lo_b[:, None] + s[None, :] * (hi_b - lo_b)[:, None]
     pa, _ = wheel.tooth_flanks(g, Ra, Z, which="a")
     _, pb = wheel.tooth_flanks(g, Rb, Z, which="b")
+    pa, pb = pa + dpsi_a, pb - dpsi_b
     rho, psi = [Ra, Rb], [pa, pb]
     if tip:
         w = np.linspace(0.0, 1.0, n_tip + 2)[1:-1]
@@ -193,7 +195,7 @@ def wheel_slab_sections(g: GearGeometry, n_profile: int, zeta: np.ndarray, lo_a,
     return np.stack([rho * np.cos(psi), rho * np.sin(psi), zz], -1)
 
 
-def _fillet_core_sections(g: GearGeometry, zeta, root, top, n: int = 16):
+def _fillet_core_sections(g: GearGeometry, zeta, root, top, n: int = 16, dpsi_a: float = 0.0, dpsi_b: float = 0.0):
     """Conservative core of the tooth below the conjugate flanks, per section: the annular sector
     root <= rho <= top, max psi_a <= psi <= min psi_b over that radius range (inside the exact tooth, so the hull
     never bulges into the concave root fillet / undercut where the worm tip passes). (len(zeta), 4, 3)."""
@@ -201,7 +203,7 @@ def _fillet_core_sections(g: GearGeometry, zeta, root, top, n: int = 16):
     R = root[:, None] + s[None, :] * (top - root)[:, None]
     Z = np.broadcast_to(zeta[:, None], R.shape)
     pa, pb = wheel.tooth_flanks(g, R, Z)
-    lo, hi = pa.max(axis=1), pb.min(axis=1)
+    lo, hi = pa.max(axis=1) + dpsi_a, pb.min(axis=1) - dpsi_b
     rho = np.stack([root, root, top, top], axis=1)
     psi = np.stack([lo, hi, lo, hi], axis=1)
     zz = np.broadcast_to(zeta[:, None], rho.shape)
@@ -211,21 +213,63 @@ def _fillet_core_sections(g: GearGeometry, zeta, root, top, n: int = 16):
 def build_wheel_tooth_pieces(g: GearGeometry, res: Resolution) -> list[trimesh.Trimesh]:
     """Slabs across the face width; where the hob tip edge cut a root fillet / undercut (concave), each slab is
     split at each flank's conjugate junction radius, so that no hull bridges the concave kink of a working flank:
-    an upper piece (both conjugate flanks + tip) and a lower, conservative core piece (_fillet_core_sections)."""
+    an upper piece (both conjugate flanks + tip) and a lower, conservative core piece (_fillet_core_sections).
+
+    Conservative on the working flanks: the wheel flank is concave across the face width, so a slab's hull
+    bulges beyond it between its sections; each flank of each upper piece is moved into the tooth by the bulge
+    measured on dense exact points of that slab (two passes), so the pieces never stand proud of the exact
+    flank (the error becomes a gap of about that size at the sections)."""
     sub = SLAB_SUBSECTIONS
     zeta = np.linspace(-g.face_width / 2, g.face_width / 2, sub * res.wheel_slabs + 1)
     root, tip = wheel.root_rho(g, zeta), wheel.tip_rho(g, zeta)
     ja, jb = conjugate_junction_rho(g, zeta, +1), conjugate_junction_rho(g, zeta, -1)
-    upper = wheel_slab_sections(g, res.profile_points, zeta, ja, tip, jb, tip)
     has_fillet = (ja > root + 1e-6 * g.m_x) | (jb > root + 1e-6 * g.m_x)
-    lower = _fillet_core_sections(g, zeta, root, np.minimum(ja, jb))
+    c = math.cos(g.alpha_n) * math.cos(g.gamma)      # |n . e_psi| of the flank at the pitch point
     out = []
     for j in range(res.wheel_slabs):
         sl = slice(sub * j, sub * (j + 1) + 1)
-        out.append(_hull(upper[sl].reshape(-1, 3)))
+        zf = np.linspace(zeta[sl][0], zeta[sl][-1], 8 * sub + 1)
+        checks = [_flank_check_points(g, zf, side) for side in (+1, -1)]
+        d = [0.0, 0.0]
+        for _ in range(CONSERVATIVE_PASSES + 1):
+            piece = _hull(wheel_slab_sections(g, res.profile_points, zeta[sl], ja[sl], tip[sl], jb[sl], tip[sl],
+                                              dpsi_a=d[0], dpsi_b=d[1]).reshape(-1, 3))
+            bulge = [max(0.0, -float(union_signed_distance([piece], pts).min())) for pts, _ in checks]
+            if max(bulge) <= 1e-9 * g.m_x:
+                break
+            d = [d[i] + bulge[i] / (checks[i][1] * c) for i in range(2)]
+        out.append(piece)
         if has_fillet[sl].any():
-            out.append(_hull(lower[sl].reshape(-1, 3)))
+            # the core stays inside the whole flank (fillet included): checked on root-to-tip points
+            full = [_flank_check_points(g, zf, side, from_root=True) for side in (+1, -1)]
+            d = [0.0, 0.0]
+            for _ in range(CONSERVATIVE_PASSES + 1):
+                core = _hull(_fillet_core_sections(g, zeta[sl], root[sl], np.minimum(ja, jb)[sl],
+                                                   dpsi_a=d[0], dpsi_b=d[1]).reshape(-1, 3))
+                bulge = [max(0.0, -float(union_signed_distance([core], pts).min())) for pts, _ in full]
+                if max(bulge) <= 1e-9 * g.m_x:
+                    break
+                d = [d[i] + bulge[i] / (full[i][1] * c) for i in range(2)]
+            out.append(core)
     return out
+
+
+CONSERVATIVE_PASSES = 2   # 0: pieces exact at the sections and bulging between them
+
+
+def _flank_check_points(g: GearGeometry, zeta: np.ndarray, side: int, n_rho: int = 49, from_root: bool = False):
+    """Exact conjugate points of tooth 0's flank A (side +1) or B (-1) from the junction to the tip at the given
+    zeta values (clustered toward the junction, where the bottom edge of the piece cuts across the flank), and
+    their mean radius: (points (k, 3), rho_mean)."""
+    lo = wheel.root_rho(g, zeta) if from_root else conjugate_junction_rho(g, zeta, side)
+    hi = wheel.tip_rho(g, zeta)
+    s = np.linspace(0.0, 1.0, n_rho) ** (1 if from_root else 2)
+    R = lo[:, None] + s[None, :] * (hi - lo)[:, None]
+    Z = np.broadcast_to(zeta[:, None], R.shape)
+    a, b = wheel.tooth_flanks(g, R, Z, which="a" if side > 0 else "b")
+    psi = a if side > 0 else b
+    pts = np.stack([R * np.cos(psi), R * np.sin(psi), Z], -1).reshape(-1, 3)
+    return pts, float(R.mean())
 
 
 SLAB_SUBSECTIONS = 4   # exact sections per slab that its hull spans (2 ends + 3 inside)
@@ -290,6 +334,21 @@ def wheel_active_flank_points(g: GearGeometry, n_rho: int = 25, n_zeta: int = 61
     return np.concatenate(pts), np.concatenate([ia.ravel(), ib.ravel()])
 
 
+def wheel_random_flank_points(g: GearGeometry, n: int, seed: int):
+    """n random (rho, zeta) of the active flank region, both flanks of tooth 0, and their conjugate flags."""
+    rng = np.random.default_rng(seed)
+    zeta = rng.uniform(-g.face_width / 2, g.face_width / 2, n)
+    lo = g.a - np.sqrt(np.maximum(g.r_a1 ** 2 - zeta ** 2, 0.0))
+    hi = wheel.tip_rho(g, zeta)
+    lo = np.minimum(lo, hi)
+    rho = lo + rng.uniform(0, 1, n) * (hi - lo)
+    pa, pb = wheel.tooth_flanks(g, rho, zeta)
+    ia = wheel.space_flank(g, rho, zeta, +1).interior
+    ib = wheel.space_flank(g, rho, zeta, -1).interior
+    pts = [np.stack([rho * np.cos(p), rho * np.sin(p), zeta], -1) for p in (pa, pb)]
+    return np.concatenate(pts), np.concatenate([ia, ib])
+
+
 def measure_piece_error(g: GearGeometry, res: Resolution, worm_pieces, wheel_pieces) -> dict:
     # worm: one turn of start 0 around the middle, away from the clipped ends
     d = 2 * math.pi / res.worm_segments_per_turn
@@ -298,6 +357,8 @@ def measure_piece_error(g: GearGeometry, res: Resolution, worm_pieces, wheel_pie
     near = [p for p in worm_pieces if abs(p.centroid[2]) < abs(g.p) * (math.pi + 2 * d) + g.p_x]
     dw = union_signed_distance(near, pts)
     pts, conj = wheel_active_flank_points(g, n_zeta=8 * res.wheel_slabs + 1)
+    rpts, rconj = wheel_random_flank_points(g, 4000, seed=12345)
+    pts, conj = np.concatenate([pts, rpts]), np.concatenate([conj, rconj])
     dh = union_signed_distance(wheel_pieces, pts)
     out = {"worm": _stats(dw), "wheel": _stats(dh[conj])}
     if not conj.all():
