@@ -225,8 +225,8 @@ def test_property_invalid_data_is_a_clear_input_error(case):
 def test_collision_pieces_against_each_other_over_mesh_cycle(seat_medium):
     """What MuJoCo sees: the convex worm pieces (middle turns) and the wheel-tooth pieces of 7 teeth, placed by
     meshgen.assembly over one mesh cycle: no intersection volume (manifold3d), minimum gap between
-    (j/2) cos(alpha_n) cos(gamma) minus the reported wheel bulge and the exact value (measured seat motor:
-    coarse 14.35, medium 21.95, fine 23.86 um against 24.53 exact)."""
+    (j/2) cos(alpha_n) cos(gamma) minus the reported wheel bulge and the exact value (measured seat motor,
+    conservative pieces: coarse 24.33, medium 24.24, fine 24.48 um against 24.53 exact)."""
     import manifold3d as mf
 
     from meshgen import assembly
