@@ -35,7 +35,7 @@ import trimesh
 from meshgen import meshes, wheel, worm
 from meshgen.geometry import GearGeometry
 
-CODE_VERSION = "meshgen-13"
+CODE_VERSION = "meshgen-14"
 
 
 @dataclass(frozen=True)
@@ -110,10 +110,16 @@ def _clip_convex(points: np.ndarray, zmin: float, zmax: float) -> np.ndarray | N
 WORM_SUBSECTIONS = 4   # the hull of a helical segment spans SUB + 1 exact ridge sections (helix chords: gap only)
 
 
-def worm_piece_points(g: GearGeometry, res: Resolution, start: int, phi0: float, phi1: float):
+def worm_piece_points(g: GearGeometry, res: Resolution, start: int, phi0: float, phi1: float,
+                      shrink: tuple[float, float] = (0.0, 0.0)):
+    """Exact ridge sections across one helical segment; shrink = (axial offset of the -H flank, of the +H flank)
+    toward the thread centre (conservative pieces)."""
     r_in = g.r_f1 - 0.1 * g.m_x
     prof = worm.ridge_profile(g, res.profile_points, r_in)
-    r, u = prof[:, 0], prof[:, 1]
+    r, u = prof[:, 0], prof[:, 1].copy()
+    half_n = len(u) // 2                      # first half: the -H flank (root -> tip), second: the +H flank
+    u[:half_n] += shrink[0]
+    u[half_n:] -= shrink[1]
     pts = []
     for phi in np.linspace(phi0, phi1, WORM_SUBSECTIONS + 1):
         pts.append(np.stack([r * np.cos(phi), r * np.sin(phi), g.p * phi + start * g.p_x + u], -1))
@@ -129,13 +135,34 @@ def worm_segment_angles(g: GearGeometry, res: Resolution, start: int):
     return np.arange(k0, k1 + 1) * d
 
 
+def worm_shrink(g: GearGeometry, res: Resolution) -> tuple[float, float]:
+    """Axial offsets that make the worm pieces conservative. All helical segments are congruent (screw
+    symmetry), so the bulge of one segment's hull beyond dense exact flank points (ZA: saddle flank) is measured
+    once per flank and the flank moved into the thread by it (CONSERVATIVE_PASSES passes); 0 for ZI."""
+    d = 2 * math.pi / res.worm_segments_per_turn
+    R, PHI = np.meshgrid(np.linspace(g.r_f1, g.r_a1, 49), np.linspace(0.0, d, 8 * WORM_SUBSECTIONS + 1),
+                         indexing="ij")
+    checks = [worm.flank_points(g, R, PHI, side).reshape(-1, 3) for side in (-1, 1)]
+    r = R[:, 0]
+    n_z = float(np.min(1.0 / np.sqrt(1.0 + (g.p / r) ** 2 + worm.half_thickness_dr(g, r) ** 2)))
+    shrink = [0.0, 0.0]
+    for _ in range(CONSERVATIVE_PASSES + 1):
+        piece = _hull(worm_piece_points(g, res, 0, 0.0, d, tuple(shrink)))
+        bulge = [max(0.0, -float(union_signed_distance([piece], pts).min())) for pts in checks]
+        if max(bulge) <= 1e-9 * g.m_x:
+            break
+        shrink = [shrink[i] + bulge[i] / n_z for i in range(2)]
+    return shrink[0], shrink[1]
+
+
 def build_worm_pieces(g: GearGeometry, res: Resolution) -> list[trimesh.Trimesh]:
     half = g.worm_length / 2
+    shrink = worm_shrink(g, res)
     out = []
     for n in range(g.z1):
         phis = worm_segment_angles(g, res, n)
         for a, b in zip(phis[:-1], phis[1:]):
-            pts = worm_piece_points(g, res, n, a, b)
+            pts = worm_piece_points(g, res, n, a, b, shrink)
             z = pts[:, 2]
             if z.max() <= -half or z.min() >= half:
                 continue
