@@ -1,5 +1,5 @@
 """Validation of contact3d on the three seed gears (issue 4), CI-sized: same gear, materials, contact law
-and load as scenarios/*.yaml; shorter ramps and durations (a few meshing periods); resolution fine
+and load as scenarios/*.yaml; shorter ramps and durations (>= 5 meshing periods in the steady window); resolution fine
 enough that meshgen's piece bulge stays inside half the backlash (involute_41 needs `fine`).
 seat_motor runs its worm at 1800 rpm instead of 36 rpm (a 0.6 Hz mesh would need 20 s of 2 us steps).
 
@@ -20,10 +20,10 @@ from wormsim.simulate import simulate
 
 SCEN = Path(__file__).resolve().parent.parent / "scenarios"
 CI = {
-    "seat_motor": ["drive.speed_rpm=1800", "drive.ramp_s=0.02", "load.ramp_s=0.02", "simulation.duration_s=0.12",
+    "seat_motor": ["drive.speed_rpm=1800", "drive.ramp_s=0.02", "load.ramp_s=0.02", "simulation.duration_s=0.25",
                    "simulation.resolution=medium"],
-    "screw_jack": ["drive.ramp_s=0.02", "load.ramp_s=0.02", "simulation.duration_s=0.2", "simulation.resolution=medium"],
-    "involute_41": ["drive.ramp_s=0.02", "load.ramp_s=0.02", "simulation.duration_s=0.2",
+    "screw_jack": ["drive.ramp_s=0.02", "load.ramp_s=0.02", "simulation.duration_s=0.35", "simulation.resolution=medium"],
+    "involute_41": ["drive.ramp_s=0.02", "load.ramp_s=0.02", "simulation.duration_s=0.3",
                     "simulation.resolution=fine"],
 }
 _CACHE: dict[str, dict] = {}
@@ -47,24 +47,32 @@ def test_ratio_within_0p1_percent(name):
 
 
 # measured on this CI configuration (docs/contact3d.md): kept strict, marked as expected failures
+_FT = ("with a constant load torque F_t = (T_load + I2 alpha2) / r2 carries the mesh only through the wheel's "
+       "acceleration, dominated by contact vibration and the convex pieces' facet ripple (the radial force shows "
+       "the meshing frequency: test below)")
 MESH_XFAIL = {
-    "screw_jack": "F_t peak 110.7 Hz (5th mesh harmonic) against z1 n1/60 = 22.15 Hz, bin 7.4 Hz: with a constant "
-                  "load torque F_t = (T + I2 alpha2)/r2 is dominated by the wheel's vibration, not by the mesh",
-    "involute_41": "F_t peak 1158.6 Hz (facet/vibration content) against z1 n1/60 = 24.14 Hz, bin 6.0 Hz",
+    "seat_motor": f"F_t peak 695.9 Hz against z1 n1/60 = 29.97 Hz, bin 5.0 Hz, 6 periods: {_FT}",
+    "screw_jack": f"F_t peak 221.4 Hz (10th mesh harmonic) against z1 n1/60 = 22.14 Hz, bin 3.7 Hz: {_FT}",
+    "involute_41": f"F_t peak 1137.5 Hz against z1 n1/60 = 24.14 Hz, bin 4.0 Hz: {_FT}",
 }
 EFF_XFAIL = {
-    "seat_motor": "efficiency 0.600 against tan(g)/tan(g+rho') = 0.620 (-3.2 %): the 7 g POM wheel vibrates "
-                  "across its 25 um half backlash (wheel speed p2p 3.7 x its mean; 79 contacts on 4.4 teeth on "
-                  "average, both flanks) and the contact damping (10 % critical) dissipates",
-    "involute_41": "efficiency 0.696 against 0.672 (+3.5 %): contact off the reference cylinder sees another "
-                   "local lead and pressure angle than the wedge formula's gamma, alpha_n at d1",
+    "seat_motor": "efficiency 0.600 against tan(g)/tan(g+rho') = 0.620 (-3.2 %): the 7 g POM wheel, with no "
+                  "driven-machine inertia, vibrates across its 25 um half backlash (wheel speed p2p 3.6 x its mean; "
+                  "79 contacts on 4.4 teeth on average, both flanks) and the contact damping (10 % critical) dissipates",
 }
+
+
+def _enough_periods(s: dict) -> None:
+    """An FFT check means something only when one bin is well below the frequency: >= 5 mesh periods."""
+    w0, w1 = s["steady_window_s"]
+    assert (w1 - w0) * s["mesh_frequency_theory_hz"] >= 5, ("steady window too short for the FFT", w0, w1)
 
 
 @pytest.mark.parametrize("name", [pytest.param(n, marks=pytest.mark.xfail(reason=MESH_XFAIL[n], strict=True))
                                   if n in MESH_XFAIL else n for n in SEEDS])
 def test_mesh_frequency(name):
     s = run(name)["summary"]
+    _enough_periods(s)
     tol = max(0.01 * s["mesh_frequency_theory_hz"], s["mesh_frequency_resolution_hz"])
     assert abs(s["mesh_frequency_hz"] - s["mesh_frequency_theory_hz"]) <= tol, (
         s["mesh_frequency_hz"], s["mesh_frequency_theory_hz"], s["mesh_frequency_resolution_hz"])
@@ -76,6 +84,7 @@ def test_mesh_frequency_in_the_radial_force(name):
     with a constant load torque F_t = (T_load + I2 alpha2) / r2 carries the mesh only through the wheel's
     acceleration, while the radial force follows the number of teeth in contact directly."""
     s = run(name)["summary"]
+    _enough_periods(s)
     tol = max(0.01 * s["mesh_frequency_theory_hz"], s["mesh_frequency_resolution_hz"])
     assert abs(s["mesh_frequency_radial_hz"] - s["mesh_frequency_theory_hz"]) <= tol, (
         s["mesh_frequency_radial_hz"], s["mesh_frequency_theory_hz"], s["mesh_frequency_resolution_hz"])
