@@ -8,9 +8,9 @@ STEP ramps are smooth on that scale); after each chunk it
 - sets the friction coefficient mu(Vs) from the sliding speed Vs = |omega1| r1 / cos(gamma),
 - records shaft angles/speeds/torques and the tooth forces: for every worm-wheel contact the force
   of the elliptic-cone constraint rows (normal, two tangents: what mj_contactForce returns) turned into
-  the assembly frame and summed ON THE WHEEL: tangential force F_t = M_z / r2 (the wheel torque of the
-  contact forces reduced to the reference radius, DIN 3975 F_t2 = 2 T2 / d2), radial F_r = sum F . e_r
-  (outward, at each contact point), axial F_a = sum F . e_z; the number of contacts and of wheel teeth
+  the assembly frame and summed ON THE WHEEL, the resultant resolved in the wheel's directions at the pitch
+  point on the line of centres (DIN 3975 F_t2, F_r2, F_a2; seed 001's x/y components): tangential, radial
+  (outward), axial; the contact torque M_z apart (wheel_contact_torque_nm); the number of contacts and of wheel teeth
   touching; contact points in the frame of wheel tooth 0 (for the contact pattern),
 - checks the guards: non-finite state or MuJoCo's bad-qacc warning (divergence), penetration beyond
   `penetration_limit_m`, the transmission error passing half a pitch (teeth jumped), a speed-driven
@@ -65,12 +65,12 @@ def penetration_limit_m(bm: BuiltModel) -> float:
 
 
 def tooth_forces(bm: BuiltModel, d: mujoco.MjData, window_ks: np.ndarray):
-    """Contact forces on the wheel: (F_t, F_r, F_a, n_contacts, n_teeth, max_pen, points_tooth0 (n,3),
+    """Contact forces on the wheel: (F_t, F_r, F_a, M_z, n_contacts, n_teeth, max_pen, points_tooth0 (n,3),
     forces (n,3) world, points world (n,3))."""
     n = d.ncon
     if n == 0:
         z = np.zeros((0, 3))
-        return 0.0, 0.0, 0.0, 0, 0, 0.0, z, z, z
+        return 0.0, 0.0, 0.0, 0.0, 0, 0, 0.0, z, z, z
     con = d.contact
     adr = np.asarray(con.efc_address[:n])
     ok = adr >= 0
@@ -83,13 +83,16 @@ def tooth_forces(bm: BuiltModel, d: mujoco.MjData, window_ks: np.ndarray):
     F = np.einsum("ni,nij->nj", f, frame)              # force on geom2, world frame
     wheel_is_2 = bm.model.geom_bodyid[geom[:, 1]] != bm.worm_body
     F = np.where(wheel_is_2[:, None], F, -F)           # force on the wheel
-    r_xy = pos[:, :2]
-    rad = np.linalg.norm(r_xy, axis=1)
-    e_r = r_xy / np.maximum(rad, 1e-12)[:, None]
-    mz = r_xy[:, 0] * F[:, 1] - r_xy[:, 1] * F[:, 0]
-    f_t = float(mz.sum() / bm.geometry.r2)
-    f_r = float(np.sum(F[:, 0] * e_r[:, 0] + F[:, 1] * e_r[:, 1]))
+    # the resultant on the wheel resolved at the pitch point P = (0, -r2, 0) on the line of centres, in the
+    # wheel's directions there (DIN 3975 F_t2, F_r2, F_a2; seed 001 resolves ADAMS's contact force the same
+    # way): tangential e_t = +x (the wheel's positive sense at P), radial e_r = -y (outward, towards the
+    # worm), axial e_z. The contact torque M_z is kept apart: M_z / r2 would equal the mean F_t, but by the
+    # wheel's torque balance it varies only through I2 alpha2 and hides the mesh.
+    mz = pos[:, 0] * F[:, 1] - pos[:, 1] * F[:, 0]
+    f_t = float(F[:, 0].sum())
+    f_r = float(-F[:, 1].sum())
     f_a = float(F[:, 2].sum())
+    tq = float(mz.sum())
     wheel_geom = np.where(wheel_is_2, geom[:, 1], geom[:, 0])
     # tooth index of each contact: slot -> tooth in the current window
     W = bm.window_teeth
@@ -103,7 +106,7 @@ def tooth_forces(bm: BuiltModel, d: mujoco.MjData, window_ks: np.ndarray):
     ang = -(th2 + 2 * math.pi * ks / bm.geometry.z2)
     c, s = np.cos(ang), np.sin(ang)
     p0 = np.stack([c * pos[:, 0] - s * pos[:, 1], s * pos[:, 0] + c * pos[:, 1], pos[:, 2]], axis=1)
-    return f_t, f_r, f_a, len(adr), n_teeth, float(max(0.0, -dist.min())), p0, F, pos
+    return f_t, f_r, f_a, tq, len(adr), n_teeth, float(max(0.0, -dist.min())), p0, F, pos
 
 
 _SLOT_CACHE: dict[int, np.ndarray] = {}
@@ -142,7 +145,7 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
     names = ["t_s", "worm_angle_rad", "wheel_angle_rad", "worm_speed_rpm", "wheel_speed_rpm",
              "worm_torque_nm", "wheel_torque_nm", "drive_command", "tangential_force_n", "radial_force_n",
              "axial_force_n", "contacts", "teeth_in_contact", "max_penetration_m", "friction_coefficient",
-             "transmission_error_rad"]
+             "transmission_error_rad", "wheel_contact_torque_nm"]
     S = {k: np.zeros(n_rec) for k in names}
     pts = np.full((n_rec, MAX_POINTS, 3), np.nan, dtype=np.float32)
     pts_world = np.full((n_rec, MAX_POINTS, 3), np.nan, dtype=np.float32)
@@ -179,7 +182,7 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
         vs = abs(w1) * geo.r1 / math.cos(geo.gamma)
         mu = float(friction_coefficient(scenario.contact, vs))
         m.geom_friction[coll, 0] = mu
-        f_t, f_r, f_a, ncon, nteeth, pen, p0, F, pw = tooth_forces(bm, d, window)
+        f_t, f_r, f_a, tq, ncon, nteeth, pen, p0, F, pw = tooth_forces(bm, d, window)
         if pen > pen_lim:
             raise SimulationError(
                 f"penetration {pen * 1e6:.1f} um at t = {t:.4g} s exceeds the tolerance {pen_lim * 1e6:.1f} um "
@@ -205,6 +208,7 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
         S["wheel_torque_nm"][i] = tq_load if worm_is_drive else tq_drive
         S["drive_command"][i] = cmd[0]
         S["tangential_force_n"][i], S["radial_force_n"][i], S["axial_force_n"][i] = f_t, f_r, f_a
+        S["wheel_contact_torque_nm"][i] = tq
         S["contacts"][i], S["teeth_in_contact"][i] = ncon, nteeth
         S["max_penetration_m"][i] = pen
         S["friction_coefficient"][i] = mu
