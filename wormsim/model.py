@@ -152,11 +152,14 @@ def build_model(scenario: Scenario, gs=None) -> BuiltModel:
         raise RuntimeError("meshgen.assembly: the wheel frame must coincide with the assembly frame at theta2 = 0")
     worm_b.pos = Tw[:3, 3]
     worm_b.quat = _mat2quat(Tw[:3, :3])
-    for body, mass, izz in ((worm_b, m1, I1), (wheel_b, m2, I2)):
+    # transverse moments of a solid cylinder of the part's length, Izz / 2 + m L^2 / 12: irrelevant on a hinge,
+    # but they must satisfy the triangle inequality with a margin that survives the 6 digits of a written MJCF
+    for body, mass, izz, length in ((worm_b, m1, I1, geo.worm_length), (wheel_b, m2, I2, geo.face_width)):
         body.explicitinertial = True
         body.mass = mass
         body.ipos = [0, 0, 0]
-        body.inertia = [izz / 2 + 1e-12, izz / 2 + 1e-12, izz]
+        ixx = izz / 2 + mass * length ** 2 / 12
+        body.inertia = [ixx, ixx, izz]
 
     def add_mesh(name, mesh):
         me = spec.add_mesh()
