@@ -33,6 +33,3 @@ class Progress:
     def __exit__(self, *exc):
         self.close()
 
-
-def null_progress() -> Progress:
-    return Progress(1.0, enabled=False)
