@@ -25,6 +25,7 @@ import math
 import numpy as np
 
 from wormsim.contact import efficiency_theory
+from wormsim.units import RPM, rad_s_to_rpm
 
 
 def steady_window(t: np.ndarray, speed: np.ndarray, t_start: float, period_s: float) -> tuple[int, int]:
@@ -101,9 +102,8 @@ def mean_speeds_rpm(S: dict, i0: int, i1: int) -> tuple[float, float]:
     span = t[i1 - 1] - t[i0]
     if span <= 0:
         return float("nan"), float("nan")
-    rpm = 60.0 / (2 * math.pi)
-    n1 = abs(S["worm_angle_rad"][i1 - 1] - S["worm_angle_rad"][i0]) / span * rpm
-    n2 = abs(S["wheel_angle_rad"][i1 - 1] - S["wheel_angle_rad"][i0]) / span * rpm
+    n1 = rad_s_to_rpm(abs(S["worm_angle_rad"][i1 - 1] - S["worm_angle_rad"][i0]) / span)
+    n2 = rad_s_to_rpm(abs(S["wheel_angle_rad"][i1 - 1] - S["wheel_angle_rad"][i0]) / span)
     return float(n1), float(n2)
 
 
@@ -115,10 +115,9 @@ def drive_summary(S: dict, scenario, geo, i0: int, i1: int, n1: float, n2: float
     drv, load = scenario.drive, scenario.load
     sl = slice(i0, i1)
     ft = S["tangential_force_n"][sl]
-    w = 2 * math.pi / 60
     T1, T2 = S["worm_torque_nm"][sl], S["wheel_torque_nm"][sl]
-    p1 = float(np.mean(T1 * S["worm_speed_rpm"][sl] * w))
-    p2 = float(np.mean(T2 * S["wheel_speed_rpm"][sl] * w))
+    p1 = float(np.mean(T1 * S["worm_speed_rpm"][sl] * RPM))
+    p2 = float(np.mean(T2 * S["wheel_speed_rpm"][sl] * RPM))
     if drv.on == "worm":
         eff = -p2 / p1 if p1 > 0 else float("nan")
     else:
