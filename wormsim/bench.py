@@ -10,7 +10,8 @@ For each seed scenario, each fidelity level runs across its resolutions and time
                       against a finer run (`reference_check` in bench_meta.json).
 
 Outputs, written atomically: bench.json (list of records), bench_meta.json (machine, reference
-check, notes), bench.png (error against wall time per simulated second, log axes, one curve per
+check, notes, and "stability": the last stable contact3d timestep per seed and how the next one failed,
+stability_edge), bench.png (error against wall time per simulated second, log axes, one curve per
 level, Pareto front marked).
 """
 from __future__ import annotations
@@ -190,6 +191,9 @@ def run_bench(quick: bool, out_dir: str | Path, repeats: int | None = None,
         finer = next((r for r in records if r["scenario"] == scen and r.get("finer") and r["status"] == "ok"), None)
         if finer is not None:
             meta["reference_check"][scen] = finer["error"]
+    if _level_available("contact3d") and (models is None or "contact3d" in models):
+        # the timestep sweep of each seed until a guard fires (stability_edge); quick: the seat motor only
+        meta["stability"] = stability_map(quick)
     write_json_atomic(out / "bench.json", records)
     write_json_atomic(out / "bench_meta.json", meta)
     plot_bench(records, out / "bench.png")
@@ -232,3 +236,107 @@ def plot_bench(records: list[dict], path: Path, key: str = "tangential_force_mea
     fig.savefig(tmp, dpi=110)
     plt.close(fig)
     os.replace(tmp, path)
+
+
+# ----------------------------------------------------------------------------- stability edge (issue 5, first slice)
+
+STABILITY_FACTORS = (1, 2, 4, 8, 16, 32)
+# drift tolerances against the run at the default timestep (docs/contact3d.md's validation criteria: ratio within
+# 0.1 %, torque balance F_t r2 within 2 %)
+STABILITY_TOLERANCES = {"ratio": 1e-3, "tangential_force_mean_n": 0.02}
+# resolution per seed for the sweep: coarse where its pieces leave no interference (involute_41 needs fine,
+# docs/contact3d.md "Validation")
+STABILITY_RESOLUTION = {"seat_motor": "coarse", "screw_jack": "coarse", "involute_41": "fine"}
+STABILITY_DURATION_S = 0.05
+# the guards' messages (wormsim.simulate) start with these words; the class names are what bench_meta.json holds
+FAILURE_CLASSES = (("diverged", "diverged"), ("teeth jumped", "teeth_jumped"), ("penetration", "penetration"),
+                   ("the drive locked", "locked"))
+
+
+def classify_failure(message: str) -> str:
+    """Class of a contact3d guard message (wormsim.simulate): diverged | teeth_jumped | penetration | locked,
+    else "other"."""
+    for head, cls in FAILURE_CLASSES:
+        if message.startswith(head):
+            return cls
+    return "other"
+
+
+def stability_edge(scenario_name: str, factors: tuple[float, ...] = STABILITY_FACTORS,
+                   duration_s: float = STABILITY_DURATION_S, overrides: tuple[str, ...] = (),
+                   resolution: str | None = None, tolerances: dict | None = None) -> dict:
+    """Sweep the contact3d timestep upward from its default h0 (wormsim.model.default_timestep: 0.4 x the explicit
+    limit of the contact spring-damper, rounded down to 1-2-5) by `factors` on a short run of
+    scenarios/<scenario_name>.yaml, until a run fails.
+
+    Each run is classified: "ok"; "inaccurate" when the ratio or the mean tangential force drifts from the run
+    at the first factor by more than `tolerances` (relative; also when a checked value is missing); or the guard
+    that stopped it (classify_failure: diverged, teeth_jumped, penetration, locked). The sweep stops at the first
+    run that is not "ok". Returns a JSON-ready record: the default and limit timesteps, every run (factor,
+    timestep_s, dt / limit, status, failure, message, ratio, tangential_force_mean_n, drift), the last stable
+    timestep (the largest "ok" one, None if the first fails) and how the next one failed.
+    Wall times are measured, never judged."""
+    import time as _time
+
+    from wormsim.errors import SimulationError
+    from wormsim.model import build_model, default_timestep
+    from wormsim.simulate import simulate
+
+    tol = dict(STABILITY_TOLERANCES if tolerances is None else tolerances)
+    base = tuple(overrides) + (f"simulation.duration_s={duration_s}",)
+    if resolution is not None:
+        base += (f"simulation.resolution={resolution}",)
+    sc0 = load_scenario(SCENARIOS / f"{scenario_name}.yaml", list(base))
+    law = build_model(sc0).law
+    h0 = default_timestep(law)
+    limit = law.stable_timestep_s(3 * law.contacts_per_pair)
+    runs: list[dict] = []
+    ref: dict | None = None
+    for f in factors:
+        dt = float(f"{h0 * f:.4g}")
+        sc = load_scenario(SCENARIOS / f"{scenario_name}.yaml", list(base) + [f"simulation.timestep_s={dt}"])
+        run = {"factor": f, "timestep_s": dt, "timestep_over_limit": dt / limit, "status": "ok", "failure": None,
+               "message": "", "ratio": None, "tangential_force_mean_n": None, "drift": {}, "wall_s": None}
+        t0 = _time.perf_counter()
+        try:
+            s = simulate(sc).summary
+        except SimulationError as exc:
+            run.update(status="failed", failure=classify_failure(str(exc)), message=str(exc))
+        else:
+            run["ratio"], run["tangential_force_mean_n"] = s.get("ratio"), s.get("tangential_force_mean_n")
+            if ref is None:
+                ref = s
+            bad = []
+            for k, lim in tol.items():
+                x, r = s.get(k), ref.get(k)
+                ok = x is not None and r is not None and np.isfinite(x) and np.isfinite(r) and r != 0
+                run["drift"][k] = abs(x - r) / abs(r) if ok else None
+                if not ok or run["drift"][k] > lim:
+                    bad.append(k)
+            if bad:
+                run.update(status="inaccurate", failure="inaccurate",
+                           message="drift beyond tolerance (or no steady value) in " + ", ".join(bad))
+        run["wall_s"] = _time.perf_counter() - t0
+        runs.append(run)
+        if run["status"] != "ok":
+            break
+    ok = [r for r in runs if r["status"] == "ok"]
+    last = ok[-1] if ok else None
+    first_bad = next((r for r in runs if r["status"] != "ok"), None)
+    return {"scenario": scenario_name, "overrides": list(base), "duration_s": duration_s,
+            "default_timestep_s": h0, "stable_limit_s": limit, "tolerances": tol,
+            "last_stable_timestep_s": last["timestep_s"] if last else None,
+            "last_stable_factor": last["factor"] if last else None,
+            "failure": first_bad["failure"] if first_bad else None,
+            "failed_timestep_s": first_bad["timestep_s"] if first_bad else None,
+            "failure_message": first_bad["message"] if first_bad else "",
+            "runs": runs}
+
+
+def stability_map(quick: bool) -> dict:
+    """stability_edge for each seed's bench variant (VARIANTS) at STABILITY_RESOLUTION; quick: the seat motor only,
+    over 0.03 s. Keyed by scenario, written to bench_meta.json under "stability"."""
+    names = ("seat_motor",) if quick else tuple(VARIANTS)
+    dur = 0.03 if quick else STABILITY_DURATION_S
+    return {n: stability_edge(n, duration_s=dur, overrides=VARIANTS[n], resolution=STABILITY_RESOLUTION[n])
+            for n in names}

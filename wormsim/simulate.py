@@ -109,6 +109,64 @@ def tooth_forces(bm: BuiltModel, d: mujoco.MjData, window_ks: np.ndarray):
     return f_t, f_r, f_a, tq, len(adr), n_teeth, float(max(0.0, -dist.min())), p0, F, pos
 
 
+def diverged_error(t: float, dt: float, bm: BuiltModel, what: str) -> SimulationError:
+    """Divergence diagnosis. Above the explicit stability limit of the contact spring-damper with three pairs in
+    parallel (ContactLaw.stable_timestep_s: h < 2/omega (sqrt(1 + zeta^2) - zeta)) the cure is the timestep: the
+    message names the limit and wormsim's default (wormsim.model.default_timestep, 0.4 x the limit rounded down
+    to 1-2-5). Within the limit the blow-up comes from a command step the light shafts cannot follow."""
+    from wormsim.model import default_timestep
+
+    lim = bm.law.stable_timestep_s(3 * bm.law.contacts_per_pair)
+    h0 = default_timestep(bm.law)
+    if dt > lim:
+        return SimulationError(
+            f"diverged at t = {t:.4g} s ({what}): timestep {dt:.3g} s is above the contact's stable limit "
+            f"{lim:.3g} s (contact stiffness {bm.law.pair_stiffness_n_per_m:.3g} N/m per tooth pair); set "
+            f"simulation.timestep_s <= {h0:.3g} s (the default for this contact: leave it unset) or lower "
+            f"contact.stiffness_n_per_m")
+    return SimulationError(
+        f"diverged at t = {t:.4g} s ({what}) at timestep {dt:.3g} s, within the contact's stable limit {lim:.3g} s: "
+        f"a torque or speed step the light shafts cannot follow; lengthen drive.ramp_s / load.ramp_s, lower "
+        f"simulation.record_every (the commands are held over each record interval) or load.torque_nm")
+
+
+def jump_error(t: float, te_pitch: float, dt: float, bm: BuiltModel, scenario: Scenario) -> SimulationError:
+    """Transmission error beyond half a pitch. Above the stable timestep this is the integration running away
+    (reported as divergence: a stiffer contact would make it worse); within it the teeth really passed each
+    other: the load overpowers the mesh."""
+    lim = bm.law.stable_timestep_s(3 * bm.law.contacts_per_pair)
+    if dt > lim:
+        return diverged_error(t, dt, bm, f"the transmission error ran away to {te_pitch:.2f} pitch")
+    return SimulationError(
+        f"teeth jumped a pitch at t = {t:.4g} s (transmission error {te_pitch:.2f} pitch) at timestep {dt:.3g} s, "
+        f"within the contact's stable limit {lim:.3g} s: the load overpowers the mesh (load {scenario.load.torque_nm} "
+        f"N m over {scenario.load.ramp_s} s, contact stiffness {bm.law.pair_stiffness_n_per_m:.3g} N/m per tooth "
+        f"pair); lower load.torque_nm or lengthen load.ramp_s, or raise contact.stiffness_n_per_m (with a smaller "
+        f"simulation.timestep_s)")
+
+
+def locked_error(t: float, w_drive: float, w_cmd: float, bm: BuiltModel, scenario: Scenario) -> SimulationError:
+    """A speed-driven drive held below half its command. When the wheel drives and the pair is self-locking at
+    standstill, rho' = atan(mu_static / cos alpha_n) >= gamma (DIN 3975: back-driving efficiency
+    tan(gamma - rho') / tan(gamma) <= 0), the diagnosis says so; otherwise the mesh is jammed."""
+    geo = bm.geometry
+    head = (f"the drive locked at t = {t:.4g} s: the {scenario.drive.on} turns at {rad_s_to_rpm(w_drive):.3g} rpm "
+            f"against a command of {rad_s_to_rpm(w_cmd):.3g} rpm")
+    mu0 = float(friction_coefficient(scenario.contact, 0.0))
+    rho = math.atan(mu0 / math.cos(geo.alpha_n))
+    if scenario.drive.on == "wheel" and rho >= geo.gamma:
+        mu_max = math.tan(geo.gamma) * math.cos(geo.alpha_n)
+        return SimulationError(
+            f"{head}: the pair is self-locking (rho' = atan(mu / cos alpha_n) = {math.degrees(rho):.2f} deg at "
+            f"standstill friction mu = {mu0:.3g} >= lead angle gamma = {math.degrees(geo.gamma):.2f} deg), so the "
+            f"wheel cannot turn the worm; drive the worm (drive.on=worm, load.on=wheel), or, to back-drive, lower "
+            f"the friction below mu = tan(gamma) cos(alpha_n) = {mu_max:.3g} or raise gear.lead_angle_deg above "
+            f"{math.degrees(rho):.2f} deg")
+    return SimulationError(
+        f"{head}: the mesh is jammed; check gear.backlash_mm, the load torque {scenario.load.torque_nm} N m "
+        f"against what the drive can deliver, and the friction")
+
+
 _SLOT_CACHE: dict[int, np.ndarray] = {}
 
 
@@ -167,17 +225,10 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
         t = float(d.time)
         # guards
         if not (np.isfinite(d.qpos).all() and np.isfinite(d.qvel).all()) or d.warning[mujoco.mjtWarning.mjWARN_BADQACC].number:
-            raise SimulationError(
-                f"diverged at t = {t:.4g} s: timestep {dt:.3g} s against the contact's stable limit ~{dt_limit:.2g} s "
-                f"(contact stiffness {bm.law.pair_stiffness_n_per_m:.3g} N/m per tooth pair); set "
-                f"simulation.timestep_s <= {0.25 * dt_limit:.2g} or lower contact.stiffness_n_per_m")
+            raise diverged_error(t, dt, bm, "non-finite state or huge acceleration (MuJoCo's bad-qacc warning)")
         te = th2 - bm.direction * th1 / geo.ratio
         if abs(te) > JUMP_PITCH * pitch_angle:
-            raise SimulationError(
-                f"teeth jumped a pitch at t = {t:.4g} s (transmission error {te / pitch_angle:.2f} pitch): the contact "
-                f"is too soft or too slow to resolve for this load/timestep; timestep {dt:.3g} s (stable limit "
-                f"~{dt_limit:.2g} s), stiffness {bm.law.pair_stiffness_n_per_m:.3g} N/m: lower simulation.timestep_s, "
-                f"raise contact.stiffness_n_per_m or lower load.torque_nm")
+            raise jump_error(t, te / pitch_angle, dt, bm, scenario)
         window = repose_window(bm, th2, window)
         vs = abs(w1) * geo.r1 / math.cos(geo.gamma)
         mu = float(friction_coefficient(scenario.contact, vs))
@@ -187,16 +238,13 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
             raise SimulationError(
                 f"penetration {pen * 1e6:.1f} um at t = {t:.4g} s exceeds the tolerance {pen_lim * 1e6:.1f} um "
                 f"(0.4 m_x): contact too soft for the load or timestep {dt:.3g} s too large (stable limit "
-                f"~{dt_limit:.2g} s); raise contact.stiffness_n_per_m or lower simulation.timestep_s")
+                f"~{dt_limit:.2g} s); raise contact.stiffness_n_per_m, lower simulation.timestep_s or lower load.torque_nm")
         if drv.speed_rpm is not None and t > ramp_end + 0.02:
             w_drive = w1 if worm_is_drive else w2
             if abs(w_drive) < 0.5 * abs(cmd[0]):
                 locked_since = t if locked_since is None else locked_since
                 if t - locked_since > max(0.05, 20 * rec * dt):
-                    raise SimulationError(
-                        f"the drive locked at t = {t:.4g} s: {rad_s_to_rpm(w_drive):.3g} rpm against a command of "
-                        f"{rad_s_to_rpm(cmd[0]):.3g} rpm; the mesh is jammed (check gear.backlash_mm, the load "
-                        f"torque {scenario.load.torque_nm} N m and the friction)")
+                    raise locked_error(t, w_drive, cmd[0], bm, scenario)
             else:
                 locked_since = None
         act = d.actuator_force

@@ -1,0 +1,158 @@
+"""contact3d's guards (wormsim.simulate, issue 5): each failure mode stops the run with SimulationError (CLI exit 3,
+summary.json "failed") and a diagnosis that says what to change; a valid run trips none; the timestep stability
+edge (wormsim.bench.stability_edge) records the last stable timestep and classifies how the next one failed.
+
+Runs are short (milliseconds of simulated time) on coarse collision pieces. Which guard fires for which input was
+measured first (seat motor demo gear, default timestep 5e-6 s, explicit stable limit 1.61e-5 s):
+  - a wheel load stepped onto the held worm: 300 N m is carried (max penetration 109 um); 700 N m trips the
+    penetration guard (349 um > 0.4 m_x = 281 um) in 3 steps; 2000 N m throws the 7 g wheel past a tooth in 2 steps
+    (transmission error -0.67 pitch) before any sampled penetration reaches the limit: teeth jumped.
+  - timestep 2e-5 s (x4, 1.24 x the limit) and above: the transmission error runs away within a millisecond
+    (1.6 to 4700 pitch); the state stays finite, MuJoCo's bad-qacc warning does not fire. This is divergence, and is
+    reported so (a stiffer contact, the jump guard's other cure, would make it worse).
+"""
+from __future__ import annotations
+
+import json
+import math
+import re
+from pathlib import Path
+
+import pytest
+
+from wormsim import cli
+from wormsim.bench import FAILURE_CLASSES, classify_failure, stability_edge
+from wormsim.errors import SimulationError
+from wormsim.model import build_model, default_timestep
+from wormsim.scenario import load_scenario
+from wormsim.simulate import JUMP_PITCH, penetration_limit_m, simulate
+
+SCEN = Path(__file__).resolve().parent.parent / "scenarios"
+DEMO = SCEN / "seat_motor_demo.yaml"
+JACK = SCEN / "screw_jack.yaml"
+
+# screw jack (gamma 5.71 deg, alpha_n 20 deg) with the WHEEL speed-driven at its nominal 55 rpm and a light load on
+# the worm; one constant friction coefficient
+WHEEL_DRIVEN = ["drive.on=wheel", "drive.speed_rpm=55", "drive.ramp_s=0.01", "load.on=worm", "load.torque_nm=0.1",
+                "load.ramp_s=0.01", "contact.friction_static=null", "contact.friction_dynamic=null",
+                "simulation.resolution=coarse"]
+# the lock guard arms 0.02 s after the ramps and fires after 0.05 s below half the command: 0.085 s covers it
+LOCK_DURATION = "simulation.duration_s=0.085"
+
+
+def _rho_deg(mu: float, alpha_n_deg: float) -> float:
+    """Virtual friction angle rho' = atan(mu / cos alpha_n) (DIN 3975)."""
+    return math.degrees(math.atan(mu / math.cos(math.radians(alpha_n_deg))))
+
+
+def test_self_locking_pair_with_speed_driven_wheel_stops_locked_through_the_cli(tmp_path, capsys):
+    """mu = 0.2: rho' = 12.0 deg > gamma = 5.71 deg, the wheel cannot turn the worm. Exit 3, a failed summary.json
+    naming the self-locking and what to change, and nothing else left in DIR."""
+    assert _rho_deg(0.2, 20.0) > 5.71
+    out = tmp_path / "locked"
+    args = ["run", str(JACK), "--out", str(out), "--no-progress"]
+    for kv in WHEEL_DRIVEN + ["contact.friction=0.2", LOCK_DURATION]:
+        args += ["--set", kv]
+    assert cli.main(args) == 3
+    err = capsys.readouterr().err
+    assert "simulation failed: the drive locked" in err
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == "failed" and summary["model"] == "contact3d"
+    msg = summary["message"]
+    assert classify_failure(msg) == "locked"
+    assert "self-locking" in msg and "drive.on=worm" in msg, msg
+    # the numbers it states: rho' at the friction given and the lead angle of the screw jack (q = 10)
+    rho = float(re.search(r"rho' = .*? = ([0-9.]+) deg", msg).group(1))
+    gamma = float(re.search(r"lead angle gamma = ([0-9.]+) deg", msg).group(1))
+    assert rho == pytest.approx(_rho_deg(0.2, 20.0), abs=0.01) and gamma == pytest.approx(5.71, abs=0.01)
+    # the friction below which back-driving works: mu < tan(gamma) cos(alpha_n)
+    mu_max = float(re.search(r"below mu = tan\(gamma\) cos\(alpha_n\) = ([0-9.]+)", msg).group(1))
+    assert mu_max == pytest.approx(math.tan(math.radians(5.7106)) * math.cos(math.radians(20)), rel=2e-3)
+    assert [p.name for p in out.iterdir()] == ["summary.json"]
+
+
+def test_valid_back_driven_run_trips_no_guard():
+    """The counter-case and the valid run: mu = 0.02 (rho' = 1.22 deg < gamma) lets the speed-driven wheel turn the
+    worm, for as long as the lock guard watches; ratio 24 holds, penetration and transmission error stay inside
+    their guards."""
+    sc = load_scenario(JACK, WHEEL_DRIVEN + ["contact.friction=0.02", LOCK_DURATION])
+    res = simulate(sc)
+    bm = res.extra["built"]
+    assert res.sim_time_s == pytest.approx(0.085, abs=1e-4)
+    # ratio from the shaft angles over the last 0.05 s (the summary's mean-speed ratio has about one 22 Hz mesh
+    # period in so short a window)
+    t = res.series["t_s"]
+    i = int((t < t[-1] - 0.05).sum())
+    d1 = res.series["worm_angle_rad"][-1] - res.series["worm_angle_rad"][i]
+    d2 = res.series["wheel_angle_rad"][-1] - res.series["wheel_angle_rad"][i]
+    assert abs(d1 / d2) == pytest.approx(24.0, rel=1e-3)
+    assert max(res.series["max_penetration_m"]) < penetration_limit_m(bm)
+    te_pitch = abs(res.series["transmission_error_rad"]).max() / (2 * math.pi / bm.geometry.z2)
+    assert te_pitch < JUMP_PITCH
+    # the worm really turned at the kinematic speed after the ramp
+    assert abs(res.series["worm_speed_rpm"][-1]) > 0.5 * 55 * 24
+
+
+@pytest.mark.parametrize("torque_nm, klass, cure", [
+    (700, "penetration", "lower load.torque_nm"),
+    (2000, "teeth_jumped", "lower load.torque_nm"),
+])
+def test_overload_on_held_worm_penetrates_or_jumps_with_a_diagnosis(torque_nm, klass, cure):
+    """A wheel load stepped onto the worm held at 0 rpm, at the default (stable) timestep: 700 N m is stopped by the
+    penetration guard (0.4 m_x); 2000 N m throws the wheel past a tooth within two steps: the jump guard's
+    message, not the divergence guard's."""
+    sc = load_scenario(DEMO, ["drive.speed_rpm=0", "drive.ramp_s=0", "load.ramp_s=0", f"load.torque_nm={torque_nm}",
+                              "simulation.duration_s=0.001"])
+    bm = build_model(sc)
+    assert bm.model.opt.timestep <= bm.law.stable_timestep_s(3 * bm.law.contacts_per_pair)
+    with pytest.raises(SimulationError) as exc:
+        simulate(sc)
+    msg = str(exc.value)
+    assert classify_failure(msg) == klass, msg
+    assert cure in msg, msg
+    if klass == "teeth_jumped":
+        assert "diverged" not in msg
+        assert abs(float(re.search(r"transmission error (-?[0-9.]+) pitch", msg).group(1))) > JUMP_PITCH
+
+
+def test_timestep_above_the_stable_limit_diverges_and_names_the_stable_timestep():
+    """dt = 1e-4 s, 20 x the default and 6 x the explicit limit of the contact spring-damper: the message is the
+    divergence guard's and states the limit (ContactLaw.stable_timestep_s with three pairs) and the default
+    timestep (wormsim.model.default_timestep) to set."""
+    sc = load_scenario(DEMO, ["simulation.timestep_s=1e-4", "simulation.duration_s=0.005"])
+    law = build_model(sc).law
+    with pytest.raises(SimulationError) as exc:
+        simulate(sc)
+    msg = str(exc.value)
+    assert classify_failure(msg) == "diverged", msg
+    limit = float(re.search(r"stable limit ([0-9.e+-]+) s", msg).group(1))
+    advice = float(re.search(r"simulation\.timestep_s <= ([0-9.e+-]+) s", msg).group(1))
+    assert limit == pytest.approx(law.stable_timestep_s(3 * law.contacts_per_pair), rel=5e-3)
+    assert advice == pytest.approx(default_timestep(law), rel=1e-9)
+    assert advice < limit < 1e-4
+
+
+def test_classify_failure_names_each_guard():
+    for head, klass in FAILURE_CLASSES:
+        assert classify_failure(f"{head} at t = 0.1 s: ...") == klass
+    assert classify_failure("internal error: ZeroDivisionError") == "other"
+
+
+def test_stability_edge_records_the_last_stable_timestep_and_the_failure():
+    """A tiny sweep on the seat motor demo (x1, x4 its default timestep, 15 ms): x1 is the reference and passes,
+    x4 (1.24 x the explicit limit) runs away and is classified as divergence; the record says so."""
+    rec = stability_edge("seat_motor_demo", factors=(1, 4), duration_s=0.015,
+                         overrides=("drive.ramp_s=0.002", "load.ramp_s=0.002"))
+    for k in ("scenario", "default_timestep_s", "stable_limit_s", "last_stable_timestep_s", "last_stable_factor",
+              "failure", "failed_timestep_s", "failure_message", "runs", "tolerances"):
+        assert k in rec, k
+    h0 = rec["default_timestep_s"]
+    assert h0 == pytest.approx(5e-6) and h0 < rec["stable_limit_s"] < 4 * h0
+    first, second = rec["runs"]
+    assert first["status"] == "ok" and first["drift"] == {"ratio": 0.0, "tangential_force_mean_n": 0.0}
+    assert first["ratio"] == pytest.approx(53.0, rel=2e-2)      # mean speeds over ~8 ms right after the ramps
+    assert second["status"] == "failed" and second["failure"] == "diverged"
+    assert second["timestep_s"] == pytest.approx(4 * h0) and second["timestep_over_limit"] > 1
+    assert rec["last_stable_timestep_s"] == pytest.approx(h0) and rec["last_stable_factor"] == 1
+    assert rec["failure"] == "diverged" and rec["failed_timestep_s"] == pytest.approx(4 * h0)
+    json.dumps(rec)                                          # bench_meta.json-ready
