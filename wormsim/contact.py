@@ -48,6 +48,26 @@ from the sliding speed Vs = omega1 r1 / cos(gamma) (seed 000):
                                           the transition velocity v_t = contact.transition_velocity_m_s)
   friction_group: mu(Vs) = tan(rho(Vs)), rho of seed 000 (wormsim.friction)
   none given: mu = 0.05 (lubricated steel/bronze, DEFAULT_FRICTION).
+
+Friction hardness (opt.impratio). MuJoCo's elliptic friction rows have no position term: their reference
+acceleration is a_ref = -b v_t (b = B / d, the normal row's damping) and their regulariser is
+R_f = R / impratio. Below the cone the solver's force is f_t = -R_f^-1 (J qacc - a_ref); where the slip is
+imposed by the mechanism (the worm turned by its servo slides along the flank), J qacc ~ 0 and
+
+    f_t = b v_t / R_f = impratio B / ((1 - d) A_hat) v_t = impratio c_c v_t,                      (2)
+
+a viscous friction, saturating at Coulomb's mu f_n only above v_reg = mu f_n / (impratio c_c). Measured with
+impratio 1: f_t / v_t = 12.16 N s/m = c_c on every unsaturated seat-motor contact; with f_n ~ 33 N per
+contact v_reg ~ 0.13 m/s, so at seed 001's 36 rpm (Vs 0.016 m/s) friction reached 12-19 % of mu f_n and the
+efficiency came out 0.92 against 0.62 (docs/contact3d.md, "Friction at low sliding speed"). We choose
+
+    impratio = max(1, mu_max F_n / (c_c v_t))                                                    (3)
+
+with F_n the whole mesh's nominal normal force at the working load (DIN 3975: T2 / (r2 cos(alpha_n)
+cos(gamma))), mu_max = max(mu(0), mu(1 m/s)) and v_t = contact.transition_velocity_m_s: even a contact
+carrying the whole load saturates once it slips faster than the static -> dynamic transition velocity (the
+stiction range of ADAMS's friction), so friction is Coulomb's wherever mu(Vs) is dynamic. Only the friction rows change: the
+normal rows and the stiffness mapping (1) are untouched.
 """
 from __future__ import annotations
 
@@ -81,6 +101,7 @@ class ContactLaw:
     impedance: float                    # d
     solref: tuple[float, float]         # (-S, -B)
     solimp: tuple[float, float, float, float, float]
+    impratio: float = 1.0               # MuJoCo opt.impratio: R_normal / R_friction, (3)
 
     def natural_frequency_rad_s(self, contacts: int) -> float:
         """omega = sqrt(n k_c A_hat): mesh mode with `contacts` contacts in parallel."""
@@ -144,6 +165,36 @@ def contact_law(contact: Contact, materials: Materials, face_width_m: float, con
         contact_damping_requested_n_s_per_m=c_req, contact_damping_n_s_per_m=c_c,
         effective_mass_kg=m_eff, inv_mass_hat=inv_mass_hat, impedance=d,
         solref=(-s, -b), solimp=(d, d, 0.001, 0.5, 2.0))
+
+
+def friction_impratio(law: ContactLaw, mu_max: float, normal_force_n: float, transition_velocity_m_s: float) -> float:
+    """(3): impratio = max(1, mu_max F_n / (c_c v_t)), so that by (2) a contact carrying F_n is on the
+    friction cone for slip above v_t."""
+    if mu_max <= 0 or normal_force_n <= 0 or law.contact_damping_n_s_per_m <= 0:
+        return 1.0
+    return max(1.0, mu_max * normal_force_n / (law.contact_damping_n_s_per_m * transition_velocity_m_s))
+
+
+def friction_regularisation_velocity_m_s(law: ContactLaw, mu: float, normal_force_n: float) -> float:
+    """v_reg = mu f_n / (impratio c_c): slip speed above which a contact carrying f_n is on the cone, by (2)."""
+    return mu * normal_force_n / (law.impratio * law.contact_damping_n_s_per_m)
+
+
+def friction_utilisation(model, data) -> np.ndarray:
+    """Per active contact (rows of an (n, 4) array): normal force f_n (N), friction force |f_t| (N), the
+    contact's mu, slip speed |v_t| (m/s). Elliptic cones: efc_force rows of a contact are (normal, tangent 1,
+    tangent 2) in the contact frame (what mj_contactForce returns) and efc_vel = J qvel the relative velocity
+    in the same rows. Utilisation = |f_t| / (mu f_n), 1 on the cone (sliding, Coulomb)."""
+    n = data.ncon
+    if n == 0:
+        return np.zeros((0, 4))
+    con = data.contact
+    adr = np.asarray(con.efc_address[:n])
+    mu = np.asarray(con.friction[:n, 0])
+    ok = adr >= 0
+    adr, mu = adr[ok], mu[ok]
+    f, v = data.efc_force, data.efc_vel
+    return np.stack([f[adr], np.hypot(f[adr + 1], f[adr + 2]), mu, np.hypot(v[adr + 1], v[adr + 2])], axis=1)
 
 
 # ----------------------------------------------------------------------------- friction

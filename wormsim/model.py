@@ -20,14 +20,14 @@ Built with mujoco.MjSpec from the template `models/worm_pair.xml` (see models/RE
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import mujoco
 import numpy as np
 
 from meshgen.geometry import GearGeometry, derive
-from wormsim.contact import ContactLaw, contact_law, efficiency_theory, friction_coefficient
+from wormsim.contact import ContactLaw, contact_law, efficiency_theory, friction_coefficient, friction_impratio
 from wormsim.scenario import Scenario, ScenarioError
 from wormsim.units import rpm_to_rad_s
 
@@ -104,6 +104,15 @@ def mesh_arms(geo: GearGeometry) -> tuple[float, float]:
     return geo.r1 * ca * math.sin(geo.gamma), geo.r2 * ca * math.cos(geo.gamma)
 
 
+def nominal_normal_force_n(scenario: Scenario, geo: GearGeometry) -> float:
+    """Whole-mesh normal force at the working load, F_n = T2 / (r2 cos(alpha_n) cos(gamma)) (DIN 3975; wheel
+    torque T2 = the load, or the worm load times the ratio when the load is on the worm). Sets the friction
+    rows' hardness (wormsim.contact (3))."""
+    load = scenario.load
+    t2 = abs(load.torque_nm) * (1.0 if load.on == "wheel" else geo.ratio)
+    return t2 / (geo.r2 * math.cos(geo.alpha_n) * math.cos(geo.gamma))
+
+
 def expected_direction(scenario: Scenario, geo: GearGeometry) -> int:
     """+1/-1: sign of the driven shaft's speed per sign of the drive command. INTERFACE.md: a positive
     worm rotation drives the wheel positive for a right-hand worm (and back-driving the same way)."""
@@ -144,6 +153,9 @@ def build_model(scenario: Scenario, gs=None) -> BuiltModel:
     slabs = max(1, _slabs_per_flank(gs))
     law = contact_law(scenario.contact, mats, geo.face_width, slabs, inv_mass_hat)
     mu0 = float(friction_coefficient(scenario.contact, 0.0))
+    mu_max = max(mu0, float(friction_coefficient(scenario.contact, 1.0)))
+    law = replace(law, impratio=friction_impratio(law, mu_max, nominal_normal_force_n(scenario, geo),
+                                                  scenario.contact.transition_velocity_m_s))
 
     worm_b, wheel_b = spec.body("worm"), spec.body("wheel")
     Tw = _assembly(geo, "worm", 0.0)
@@ -244,6 +256,7 @@ def build_model(scenario: Scenario, gs=None) -> BuiltModel:
 
     o = spec.option
     o.timestep = default_timestep(law) if scenario.simulation.timestep_s is None else scenario.simulation.timestep_s
+    o.impratio = law.impratio      # friction rows' hardness, wormsim.contact (3)
     o.integrator = {"implicitfast": mujoco.mjtIntegrator.mjINT_IMPLICITFAST, "rk4": mujoco.mjtIntegrator.mjINT_RK4,
                     "euler": mujoco.mjtIntegrator.mjINT_EULER, "implicit": mujoco.mjtIntegrator.mjINT_IMPLICIT,
                     "discrete": mujoco.mjtIntegrator.mjINT_DISCRETE}[scenario.simulation.integrator]

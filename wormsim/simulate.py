@@ -280,6 +280,7 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
         "contact_damping_used_n_s_per_m": bm.law.contact_damping_n_s_per_m * bm.law.contacts_per_pair,
         "contact_damping_ratio": bm.law.damping_ratio,
         "friction": friction_mode(scenario.contact),
+        "friction_impratio": bm.law.impratio,
         "window_teeth": bm.window_teeth, "collision_geoms": int(len(coll)),
         "step_wall_us": 1e6 * wall / max(n_rec * rec, 1),
         "piece_error_um": getattr(bm.pieces, "piece_error_um", None),
