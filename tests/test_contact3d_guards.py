@@ -132,6 +132,21 @@ def test_timestep_above_the_stable_limit_diverges_and_names_the_stable_timestep(
     assert advice < limit < 1e-4
 
 
+
+def test_bad_qacc_at_a_stable_timestep_names_the_command_step_and_its_cure():
+    """MuJoCo's bad-qacc warning at the default (stable) timestep: with record_every = 400 the runner holds the
+    commands of each 2 ms record interval at its midpoint value, so the 2 ms speed ramp starts as a step of the
+    worm's stiff velocity servo (100 N m load). The divergence guard names that cause and its cures; the cure it
+    names (record_every = 1, the commands then follow the ramp) runs the same input through."""
+    base = ["simulation.duration_s=0.004", "load.ramp_s=0.002", "drive.ramp_s=0.002", "load.torque_nm=100"]
+    with pytest.raises(SimulationError) as exc:
+        simulate(load_scenario(DEMO, base + ["simulation.record_every=400"]))
+    msg = str(exc.value)
+    assert classify_failure(msg) == "diverged" and "bad-qacc" in msg, msg
+    assert "within the contact's stable limit" in msg and "simulation.record_every" in msg and "ramp_s" in msg
+    res = simulate(load_scenario(DEMO, base + ["simulation.record_every=1"]))
+    assert res.sim_time_s == pytest.approx(0.004, abs=1e-5)
+
 def test_classify_failure_names_each_guard():
     for head, klass in FAILURE_CLASSES:
         assert classify_failure(f"{head} at t = 0.1 s: ...") == klass
