@@ -13,8 +13,10 @@ STEP ramps are smooth on that scale); after each chunk it
   (outward), axial; the contact torque M_z apart (wheel_contact_torque_nm); the number of contacts and of wheel teeth
   touching; contact points in the frame of wheel tooth 0 (for the contact pattern),
 - checks the guards: non-finite state or MuJoCo's bad-qacc warning (divergence), penetration beyond
-  `penetration_limit_m`, the transmission error passing half a pitch (teeth jumped), a speed-driven
-  drive stuck below half its command (locked). Each raises SimulationError with what to change.
+  `penetration_limit_m`, the transmission error passing half a pitch (teeth jumped; divergence when the
+  timestep is above the contact's stable limit), a speed-driven drive stuck below half its command (locked;
+  self-locking named when the wheel drives). Each raises SimulationError with what to change
+  (diverged_error, jump_error, locked_error; docs/contact3d.md "Failure modes and guards").
 """
 from __future__ import annotations
 
