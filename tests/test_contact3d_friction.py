@@ -18,7 +18,7 @@ import pytest
 
 from wormsim.contact import friction_coefficient, friction_regularisation_velocity_m_s, friction_utilisation
 from wormsim.model import build_model, repose_window
-from wormsim.scenario import load_scenario
+from wormsim.scenario import ScenarioError, load_scenario
 from wormsim.simulate import commands
 
 SCEN = Path(__file__).resolve().parent.parent / "scenarios"
@@ -94,3 +94,22 @@ def test_impratio_follows_the_working_load():
     expected = 0.08 * f_n / (bm.law.contact_damping_n_s_per_m * 1e-3)
     assert bm.law.impratio == pytest.approx(expected, rel=1e-3)
     assert bm.model.opt.impratio == pytest.approx(bm.law.impratio)
+
+
+def test_load_inertia_is_the_loaded_hinge_armature_and_in_the_contact_mass():
+    """load.inertia_kg_m2 (driven machine, rigid on the loaded shaft): the wheel hinge's armature, and the contact
+    law's A_hat = arm1^2 / I1 + arm2^2 / (I2 + J) (wormsim.model.mesh_arms) uses it; the bare gear is unchanged."""
+    from wormsim.model import mesh_arms
+
+    over = ["simulation.resolution=coarse"]
+    bare = build_model(load_scenario(SCEN / "seat_motor.yaml", over))
+    heavy = build_model(load_scenario(SCEN / "seat_motor.yaml", over + ["load.inertia_kg_m2=1e-4"]))
+    assert bare.model.dof_armature[bare.wheel_dof] == 0.0
+    assert heavy.model.dof_armature[heavy.wheel_dof] == pytest.approx(1e-4)
+    assert heavy.model.dof_armature[heavy.worm_dof] == 0.0
+    a1, a2 = mesh_arms(heavy.geometry)
+    i1, i2 = heavy.meta["worm_inertia_kg_m2"], heavy.meta["wheel_inertia_kg_m2"]
+    assert bare.law.inv_mass_hat == pytest.approx(a1 ** 2 / i1 + a2 ** 2 / i2, rel=1e-12)
+    assert heavy.law.inv_mass_hat == pytest.approx(a1 ** 2 / i1 + a2 ** 2 / (i2 + 1e-4), rel=1e-12)
+    with pytest.raises(ScenarioError, match="inertia_kg_m2"):
+        load_scenario(SCEN / "seat_motor.yaml", ["load.inertia_kg_m2=-1"])

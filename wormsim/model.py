@@ -14,7 +14,8 @@ Built with mujoco.MjSpec from the template `models/worm_pair.xml` (see models/RE
 - drive: speed -> `velocity` actuator (kv chosen for a 0.1 % speed droop at the expected torque, integrated
   implicitly by implicitfast), torque -> `motor`; the command follows ADAMS STEP over drive.ramp_s;
 - load: `motor` on the other shaft, resisting (sign opposite to the expected motion), STEP from
-  load.start_s over load.ramp_s;
+  load.start_s over load.ramp_s; a driven-machine inertia load.inertia_kg_m2 is the loaded hinge's armature
+  (rigid on the shaft) and counts in that shaft's effective mass of the contact law;
 - contact law: wormsim.contact (solref/solimp per collision geom; body_invweight0 set to A_hat).
 """
 from __future__ import annotations
@@ -149,7 +150,10 @@ def build_model(scenario: Scenario, gs=None) -> BuiltModel:
     m1, I1 = _axial_inertia(gs.worm_visual, mats.worm.density_kg_m3, 0.0, geo.r1, geo.worm_length)
     m2, I2 = _axial_inertia(gs.wheel_visual, mats.wheel.density_kg_m3, 0.0, geo.r2, geo.face_width)
     arm1, arm2 = mesh_arms(geo)
-    inv_mass_hat = arm1 ** 2 / I1 + arm2 ** 2 / I2
+    # driven-machine inertia J on the loaded shaft (joint armature) belongs to that shaft's effective mass
+    j_load = scenario.load.inertia_kg_m2
+    J1, J2 = (j_load, 0.0) if scenario.load.on == "worm" else (0.0, j_load)
+    inv_mass_hat = arm1 ** 2 / (I1 + J1) + arm2 ** 2 / (I2 + J2)
     slabs = max(1, _slabs_per_flank(gs))
     law = contact_law(scenario.contact, mats, geo.face_width, slabs, inv_mass_hat)
     mu0 = float(friction_coefficient(scenario.contact, 0.0))
@@ -253,6 +257,8 @@ def build_model(scenario: Scenario, gs=None) -> BuiltModel:
     lo.name, lo.target, lo.trntype = "load", load_joint, mujoco.mjtTrn.mjTRN_JOINT
     lo.set_to_motor()
     lo.ctrllimited = False
+    spec.joint(load_joint).armature = j_load
+    meta["load_inertia_kg_m2"] = j_load
 
     o = spec.option
     o.timestep = default_timestep(law) if scenario.simulation.timestep_s is None else scenario.simulation.timestep_s
@@ -265,7 +271,7 @@ def build_model(scenario: Scenario, gs=None) -> BuiltModel:
     geom_id = lambda n: mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, n)  # noqa: E731
     slot_geoms = np.array([[geom_id(n) for n in row] for row in slot_names], dtype=int)
     slot_bodies = np.array([mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, f"slot{i}") for i in range(W)])
-    _set_inv_mass_hat(model, law, arm1 ** 2 / I1, arm2 ** 2 / I2, slot_bodies)
+    _set_inv_mass_hat(model, law, arm1 ** 2 / (I1 + J1), arm2 ** 2 / (I2 + J2), slot_bodies)
     jid = lambda n: mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, n)  # noqa: E731
     return BuiltModel(
         model=model, spec=spec, geometry=geo, law=law,

@@ -120,6 +120,8 @@ class Load(_Strict):
     torque_nm: float = Field(0.0, gt=-1e6, lt=1e6, description="resisting torque")
     start_s: NonNegFloat = Field(0.0, description="STEP ramp of the load starts here")
     ramp_s: NonNegFloat = Field(0.0, description="STEP ramp time of the load")
+    inertia_kg_m2: float = Field(0.0, ge=0, le=1e6, description=(
+        "driven-machine inertia rigidly on the loaded shaft (contact3d: joint armature; 0 = bare gear)"))
 
 
 class Simulation(_Strict):
