@@ -3,7 +3,7 @@
 MuJoCo's elliptic friction rows are regularised: below the cone the friction force is viscous in the slip,
 f_t = slope v_t (wormsim.contact (2)). With impratio 1 the slope was the contact damping c_c (12 N s/m per
 seat-motor contact) and at seed 001's real 36 rpm (sliding speed Vs = omega1 r1 / cos(gamma) = 0.016 m/s)
-friction reached 12-19 % of mu f_n. The model now sets impratio by (2); these tests read every contact's
+friction reached 12-19 % of mu f_n. The model now sets impratio by (3); these tests read every contact's
 friction force |f_t| against mu f_n (the utilisation) over a short run of the seat motor.
 """
 from __future__ import annotations
@@ -58,8 +58,8 @@ def sliding_contacts(rpm: float, impratio: float | None = None) -> tuple[np.ndar
 @pytest.mark.parametrize("rpm", [36.0, 1800.0])
 def test_friction_saturates_on_sliding_contacts(rpm):
     """Seed 001's 36 rpm (Vs 0.016 m/s) and the CI's 1800 rpm (Vs 0.79 m/s): the mean of |f_t| / (mu f_n) over
-    sliding contacts (slip above half of Vs) is >= 0.95. Measured before the fix (impratio 1): 0.19 at 36 rpm,
-    0.999 at 1800 rpm; after: 1.000 at both."""
+    sliding contacts (slip above half of Vs) is >= 0.95. Measured here before the fix (impratio 1): 0.176 at 36 rpm,
+    1.000 at 1800 rpm; after: 1.000 at both."""
     C, vs, _ = sliding_contacts(rpm)
     sliding = C[:, 3] > 0.5 * vs
     assert sliding.sum() >= 100, sliding.sum()
