@@ -257,31 +257,34 @@ def build_wheel_tooth_pieces(g: GearGeometry, res: Resolution) -> list[trimesh.T
         sl = slice(sub * j, sub * (j + 1) + 1)
         zf = np.linspace(zeta[sl][0], zeta[sl][-1], 8 * sub + 1)
         checks = [_flank_check_points(g, zf, side) for side in (+1, -1)]
-        d = [0.0, 0.0]
-        for _ in range(CONSERVATIVE_PASSES + 1):
-            piece = _hull(wheel_slab_sections(g, res.profile_points, zeta[sl], ja[sl], tip[sl], jb[sl], tip[sl],
-                                              dpsi_a=d[0], dpsi_b=d[1]).reshape(-1, 3))
-            bulge = [max(0.0, -float(union_signed_distance([piece], pts).min())) for pts, _ in checks]
-            if max(bulge) <= 1e-9 * g.m_x:
-                break
-            d = [d[i] + bulge[i] / (checks[i][1] * c) for i in range(2)]
-        out.append(piece)
+        out.append(_conservative_hull(
+            lambda da, db: wheel_slab_sections(g, res.profile_points, zeta[sl], ja[sl], tip[sl], jb[sl], tip[sl],
+                                               dpsi_a=da, dpsi_b=db), checks, g.m_x, c))
         if has_fillet[sl].any():
             # the core stays inside the whole flank (fillet included): checked on root-to-tip points
             full = [_flank_check_points(g, zf, side, from_root=True) for side in (+1, -1)]
-            d = [0.0, 0.0]
-            for _ in range(CONSERVATIVE_PASSES + 1):
-                core = _hull(_fillet_core_sections(g, zeta[sl], root[sl], np.minimum(ja, jb)[sl],
-                                                   dpsi_a=d[0], dpsi_b=d[1]).reshape(-1, 3))
-                bulge = [max(0.0, -float(union_signed_distance([core], pts).min())) for pts, _ in full]
-                if max(bulge) <= 1e-9 * g.m_x:
-                    break
-                d = [d[i] + bulge[i] / (full[i][1] * c) for i in range(2)]
-            out.append(core)
+            out.append(_conservative_hull(
+                lambda da, db: _fillet_core_sections(g, zeta[sl], root[sl], np.minimum(ja, jb)[sl],
+                                                     dpsi_a=da, dpsi_b=db), full, g.m_x, c))
     return out
 
 
 CONSERVATIVE_PASSES = 2   # 0: pieces exact at the sections and bulging between them
+
+
+def _conservative_hull(sections, checks, m_x: float, c: float) -> trimesh.Trimesh:
+    """Hull of `sections(dpsi_a, dpsi_b)` made conservative: each flank side is moved into the tooth by the
+    bulge measured on its exact check points (`checks[i] = (points, scale)`), repeated CONSERVATIVE_PASSES
+    times or until the bulge is below 1e-9 m_x."""
+    d = [0.0, 0.0]
+    piece = None
+    for _ in range(CONSERVATIVE_PASSES + 1):
+        piece = _hull(sections(d[0], d[1]).reshape(-1, 3))
+        bulge = [max(0.0, -float(union_signed_distance([piece], pts).min())) for pts, _ in checks]
+        if max(bulge) <= 1e-9 * m_x:
+            break
+        d = [d[i] + bulge[i] / (checks[i][1] * c) for i in range(2)]
+    return piece
 
 
 def _flank_check_points(g: GearGeometry, zeta: np.ndarray, side: int, n_rho: int = 49, from_root: bool = False):
