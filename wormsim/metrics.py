@@ -14,7 +14,8 @@
   the peak's three bins; bin width 1 / T_window reported as `mesh_frequency_resolution_hz`; theory
   z1 n1 / 60 with n1 the mean worm speed;
 - forces: means and peak-to-peak (max - min) over the window, magnitudes of the means;
-- efficiency = output power / input power over the window = mean(-T_load w_load) / mean(T_drive w_drive);
+- efficiency = output power / input power over the window = mean(-T_load w_load) / mean(T_drive w_drive)
+  (contact3d: the series worm_power_w / wheel_power_w, T w averaged over every step of each sample);
   theory tan(g) / tan(g + rho') (or tan(g - rho') / tan(g) back-driving), rho' = atan(mu / cos(alpha_n)),
   mu the mean friction coefficient applied over the window.
 """
@@ -116,8 +117,11 @@ def drive_summary(S: dict, scenario, geo, i0: int, i1: int, n1: float, n2: float
     sl = slice(i0, i1)
     ft = S["tangential_force_n"][sl]
     T1, T2 = S["worm_torque_nm"][sl], S["wheel_torque_nm"][sl]
-    p1 = float(np.mean(T1 * S["worm_speed_rpm"][sl] * RPM))
-    p2 = float(np.mean(T2 * S["wheel_speed_rpm"][sl] * RPM))
+    if "worm_power_w" in S:         # contact3d: the interval means of T w over every step
+        p1, p2 = float(np.mean(S["worm_power_w"][sl])), float(np.mean(S["wheel_power_w"][sl]))
+    else:
+        p1 = float(np.mean(T1 * S["worm_speed_rpm"][sl] * RPM))
+        p2 = float(np.mean(T2 * S["wheel_speed_rpm"][sl] * RPM))
     if drv.on == "worm":
         eff = -p2 / p1 if p1 > 0 else float("nan")
     else:

@@ -16,7 +16,9 @@ Built with mujoco.MjSpec from the template `models/worm_pair.xml` (see models/RE
 - load: `motor` on the other shaft, resisting (sign opposite to the expected motion), STEP from
   load.start_s over load.ramp_s; a driven-machine inertia load.inertia_kg_m2 is the loaded hinge's armature
   (rigid on the shaft) and counts in that shaft's effective mass of the contact law;
-- contact law: wormsim.contact (solref/solimp per collision geom; body_invweight0 set to A_hat).
+- contact law: wormsim.contact (solref/solimp per collision geom; body_invweight0 set to A_hat);
+- a contact sensor (worm against the wheel's subtree, reduce="netforce") gives the resultant tooth force
+  every step, which wormsim.simulate averages over each record interval.
 """
 from __future__ import annotations
 
@@ -33,6 +35,7 @@ from wormsim.scenario import Scenario, ScenarioError
 from wormsim.units import rpm_to_rad_s
 
 TEMPLATE = Path(__file__).resolve().parent.parent / "models" / "worm_pair.xml"
+MESH_SENSOR_DATA = 1 | 2 | 4 | 16    # contact sensor fields found, force, torque, pos (mjtConDataField bits)
 SPEED_DROOP = 1e-3          # velocity servo: kv = T_expected / (SPEED_DROOP * omega_cmd)
 
 
@@ -266,6 +269,14 @@ def build_model(scenario: Scenario, gs=None) -> BuiltModel:
     o.integrator = {"implicitfast": mujoco.mjtIntegrator.mjINT_IMPLICITFAST, "rk4": mujoco.mjtIntegrator.mjINT_RK4,
                     "euler": mujoco.mjtIntegrator.mjINT_EULER, "implicit": mujoco.mjtIntegrator.mjINT_IMPLICIT,
                     "discrete": mujoco.mjtIntegrator.mjINT_DISCRETE}[scenario.simulation.integrator]
+
+    sen = spec.add_sensor()
+    sen.name, sen.type = "mesh_force", mujoco.mjtSensor.mjSENS_CONTACT
+    sen.objtype, sen.objname = mujoco.mjtObj.mjOBJ_BODY, "worm"
+    sen.reftype, sen.refname = mujoco.mjtObj.mjOBJ_XBODY, "wheel"
+    sen.intprm[0] = MESH_SENSOR_DATA
+    sen.intprm[1] = 3       # reduce = netforce
+    sen.intprm[2] = 1       # num
 
     model = spec.compile()
     geom_id = lambda n: mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, n)  # noqa: E731

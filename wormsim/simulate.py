@@ -1,17 +1,20 @@
 """contact3d runner: steps the MuJoCo model of wormsim.model, reads the tooth forces, guards the run.
 
-`simulate(scenario, progress) -> Result` (the interface of wormsim.run). The loop advances the model in
-chunks of `record_every` steps with mujoco.mj_step(nstep=...) (controls are held over a chunk: the
-STEP ramps are smooth on that scale); after each chunk it
+`simulate(scenario, progress) -> Result` (the interface of wormsim.run). The loop steps the model one step at a
+time (the drive and load commands follow their STEP ramps at each step's midpoint) and, at every step, adds up
+the model's contact sensor (worm against the wheel's subtree, reduce="netforce": the resultant tooth force on the
+wheel, its point and moment) and the shaft powers T w. Every `record_every` steps it stores one sample whose
+forces, moment, contact count, torques and powers are the MEANS over those steps (a box-car filter: the contact
+vibration at 10-80 kHz does not alias into the meshing band, and the box's nulls at multiples of the sampling
+rate cancel exactly what would fold onto 0 Hz), and whose angles and speeds are the values at its end. Then it
 
 - re-poses the wheel's collision window by whole pitches (wormsim.model.repose_window),
 - sets the friction coefficient mu(Vs) from the sliding speed Vs = |omega1| r1 / cos(gamma),
-- records shaft angles/speeds/torques and the tooth forces: for every worm-wheel contact the force
-  of the elliptic-cone constraint rows (normal, two tangents: what mj_contactForce returns) turned into
-  the assembly frame and summed ON THE WHEEL, the resultant resolved in the wheel's directions at the pitch
-  point on the line of centres (DIN 3975 F_t2, F_r2, F_a2; seed 001's x/y components): tangential, radial
-  (outward), axial; the contact torque M_z apart (wheel_contact_torque_nm); the number of contacts and of wheel teeth
-  touching; contact points in the frame of wheel tooth 0 (for the contact pattern),
+- resolves the mean resultant on the wheel in the wheel's directions at the pitch point on the line of centres
+  (DIN 3975 F_t2, F_r2, F_a2; seed 001's x/y components): tangential, radial (outward), axial; the contact
+  torque M_z apart (wheel_contact_torque_nm); and takes, at the sample instant, the number of wheel teeth
+  touching, the largest penetration and the contact points in the frame of wheel tooth 0 (for the contact
+  pattern), from the contacts' elliptic-cone rows (what mj_contactForce returns, tooth_forces),
 - checks the guards: non-finite state or MuJoCo's bad-qacc warning (divergence), penetration beyond
   `penetration_limit_m`, the transmission error passing half a pitch (teeth jumped; divergence when the
   timestep is above the contact's stable limit), a speed-driven drive stuck below half its command (locked;
@@ -34,10 +37,8 @@ from wormsim.scenario import Scenario
 from wormsim.units import rad_s_to_rpm, rpm_to_rad_s, step
 
 MAX_POINTS = 48             # contact points kept per sample (for the pattern and the recording)
-TARGET_SAMPLES = 20000      # automatic record_every aims at about this many samples per run. Sampling the
-                            # force every few steps aliases the contact vibration (10-80 kHz) into the
-                            # meshing band (measured: seat motor CI run, F_t peak 346 Hz at every 4th step
-                            # against 18 Hz at every step); recording every step costs ~25 % more wall time
+TARGET_SAMPLES = 20000      # automatic record_every aims at about this many samples per run (each the mean
+                            # over its interval, so decimation does not alias the contact vibration)
 JUMP_PITCH = 0.5            # transmission error (in pitches) that counts as teeth jumping
 
 
@@ -198,14 +199,13 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
     coll = np.concatenate([bm.worm_geoms, bm.wheel_slot_geoms.ravel()])
     pen_lim = penetration_limit_m(bm)
     pitch_angle = 2 * math.pi / geo.z2
-    sign_cmd = bm.drive_sign
     ramp_end = max(drv.ramp_s, scenario.load.start_s + scenario.load.ramp_s)
     dt_limit = bm.law.stable_timestep_s(3 * bm.law.contacts_per_pair)
 
     names = ["t_s", "worm_angle_rad", "wheel_angle_rad", "worm_speed_rpm", "wheel_speed_rpm",
              "worm_torque_nm", "wheel_torque_nm", "drive_command", "tangential_force_n", "radial_force_n",
              "axial_force_n", "contacts", "teeth_in_contact", "max_penetration_m", "friction_coefficient",
-             "transmission_error_rad", "wheel_contact_torque_nm"]
+             "transmission_error_rad", "wheel_contact_torque_nm", "worm_power_w", "wheel_power_w"]
     S = {k: np.zeros(n_rec) for k in names}
     pts = np.full((n_rec, MAX_POINTS, 3), np.nan, dtype=np.float32)
     pts_world = np.full((n_rec, MAX_POINTS, 3), np.nan, dtype=np.float32)
@@ -216,14 +216,36 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
     locked_since = None
     t_wall = time.perf_counter()
     worm_is_drive = drv.on == "worm"
+    sd, act, qv, ctrl = d.sensordata, d.actuator_force, d.qvel, d.ctrl
+    s0 = int(m.sensor_adr[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SENSOR, "mesh_force")])
+    ia_drv, ia_load, dof1, dof2 = bm.drive_actuator, bm.load_actuator, bm.worm_dof, bm.wheel_dof
+    # worm / wheel actuator on each shaft: (drive, load) or (load, drive)
+    a1, a2 = (ia_drv, ia_load) if worm_is_drive else (ia_load, ia_drv)
+    j_mid = (np.arange(rec) + 0.5) * dt
     for i in range(n_rec):
-        t_mid = (i * rec + 0.5 * rec) * dt
-        cmd, load_t = commands(scenario, np.array([t_mid]), bm.direction)
-        d.ctrl[bm.drive_actuator] = cmd[0]
-        d.ctrl[bm.load_actuator] = load_t[0]
-        mujoco.mj_step(m, d, nstep=rec)
+        cmd, load_t = commands(scenario, i * rec * dt + j_mid, bm.direction)
+        fx = fy = fz = mz = nc = t1 = t2 = p1 = p2 = 0.0
+        for j in range(rec):
+            ctrl[ia_drv] = cmd[j]
+            ctrl[ia_load] = load_t[j]
+            w1j, w2j = qv[dof1], qv[dof2]
+            mujoco.mj_step(m, d)
+            # actuator forces of this step (computed at its start, with the speeds above) and the sensor's
+            # resultant (found, F (3), torque about the point (3), point (3); global frame, on the wheel)
+            q1, q2 = act[a1], act[a2]
+            t1 += q1
+            t2 += q2
+            p1 += q1 * w1j
+            p2 += q2 * w2j
+            nc += sd[s0]
+            f0, f1, f2 = sd[s0 + 1], sd[s0 + 2], sd[s0 + 3]
+            fx += f0
+            fy += f1
+            fz += f2
+            mz += sd[s0 + 6] + sd[s0 + 7] * f1 - sd[s0 + 8] * f0
+        cmd = cmd[-1:]
         th1, th2 = float(d.qpos[qa_worm]), float(d.qpos[qa_wheel])
-        w1, w2 = float(d.qvel[bm.worm_dof]), float(d.qvel[bm.wheel_dof])
+        w1, w2 = float(qv[dof1]), float(qv[dof2])
         t = float(d.time)
         # guards
         if not (np.isfinite(d.qpos).all() and np.isfinite(d.qvel).all()) or d.warning[mujoco.mjtWarning.mjWARN_BADQACC].number:
@@ -235,7 +257,7 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
         vs = abs(w1) * geo.r1 / math.cos(geo.gamma)
         mu = float(friction_coefficient(scenario.contact, vs))
         m.geom_friction[coll, 0] = mu
-        f_t, f_r, f_a, tq, ncon, nteeth, pen, p0, F, pw = tooth_forces(bm, d, window)
+        _, _, _, _, _, nteeth, pen, p0, F, pw = tooth_forces(bm, d, window)
         if pen > pen_lim:
             raise SimulationError(
                 f"penetration {pen * 1e6:.1f} um at t = {t:.4g} s exceeds the tolerance {pen_lim * 1e6:.1f} um "
@@ -249,17 +271,16 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
                     raise locked_error(t, w_drive, cmd[0], bm, scenario)
             else:
                 locked_since = None
-        act = d.actuator_force
-        tq_drive, tq_load = float(act[bm.drive_actuator]), float(act[bm.load_actuator])
         S["t_s"][i] = t
         S["worm_angle_rad"][i], S["wheel_angle_rad"][i] = th1, th2
         S["worm_speed_rpm"][i], S["wheel_speed_rpm"][i] = rad_s_to_rpm(w1), rad_s_to_rpm(w2)
-        S["worm_torque_nm"][i] = tq_drive if worm_is_drive else tq_load
-        S["wheel_torque_nm"][i] = tq_load if worm_is_drive else tq_drive
+        S["worm_torque_nm"][i], S["wheel_torque_nm"][i] = t1 / rec, t2 / rec
+        S["worm_power_w"][i], S["wheel_power_w"][i] = p1 / rec, p2 / rec
         S["drive_command"][i] = cmd[0]
-        S["tangential_force_n"][i], S["radial_force_n"][i], S["axial_force_n"][i] = f_t, f_r, f_a
-        S["wheel_contact_torque_nm"][i] = tq
-        S["contacts"][i], S["teeth_in_contact"][i] = ncon, nteeth
+        # the mean resultant at the pitch point P = (0, -r2, 0): e_t = +x, e_r = -y (tooth_forces)
+        S["tangential_force_n"][i], S["radial_force_n"][i], S["axial_force_n"][i] = fx / rec, -fy / rec, fz / rec
+        S["wheel_contact_torque_nm"][i] = mz / rec
+        S["contacts"][i], S["teeth_in_contact"][i] = nc / rec, nteeth
         S["max_penetration_m"][i] = pen
         S["friction_coefficient"][i] = mu
         S["transmission_error_rad"][i] = te
