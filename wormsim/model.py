@@ -266,6 +266,8 @@ def build_model(scenario: Scenario, gs=None) -> BuiltModel:
     o = spec.option
     o.timestep = default_timestep(law) if scenario.simulation.timestep_s is None else scenario.simulation.timestep_s
     o.impratio = law.impratio      # friction rows' hardness, wormsim.contact (3)
+    if scenario.simulation.speculative:
+        o.enableflags |= int(mujoco.mjtEnableBit.mjENBL_SPECULATIVE)
     o.integrator = {"implicitfast": mujoco.mjtIntegrator.mjINT_IMPLICITFAST, "rk4": mujoco.mjtIntegrator.mjINT_RK4,
                     "euler": mujoco.mjtIntegrator.mjINT_EULER, "implicit": mujoco.mjtIntegrator.mjINT_IMPLICIT,
                     "discrete": mujoco.mjtIntegrator.mjINT_DISCRETE}[scenario.simulation.integrator]
@@ -273,7 +275,7 @@ def build_model(scenario: Scenario, gs=None) -> BuiltModel:
     sen = spec.add_sensor()
     sen.name, sen.type = "mesh_force", mujoco.mjtSensor.mjSENS_CONTACT
     sen.objtype, sen.objname = mujoco.mjtObj.mjOBJ_BODY, "worm"
-    sen.reftype, sen.refname = mujoco.mjtObj.mjOBJ_XBODY, "wheel"
+    sen.reftype, sen.refname = mujoco.mjtObj.mjOBJ_XBODY, "wheel"   # XBODY: the wheel's subtree (its slots)
     sen.intprm[0] = MESH_SENSOR_DATA
     sen.intprm[1] = 3       # reduce = netforce
     sen.intprm[2] = 1       # num

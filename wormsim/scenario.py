@@ -129,7 +129,10 @@ class Simulation(_Strict):
     timestep_s: float | None = Field(None, gt=0, le=0.01, description="default documented; the summary states the one used")
     resolution: Literal["coarse", "medium", "fine"] = Field("medium", description="collision decomposition level (contact3d)")
     integrator: Literal["implicitfast", "rk4", "euler", "implicit", "discrete"] = "implicitfast"
-    record_every: int = Field(1, ge=1, le=100000, description="store every n-th step in the time series")
+    record_every: int = Field(1, ge=1, le=100000, description=(
+        "store every n-th step in the time series (forces, torques and powers: the mean over those n steps)"))
+    speculative: bool = Field(False, description=(
+        "contact3d: MuJoCo's speculative contacts (sweep fast geoms over the step against tunnelling)"))
     mesh_stiffness_samples: int = Field(
         64, ge=8, le=4096, description="torsional: k(theta) samples per mesh cycle (tooth contact analysis)")
 

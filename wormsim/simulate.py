@@ -293,7 +293,10 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
 
     summary = contact3d_summary(S, scenario, bm)
     summary.update({
-        "scenario": scenario.name, "timestep_s": dt, "timestep_stable_limit_s": dt_limit, "resolution": scenario.simulation.resolution,
+        "scenario": scenario.name, "timestep_s": dt, "timestep_stable_limit_s": dt_limit,
+        "timestep_source": ("scenario" if scenario.simulation.timestep_s is not None else
+                            "default: 0.4 x the stable limit, rounded down to 1-2-5 (docs/bench.md, stability map)"),
+        "speculative": scenario.simulation.speculative, "resolution": scenario.simulation.resolution,
         "integrator": scenario.simulation.integrator, "record_every": rec,
         "contact_pair_stiffness_n_per_m": bm.law.pair_stiffness_n_per_m,
         "contact_stiffness_source": bm.law.stiffness_source,
