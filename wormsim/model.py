@@ -30,6 +30,7 @@ import mujoco
 import numpy as np
 
 from meshgen.geometry import GearGeometry, derive
+from wormsim.backlash import check_backlash
 from wormsim.contact import ContactLaw, contact_law, efficiency_theory, friction_coefficient, friction_impratio
 from wormsim.scenario import Scenario, ScenarioError
 from wormsim.units import rpm_to_rad_s
@@ -145,6 +146,9 @@ def build_model(scenario: Scenario, gs=None) -> BuiltModel:
     if scenario.gear is None or scenario.drive is None:
         raise ScenarioError("model: contact3d needs gear: and drive: blocks")
     geo, gs = (derive(scenario.gear), gs) if gs is not None else gear_set(scenario)
+    # backlash against the pieces' residual bulge (wormsim.backlash (2)): exit 2 before the teeth start jammed
+    backlash_meta = check_backlash(geo, gs.piece_error_um, scenario.simulation.resolution) \
+        if getattr(gs, "piece_error_um", None) else {}
     mats = scenario.materials
     spec = mujoco.MjSpec.from_file(str(TEMPLATE))
     spec.modelname = scenario.name
@@ -238,7 +242,8 @@ def build_model(scenario: Scenario, gs=None) -> BuiltModel:
     a = spec.add_actuator()
     a.name, a.target, a.trntype = "drive", drive_joint, mujoco.mjtTrn.mjTRN_JOINT
     meta = {"worm_mass_kg": m1, "wheel_mass_kg": m2, "worm_inertia_kg_m2": I1, "wheel_inertia_kg_m2": I2,
-            "window_teeth": W, "worm_pieces": len(gs.worm_pieces), "tooth_pieces": len(gs.wheel_tooth_pieces)}
+            "window_teeth": W, "worm_pieces": len(gs.worm_pieces), "tooth_pieces": len(gs.wheel_tooth_pieces),
+            **backlash_meta}
     if drv.speed_rpm is not None:
         w_cmd = abs(rpm_to_rad_s(drv.speed_rpm))
         eta = efficiency_theory(geo.gamma, geo.alpha_n, float(friction_coefficient(scenario.contact, 1.0)),
