@@ -29,13 +29,16 @@ rho' = atan(mu / cos alpha_n), mu = mu(Vs) of wormsim.contact (constant, static/
 transition velocity v_t, or seed 000's rho(Vs) groups), Vs = omega1 r1 / cos(gamma) (signed). The torque the
 mesh takes from the worm is
 
-    T1m = hand (T2m / r2) r1 tan(gamma + s rho'),   s = sign(T2m) hand tanh(Vs / v_t)
+    T1m = hand (T2m / r2) r1 tan(gamma + s rho'),   s = sign(T2m) hand tanh(Vs / v_s),   v_s = v_t / 10
 
 s = +1 is tractive (the worm drives: T2m omega2 > 0, eta = tan g / tan(g + rho')), s = -1 back-driving
 (tan(g - rho') / tan g), and tanh the smooth transition through Vs = 0 (v_t = contact.transition_velocity_m_s).
 Without friction T1m omega1 = T2m omega2 (power balance, p = r1 tan g = r2 z1 / z2). Self-locking comes out:
-for rho' > gamma a wheel torque makes tan(gamma - s rho') = 0 at Vs = v_t atanh(gamma / rho'), a creep of the
-order of v_t.
+for rho' > gamma a wheel torque makes tan(gamma - s rho') = 0 at Vs = v_s atanh(gamma / rho'), a creep of the
+order of v_s. v_s is a tenth of v_t (SIGN_VELOCITY_FRACTION) so that this creep stays below the static -> dynamic
+transition and a pair whose STATIC rho' exceeds gamma holds from rest even where its dynamic rho' is below gamma
+(with v_s = v_t the creep, 1.75 v_t at rho' = gamma + 0.3 deg, reached mu_dynamic and the worm ran back:
+tests/test_stability_backlash_locking.py, docs/stability_backlash_locking.md).
 
 Equations of motion:
 
@@ -86,6 +89,7 @@ SPEED_DROOP = 1e-3          # speed servo: kv = T_expected / (SPEED_DROOP * omeg
 MAX_SAMPLES = 20000
 SAMPLES_PER_MESH_PERIOD = 64
 RTOL, ATOL_ANGLE = 1e-7, 1e-10
+SIGN_VELOCITY_FRACTION = 0.1  # v_s / v_t: friction-direction regularisation (module docstring)
 
 
 def inertias(scenario: Scenario, g: GearGeometry) -> tuple[float, float]:
@@ -143,6 +147,7 @@ class _Mesh:
         self.c_theta_per_k = self.c_lin * self.arm0 ** 2 / self.k_mean
         self.d_max = c.penetration_depth_m
         self.vt = c.transition_velocity_m_s
+        self.v_sign = SIGN_VELOCITY_FRACTION * self.vt
         self.mu = _mu_scalar(c)
         self.cos_an = math.cos(g.alpha_n)
         self.omega_mesh = math.sqrt(self.k_mean * (1.0 / I2 + self.hz ** 2 / I1))
@@ -173,7 +178,7 @@ class _Mesh:
         g = self.g
         vs = w1 * g.r1 / math.cos(g.gamma)
         rho = math.atan(self.mu(vs) / self.cos_an)
-        s = side * g.hand * math.tanh(vs / self.vt)
+        s = side * g.hand * math.tanh(vs / self.v_sign)
         T1m = g.hand * (T2m / g.r2) * g.r1 * math.tan(g.gamma + s * rho)
         return T2m, T1m
 
@@ -188,7 +193,7 @@ class _Mesh:
         vs = w1 * g.r1 / math.cos(g.gamma)
         mu = np.asarray(friction_coefficient_vec(self.mu, vs))
         rho = np.arctan(mu / self.cos_an)
-        s = np.sign(T2m) * g.hand * np.tanh(vs / self.vt)
+        s = np.sign(T2m) * g.hand * np.tanh(vs / self.v_sign)
         ft = T2m / g.r2
         phase = np.mod(th1, self.period) / self.period * self.N
         kf = np.interp(phase, np.arange(self.N + 1), self.kf + self.kf[:1])
