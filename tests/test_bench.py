@@ -45,3 +45,20 @@ def test_quick_bench_torsional_level_writes_files_and_records(tmp_path):
         assert r["resolution"]["mesh_stiffness_samples"] in (16, 64)
     assert (tmp_path / "bench.png").read_bytes()[:4] == b"\x89PNG"
     assert "machine" in json.loads((tmp_path / "bench_meta.json").read_text())
+
+
+def test_bench_cases_restricted_to_named_seeds():
+    from wormsim.bench import bench_cases
+
+    cases = bench_cases(quick=False, models=("torsional",), scenarios=("screw_jack",))
+    assert cases and {c.scenario for c in cases} == {"screw_jack"}
+
+
+def test_bench_cli_rejects_unknown_seed_and_bad_repeats(tmp_path, capsys):
+    from wormsim.cli import main
+
+    assert main(["bench", "--scenario", "gearbox", "--out", str(tmp_path)]) == 2
+    assert "bench --scenario" in capsys.readouterr().err
+    assert main(["bench", "--repeats", "0", "--out", str(tmp_path)]) == 2
+    assert "allowed: an integer >= 1" in capsys.readouterr().err
+    assert not (tmp_path / "bench.json").exists()

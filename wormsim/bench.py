@@ -27,7 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from wormsim.output import write_json_atomic
-from wormsim.scenario import load_scenario
+from wormsim.scenario import ScenarioError, load_scenario
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENARIOS = ROOT / "scenarios"
@@ -71,13 +71,20 @@ def contact3d_default_timestep(name: str, overrides: tuple[str, ...] = ()) -> fl
     return float(build_model(sc).model.opt.timestep)
 
 
-def bench_cases(quick: bool, models: tuple[str, ...] | None = None) -> list[BenchCase]:
+def bench_cases(quick: bool, models: tuple[str, ...] | None = None,
+                scenarios: tuple[str, ...] | None = None) -> list[BenchCase]:
     """The grid. contact3d: resolution levels x timesteps of 2, 1 and 1/2 times its default (the default
     is 0.4 x the explicit stability limit, so 2x probes the edge); the reference is the finest level at
     the default step, checked against half that step. torsional: k(theta) samples per mesh cycle.
     quick: the seat motor only, 0.15 s, coarse/medium (a few minutes; CI runs the torsional part only).
-    models: only these levels."""
+    models: only these levels. scenarios: only these seeds (names of VARIANTS)."""
     names = ("seat_motor",) if quick else tuple(VARIANTS)
+    if scenarios is not None:
+        unknown = sorted(set(scenarios) - set(VARIANTS))
+        if unknown:
+            raise ScenarioError(f"bench --scenario: {', '.join(unknown)} is not a seed scenario; "
+                                f"allowed: {', '.join(VARIANTS)}")
+        names = tuple(n for n in VARIANTS if n in scenarios)
     levels = ("coarse", "medium") if quick else ("coarse", "medium", "fine")
     out: list[BenchCase] = []
     for name in names:
@@ -130,8 +137,10 @@ def pareto_front(cost: np.ndarray, error: np.ndarray) -> np.ndarray:
 
 
 def machine_info() -> dict:
+    """Platform, CPU count and the 1-minute load average (wall times are only comparable at the same load)."""
     return {"platform": platform.platform(), "python": platform.python_version(),
-            "processor": platform.processor() or platform.machine(), "cpu_count": os.cpu_count()}
+            "processor": platform.processor() or platform.machine(), "cpu_count": os.cpu_count(),
+            "load_average_1min": os.getloadavg()[0] if hasattr(os, "getloadavg") else None}
 
 
 def _run_case(case: BenchCase, repeats: int) -> tuple[dict, float, float]:
@@ -155,14 +164,17 @@ def _run_case(case: BenchCase, repeats: int) -> tuple[dict, float, float]:
 
 
 def run_bench(quick: bool, out_dir: str | Path, repeats: int | None = None,
-              models: tuple[str, ...] | None = None) -> list[dict]:
+              models: tuple[str, ...] | None = None, scenarios: tuple[str, ...] | None = None) -> list[dict]:
     from wormsim.errors import SimulationError
 
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
+    if repeats is not None and repeats < 1:
+        raise ScenarioError(f"bench --repeats: {repeats} is not allowed; allowed: an integer >= 1")
     repeats = repeats or (1 if quick else 3)
     records, summaries, notes = [], {}, []
-    for case in bench_cases(quick, models):
+    machine_start = machine_info()
+    for case in bench_cases(quick, models, scenarios):
         try:
             summary, wall, sim_s = _run_case(case, repeats)
         except SimulationError as exc:
@@ -178,7 +190,9 @@ def run_bench(quick: bool, out_dir: str | Path, repeats: int | None = None,
                "reference": case.reference, "finer": case.finer, "error": {}}
         summaries[id(rec)] = summary
         records.append(rec)
-    meta = {"machine": machine_info(), "quick": quick, "repeats": repeats, "reference_check": {}, "notes": notes}
+    meta = {"machine": machine_start, "load_average_1min_end": machine_info()["load_average_1min"],
+            "quick": quick, "repeats": repeats, "scenarios": sorted({r["scenario"] for r in records}),
+            "reference_check": {}, "notes": notes}
     for scen in {r["scenario"] for r in records}:
         ref = next((r for r in records if r["scenario"] == scen and r.get("reference") and r["status"] == "ok"), None)
         if ref is None:
@@ -193,7 +207,7 @@ def run_bench(quick: bool, out_dir: str | Path, repeats: int | None = None,
             meta["reference_check"][scen] = finer["error"]
     if _level_available("contact3d") and (models is None or "contact3d" in models):
         # the timestep sweep of each seed until a guard fires (stability_edge); quick: the seat motor only
-        meta["stability"] = stability_map(quick)
+        meta["stability"] = stability_map(quick, scenarios)
     write_json_atomic(out / "bench.json", records)
     write_json_atomic(out / "bench_meta.json", meta)
     plot_bench(records, out / "bench.png")
@@ -351,10 +365,12 @@ def stability_edge(scenario_name: str, factors: tuple[float, ...] = STABILITY_FA
             "runs": runs}
 
 
-def stability_map(quick: bool) -> dict:
+def stability_map(quick: bool, scenarios: tuple[str, ...] | None = None) -> dict:
     """stability_edge for each seed's bench variant (VARIANTS) at STABILITY_RESOLUTION; quick: the seat motor only
     (about half a minute). Keyed by scenario, written to bench_meta.json under "stability"."""
     names = ("seat_motor",) if quick else tuple(VARIANTS)
+    if scenarios is not None:
+        names = tuple(n for n in names if n in scenarios)
     dur = STABILITY_DURATION_S          # 1.5 mesh periods of the seat motor at 1800 rpm; shorter runs have no steady window
     return {n: stability_edge(n, duration_s=dur, overrides=VARIANTS[n], resolution=STABILITY_RESOLUTION[n])
             for n in names}

@@ -36,6 +36,9 @@ def build_parser() -> argparse.ArgumentParser:
     _add_scenario_args(p)
     p = sub.add_parser("bench", help="speed-accuracy benchmark: bench.json and bench.png")
     p.add_argument("--quick", action="store_true", help="CI-sized subset")
+    p.add_argument("--repeats", type=int, default=None, help="timed runs per case (median; default 1 quick, 3 full)")
+    p.add_argument("--scenario", action="append", default=None, dest="scenarios",
+                   help="only this seed scenario (repeatable): seat_motor, screw_jack, involute_41")
     p.add_argument("--out", required=True)
     p = sub.add_parser("schema", help="print the scenario JSON schema (for editors)")
     p.add_argument("--out", help="write to this file instead of stdout")
@@ -83,7 +86,8 @@ def _cmd_model(args) -> int:
 def _cmd_bench(args) -> int:
     from wormsim.bench import run_bench
 
-    run_bench(quick=args.quick, out_dir=args.out)
+    run_bench(quick=args.quick, out_dir=args.out, repeats=args.repeats,
+              scenarios=tuple(args.scenarios) if args.scenarios else None)
     return EXIT_OK
 
 
