@@ -208,3 +208,16 @@ def test_variants_hand_profile_starts_direction(overrides):
     w1, w2 = r.series["worm_speed_rpm"][-1], r.series["wheel_speed_rpm"][-1]
     assert np.sign(w1) == np.sign(sc.drive.speed_rpm)
     assert np.sign(w2) == np.sign(w1) * g.hand
+
+
+def test_driven_machine_inertia_adds_to_the_loaded_shaft():
+    from wormsim.torsional import inertias
+
+    base = load_scenario(ROOT / "scenarios" / "seat_motor.yaml")
+    g = derive(base.gear)
+    i1, i2 = inertias(base, g)
+    j1, j2 = inertias(load_scenario(ROOT / "scenarios" / "seat_motor.yaml", ["load.inertia_kg_m2=2e-4"]), g)
+    assert j1 == i1 and abs(j2 - i2 - 2e-4) < 1e-15
+    k1, k2 = inertias(load_scenario(ROOT / "scenarios" / "seat_motor.yaml", ["load.inertia_kg_m2=2e-4", "load.on=worm",
+                                                               "drive.on=wheel"]), g)
+    assert k2 == i2 and abs(k1 - i1 - 2e-4) < 1e-15

@@ -93,11 +93,14 @@ SIGN_VELOCITY_FRACTION = 0.1  # v_s / v_t: friction-direction regularisation (mo
 
 
 def inertias(scenario: Scenario, g: GearGeometry) -> tuple[float, float]:
-    """(I1, I2) in kg m^2: solid cylinders (module docstring)."""
+    """(I1, I2) in kg m^2: solid cylinders (module docstring), plus the driven-machine inertia
+    load.inertia_kg_m2 on the loaded shaft (rigid on it, as contact3d's joint armature)."""
     mats = scenario.materials
     m1 = mats.worm.density_kg_m3 * math.pi * g.r1 ** 2 * g.worm_length
     m2 = mats.wheel.density_kg_m3 * math.pi * g.r2 ** 2 * g.face_width
-    return 0.5 * m1 * g.r1 ** 2, 0.5 * m2 * g.r2 ** 2
+    j = scenario.load.inertia_kg_m2
+    j1, j2 = (j, 0.0) if scenario.load.on == "worm" else (0.0, j)
+    return 0.5 * m1 * g.r1 ** 2 + j1, 0.5 * m2 * g.r2 ** 2 + j2
 
 
 def _mu_scalar(contact):
@@ -407,7 +410,7 @@ def simulate(scenario: Scenario, progress=None, method: str = "implicit") -> Res
         "solver": "backward Euler (fixed step, Newton)" if method != "lsoda" else f"scipy LSODA rtol {RTOL}",
         "solver_rhs_evaluations": int(nfev),
         "solve_wall_s": wall, "mesh_stiffness_wall_s": t_ms,
-        "worm_inertia_kg_m2": I1, "wheel_inertia_kg_m2": I2, "inertia_source": "solid cylinders r1 x b1, r2 x b2",
+        "worm_inertia_kg_m2": I1, "wheel_inertia_kg_m2": I2, "inertia_source": "solid cylinders r1 x b1, r2 x b2 (+ load.inertia_kg_m2 on the loaded shaft)",
         "mesh_natural_frequency_hz": mesh.omega_mesh / (2 * math.pi),
         "contact_damping_requested_n_s_per_m": mesh.c_req, "contact_damping_used_n_s_per_m": mesh.c_lin,
         "contact_damping_ratio": mesh.c_lin / mesh.c_crit, "drive_kv_nm_s": kv if speed_driven else None,
