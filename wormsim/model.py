@@ -146,13 +146,17 @@ def window_teeth_at(theta2: float, z2: int, window: int, tooth0_angle: float) ->
 
 # ----------------------------------------------------------------------------- build
 
-def build_model(scenario: Scenario, gs=None) -> BuiltModel:
+def build_model(scenario: Scenario, gs=None, check_backlash_vs_pieces: bool = True,
+                window_teeth: int | None = None) -> BuiltModel:
+    """The compiled contact3d model. check_backlash_vs_pieces=False skips wormsim.backlash's check (only to measure
+    what happens below its limit). window_teeth: wheel tooth slots with collision (default window_size; geo.z2 =
+    every tooth, for a standalone file that the viewer can turn without re-posing)."""
     if scenario.gear is None or scenario.drive is None:
         raise ScenarioError("model: contact3d needs gear: and drive: blocks")
     geo, gs = (derive(scenario.gear), gs) if gs is not None else gear_set(scenario)
     # backlash against the pieces' residual bulge (wormsim.backlash (2)): exit 2 before the teeth start jammed
     backlash_meta = check_backlash(geo, gs.piece_error_um, scenario.simulation.resolution) \
-        if getattr(gs, "piece_error_um", None) else {}
+        if check_backlash_vs_pieces and getattr(gs, "piece_error_um", None) else {}
     mats = scenario.materials
     spec = mujoco.MjSpec.from_file(str(TEMPLATE))
     spec.modelname = scenario.name
@@ -216,7 +220,7 @@ def build_model(scenario: Scenario, gs=None) -> BuiltModel:
         worm_names.append(g.name)
     for j, piece in enumerate(gs.wheel_tooth_pieces):
         add_mesh(f"tooth_piece_{j}", piece)
-    W = window_size(geo)
+    W = window_size(geo) if window_teeth is None else int(min(max(window_teeth, 1), geo.z2))
     tooth0 = _tooth0_angle(gs)
     ks = window_teeth_at(0.0, geo.z2, W, tooth0)
     slot_names = [[None] * len(gs.wheel_tooth_pieces) for _ in range(W)]
@@ -371,12 +375,14 @@ def default_timestep(law: ContactLaw, contacts: int | None = None) -> float:
 def write_model(scenario: Scenario, out_dir: str | Path) -> Path:
     """DIR/model.xml + DIR/meshes/*.stl: opens with `python -m mujoco.viewer --mjcf DIR/model.xml`.
 
-    The standalone file holds the collision window at t = 0 (the viewer does not re-pose it) and
-    MuJoCo recomputes body_invweight0 on load, so its contact stiffness differs from a wormsim run's.
+    The standalone file gives every wheel tooth its collision pieces (the viewer does not re-pose a window,
+    so the wheel can turn any number of turns), and MuJoCo recomputes body_invweight0 on load, so its
+    contact stiffness differs from a wormsim run's.
     """
     out = Path(out_dir)
     (out / "meshes").mkdir(parents=True, exist_ok=True)
-    bm = build_model(scenario)
+    geo = derive(scenario.gear) if scenario.gear is not None else None
+    bm = build_model(scenario, window_teeth=geo.z2 if geo is not None else None)
     spec = bm.spec
     import trimesh
 
