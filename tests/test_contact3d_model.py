@@ -74,6 +74,10 @@ def test_write_model_is_standalone(tmp_path, name):
     path = write_model(sc, tmp_path / "m")
     m = mujoco.MjModel.from_xml_path(str(path))
     assert m.nu == 2 and m.njnt == 2 and (tmp_path / "m" / "meshes").is_dir()
+    # every wheel tooth has its collision pieces, so the viewer's wheel can turn past the run's window
+    z2 = sc.gear.wheel_teeth
+    slots = {mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, b) for b in range(m.nbody)} - {"world", "worm", "wheel"}
+    assert len(slots) == z2
 
 
 def test_too_large_timestep_stops_with_a_diagnosis():
