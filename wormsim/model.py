@@ -111,14 +111,15 @@ def mesh_arms(geo: GearGeometry) -> tuple[float, float]:
 
 def nominal_normal_force_n(scenario: Scenario, geo: GearGeometry) -> float:
     """Whole-mesh normal force at the working load, F_n = T2 / (r2 cos(alpha_n) cos(gamma)) (DIN 3975; wheel
-    torque T2 = the load, or the worm load times the ratio when the load is on the worm; a torque drive counts the
-    same way, the larger of the two: a wheel driven by a torque against a free worm loads the mesh with no load
-    torque at all). Sets the friction rows' hardness (wormsim.contact (3)); with T2 = 0 impratio fell to 1 and a
+    torque T2 = the load, or the worm load times the ratio when the load is on the worm; a torque driving the WHEEL
+    counts too, the larger of the two: it passes through the mesh whatever the worm does, and against a free worm it
+    is the only load. A torque driving the worm is not counted: what it does not pass to the wheel load accelerates
+    the worm). Sets the friction rows' hardness (wormsim.contact (3)); with T2 = 0 impratio fell to 1 and a
     self-locking pair crept back at ~110 rpm instead of 0.2 rpm (docs/stability_backlash_locking.md)."""
     load, drv = scenario.load, scenario.drive
     t2 = abs(load.torque_nm) * (1.0 if load.on == "wheel" else geo.ratio)
-    if drv.torque_nm is not None:
-        t2 = max(t2, abs(drv.torque_nm) * (1.0 if drv.on == "wheel" else geo.ratio))
+    if drv.torque_nm is not None and drv.on == "wheel":
+        t2 = max(t2, abs(drv.torque_nm))
     return t2 / (geo.r2 * math.cos(geo.alpha_n) * math.cos(geo.gamma))
 
 
