@@ -30,7 +30,7 @@ import mujoco
 import numpy as np
 
 from wormsim.contact import efficiency_theory, friction_coefficient, friction_mode
-from wormsim.errors import SimulationError
+from wormsim.errors import ScenarioError, SimulationError
 from wormsim.model import BuiltModel, build_model, repose_window
 from wormsim.result import Result
 from wormsim.scenario import Scenario
@@ -40,6 +40,11 @@ MAX_POINTS = 48             # contact points kept per sample (for the pattern an
 TARGET_SAMPLES = 20000      # automatic record_every aims at about this many samples per run (each the mean
                             # over its interval, so decimation does not alias the contact vibration)
 JUMP_PITCH = 0.5            # transmission error (in pitches) that counts as teeth jumping
+MAX_WORM_TURN_PER_STEP_RAD = 0.035   # largest worm rotation per step contact3d resolves (2.0 deg; measured on the
+                            # seat motor and screw jack gears, docs/stability_speed.md: <= 0.035 rad holds ratio and
+                            # torque balance; 0.061 rad tunnels the seat worm through the wheel, 0.07 rad costs the
+                            # screw jack 15 % efficiency, 0.21 rad tunnels it)
+OVERSPEED_GUARD = 1.25      # the running check fires at this multiple of MAX_WORM_TURN_PER_STEP_RAD
 
 
 def _record_every(scenario: Scenario, dt: float, n_steps: int) -> int:
@@ -60,6 +65,58 @@ def commands(scenario: Scenario, t: np.ndarray, direction: int) -> tuple[np.ndar
     s = (np.sign(target) or 1.0) * direction
     load_t = step(t, load.start_s, 0.0, load.start_s + load.ramp_s, -s * load.torque_nm)
     return np.atleast_1d(drive), np.atleast_1d(load_t)
+
+
+def worm_speed_command_rad_s(scenario: Scenario, bm: BuiltModel) -> float | None:
+    """Worm speed the drive commands: |speed_rpm| when the worm is speed-driven, ratio x |speed_rpm| when the wheel
+    is (kinematics z2 / z1); None for a torque drive (its speed is known only while running)."""
+    drv = scenario.drive
+    if drv.speed_rpm is None:
+        return None
+    w = abs(rpm_to_rad_s(drv.speed_rpm))
+    return w if drv.on == "worm" else w * bm.geometry.ratio
+
+
+def speed_timestep_limit_s(w1_rad_s: float) -> float:
+    """Largest timestep at worm speed w1: h <= MAX_WORM_TURN_PER_STEP_RAD / w1 (the worm turns at most 0.035 rad
+    per step; measured, docs/stability_speed.md)."""
+    return MAX_WORM_TURN_PER_STEP_RAD / w1_rad_s
+
+
+def _round_down_125(h: float) -> float:
+    """Largest 1, 2 or 5 x 10^e not above h (as wormsim.model.default_timestep rounds)."""
+    e = math.floor(math.log10(h))
+    for mant in (5, 2, 1):
+        if float(f"{mant}e{e}") <= h * (1 + 1e-12):
+            return float(f"{mant}e{e}")          # the decimal value (5e-06, not 5 * 10.0 ** -6 = 4.9999999999999996e-06)
+    return float(f"1e{e}")
+
+
+def choose_timestep(scenario: Scenario, bm: BuiltModel) -> tuple[float, str]:
+    """(timestep, timestep_source). The contact's default (wormsim.model.default_timestep: 0.4 x the explicit
+    stability limit, 1-2-5) unless the commanded worm speed needs a smaller one: then h = the speed limit
+    MAX_WORM_TURN_PER_STEP_RAD / w1 rounded down to 1-2-5. A timestep set in the scenario above the speed limit is
+    refused (ScenarioError naming simulation.timestep_s and its allowed range): beyond it the worm's convex pieces
+    jump through the wheel's between steps, and simulation.speculative does not prevent it (measured: it fails
+    earlier; docs/stability_speed.md)."""
+    h = float(bm.model.opt.timestep)
+    w1 = worm_speed_command_rad_s(scenario, bm)
+    if scenario.simulation.timestep_s is not None:
+        if w1 is not None and w1 * h > MAX_WORM_TURN_PER_STEP_RAD:
+            lim = speed_timestep_limit_s(w1)
+            raise ScenarioError(
+                f"simulation.timestep_s = {h:.3g} s is too large for the worm speed {rad_s_to_rpm(w1):.0f} rpm: the "
+                f"worm would turn {w1 * h:.3g} rad per step, contact3d resolves at most {MAX_WORM_TURN_PER_STEP_RAD} "
+                f"rad (beyond it the thread passes through the wheel's teeth between steps); allowed range: 0 < "
+                f"simulation.timestep_s <= {lim:.3g} s, or leave it unset (the default then follows the speed). "
+                f"simulation.speculative does not prevent it (measured: it tunnels sooner, docs/stability_speed.md)")
+        return h, "scenario"
+    src = "default: 0.4 x the stable limit, rounded down to 1-2-5 (docs/bench.md, stability map)"
+    if w1 is not None and w1 * h > MAX_WORM_TURN_PER_STEP_RAD:
+        h = _round_down_125(speed_timestep_limit_s(w1))
+        src = (f"worm speed: {rad_s_to_rpm(w1):.0f} rpm needs <= {MAX_WORM_TURN_PER_STEP_RAD} rad of worm rotation "
+               f"per step, rounded down to 1-2-5 (below the contact's default; docs/stability_speed.md)")
+    return h, src
 
 
 def penetration_limit_m(bm: BuiltModel) -> float:
@@ -148,6 +205,18 @@ def jump_error(t: float, te_pitch: float, dt: float, bm: BuiltModel, scenario: S
         f"simulation.timestep_s)")
 
 
+def overspeed_error(t: float, w1: float, dt: float) -> SimulationError:
+    """The worm turns more than OVERSPEED_GUARD x MAX_WORM_TURN_PER_STEP_RAD per step (a torque drive running away,
+    or a timestep set past the speed check): its pieces would pass through the wheel's between steps."""
+    lim = speed_timestep_limit_s(abs(w1))
+    return SimulationError(
+        f"worm overspeed at t = {t:.4g} s: the worm turns {rad_s_to_rpm(abs(w1)):.0f} rpm, {abs(w1) * dt:.3g} rad per "
+        f"step of {dt:.3g} s, beyond the {MAX_WORM_TURN_PER_STEP_RAD} rad contact3d resolves (the thread passes "
+        f"through the wheel's teeth between steps); set simulation.timestep_s <= {lim:.3g} s (or leave it unset for "
+        f"a speed-driven worm), or lower the drive (drive.speed_rpm / drive.torque_nm); simulation.speculative does "
+        f"not prevent it (measured: it tunnels sooner, docs/stability_speed.md)")
+
+
 def locked_error(t: float, w_drive: float, w_cmd: float, bm: BuiltModel, scenario: Scenario) -> SimulationError:
     """A speed-driven drive held below half its command. When the wheel drives and the pair is self-locking at
     standstill, rho' = atan(mu_static / cos alpha_n) >= gamma (DIN 3975: back-driving efficiency
@@ -214,6 +283,7 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
     window = repose_window(bm, 0.0)
     mujoco.mj_forward(m, d)
     locked_since = None
+    turn_max = 0.0
     t_wall = time.perf_counter()
     worm_is_drive = drv.on == "worm"
     sd, act, qv, ctrl = d.sensordata, d.actuator_force, d.qvel, d.ctrl
@@ -250,6 +320,10 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
         # guards
         if not (np.isfinite(d.qpos).all() and np.isfinite(d.qvel).all()) or d.warning[mujoco.mjtWarning.mjWARN_BADQACC].number:
             raise diverged_error(t, dt, bm, "non-finite state or huge acceleration (MuJoCo's bad-qacc warning)")
+        turn = abs(w1) * dt
+        turn_max = max(turn_max, turn)
+        if turn > OVERSPEED_GUARD * MAX_WORM_TURN_PER_STEP_RAD:
+            raise overspeed_error(t, w1, dt)
         te = th2 - bm.direction * th1 / geo.ratio
         if abs(te) > JUMP_PITCH * pitch_angle:
             raise jump_error(t, te / pitch_angle, dt, bm, scenario)
@@ -294,8 +368,10 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
     summary = contact3d_summary(S, scenario, bm)
     summary.update({
         "scenario": scenario.name, "timestep_s": dt, "timestep_stable_limit_s": dt_limit,
-        "timestep_source": ("scenario" if scenario.simulation.timestep_s is not None else
-                            "default: 0.4 x the stable limit, rounded down to 1-2-5 (docs/bench.md, stability map)"),
+        "timestep_source": bm.meta.get("timestep_source") or (
+            "scenario" if scenario.simulation.timestep_s is not None else
+            "default: 0.4 x the stable limit, rounded down to 1-2-5 (docs/bench.md, stability map)"),
+        "worm_turn_per_step_max_rad": turn_max,
         "speculative": scenario.simulation.speculative, "resolution": scenario.simulation.resolution,
         "integrator": scenario.simulation.integrator, "record_every": rec,
         "contact_pair_stiffness_n_per_m": bm.law.pair_stiffness_n_per_m,
@@ -317,6 +393,9 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
 
 def simulate(scenario: Scenario, progress=None) -> Result:
     bm = build_model(scenario)
+    h, src = choose_timestep(scenario, bm)
+    bm.model.opt.timestep = h
+    bm.meta["timestep_source"] = src
     return run_model(bm, scenario, progress)
 
 

@@ -1,0 +1,157 @@
+"""contact3d stability hard cases (issue 5): high worm speed (tunnelling; MuJoCo's speculative contacts) and the
+start-up impact. Measured first on the screw jack gear (seed 002, coarse pieces, contact default timestep 1e-5 s);
+the numbers are in docs/stability_speed.md.
+
+High speed: what matters is the worm's rotation per step, w1 h. Up to 0.035 rad (2 deg) per step the screw jack and
+the seat motor demo keep the ratio (0.1 %) and the torque balance (2 %); from 0.05 rad the seat worm tunnels through
+the wheel (penetration guard: 403 um at 0.050 rad, 565 um at 0.061 rad); the screw jack still runs at 0.07 rad with
+a scattered efficiency (0.54 to 0.64 for timesteps 1 % apart, theory 0.649) and tunnels at 0.21 rad (1659 um). wormsim.simulate therefore picks h <= 0.035 rad / w1 (1-2-5) when the default is larger,
+refuses a scenario timestep above it (ScenarioError, exit 2) and stops a worm that overspeeds while running (a
+torque drive running away) at 1.25 x that turn per step.
+
+Speculative contacts (simulation.speculative): below the speed limit they change nothing (the time series are
+identical, each step costs about 3 x); at 0.07 rad per step, where the plain run completes, the speculative run
+tunnels (penetration guard). They do not extend the speed range.
+"""
+from __future__ import annotations
+
+import math
+import re
+from pathlib import Path
+
+import mujoco
+import numpy as np
+import pytest
+
+from wormsim import simulate as sim_mod
+from wormsim.errors import ScenarioError, SimulationError
+from wormsim.model import build_model
+from wormsim.scenario import load_scenario
+from wormsim.simulate import MAX_WORM_TURN_PER_STEP_RAD, OVERSPEED_GUARD, run_model, simulate
+
+JACK = Path(__file__).resolve().parent.parent / "scenarios" / "screw_jack.yaml"
+COARSE = ["simulation.resolution=coarse"]
+RPM = 2 * math.pi / 60
+
+
+def _jack(rpm: float, duration_s: float, *extra: str):
+    return load_scenario(JACK, COARSE + [f"drive.speed_rpm={rpm}", "drive.ramp_s=0.01", "load.ramp_s=0.01",
+                                         f"simulation.duration_s={duration_s}", *extra])
+
+
+def _ratio_and_torque_balance(res) -> tuple[float, float]:
+    s, bm = res.summary, res.extra["built"]
+    return s["ratio"] / s["ratio_theory"] - 1, s["tangential_force_mean_n"] * bm.geometry.r2 / 12.0 - 1
+
+
+def test_screw_jack_at_30x_speed_gets_a_safe_timestep_and_keeps_the_physics():
+    """40000 rpm (30 x the seed's 1330): at the contact's default 1e-5 s the worm would turn 0.042 rad per step. The
+    runner picks 5e-6 s (0.035 / 4189 rad/s = 8.4e-6, rounded down to 1-2-5) and says so; the run keeps the CI
+    tolerances (measured ratio 24.0013, F_t 397.4 N against 400 N, efficiency 0.6501 against 0.6492; at 4.95e-6 and
+    5.05e-6 s: 24.0012 / 24.0034, 396.4 / 401.9 N, 0.6499 / 0.6504)."""
+    sc = _jack(40000, 0.03)
+    assert sc.simulation.timestep_s is None
+    res = simulate(sc)
+    s = res.summary
+    assert s["timestep_s"] == 5e-6
+    assert s["timestep_s"] < 0.4 * s["timestep_stable_limit_s"]     # the speed, not the contact, set it
+    assert s["timestep_source"].startswith("worm speed: 40000 rpm"), s["timestep_source"]
+    assert s["worm_turn_per_step_max_rad"] <= MAX_WORM_TURN_PER_STEP_RAD
+    d_ratio, d_torque = _ratio_and_torque_balance(res)
+    assert abs(d_ratio) < 1e-3 and abs(d_torque) < 0.02, (s["ratio"], s["tangential_force_mean_n"])
+    assert abs(s["efficiency"] / s["efficiency_theory"] - 1) < 0.03, (s["efficiency"], s["efficiency_theory"])
+
+
+def test_a_scenario_timestep_too_large_for_the_speed_is_refused_with_its_allowed_range():
+    """The same 66500 rpm with simulation.timestep_s = 1e-5 s: ScenarioError (exit 2) before any step, naming the
+    field, the allowed range (<= 0.035 rad / w1 = 5.03e-6 s) and that speculative does not prevent it. The seed
+    speed with the same timestep stays allowed (0.0014 rad per step)."""
+    with pytest.raises(ScenarioError) as exc:
+        simulate(_jack(66500, 0.03, "simulation.timestep_s=1e-5"))
+    msg = str(exc.value)
+    assert msg.startswith("simulation.timestep_s = 1e-05 s"), msg
+    allowed = float(re.search(r"allowed range: 0 < simulation\.timestep_s <= ([0-9.e+-]+) s", msg).group(1))
+    assert allowed == pytest.approx(MAX_WORM_TURN_PER_STEP_RAD / (66500 * RPM), rel=2e-3)
+    assert "simulation.speculative does not prevent it" in msg
+    seed = _jack(1330, 0.01, "simulation.timestep_s=1e-5")
+    bm = build_model(seed)
+    h, src = sim_mod.choose_timestep(seed, bm)
+    assert h == 1e-5 and src == "scenario"
+    # unset: the contact's default (1e-5 s for the screw jack), the speed does not bind
+    h, src = sim_mod.choose_timestep(_jack(1330, 0.01), bm)
+    assert h == 1e-5 and src.startswith("default"), src
+
+
+def test_a_torque_driven_worm_running_away_stops_at_the_overspeed_guard():
+    """2 N m on the worm against 12 N m on the wheel (0.77 N m needed at efficiency 0.65): the worm accelerates
+    without bound. At the default 1e-5 s the overspeed guard stops it when it turns 1.25 x 0.035 rad per step
+    (measured t = 0.063 s, 41800 rpm), before its pieces tunnel through the wheel (the penetration guard fired at
+    0.21 rad per step on the plain run); the message names simulation.timestep_s and the limit at that speed."""
+    sc = load_scenario(JACK, COARSE + ["drive.speed_rpm=null", "drive.torque_nm=2", "drive.ramp_s=0.005",
+                                       "load.ramp_s=0.005", "simulation.duration_s=0.1"])
+    with pytest.raises(SimulationError) as exc:
+        simulate(sc)
+    msg = str(exc.value)
+    assert msg.startswith("worm overspeed at t = "), msg
+    rpm = float(re.search(r"the worm turns ([0-9.]+) rpm", msg).group(1))
+    turn = float(re.search(r"rpm, ([0-9.]+) rad per step of 1e-05 s", msg).group(1))
+    assert turn == pytest.approx(rpm * RPM * 1e-5, rel=2e-3)
+    assert OVERSPEED_GUARD * MAX_WORM_TURN_PER_STEP_RAD < turn < 1.1 * OVERSPEED_GUARD * MAX_WORM_TURN_PER_STEP_RAD
+    lim = float(re.search(r"simulation\.timestep_s <= ([0-9.e+-]+) s", msg).group(1))
+    assert lim == pytest.approx(MAX_WORM_TURN_PER_STEP_RAD / (rpm * RPM), rel=2e-2)
+
+
+def test_speculative_contacts_change_nothing_below_the_speed_limit():
+    """26600 rpm (20 x, 0.028 rad per step at 1e-5 s): the speculative flag is set in the model, and the run's time
+    series are identical to the plain run's (no geom sweeps past MuJoCo's fast-geom threshold into a new contact);
+    measured cost 1368 against 478 us per step."""
+    plain = simulate(_jack(26600, 0.02))
+    spec_sc = _jack(26600, 0.02, "simulation.speculative=true")
+    spec = simulate(spec_sc)
+    assert spec.extra["built"].model.opt.enableflags & int(mujoco.mjtEnableBit.mjENBL_SPECULATIVE)
+    assert not plain.extra["built"].model.opt.enableflags & int(mujoco.mjtEnableBit.mjENBL_SPECULATIVE)
+    assert spec.summary["speculative"] is True
+    for key in ("tangential_force_n", "wheel_angle_rad", "max_penetration_m"):
+        np.testing.assert_array_equal(spec.series[key], plain.series[key])
+    d_ratio, d_torque = _ratio_and_torque_balance(spec)
+    assert abs(d_ratio) < 1e-3 and abs(d_torque) < 0.025, (spec.summary["ratio"], spec.summary["tangential_force_mean_n"])
+
+
+def test_speculative_contacts_tunnel_sooner_beyond_the_speed_limit(monkeypatch):
+    """What the runner's speed check prevents, with the check and the overspeed guard switched off: 66500 rpm at
+    1e-5 s (0.0696 rad per step). The plain run completes with the ratio within 0.1 % (measured 23.9926; its
+    efficiency scatters from 0.54 to 0.64 for timesteps 0.1 % apart, theory 0.649); the speculative run tunnels: the penetration guard fires (measured 1070 um > 1000 um
+    at t = 0.0101 s)."""
+    monkeypatch.setattr(sim_mod, "OVERSPEED_GUARD", math.inf)
+
+    def run(*extra):
+        sc = _jack(66500, 0.02, *extra)
+        bm = build_model(sc)                       # the contact's default 1e-5 s; run_model without simulate's
+        assert bm.model.opt.timestep == 1e-5       # choose_timestep
+        return run_model(bm, sc)
+
+    plain = run()
+    assert plain.summary["timestep_s"] == 1e-5
+    assert plain.summary["worm_turn_per_step_max_rad"] == pytest.approx(0.0696, rel=0.02)
+    assert abs(plain.summary["ratio"] / 24 - 1) < 1e-3, plain.summary["ratio"]
+    with pytest.raises(SimulationError) as exc:
+        run("simulation.speculative=true")
+    assert str(exc.value).startswith("penetration"), str(exc.value)
+
+
+def test_startup_impact_step_against_ramp():
+    """Screw jack at 6650 rpm (5 x), 0.04 s. Drive and load stepped at t = 0 (ramp_s = 0): the teeth take a
+    start-up peak of 11931 N within 0.2 ms, 29.9 x the steady mean F_t (400 N) and 7.7 x the steady window's own
+    max |F_t| (1557 N); penetration 18 um, far below the 1000 um guard; the run completes with the ratio right.
+    With 0.01 s ramps the start-up peak (1410 N) stays below the steady max (1601 N)."""
+    step = simulate(_jack(6650, 0.04, "drive.ramp_s=0", "load.ramp_s=0")).summary
+    ramp = simulate(_jack(6650, 0.04)).summary
+    for s in (step, ramp):
+        assert abs(s["ratio"] / 24 - 1) < 1e-3, s["ratio"]
+        assert 0 < s["startup_time_s"] == pytest.approx(s["steady_window_s"][0])
+        assert s["startup_penetration_max_um"] < 100
+    assert step["startup_tangential_force_peak_n"] > 20 * step["tangential_force_mean_n"]
+    assert step["startup_tangential_force_peak_n"] > 5 * step["tangential_force_max_n"]
+    assert ramp["startup_tangential_force_peak_n"] < 1.1 * ramp["tangential_force_max_n"]
+    assert step["startup_tangential_force_peak_n"] > 5 * ramp["startup_tangential_force_peak_n"]
+    assert step["startup_penetration_max_um"] > 2 * ramp["startup_penetration_max_um"]
