@@ -23,6 +23,7 @@ import mujoco
 import numpy as np
 import pytest
 
+from wormsim import cli
 from wormsim import simulate as sim_mod
 from wormsim.errors import ScenarioError, SimulationError
 from wormsim.model import build_model
@@ -80,6 +81,21 @@ def test_a_scenario_timestep_too_large_for_the_speed_is_refused_with_its_allowed
     # unset: the contact's default (1e-5 s for the screw jack), the speed does not bind
     h, src = sim_mod.choose_timestep(_jack(1330, 0.01), bm)
     assert h == 1e-5 and src.startswith("default"), src
+    # a speed-driven wheel: the worm turns ratio x faster (2000 x 24 = 48000 rpm -> 0.035 / 5027 rad/s = 7e-6 -> 5e-6)
+    wheel = load_scenario(JACK, COARSE + ["drive.on=wheel", "drive.speed_rpm=2000", "load.on=worm",
+                                          "load.torque_nm=0.1"])
+    h, src = sim_mod.choose_timestep(wheel, bm)
+    assert h == 5e-6 and src.startswith("worm speed: 48000 rpm"), (h, src)
+
+
+def test_the_refusal_through_the_cli_is_exit_2(tmp_path, capsys):
+    """`wormsim run` with the too-large timestep: exit 2 (invalid input), the message on stderr names the field."""
+    args = ["run", str(JACK), "--out", str(tmp_path / "o"), "--no-progress"]
+    for kv in COARSE + ["drive.speed_rpm=66500", "simulation.timestep_s=1e-5", "simulation.duration_s=0.01"]:
+        args += ["--set", kv]
+    assert cli.main(args) == 2
+    err = capsys.readouterr().err
+    assert "simulation.timestep_s = 1e-05 s is too large for the worm speed 66500 rpm" in err, err
 
 
 def test_a_torque_driven_worm_running_away_stops_at_the_overspeed_guard():

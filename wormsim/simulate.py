@@ -18,8 +18,13 @@ rate cancel exactly what would fold onto 0 Hz), and whose angles and speeds are 
 - checks the guards: non-finite state or MuJoCo's bad-qacc warning (divergence), penetration beyond
   `penetration_limit_m`, the transmission error passing half a pitch (teeth jumped; divergence when the
   timestep is above the contact's stable limit), a speed-driven drive stuck below half its command (locked;
-  self-locking named when the wheel drives). Each raises SimulationError with what to change
-  (diverged_error, jump_error, locked_error; docs/contact3d.md "Failure modes and guards").
+  self-locking named when the wheel drives), the worm turning more than 1.25 x MAX_WORM_TURN_PER_STEP_RAD per
+  step (overspeed: its pieces would tunnel through the wheel's). Each raises SimulationError with what to change
+  (diverged_error, jump_error, locked_error, overspeed_error; docs/contact3d.md "Failure modes and guards").
+
+Before the loop, simulate() sets the timestep (choose_timestep): the contact's default, unless the commanded worm
+speed w1 needs h <= MAX_WORM_TURN_PER_STEP_RAD / w1 (measured, docs/stability_speed.md); a scenario timestep above
+that is refused with ScenarioError.
 """
 from __future__ import annotations
 
