@@ -155,19 +155,39 @@ def test_speculative_contacts_tunnel_sooner_beyond_the_speed_limit(monkeypatch):
     assert str(exc.value).startswith("penetration"), str(exc.value)
 
 
-def test_startup_impact_step_against_ramp():
-    """Screw jack at 6650 rpm (5 x), 0.04 s. Drive and load stepped at t = 0 (ramp_s = 0): the teeth take a
-    start-up peak of 11931 N within 0.2 ms, 29.9 x the steady mean F_t (400 N) and 7.7 x the steady window's own
-    max |F_t| (1557 N); penetration 18 um, far below the 1000 um guard; the run completes with the ratio right.
-    With 0.01 s ramps the start-up peak (1410 N) stays below the steady max (1601 N)."""
-    step = simulate(_jack(6650, 0.04, "drive.ramp_s=0", "load.ramp_s=0")).summary
-    ramp = simulate(_jack(6650, 0.04)).summary
+SEAT_DEMO = JACK.parent / "seat_motor_demo.yaml"
+
+
+# (scenario, worm rpm, run s, ramp s, step peak / steady mean >, step peak / steady max >); measured factors in the
+# test's docstring
+STARTUP_CASES = [
+    pytest.param(JACK, 6650, 0.04, 0.01, 20.0, 5.0, id="screw_jack"),
+    pytest.param(SEAT_DEMO, 9000, 0.03, 0.01, 2.5, 2.2, id="seat_motor_demo"),
+]
+
+
+@pytest.mark.parametrize("path, rpm, duration_s, ramp_s, over_mean, over_max", STARTUP_CASES)
+def test_startup_impact_step_against_ramp(path, rpm, duration_s, ramp_s, over_mean, over_max):
+    """Drive and load stepped at t = 0 (ramp_s = 0) against ramps, coarse pieces, default timesteps. Measured:
+    screw jack at 6650 rpm (5 x): step peak 11931 N within 0.2 ms, 29.9 x the steady mean F_t (400 N) and 7.7 x the
+    steady window's own max |F_t| (1557 N; the jack's mesh fluctuates by 1443 N p2p); penetration 18 um against the
+    1000 um guard; with 0.01 s ramps the start-up peak 1410 N stays below the steady max 1601 N.
+    Seat motor demo gear at 9000 rpm: step peak 3822 N, 2.97 x the mean 1289 N and 2.67 x the steady max 1431 N;
+    penetration 27 um against 281 um; with ramps 1429 N = 1.11 x the mean, 1.00 x the steady max.
+    No guard fires and both runs keep the ratio."""
+    def run(ramp):
+        return simulate(load_scenario(path, COARSE + [f"drive.speed_rpm={rpm}", f"drive.ramp_s={ramp}",
+                                                      f"load.ramp_s={ramp}", f"simulation.duration_s={duration_s}"]
+                                      )).summary
+
+    step, ramp = run(0), run(ramp_s)
     for s in (step, ramp):
-        assert abs(s["ratio"] / 24 - 1) < 1e-3, s["ratio"]
+        assert abs(s["ratio"] / s["ratio_theory"] - 1) < 1e-3, s["ratio"]
         assert 0 < s["startup_time_s"] == pytest.approx(s["steady_window_s"][0])
         assert s["startup_penetration_max_um"] < 100
-    assert step["startup_tangential_force_peak_n"] > 20 * step["tangential_force_mean_n"]
-    assert step["startup_tangential_force_peak_n"] > 5 * step["tangential_force_max_n"]
+    peak = step["startup_tangential_force_peak_n"]
+    assert peak > over_mean * step["tangential_force_mean_n"], (peak, step["tangential_force_mean_n"])
+    assert peak > over_max * step["tangential_force_max_n"], (peak, step["tangential_force_max_n"])
     assert ramp["startup_tangential_force_peak_n"] < 1.1 * ramp["tangential_force_max_n"]
-    assert step["startup_tangential_force_peak_n"] > 5 * ramp["startup_tangential_force_peak_n"]
-    assert step["startup_penetration_max_um"] > 2 * ramp["startup_penetration_max_um"]
+    assert peak > 2.5 * ramp["startup_tangential_force_peak_n"]
+    assert step["startup_penetration_max_um"] > 1.5 * ramp["startup_penetration_max_um"]
