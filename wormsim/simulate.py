@@ -34,7 +34,7 @@ import time
 import mujoco
 import numpy as np
 
-from wormsim.contact import efficiency_theory, friction_coefficient, friction_mode
+from wormsim.contact import efficiency_theory, friction_coefficient, friction_coefficient_scalar, friction_mode
 from wormsim.errors import ScenarioError, SimulationError
 from wormsim.model import BuiltModel, build_model, repose_window
 from wormsim.result import Result
@@ -44,11 +44,12 @@ from wormsim.units import rad_s_to_rpm, rpm_to_rad_s, step
 MAX_POINTS = 48             # contact points kept per sample (for the pattern and the recording)
 TARGET_SAMPLES = 20000      # automatic record_every aims at about this many samples per run (each the mean
                             # over its interval, so decimation does not alias the contact vibration)
+_ROWS3 = np.arange(3)       # the normal and two tangent rows of an elliptic-cone contact
 JUMP_PITCH = 0.5            # transmission error (in pitches) that counts as teeth jumping
 MAX_WORM_TURN_PER_STEP_RAD = 0.035   # largest worm rotation per step contact3d resolves (2.0 deg; measured on the
                             # seat motor and screw jack gears, docs/stability_speed.md: <= 0.035 rad holds ratio and
-                            # torque balance; 0.061 rad tunnels the seat worm through the wheel, 0.07 rad costs the
-                            # screw jack 15 % efficiency, 0.21 rad tunnels it)
+                            # torque balance; 0.050 rad tunnels the seat worm through the wheel, at 0.07 rad the
+                            # screw jack's efficiency scatters from 0.54 to 0.64 (theory 0.65), 0.21 rad tunnels it)
 OVERSPEED_GUARD = 1.25      # the running check fires at this multiple of MAX_WORM_TURN_PER_STEP_RAD
 
 
@@ -144,7 +145,7 @@ def tooth_forces(bm: BuiltModel, d: mujoco.MjData, window_ks: np.ndarray):
     frame = np.asarray(con.frame[:n])[ok].reshape(-1, 3, 3)
     pos = np.asarray(con.pos[:n])[ok]
     dist = np.asarray(con.dist[:n])[ok]
-    f = np.stack([d.efc_force[adr], d.efc_force[adr + 1], d.efc_force[adr + 2]], axis=1)
+    f = d.efc_force[adr[:, None] + _ROWS3]
     F = np.einsum("ni,nij->nj", f, frame)              # force on geom2, world frame
     wheel_is_2 = bm.model.geom_bodyid[geom[:, 1]] != bm.worm_body
     F = np.where(wheel_is_2[:, None], F, -F)           # force on the wheel
@@ -163,9 +164,10 @@ def tooth_forces(bm: BuiltModel, d: mujoco.MjData, window_ks: np.ndarray):
     W = bm.window_teeth
     slot_of = _slot_lookup(bm)
     slots = slot_of[wheel_geom]
-    by_slot = {int(k % W): int(k) for k in window_ks}
-    ks = np.array([by_slot.get(int(s), 0) for s in slots])
-    n_teeth = len(set(ks.tolist()))
+    tooth_of_slot = np.zeros(W, dtype=int)
+    tooth_of_slot[np.asarray(window_ks) % W] = window_ks
+    ks = tooth_of_slot[slots]
+    n_teeth = int(np.unique(ks).size)
     # contact points in tooth-0 frame: undo wheel rotation and tooth angle
     th2 = float(d.qpos[bm.model.jnt_qposadr[bm.model.dof_jntid[bm.wheel_dof]]])
     ang = -(th2 + 2 * math.pi * ks / bm.geometry.z2)
@@ -192,7 +194,7 @@ def diverged_error(t: float, dt: float, bm: BuiltModel, what: str) -> Simulation
     return SimulationError(
         f"diverged at t = {t:.4g} s ({what}) at timestep {dt:.3g} s, within the contact's stable limit {lim:.3g} s: "
         f"a torque or speed step the light shafts cannot follow; lengthen drive.ramp_s / load.ramp_s, lower "
-        f"simulation.record_every (the commands are held over each record interval) or load.torque_nm")
+        f"load.torque_nm")
 
 
 def jump_error(t: float, te_pitch: float, dt: float, bm: BuiltModel, scenario: Scenario) -> SimulationError:
@@ -296,13 +298,19 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
     ia_drv, ia_load, dof1, dof2 = bm.drive_actuator, bm.load_actuator, bm.worm_dof, bm.wheel_dof
     # worm / wheel actuator on each shaft: (drive, load) or (load, drive)
     a1, a2 = (ia_drv, ia_load) if worm_is_drive else (ia_load, ia_drv)
-    j_mid = (np.arange(rec) + 0.5) * dt
+    mu_of = friction_coefficient_scalar(scenario.contact)
+    mu_set = None
+    # the commands at each step's midpoint, evaluated for blocks of about 4096 steps at once
+    block = max(1, 4096 // rec)
     for i in range(n_rec):
-        cmd, load_t = commands(scenario, i * rec * dt + j_mid, bm.direction)
+        if i % block == 0:
+            t_blk = (i * rec + np.arange(min(block, n_rec - i) * rec) + 0.5) * dt
+            cmd_blk, load_blk = (a.tolist() for a in commands(scenario, t_blk, bm.direction))
+        o = (i % block) * rec
         fx = fy = fz = mz = nc = t1 = t2 = p1 = p2 = 0.0
-        for j in range(rec):
-            ctrl[ia_drv] = cmd[j]
-            ctrl[ia_load] = load_t[j]
+        for j in range(o, o + rec):
+            ctrl[ia_drv] = cmd_blk[j]
+            ctrl[ia_load] = load_blk[j]
             w1j, w2j = qv[dof1], qv[dof2]
             mujoco.mj_step(m, d)
             # actuator forces of this step (computed at its start, with the speeds above) and the sensor's
@@ -318,12 +326,12 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
             fy += f1
             fz += f2
             mz += sd[s0 + 6] + sd[s0 + 7] * f1 - sd[s0 + 8] * f0
-        cmd = cmd[-1:]
+        cmd = cmd_blk[o + rec - 1]
         th1, th2 = float(d.qpos[qa_worm]), float(d.qpos[qa_wheel])
         w1, w2 = float(qv[dof1]), float(qv[dof2])
         t = float(d.time)
         # guards
-        if not (np.isfinite(d.qpos).all() and np.isfinite(d.qvel).all()) or d.warning[mujoco.mjtWarning.mjWARN_BADQACC].number:
+        if not math.isfinite(th1 + th2 + w1 + w2) or d.warning[mujoco.mjtWarning.mjWARN_BADQACC].number:
             raise diverged_error(t, dt, bm, "non-finite state or huge acceleration (MuJoCo's bad-qacc warning)")
         turn = abs(w1) * dt
         turn_max = max(turn_max, turn)
@@ -334,8 +342,9 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
             raise jump_error(t, te / pitch_angle, dt, bm, scenario)
         window = repose_window(bm, th2, window)
         vs = abs(w1) * geo.r1 / math.cos(geo.gamma)
-        mu = float(friction_coefficient(scenario.contact, vs))
-        m.geom_friction[coll, 0] = mu
+        mu = mu_of(vs)
+        if mu != mu_set:
+            m.geom_friction[coll, 0] = mu_set = mu
         _, _, _, _, _, nteeth, pen, p0, F, pw = tooth_forces(bm, d, window)
         if pen > pen_lim:
             raise SimulationError(
@@ -344,10 +353,10 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
                 f"~{dt_limit:.2g} s); raise contact.stiffness_n_per_m, lower simulation.timestep_s or lower load.torque_nm")
         if drv.speed_rpm is not None and t > ramp_end + 0.02:
             w_drive = w1 if worm_is_drive else w2
-            if abs(w_drive) < 0.5 * abs(cmd[0]):
+            if abs(w_drive) < 0.5 * abs(cmd):
                 locked_since = t if locked_since is None else locked_since
                 if t - locked_since > max(0.05, 20 * rec * dt):
-                    raise locked_error(t, w_drive, cmd[0], bm, scenario)
+                    raise locked_error(t, w_drive, cmd, bm, scenario)
             else:
                 locked_since = None
         S["t_s"][i] = t
@@ -355,7 +364,7 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
         S["worm_speed_rpm"][i], S["wheel_speed_rpm"][i] = rad_s_to_rpm(w1), rad_s_to_rpm(w2)
         S["worm_torque_nm"][i], S["wheel_torque_nm"][i] = t1 / rec, t2 / rec
         S["worm_power_w"][i], S["wheel_power_w"][i] = p1 / rec, p2 / rec
-        S["drive_command"][i] = cmd[0]
+        S["drive_command"][i] = cmd
         # the mean resultant at the pitch point P = (0, -r2, 0): e_t = +x, e_r = -y (tooth_forces)
         S["tangential_force_n"][i], S["radial_force_n"][i], S["axial_force_n"][i] = fx / rec, -fy / rec, fz / rec
         S["wheel_contact_torque_nm"][i] = mz / rec
