@@ -8,15 +8,17 @@ flank normal at the pitch point that is the clearance per flank (DIN 3975 force 
 meshgen's convex pieces are made conservative (moved inside the exact flanks by their measured bulge), but a
 residual bulge b remains (piece_error_um: the most negative signed distance of dense exact flank points from the
 union of pieces, docs/geometry.md): worm flanks, wheel conjugate flanks, wheel fillet / undercut zone. Worm piece
-against wheel piece the clearance is at least c - b_worm - b_wheel (tests/test_pieces.py), so the pieces never
-interfere when
+against wheel piece the clearance is about c - b_worm - b_wheel (tests/test_pieces.py), so contact3d requires
 
     c > b = max(0, -min_signed(worm)) + max(0, -min_signed(wheel), -min_signed(wheel_undercut_zone)),   (2)
 
 i.e. j > j_min = 2 b / (cos(alpha_n) cos(gamma)). Below it the pieces can overlap at the rigid-conjugate pose: a
-preload that rigid pieces with a soft contact turn into a friction drag on the back flanks (measured, involute_41 at
-coarse with j = 0: 3.5 um interference over a mesh cycle, 1.65 um at t = 0, efficiency 0.571 against 0.651-0.655
-with j >= 0.02 mm; docs/stability_backlash_locking.md). Zero backlash (both flanks touching) is physically a
+preload that rigid pieces with a soft contact turn into a friction drag on the back flanks (measured, involute_41
+with j = 0: 3.5 um overlap over a mesh cycle at coarse, efficiency 0.571 against 0.655 with j = 0.2 mm; 0.55 um at
+fine, 0.625 against 0.653; docs/stability_backlash_locking.md). (2) is a practical limit, not a guarantee: b comes
+from sampled points, and the overlap measured at j = 0 (piece_play) was 0.01-0.25 b for involute_41 and 1.1-1.8 b
+(at most 0.53 um) for the seat motor and the screw jack; above j_min no overlap was found in any case run.
+Zero backlash (both flanks touching) is physically a
 preloaded pair: contact3d does not model a preload, so j = 0 always fails (2) (every level leaves some bulge) and
 is rejected with j_min; a backlash just above j_min gives a pair that touches both flanks within the piece error.
 
