@@ -281,7 +281,8 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
     names = ["t_s", "worm_angle_rad", "wheel_angle_rad", "worm_speed_rpm", "wheel_speed_rpm",
              "worm_torque_nm", "wheel_torque_nm", "drive_command", "tangential_force_n", "radial_force_n",
              "axial_force_n", "contacts", "teeth_in_contact", "max_penetration_m", "friction_coefficient",
-             "transmission_error_rad", "wheel_contact_torque_nm", "worm_power_w", "wheel_power_w"]
+             "transmission_error_rad", "wheel_contact_torque_nm", "worm_power_w", "wheel_power_w",
+             "tangential_force_abs_max_n"]
     S = {k: np.zeros(n_rec) for k in names}
     pts = np.full((n_rec, MAX_POINTS, 3), np.nan, dtype=np.float32)
     pts_world = np.full((n_rec, MAX_POINTS, 3), np.nan, dtype=np.float32)
@@ -307,7 +308,7 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
             t_blk = (i * rec + np.arange(min(block, n_rec - i) * rec) + 0.5) * dt
             cmd_blk, load_blk = (a.tolist() for a in commands(scenario, t_blk, bm.direction))
         o = (i % block) * rec
-        fx = fy = fz = mz = nc = t1 = t2 = p1 = p2 = 0.0
+        fx = fy = fz = mz = nc = t1 = t2 = p1 = p2 = fpk = 0.0
         for j in range(o, o + rec):
             ctrl[ia_drv] = cmd_blk[j]
             ctrl[ia_load] = load_blk[j]
@@ -323,6 +324,8 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
             nc += sd[s0]
             f0, f1, f2 = sd[s0 + 1], sd[s0 + 2], sd[s0 + 3]
             fx += f0
+            if abs(f0) > fpk:                   # the per-step peak (the start-up impact is shorter than an interval)
+                fpk = abs(f0)
             fy += f1
             fz += f2
             mz += sd[s0 + 6] + sd[s0 + 7] * f1 - sd[s0 + 8] * f0
@@ -368,6 +371,7 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
         # the mean resultant at the pitch point P = (0, -r2, 0): e_t = +x, e_r = -y (tooth_forces)
         S["tangential_force_n"][i], S["radial_force_n"][i], S["axial_force_n"][i] = fx / rec, -fy / rec, fz / rec
         S["wheel_contact_torque_nm"][i] = mz / rec
+        S["tangential_force_abs_max_n"][i] = fpk
         S["contacts"][i], S["teeth_in_contact"][i] = nc / rec, nteeth
         S["max_penetration_m"][i] = pen
         S["friction_coefficient"][i] = mu
