@@ -134,18 +134,18 @@ def test_timestep_above_the_stable_limit_diverges_and_names_the_stable_timestep(
 
 
 def test_bad_qacc_at_a_stable_timestep_names_the_command_step_and_its_cure():
-    """MuJoCo's bad-qacc warning at the default (stable) timestep: with record_every = 400 the runner holds the
-    commands of each 2 ms record interval at its midpoint value, so the 2 ms speed ramp starts as a step of the
-    worm's stiff velocity servo (100 N m load). The divergence guard names that cause and its cures; the cure it
-    names (record_every = 1, the commands then follow the ramp) runs the same input through."""
-    base = ["simulation.duration_s=0.004", "load.ramp_s=0.002", "drive.ramp_s=0.002", "load.torque_nm=100"]
+    """MuJoCo's bad-qacc warning at the default (stable) timestep: a 100 N m load and the full speed command applied
+    as steps at t = 0 (ramp_s = 0) on the 7 g seat wheel. The divergence guard names that cause and its cure; the
+    cure it names (2 ms ramps, which the runner follows step by step) runs the same load through."""
+    base = ["simulation.duration_s=0.004", "load.torque_nm=100"]
     with pytest.raises(SimulationError) as exc:
-        simulate(load_scenario(DEMO, base + ["simulation.record_every=400"]))
+        simulate(load_scenario(DEMO, base + ["load.ramp_s=0", "drive.ramp_s=0"]))
     msg = str(exc.value)
     assert classify_failure(msg) == "diverged" and "bad-qacc" in msg, msg
-    assert "within the contact's stable limit" in msg and "simulation.record_every" in msg and "ramp_s" in msg
-    res = simulate(load_scenario(DEMO, base + ["simulation.record_every=1"]))
+    assert "within the contact's stable limit" in msg and "drive.ramp_s" in msg and "load.ramp_s" in msg
+    res = simulate(load_scenario(DEMO, base + ["load.ramp_s=0.002", "drive.ramp_s=0.002"]))
     assert res.sim_time_s == pytest.approx(0.004, abs=1e-5)
+
 
 def test_classify_failure_names_each_guard():
     for head, klass in FAILURE_CLASSES:
@@ -181,8 +181,8 @@ def test_bench_writes_the_stability_record_into_bench_meta(tmp_path, monkeypatch
     the first step and no stable timestep."""
     from wormsim import bench
 
-    monkeypatch.setattr(bench, "bench_cases", lambda quick, models=None: [])
-    monkeypatch.setattr(bench, "stability_map", lambda quick: {"seat_motor_demo": stability_edge(
+    monkeypatch.setattr(bench, "bench_cases", lambda quick, models=None, scenarios=None: [])
+    monkeypatch.setattr(bench, "stability_map", lambda quick, scenarios=None: {"seat_motor_demo": stability_edge(
         "seat_motor_demo", factors=(4,), duration_s=0.002, overrides=("drive.ramp_s=0.002", "load.ramp_s=0.002"))})
     bench.run_bench(quick=True, out_dir=tmp_path, models=("contact3d",))
     rec = json.loads((tmp_path / "bench_meta.json").read_text())["stability"]["seat_motor_demo"]

@@ -226,6 +226,30 @@ def friction_coefficient(contact: Contact, sliding_speed_m_s) -> float | np.ndar
     return float(out) if np.ndim(out) == 0 else out
 
 
+def friction_coefficient_scalar(contact: Contact):
+    """A float-only mu(Vs) equal to friction_coefficient (fast per step: the torsional ODE's right-hand side and
+    contact3d's runner)."""
+    if contact.friction_group is not None or (contact.friction is None and contact.friction_static is None):
+        mu_c = None if contact.friction_group is not None else float(friction_coefficient(contact, 0.0))
+        if mu_c is not None:
+            return lambda vs: mu_c
+        from wormsim.friction import GROUPS
+        from wormsim.units import DEG
+        a, b, c = GROUPS[contact.friction_group]
+        return lambda vs: math.tan(DEG / (a * abs(vs) ** b + c))
+    if contact.friction is not None:
+        mu_c = float(contact.friction)
+        return lambda vs: mu_c
+    ms, md, vt = contact.friction_static, contact.friction_dynamic, contact.transition_velocity_m_s
+
+    def mu(vs):
+        x = abs(vs) / vt
+        if x >= 1.0:
+            return md
+        return ms + (md - ms) * x * x * (3.0 - 2.0 * x)
+    return mu
+
+
 def efficiency_theory(lead_angle_rad: float, normal_pressure_angle_rad: float, mu: float,
                       backdriving: bool = False) -> float:
     """Wedge efficiencies with the virtual friction angle rho' = atan(mu / cos(alpha_n)) (DIN 3975):

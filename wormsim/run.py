@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from wormsim.errors import SimulationError
+from wormsim.errors import ScenarioError, SimulationError
 from wormsim.output import ResultDir
 from wormsim.progress import Progress
 from wormsim.result import Result
@@ -48,7 +48,7 @@ def run_scenario(scenario: Scenario, out_dir: str | Path, progress: bool | None 
         np.savez_compressed(rd.path("timeseries.npz"), **res.series)
         mod.write_report(res, rd.path("report.png"))
         mod.write_recording(res, rd.path("recording.rrd"))
-    except SimulationError as exc:
+    except (SimulationError, ScenarioError) as exc:     # a diagnosis (exit 3) or input found invalid (exit 2)
         rd.fail({"status": "failed", "message": str(exc), **base,
                  "wall_time_s": time.perf_counter() - t0, "sim_time_s": None, "steps": None})
         raise

@@ -77,6 +77,7 @@ from scipy.integrate import solve_ivp
 
 from meshgen.geometry import GearGeometry, derive
 from wormsim.contact import (DEFAULT_DAMPING_RATIO, MAX_DAMPING_RATIO, effective_modulus_pa, efficiency_theory,
+                             friction_coefficient_scalar,
                              friction_coefficient, friction_mode)
 from wormsim.errors import SimulationError
 from wormsim.mesh_stiffness import MeshStiffness, mesh_stiffness, per_length_stiffness
@@ -103,27 +104,7 @@ def inertias(scenario: Scenario, g: GearGeometry) -> tuple[float, float]:
     return 0.5 * m1 * g.r1 ** 2 + j1, 0.5 * m2 * g.r2 ** 2 + j2
 
 
-def _mu_scalar(contact):
-    """A float-only mu(Vs) equal to wormsim.contact.friction_coefficient (fast inside the ODE right-hand side)."""
-    if contact.friction_group is not None or (contact.friction is None and contact.friction_static is None):
-        mu_c = None if contact.friction_group is not None else float(friction_coefficient(contact, 0.0))
-        if mu_c is not None:
-            return lambda vs: mu_c
-        from wormsim.friction import GROUPS
-        from wormsim.units import DEG
-        a, b, c = GROUPS[contact.friction_group]
-        return lambda vs: math.tan(DEG / (a * abs(vs) ** b + c))
-    if contact.friction is not None:
-        mu_c = float(contact.friction)
-        return lambda vs: mu_c
-    ms, md, vt = contact.friction_static, contact.friction_dynamic, contact.transition_velocity_m_s
-
-    def mu(vs):
-        x = abs(vs) / vt
-        if x >= 1.0:
-            return md
-        return ms + (md - ms) * x * x * (3.0 - 2.0 * x)
-    return mu
+_mu_scalar = friction_coefficient_scalar     # (kept for tests/test_torsional.py)
 
 
 class _Mesh:
