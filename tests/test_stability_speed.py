@@ -87,6 +87,9 @@ def test_a_scenario_timestep_too_large_for_the_speed_is_refused_with_its_allowed
                                           "load.torque_nm=0.1"])
     h, src = sim_mod.choose_timestep(wheel, bm)
     assert h == 5e-6 and src.startswith("worm speed: 48000 rpm"), (h, src)
+    # above the contact's stable limit (2.53e-5 s) the divergence guard speaks first (it names that limit)
+    bm.model.opt.timestep = 5e-5
+    assert sim_mod.choose_timestep(_jack(26600, 0.01, "simulation.timestep_s=5e-5"), bm) == (5e-5, "scenario")
 
 
 def test_the_refusal_through_the_cli_is_exit_2(tmp_path, capsys):

@@ -102,13 +102,16 @@ def choose_timestep(scenario: Scenario, bm: BuiltModel) -> tuple[float, str]:
     """(timestep, timestep_source). The contact's default (wormsim.model.default_timestep: 0.4 x the explicit
     stability limit, 1-2-5) unless the commanded worm speed needs a smaller one: then h = the speed limit
     MAX_WORM_TURN_PER_STEP_RAD / w1 rounded down to 1-2-5. A timestep set in the scenario above the speed limit is
-    refused (ScenarioError naming simulation.timestep_s and its allowed range): beyond it the worm's convex pieces
+    refused (ScenarioError naming simulation.timestep_s and its allowed range; a timestep above the contact's
+    stable limit is left to the divergence guard, whose message names that limit): beyond it the worm's convex pieces
     jump through the wheel's between steps, and simulation.speculative does not prevent it (measured: it fails
     earlier; docs/stability_speed.md)."""
     h = float(bm.model.opt.timestep)
     w1 = worm_speed_command_rad_s(scenario, bm)
     if scenario.simulation.timestep_s is not None:
-        if w1 is not None and w1 * h > MAX_WORM_TURN_PER_STEP_RAD:
+        # above the contact's stable limit the divergence guard's diagnosis (which names that limit) comes first
+        stable = h <= bm.law.stable_timestep_s(3 * bm.law.contacts_per_pair)
+        if stable and w1 is not None and w1 * h > MAX_WORM_TURN_PER_STEP_RAD:
             lim = speed_timestep_limit_s(w1)
             raise ScenarioError(
                 f"simulation.timestep_s = {h:.3g} s is too large for the worm speed {rad_s_to_rpm(w1):.0f} rpm: the "
@@ -339,6 +342,8 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
         turn = abs(w1) * dt
         turn_max = max(turn_max, turn)
         if turn > OVERSPEED_GUARD * MAX_WORM_TURN_PER_STEP_RAD:
+            if dt > dt_limit:
+                raise diverged_error(t, dt, bm, f"the worm ran away to {rad_s_to_rpm(abs(w1)):.0f} rpm")
             raise overspeed_error(t, w1, dt)
         te = th2 - bm.direction * th1 / geo.ratio
         if abs(te) > JUMP_PITCH * pitch_angle:
