@@ -267,7 +267,7 @@ STABILITY_RESOLUTION = {"seat_motor": "coarse", "screw_jack": "coarse", "involut
 STABILITY_DURATION_S = 0.05
 # the guards' messages (wormsim.simulate) start with these words; the class names are what bench_meta.json holds
 FAILURE_CLASSES = (("diverged", "diverged"), ("teeth jumped", "teeth_jumped"), ("penetration", "penetration"),
-                   ("the drive locked", "locked"))
+                   ("the drive locked", "locked"), ("worm overspeed", "overspeed"))
 
 
 def classify_failure(message: str) -> str:

@@ -30,7 +30,7 @@ import mujoco
 import numpy as np
 
 from meshgen.geometry import GearGeometry, derive
-from wormsim.backlash import check_backlash
+from wormsim.backlash import check_backlash, check_conjugate_interference
 from wormsim.contact import ContactLaw, contact_law, efficiency_theory, friction_coefficient, friction_impratio
 from wormsim.scenario import Scenario, ScenarioError
 from wormsim.units import rpm_to_rad_s
@@ -300,7 +300,7 @@ def build_model(scenario: Scenario, gs=None, check_backlash_vs_pieces: bool = Tr
     slot_bodies = np.array([mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, f"slot{i}") for i in range(W)])
     _set_inv_mass_hat(model, law, arm1 ** 2 / (I1 + J1), arm2 ** 2 / (I2 + J2), slot_bodies)
     jid = lambda n: mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, n)  # noqa: E731
-    return BuiltModel(
+    bm = BuiltModel(
         model=model, spec=spec, geometry=geo, law=law,
         worm_body=mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "worm"),
         wheel_body=mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "wheel"),
@@ -310,6 +310,10 @@ def build_model(scenario: Scenario, gs=None, check_backlash_vs_pieces: bool = Tr
         worm_geoms=np.array([geom_id(n) for n in worm_names], dtype=int),
         wheel_slot_geoms=slot_geoms, slot_bodies=slot_bodies,
         window_teeth=W, tooth0_angle_rad=tooth0, direction=direction, drive_sign=drive_sign, pieces=gs, meta=meta)
+    if check_backlash_vs_pieces:
+        # the model itself at the rigid-conjugate pose (wormsim.backlash.check_conjugate_interference): exit 2
+        meta["conjugate_interference_m"] = check_conjugate_interference(bm, scenario.simulation.resolution)
+    return bm
 
 
 def _slabs_per_flank(gs) -> int:
