@@ -98,3 +98,22 @@ def test_torque_balance_within_2_percent(name):
 def test_efficiency_within_3_percent_of_wedge(name):
     s = run(name)["summary"]
     assert abs(s["efficiency"] / s["efficiency_theory"] - 1) < 0.03, (s["efficiency"], s["efficiency_theory"])
+
+
+RADIAL_XFAIL = {
+    "seat_motor": "line-of-centres radial force 237.6 N against DIN 3975's 229.1 N (+3.7 %; the plain resultant gives "
+                  "225 N, -1.8 %): with alpha_n 10 deg the radial force is the smallest component, the 58 % undercut "
+                  "wheel and both flanks touching (79 contacts on 4.4 teeth) leave contacts whose normals are not the "
+                  "pitch-point normal turned about the worm axis; not explained further",
+}
+
+
+@pytest.mark.parametrize("name", [pytest.param(n, marks=pytest.mark.xfail(reason=RADIAL_XFAIL[n], strict=True))
+                                  if n in RADIAL_XFAIL else n for n in SEEDS])
+def test_radial_force_on_the_line_of_centres_is_din_3975(name):
+    """Each contact's force turned about the worm axis onto the line of centres, summed, against DIN 3975's
+    F_r2 = F_t2 tan(alpha_n) cos(rho') / cos(gamma + rho') within 3 % (wormsim.metrics.radial_force_check). The plain
+    resultant's radial component is lower (screw jack about -13 %): the contacts sit around the worm at +-20-30 deg."""
+    s = run(name)["summary"]
+    assert abs(s["radial_force_line_of_centres_mean_n"] / s["radial_force_theory_n"] - 1) < 0.03, (
+        s["radial_force_line_of_centres_mean_n"], s["radial_force_theory_n"], s["radial_force_mean_n"])

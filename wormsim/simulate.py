@@ -285,7 +285,7 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
              "worm_torque_nm", "wheel_torque_nm", "drive_command", "tangential_force_n", "radial_force_n",
              "axial_force_n", "contacts", "teeth_in_contact", "max_penetration_m", "friction_coefficient",
              "transmission_error_rad", "wheel_contact_torque_nm", "worm_power_w", "wheel_power_w",
-             "tangential_force_abs_max_n"]
+             "tangential_force_abs_max_n", "radial_force_line_of_centres_n"]
     S = {k: np.zeros(n_rec) for k in names}
     pts = np.full((n_rec, MAX_POINTS, 3), np.nan, dtype=np.float32)
     pts_world = np.full((n_rec, MAX_POINTS, 3), np.nan, dtype=np.float32)
@@ -354,6 +354,10 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
         if mu != mu_set:
             m.geom_friction[coll, 0] = mu_set = mu
         _, _, _, _, _, nteeth, pen, p0, F, pw = tooth_forces(bm, d, window)
+        # each contact's force turned about the worm axis onto the line of centres (phi = its angle about the
+        # worm axis from the line of centres): the radial force DIN 3975's single pitch-point contact means
+        phi = np.arctan2(pw[:, 2], pw[:, 1] + geo.a)
+        fr_lc = float(-(F[:, 1] * np.cos(phi) + F[:, 2] * np.sin(phi)).sum())
         if pen > pen_lim:
             raise SimulationError(
                 f"penetration {pen * 1e6:.1f} um at t = {t:.4g} s exceeds the tolerance {pen_lim * 1e6:.1f} um "
@@ -376,6 +380,7 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
         # the mean resultant at the pitch point P = (0, -r2, 0): e_t = +x, e_r = -y (tooth_forces)
         S["tangential_force_n"][i], S["radial_force_n"][i], S["axial_force_n"][i] = fx / rec, -fy / rec, fz / rec
         S["wheel_contact_torque_nm"][i] = mz / rec
+        S["radial_force_line_of_centres_n"][i] = fr_lc
         S["tangential_force_abs_max_n"][i] = fpk
         S["contacts"][i], S["teeth_in_contact"][i] = nc / rec, nteeth
         S["max_penetration_m"][i] = pen
