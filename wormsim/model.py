@@ -312,7 +312,8 @@ def build_model(scenario: Scenario, gs=None, check_backlash_vs_pieces: bool = Tr
         window_teeth=W, tooth0_angle_rad=tooth0, direction=direction, drive_sign=drive_sign, pieces=gs, meta=meta)
     if check_backlash_vs_pieces:
         # the model itself at the rigid-conjugate pose (wormsim.backlash.check_conjugate_interference): exit 2
-        meta["conjugate_interference_m"] = check_conjugate_interference(bm, scenario.simulation.resolution)
+        meta["conjugate_interference_m"] = check_conjugate_interference(
+            bm, scenario.simulation.resolution, nominal_normal_force_n(scenario, geo))
     return bm
 
 
