@@ -179,6 +179,22 @@ def tooth_forces(bm: BuiltModel, d: mujoco.MjData, window_ks: np.ndarray):
     return f_t, f_r, f_a, tq, len(adr), n_teeth, float(max(0.0, -dist.min())), p0, F, pos
 
 
+def _contact_radius_efficiency(F: np.ndarray, pw: np.ndarray, geo, mu: float, worm_drives: bool):
+    """Force-weighted worm radius of the contacts and the wedge efficiency at each contact's own radius: the local
+    lead angle of a helicoid is tan(gamma_r) = tan(gamma) r1 / r (same lead, DIN 3975), so
+    eta_r = tan(gamma_r) / tan(gamma_r + rho') driving (tan(gamma_r - rho') / tan(gamma_r) back-driving, >= 0),
+    rho' = atan(mu / cos alpha_n), averaged with the contact forces as weights. (nan, nan) without contacts."""
+    w = np.linalg.norm(F, axis=1)
+    W = float(w.sum())
+    if W <= 0:
+        return float("nan"), float("nan")
+    r = np.hypot(pw[:, 1] + geo.a, pw[:, 2])
+    g = np.arctan(math.tan(geo.gamma) * geo.r1 / np.maximum(r, 1e-12))
+    rho = math.atan(mu / math.cos(geo.alpha_n))
+    eta = np.tan(g) / np.tan(g + rho) if worm_drives else np.maximum(np.tan(g - rho), 0.0) / np.tan(g)
+    return float((w * r).sum() / W), float((w * eta).sum() / W)
+
+
 def diverged_error(t: float, dt: float, bm: BuiltModel, what: str) -> SimulationError:
     """Divergence diagnosis. Above the explicit stability limit of the contact spring-damper with three pairs in
     parallel (ContactLaw.stable_timestep_s: h < 2/omega (sqrt(1 + zeta^2) - zeta)) the cure is the timestep: the
@@ -285,7 +301,8 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
              "worm_torque_nm", "wheel_torque_nm", "drive_command", "tangential_force_n", "radial_force_n",
              "axial_force_n", "contacts", "teeth_in_contact", "max_penetration_m", "friction_coefficient",
              "transmission_error_rad", "wheel_contact_torque_nm", "worm_power_w", "wheel_power_w",
-             "tangential_force_abs_max_n", "radial_force_line_of_centres_n"]
+             "tangential_force_abs_max_n", "radial_force_line_of_centres_n", "worm_contact_radius_m",
+             "efficiency_theory_at_contact_radius"]
     S = {k: np.zeros(n_rec) for k in names}
     pts = np.full((n_rec, MAX_POINTS, 3), np.nan, dtype=np.float32)
     pts_world = np.full((n_rec, MAX_POINTS, 3), np.nan, dtype=np.float32)
@@ -358,6 +375,7 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
         # worm axis from the line of centres): the radial force DIN 3975's single pitch-point contact means
         phi = np.arctan2(pw[:, 2], pw[:, 1] + geo.a)
         fr_lc = float(-(F[:, 1] * np.cos(phi) + F[:, 2] * np.sin(phi)).sum())
+        r_c, eta_c = _contact_radius_efficiency(F, pw, geo, mu, worm_is_drive)
         if pen > pen_lim:
             raise SimulationError(
                 f"penetration {pen * 1e6:.1f} um at t = {t:.4g} s exceeds the tolerance {pen_lim * 1e6:.1f} um "
@@ -381,6 +399,7 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
         S["tangential_force_n"][i], S["radial_force_n"][i], S["axial_force_n"][i] = fx / rec, -fy / rec, fz / rec
         S["wheel_contact_torque_nm"][i] = mz / rec
         S["radial_force_line_of_centres_n"][i] = fr_lc
+        S["worm_contact_radius_m"][i], S["efficiency_theory_at_contact_radius"][i] = r_c, eta_c
         S["tangential_force_abs_max_n"][i] = fpk
         S["contacts"][i], S["teeth_in_contact"][i] = nc / rec, nteeth
         S["max_penetration_m"][i] = pen
