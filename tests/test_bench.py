@@ -62,3 +62,28 @@ def test_bench_cli_rejects_unknown_seed_and_bad_repeats(tmp_path, capsys):
     assert main(["bench", "--repeats", "0", "--out", str(tmp_path)]) == 2
     assert "allowed: an integer >= 1" in capsys.readouterr().err
     assert not (tmp_path / "bench.json").exists()
+
+
+def test_full_grid_runs_each_contact3d_case_once_and_marks_the_finer_check():
+    from wormsim.bench import bench_cases
+
+    cases = [c for c in bench_cases(quick=False, scenarios=("screw_jack",)) if c.model == "contact3d"]
+    keys = [(c.resolution["level"], c.timestep_s) for c in cases]
+    assert len(keys) == len(set(keys)) == 9
+    assert sum(c.reference for c in cases) == 1 and sum(c.finer for c in cases) == 1
+    ref = next(c for c in cases if c.reference)
+    fin = next(c for c in cases if c.finer)
+    assert fin.resolution == ref.resolution and abs(fin.timestep_s - ref.timestep_s / 2) < 1e-12
+
+
+def test_json_results_are_readable_by_others(tmp_path):
+    import os
+    import stat
+
+    from wormsim.output import write_json_atomic
+
+    write_json_atomic(tmp_path / "x.json", {"a": 1})
+    mode = stat.S_IMODE(os.stat(tmp_path / "x.json").st_mode)
+    umask = os.umask(0)
+    os.umask(umask)
+    assert mode == 0o666 & ~umask

@@ -43,6 +43,9 @@ def write_json_atomic(path: Path, data) -> None:
     with os.fdopen(fd, "w") as fh:
         json.dump(_clean(data), fh, indent=2)
         fh.write("\n")
+    umask = os.umask(0)
+    os.umask(umask)
+    os.chmod(tmp, 0o666 & ~umask)       # mkstemp creates 0600; a result file is as readable as any other file
     os.replace(tmp, path)
 
 
