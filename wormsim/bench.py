@@ -239,11 +239,14 @@ def plot_bench(records: list[dict], path: Path, key: str = "tangential_force_mea
         for label in sorted({p[2] for p in pts}):
             sel = sorted((p for p in pts if p[2] == label), key=lambda p: p[0])
             ax.plot([p[0] for p in sel], [p[1] for p in sel], "o-", label=label, alpha=0.8)
-        if pts:
-            c, e = np.array([p[0] for p in pts]), np.array([p[1] for p in pts])
+        # the Pareto front of each seed (errors of different gears are not comparable with each other)
+        for k, scen in enumerate(sorted({p[2].split("/")[0] for p in pts})):
+            sel = [p for p in pts if p[2].split("/")[0] == scen]
+            c, e = np.array([p[0] for p in sel]), np.array([p[1] for p in sel])
             m = pareto_front(c, e)
             order = np.argsort(c[m])
-            ax.plot(c[m][order], e[m][order], "k--", lw=1.5, label="Pareto front")
+            ax.plot(c[m][order], e[m][order], "k--", lw=1.2, alpha=0.8,
+                    label="Pareto front (per seed)" if k == 0 else None)
         ax.set_xscale("log"); ax.set_yscale("log")
         ax.set_xlabel("wall time per simulated second [s/s]")
         ax.set_ylabel((f"relative error of {mode}" if mode == key else "worst relative error of the ERROR_KEYS")
