@@ -96,7 +96,11 @@ def conjugate_interference_m(bm, n_angles: int = 16) -> float:
     milliseconds). (2) rests on meshgen's sampled bulge; this is the model itself. Found needed: a wide-faced
     gear (m_x 4 mm, q 16, z2 80, b2 50 mm) passed (2) at coarse (sampled bulge 13 um against c = 56 um) while its
     coarse wheel slabs stood 130 um into the worm's pieces, and the run jammed (efficiency 0.0006)."""
-    return float(piece_play(bm, n_angles=n_angles, iterations=0)["interference_max_m"])
+    depth, restore = _depth_probe(bm)
+    try:
+        return max(depth(th1, th2) for th1, th2 in _conjugate_poses(bm.geometry, n_angles))
+    finally:
+        restore()
 
 
 INTERFERENCE_TOLERANCE = 0.05    # of the working deflection F_n / K_pair (a preload of 5 % of the working load)
@@ -113,28 +117,31 @@ def check_conjugate_interference(bm, resolution: str, working_normal_force_n: fl
     if pen > tol:
         g = bm.geometry
         finer = FINER.get(resolution)
+        cure = (f"use simulation.resolution {finer} (allowed: coarse, medium, fine; finer pieces bulge less) or "
+                if finer else "")
         raise ScenarioError(
             f"at simulation.resolution {resolution} the collision pieces of worm and wheel interfere by "
             f"{pen / UM:.3g} um at the rigid-conjugate pose (gear.backlash_mm = {g.backlash / MM:.4g} leaves "
             f"{flank_clearance_m(g) / UM:.3g} um per flank; allowed: {tol / UM:.3g} um, 5 % of the working "
-            f"deflection): the mesh would start jammed; "
-            + (f"use simulation.resolution {finer} (allowed: coarse, medium, fine; finer pieces bulge less)"
-               if finer else "raise gear.backlash_mm")
-            + (" or raise gear.backlash_mm" if finer else ""))
+            f"deflection): the mesh would start jammed; {cure}raise gear.backlash_mm")
     return pen
 
 
-def piece_play(bm, n_angles: int = 8, iterations: int = 32) -> dict:
-    """The circumferential play the collision pieces really leave, at the rigid-conjugate pose theta2 =
-    hand theta1 z1 / z2 for n_angles worm angles over one mesh cycle (2 pi / z1): with the worm held, the wheel is
-    turned each way by bisection until some piece pair penetrates (MuJoCo's collision, margin 0). Returns, in m:
-    play_min / play_max (arc at r2, both sides added), interference_max (deepest penetration at the conjugate pose;
-    0 when the pieces are clear there)."""
+def _conjugate_poses(g: GearGeometry, n_angles: int):
+    """(theta1, theta2) of the rigid-conjugate pose theta2 = hand theta1 z1 / z2 at n_angles worm angles over one
+    mesh cycle (2 pi / z1)."""
+    for th1 in np.linspace(0.0, 2 * math.pi / g.z1, n_angles, endpoint=False):
+        yield float(th1), g.hand * float(th1) * g.z1 / g.z2
+
+
+def _depth_probe(bm):
+    """(depth(theta1, theta2), restore()): the deepest piece penetration at a pose (MuJoCo's collision, margin 0;
+    the wheel window re-posed for theta2) on a scratch MjData; restore() puts the window back."""
     import mujoco
 
     from wormsim.model import repose_window
 
-    m, g = bm.model, bm.geometry
+    m = bm.model
     d = mujoco.MjData(m)
     q1 = int(m.jnt_qposadr[m.dof_jntid[bm.worm_dof]])
     q2 = int(m.jnt_qposadr[m.dof_jntid[bm.wheel_dof]])
@@ -147,24 +154,37 @@ def piece_play(bm, n_angles: int = 8, iterations: int = 32) -> dict:
         mujoco.mj_collision(m, d)
         return max(0.0, -float(np.min(d.contact.dist[:d.ncon]))) if d.ncon else 0.0
 
+    def restore() -> None:
+        m.body_quat[bm.slot_bodies] = quat0
+
+    return depth, restore
+
+
+def piece_play(bm, n_angles: int = 8, iterations: int = 32) -> dict:
+    """The circumferential play the collision pieces really leave, at the rigid-conjugate pose theta2 =
+    hand theta1 z1 / z2 for n_angles worm angles over one mesh cycle (2 pi / z1): with the worm held, the wheel is
+    turned each way by bisection until some piece pair penetrates (MuJoCo's collision, margin 0). Returns, in m:
+    play_min / play_max (arc at r2, both sides added), interference_max (deepest penetration at the conjugate pose;
+    0 when the pieces are clear there)."""
+    g = bm.geometry
+    depth, restore = _depth_probe(bm)
     pitch = 2 * math.pi / g.z2
     plays, pens = [], []
     try:
-        for th1 in np.linspace(0.0, 2 * math.pi / g.z1, n_angles, endpoint=False):
-            th2 = g.hand * th1 * g.z1 / g.z2
+        for th1, th2 in _conjugate_poses(g, n_angles):
             pen = depth(th1, th2)
             pens.append(pen)
-            side = []
+            if pen > 0:
+                plays.append(0.0)
+                continue
+            play = 0.0
             for s in (1.0, -1.0):
                 lo, hi = 0.0, 0.25 * pitch
-                if pen > 0:
-                    side.append(0.0)
-                    continue
                 for _ in range(iterations):
                     mid = 0.5 * (lo + hi)
                     lo, hi = (lo, mid) if depth(th1, th2 + s * mid) > 0 else (mid, hi)
-                side.append(lo)
-            plays.append(sum(side) * g.r2)
+                play += lo
+            plays.append(play * g.r2)
     finally:
-        m.body_quat[bm.slot_bodies] = quat0
+        restore()
     return {"play_min_m": float(min(plays)), "play_max_m": float(max(plays)), "interference_max_m": float(max(pens))}

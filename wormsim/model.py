@@ -364,16 +364,20 @@ def repose_window(bm: BuiltModel, theta2: float, current: np.ndarray | None = No
     return ks
 
 
+def round_down_125(h: float) -> float:
+    """Largest 1, 2 or 5 x 10^e not above h, as the decimal value (5e-06, not 5 * 10.0 ** -6 = 4.9999999999999996e-06)."""
+    e = math.floor(math.log10(h))
+    for mant in (5, 2, 1):
+        if float(f"{mant}e{e}") <= h * (1 + 1e-12):
+            return float(f"{mant}e{e}")
+    return float(f"1e{e}")
+
+
 def default_timestep(law: ContactLaw, contacts: int | None = None) -> float:
     """0.4 x the explicit stability limit with `contacts` (default 3 pairs' worth) in parallel,
     rounded down to 1-2-5 steps."""
     n = contacts if contacts is not None else 3 * law.contacts_per_pair
-    h = 0.4 * law.stable_timestep_s(n)
-    e = math.floor(math.log10(h))
-    for mant in (5, 2, 1):
-        if mant * 10 ** e <= h:
-            return mant * 10 ** e
-    return 10 ** e
+    return round_down_125(0.4 * law.stable_timestep_s(n))
 
 
 # ----------------------------------------------------------------------------- standalone MJCF

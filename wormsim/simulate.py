@@ -14,7 +14,7 @@ rate cancel exactly what would fold onto 0 Hz), and whose angles and speeds are 
   (DIN 3975 F_t2, F_r2, F_a2; seed 001's x/y components): tangential, radial (outward), axial; the contact
   torque M_z apart (wheel_contact_torque_nm); and takes, at the sample instant, the number of wheel teeth
   touching, the largest penetration and the contact points in the frame of wheel tooth 0 (for the contact
-  pattern), from the contacts' elliptic-cone rows (what mj_contactForce returns, tooth_forces),
+  pattern), from the contacts' elliptic-cone rows (what mj_contactForce returns, contact_details),
 - checks the guards: non-finite state or MuJoCo's bad-qacc warning (divergence), penetration beyond
   `penetration_limit_m`, the transmission error passing half a pitch (teeth jumped; divergence when the
   timestep is above the contact's stable limit), a speed-driven drive stuck below half its command (locked;
@@ -36,7 +36,7 @@ import numpy as np
 
 from wormsim.contact import efficiency_theory, friction_coefficient, friction_coefficient_scalar, friction_mode
 from wormsim.errors import ScenarioError, SimulationError
-from wormsim.model import BuiltModel, build_model, repose_window
+from wormsim.model import BuiltModel, build_model, default_timestep, repose_window, round_down_125
 from wormsim.result import Result
 from wormsim.scenario import Scenario
 from wormsim.units import rad_s_to_rpm, rpm_to_rad_s, step
@@ -89,15 +89,6 @@ def speed_timestep_limit_s(w1_rad_s: float) -> float:
     return MAX_WORM_TURN_PER_STEP_RAD / w1_rad_s
 
 
-def _round_down_125(h: float) -> float:
-    """Largest 1, 2 or 5 x 10^e not above h (as wormsim.model.default_timestep rounds)."""
-    e = math.floor(math.log10(h))
-    for mant in (5, 2, 1):
-        if float(f"{mant}e{e}") <= h * (1 + 1e-12):
-            return float(f"{mant}e{e}")          # the decimal value (5e-06, not 5 * 10.0 ** -6 = 4.9999999999999996e-06)
-    return float(f"1e{e}")
-
-
 def choose_timestep(scenario: Scenario, bm: BuiltModel) -> tuple[float, str]:
     """(timestep, timestep_source). The contact's default (wormsim.model.default_timestep: 0.4 x the explicit
     stability limit, 1-2-5) unless the commanded worm speed needs a smaller one: then h = the speed limit
@@ -122,7 +113,7 @@ def choose_timestep(scenario: Scenario, bm: BuiltModel) -> tuple[float, str]:
         return h, "scenario"
     src = "default: 0.4 x the stable limit, rounded down to 1-2-5 (docs/bench.md, stability map)"
     if w1 is not None and w1 * h > MAX_WORM_TURN_PER_STEP_RAD:
-        h = _round_down_125(speed_timestep_limit_s(w1))
+        h = round_down_125(speed_timestep_limit_s(w1))
         src = (f"worm speed: {rad_s_to_rpm(w1):.0f} rpm needs <= {MAX_WORM_TURN_PER_STEP_RAD} rad of worm rotation "
                f"per step, rounded down to 1-2-5 (below the contact's default; docs/stability_speed.md)")
     return h, src
@@ -133,13 +124,14 @@ def penetration_limit_m(bm: BuiltModel) -> float:
     return 0.4 * bm.geometry.m_x
 
 
-def tooth_forces(bm: BuiltModel, d: mujoco.MjData, window_ks: np.ndarray):
-    """Contact forces on the wheel: (F_t, F_r, F_a, M_z, n_contacts, n_teeth, max_pen, points_tooth0 (n,3),
-    forces (n,3) world, points world (n,3))."""
+def contact_details(bm: BuiltModel, d: mujoco.MjData, window_ks: np.ndarray):
+    """The contacts one by one (the resultant comes from the contact sensor): (n_teeth touching, max penetration,
+    points in the frame of wheel tooth 0 (n, 3), forces on the wheel (n, 3) world, points (n, 3) world). Forces are
+    the elliptic-cone rows (normal, two tangents: what mj_contactForce returns) turned into the world frame."""
     n = d.ncon
     if n == 0:
         z = np.zeros((0, 3))
-        return 0.0, 0.0, 0.0, 0.0, 0, 0, 0.0, z, z, z
+        return 0, 0.0, z, z, z
     con = d.contact
     adr = np.asarray(con.efc_address[:n])
     ok = adr >= 0
@@ -152,31 +144,20 @@ def tooth_forces(bm: BuiltModel, d: mujoco.MjData, window_ks: np.ndarray):
     F = np.einsum("ni,nij->nj", f, frame)              # force on geom2, world frame
     wheel_is_2 = bm.model.geom_bodyid[geom[:, 1]] != bm.worm_body
     F = np.where(wheel_is_2[:, None], F, -F)           # force on the wheel
-    # the resultant on the wheel resolved at the pitch point P = (0, -r2, 0) on the line of centres, in the
-    # wheel's directions there (DIN 3975 F_t2, F_r2, F_a2; seed 001 resolves ADAMS's contact force the same
-    # way): tangential e_t = +x (the wheel's positive sense at P), radial e_r = -y (outward, towards the
-    # worm), axial e_z. The contact torque M_z is kept apart: M_z / r2 would equal the mean F_t, but by the
-    # wheel's torque balance it varies only through I2 alpha2 and hides the mesh.
-    mz = pos[:, 0] * F[:, 1] - pos[:, 1] * F[:, 0]
-    f_t = float(F[:, 0].sum())
-    f_r = float(-F[:, 1].sum())
-    f_a = float(F[:, 2].sum())
-    tq = float(mz.sum())
     wheel_geom = np.where(wheel_is_2, geom[:, 1], geom[:, 0])
     # tooth index of each contact: slot -> tooth in the current window
     W = bm.window_teeth
-    slot_of = _slot_lookup(bm)
-    slots = slot_of[wheel_geom]
+    slots = _slot_lookup(bm)[wheel_geom]
     tooth_of_slot = np.zeros(W, dtype=int)
     tooth_of_slot[np.asarray(window_ks) % W] = window_ks
     ks = tooth_of_slot[slots]
-    n_teeth = int(np.unique(ks).size)
     # contact points in tooth-0 frame: undo wheel rotation and tooth angle
     th2 = float(d.qpos[bm.model.jnt_qposadr[bm.model.dof_jntid[bm.wheel_dof]]])
     ang = -(th2 + 2 * math.pi * ks / bm.geometry.z2)
     c, s = np.cos(ang), np.sin(ang)
     p0 = np.stack([c * pos[:, 0] - s * pos[:, 1], s * pos[:, 0] + c * pos[:, 1], pos[:, 2]], axis=1)
-    return f_t, f_r, f_a, tq, len(adr), n_teeth, float(max(0.0, -dist.min())), p0, F, pos
+    pen = float(max(0.0, -dist.min())) if len(dist) else 0.0
+    return int(np.unique(ks).size), pen, p0, F, pos
 
 
 def _contact_radius_efficiency(F: np.ndarray, pw: np.ndarray, geo, mu: float, worm_drives: bool):
@@ -200,8 +181,6 @@ def diverged_error(t: float, dt: float, bm: BuiltModel, what: str) -> Simulation
     parallel (ContactLaw.stable_timestep_s: h < 2/omega (sqrt(1 + zeta^2) - zeta)) the cure is the timestep: the
     message names the limit and wormsim's default (wormsim.model.default_timestep, 0.4 x the limit rounded down
     to 1-2-5). Within the limit the blow-up comes from a command step the light shafts cannot follow."""
-    from wormsim.model import default_timestep
-
     lim = bm.law.stable_timestep_s(3 * bm.law.contacts_per_pair)
     h0 = default_timestep(bm.law)
     if dt > lim:
@@ -370,7 +349,7 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
         mu = mu_of(vs)
         if mu != mu_set:
             m.geom_friction[coll, 0] = mu_set = mu
-        _, _, _, _, _, nteeth, pen, p0, F, pw = tooth_forces(bm, d, window)
+        nteeth, pen, p0, F, pw = contact_details(bm, d, window)
         # each contact's force turned about the worm axis onto the line of centres (phi = its angle about the
         # worm axis from the line of centres): the radial force DIN 3975's single pitch-point contact means
         phi = np.arctan2(pw[:, 2], pw[:, 1] + geo.a)
@@ -395,7 +374,11 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
         S["worm_torque_nm"][i], S["wheel_torque_nm"][i] = t1 / rec, t2 / rec
         S["worm_power_w"][i], S["wheel_power_w"][i] = p1 / rec, p2 / rec
         S["drive_command"][i] = cmd
-        # the mean resultant at the pitch point P = (0, -r2, 0): e_t = +x, e_r = -y (tooth_forces)
+        # the mean resultant on the wheel resolved at the pitch point P = (0, -r2, 0) on the line of centres, in the
+        # wheel's directions there (DIN 3975 F_t2, F_r2, F_a2; seed 001 resolves ADAMS's contact force the same
+        # way): tangential e_t = +x, radial e_r = -y (outward, towards the worm), axial e_z. The contact torque M_z
+        # is kept apart: M_z / r2 equals the mean F_t, but by the wheel's torque balance it varies only through
+        # I2 alpha2 and hides the mesh
         S["tangential_force_n"][i], S["radial_force_n"][i], S["axial_force_n"][i] = fx / rec, -fy / rec, fz / rec
         S["wheel_contact_torque_nm"][i] = mz / rec
         S["radial_force_line_of_centres_n"][i] = fr_lc
