@@ -119,10 +119,10 @@ def bench_cases(quick: bool, models: tuple[str, ...] | None = None,
     return out
 
 
-def relative_errors(summary: dict, reference: dict) -> dict:
-    """|x - x_ref| / |x_ref| for each ERROR_KEYS entry both summaries hold (None where undefined)."""
+def relative_errors(summary: dict, reference: dict, keys: tuple[str, ...] = ERROR_KEYS) -> dict:
+    """|x - x_ref| / |x_ref| for each of `keys` both summaries hold (None where undefined)."""
     err = {}
-    for k in ERROR_KEYS:
+    for k in keys:
         x, r = summary.get(k), reference.get(k)
         if x is None or r is None or not np.isfinite(x) or not np.isfinite(r) or r == 0:
             err[k] = None
@@ -346,13 +346,8 @@ def stability_edge(scenario_name: str, factors: tuple[float, ...] = STABILITY_FA
             run["ratio_angles"] = s["ratio_angles"]
             if ref is None:
                 ref = s
-            bad = []
-            for k, lim in tol.items():
-                x, r = s.get(k), ref.get(k)
-                ok = x is not None and r is not None and np.isfinite(x) and np.isfinite(r) and r != 0
-                run["drift"][k] = abs(x - r) / abs(r) if ok else None
-                if not ok or run["drift"][k] > lim:
-                    bad.append(k)
+            run["drift"] = relative_errors(s, ref, tuple(tol))
+            bad = [k for k, lim in tol.items() if run["drift"][k] is None or run["drift"][k] > lim]
             if bad:
                 run.update(status="inaccurate", failure="inaccurate",
                            message="drift beyond tolerance (or no steady value) in " + ", ".join(bad))
