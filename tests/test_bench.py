@@ -2,7 +2,8 @@
 never asserted)."""
 import numpy as np
 
-from wormsim.bench import ERROR_KEYS, pareto_front, plot_bench, relative_errors
+from wormsim.bench.cases import ERROR_KEYS, relative_errors
+from wormsim.bench.run import pareto_front, plot_bench
 
 
 def test_relative_errors_only_where_defined():
@@ -32,7 +33,7 @@ def test_quick_bench_torsional_level_writes_files_and_records(tmp_path):
     the files and each record's keys (speed is measured, never asserted)."""
     import json
 
-    from wormsim.bench import run_bench
+    from wormsim.bench.run import run_bench
 
     recs = run_bench(quick=True, out_dir=tmp_path, models=("torsional",))
     assert recs and all(r["model"] == "torsional" for r in recs)
@@ -48,7 +49,7 @@ def test_quick_bench_torsional_level_writes_files_and_records(tmp_path):
 
 
 def test_bench_cases_restricted_to_named_seeds():
-    from wormsim.bench import bench_cases
+    from wormsim.bench.cases import bench_cases
 
     cases = bench_cases(quick=False, models=("torsional",), scenarios=("screw_jack",))
     assert cases and {c.scenario for c in cases} == {"screw_jack"}
@@ -65,7 +66,7 @@ def test_bench_cli_rejects_unknown_seed_and_bad_repeats(tmp_path, capsys):
 
 
 def test_full_grid_runs_each_contact3d_case_once_and_marks_the_finer_check():
-    from wormsim.bench import bench_cases
+    from wormsim.bench.cases import bench_cases
 
     cases = [c for c in bench_cases(quick=False, scenarios=("screw_jack",)) if c.model == "contact3d"]
     keys = [(c.resolution["level"], c.timestep_s) for c in cases]

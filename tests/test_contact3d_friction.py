@@ -1,7 +1,7 @@
 """Friction of contact3d at low sliding speed (docs/contact3d.md, "Friction at low sliding speed").
 
 MuJoCo's elliptic friction rows are regularised: below the cone the friction force is viscous in the slip,
-f_t = slope v_t (wormsim.contact (2)). With impratio 1 the slope was the contact damping c_c (12 N s/m per
+f_t = slope v_t (wormsim.contact3d.law (2)). With impratio 1 the slope was the contact damping c_c (12 N s/m per
 seat-motor contact) and at seed 001's real 36 rpm (sliding speed Vs = omega1 r1 / cos(gamma) = 0.016 m/s)
 friction reached 12-19 % of mu f_n. The model now sets impratio by (3); these tests read every contact's
 friction force |f_t| against mu f_n (the utilisation) over a short run of the seat motor.
@@ -16,10 +16,10 @@ import mujoco
 import numpy as np
 import pytest
 
-from wormsim.contact import friction_coefficient, friction_regularisation_velocity_m_s, friction_utilisation
-from wormsim.model import build_model, repose_window
+from wormsim.contact3d.law import friction_coefficient, friction_regularisation_velocity_m_s, friction_utilisation
+from wormsim.contact3d.mjcf import build_model, repose_window
 from wormsim.scenario import ScenarioError, load_scenario
-from wormsim.simulate import commands
+from wormsim.contact3d.runner import commands
 
 SCEN = Path(__file__).resolve().parent.parent / "scenarios"
 DURATION_S = 0.05           # 10 000 steps of 5 us; contacts read over the last 40 % (after the 0.01 s ramps)
@@ -28,7 +28,7 @@ DURATION_S = 0.05           # 10 000 steps of 5 us; contacts read over the last 
 def sliding_contacts(rpm: float, impratio: float | None = None) -> tuple[np.ndarray, float, object]:
     """Seat motor (seed 001 gear, load and contact law; coarse pieces) with the worm at `rpm`: rows
     (f_n, |f_t|, mu, |v_t|) of every loaded contact sampled every 20 steps over the last 40 % of the run,
-    the sliding speed Vs, and the model. mu(Vs) is set as wormsim.simulate sets it."""
+    the sliding speed Vs, and the model. mu(Vs) is set as wormsim.contact3d.runner sets it."""
     sc = load_scenario(SCEN / "seat_motor.yaml", [f"drive.speed_rpm={rpm}", "drive.ramp_s=0.01", "load.ramp_s=0.01",
                                                   f"simulation.duration_s={DURATION_S}", "simulation.resolution=coarse"])
     bm = build_model(sc)
@@ -71,7 +71,7 @@ def test_friction_saturates_on_sliding_contacts(rpm):
 def test_soft_friction_rows_are_viscous_below_the_cone():
     """The diagnosis itself, so that it stays checked: with impratio 1 (the old setting) friction at 36 rpm is
     under-applied (mean utilisation < 0.5) and every unsaturated contact's f_t / v_t is the slope of
-    wormsim.contact (2), b / (A_hat + R_f) = c_c at impratio 1 (within 2 %)."""
+    wormsim.contact3d.law (2), b / (A_hat + R_f) = c_c at impratio 1 (within 2 %)."""
     C, vs, bm = sliding_contacts(36.0, impratio=1.0)
     util = C[:, 1] / (C[:, 2] * C[:, 0])
     assert util.mean() < 0.5, util.mean()
@@ -98,8 +98,8 @@ def test_impratio_follows_the_working_load():
 
 def test_load_inertia_is_the_loaded_hinge_armature_and_in_the_contact_mass():
     """load.inertia_kg_m2 (driven machine, rigid on the loaded shaft): the wheel hinge's armature, and the contact
-    law's A_hat = arm1^2 / I1 + arm2^2 / (I2 + J) (wormsim.model.mesh_arms) uses it; the bare gear is unchanged."""
-    from wormsim.model import mesh_arms
+    law's A_hat = arm1^2 / I1 + arm2^2 / (I2 + J) (wormsim.contact3d.mjcf.mesh_arms) uses it; the bare gear is unchanged."""
+    from wormsim.contact3d.mjcf import mesh_arms
 
     over = ["simulation.resolution=coarse"]
     bare = build_model(load_scenario(SCEN / "seat_motor.yaml", over))

@@ -1,4 +1,4 @@
-"""contact3d's guards (wormsim.simulate, issue 5): each failure mode stops the run with SimulationError (CLI exit 3,
+"""contact3d's guards (wormsim.contact3d.runner, issue 5): each failure mode stops the run with SimulationError (CLI exit 3,
 summary.json "failed") and a diagnosis that says what to change; a valid run trips none; the timestep stability
 edge (wormsim.bench.stability_edge) records the last stable timestep and classifies how the next one failed.
 
@@ -21,11 +21,11 @@ from pathlib import Path
 import pytest
 
 from wormsim import cli
-from wormsim.bench import FAILURE_CLASSES, classify_failure, stability_edge
+from wormsim.bench.stability import FAILURE_CLASSES, classify_failure, stability_edge
 from wormsim.errors import SimulationError
-from wormsim.model import build_model, default_timestep
+from wormsim.contact3d.mjcf import build_model, default_timestep
 from wormsim.scenario import load_scenario
-from wormsim.simulate import JUMP_PITCH, penetration_limit_m, simulate
+from wormsim.contact3d.runner import JUMP_PITCH, penetration_limit_m, simulate
 
 SCEN = Path(__file__).resolve().parent.parent / "scenarios"
 DEMO = SCEN / "seat_motor_demo.yaml"
@@ -118,7 +118,7 @@ def test_overload_on_held_worm_penetrates_or_jumps_with_a_diagnosis(torque_nm, k
 def test_timestep_above_the_stable_limit_diverges_and_names_the_stable_timestep():
     """dt = 1e-4 s, 20 x the default and 6 x the explicit limit of the contact spring-damper: the message is the
     divergence guard's and states the limit (ContactLaw.stable_timestep_s with three pairs) and the default
-    timestep (wormsim.model.default_timestep) to set."""
+    timestep (wormsim.contact3d.mjcf.default_timestep) to set."""
     sc = load_scenario(DEMO, ["simulation.timestep_s=1e-4", "simulation.duration_s=0.005"])
     law = build_model(sc).law
     with pytest.raises(SimulationError) as exc:
@@ -179,7 +179,7 @@ def test_bench_writes_the_stability_record_into_bench_meta(tmp_path, monkeypatch
     """run_bench puts stability_map's record under "stability" in bench_meta.json. The grid is emptied and the map
     cut to one sweep step of 2 ms at x4 (a timestep that runs away within 1 ms), so the record holds a failure at
     the first step and no stable timestep."""
-    from wormsim import bench
+    from wormsim.bench import run as bench
 
     monkeypatch.setattr(bench, "bench_cases", lambda quick, models=None, scenarios=None: [])
     monkeypatch.setattr(bench, "stability_map", lambda quick, scenarios=None: {"seat_motor_demo": stability_edge(

@@ -1,4 +1,4 @@
-"""Contact law of contact3d (wormsim.contact): the mapping's numbers, friction, and the static mesh
+"""Contact law of contact3d (wormsim.contact3d.law): the mapping's numbers, friction, and the static mesh
 stiffness the MuJoCo model actually shows under a known torque (issue 4: within 5 % of the specified)."""
 from __future__ import annotations
 
@@ -9,8 +9,8 @@ import mujoco
 import numpy as np
 import pytest
 
-from wormsim.contact import friction_coefficient, hertz_line_stiffness_n_per_m
-from wormsim.model import build_model
+from wormsim.contact3d.law import friction_coefficient, hertz_line_stiffness_n_per_m
+from wormsim.contact3d.mjcf import build_model
 from wormsim.scenario import Contact, load_scenario
 
 SCEN = Path(__file__).resolve().parent.parent / "scenarios"

@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 from wormsim.errors import SimulationError
-from wormsim.model import build_model, repose_window, write_model
+from wormsim.contact3d.mjcf import build_model, repose_window, write_model
 from wormsim.scenario import load_scenario
-from wormsim.simulate import simulate
+from wormsim.contact3d.runner import simulate
 
 SCEN = Path(__file__).resolve().parent.parent / "scenarios"
 COARSE = ["simulation.resolution=coarse"]

@@ -16,7 +16,7 @@ from pathlib import Path
 import pytest
 
 from wormsim.scenario import load_scenario
-from wormsim.simulate import simulate
+from wormsim.contact3d.runner import simulate
 
 SCEN = Path(__file__).resolve().parent.parent / "scenarios"
 CI = {
@@ -115,7 +115,7 @@ RADIAL_XFAIL = {
                                   if n in RADIAL_XFAIL else n for n in SEEDS])
 def test_radial_force_on_the_line_of_centres_is_din_3975(name):
     """Each contact's force turned about the worm axis onto the line of centres, summed, against DIN 3975's
-    F_r2 = F_t2 tan(alpha_n) cos(rho') / cos(gamma + rho') within 3 % (wormsim.metrics.radial_force_check). The plain
+    F_r2 = F_t2 tan(alpha_n) cos(rho') / cos(gamma + rho') within 3 % (wormsim.contact3d.metrics.radial_force_check). The plain
     resultant's radial component is lower (screw jack about -13 %): the contacts sit around the worm at +-20-30 deg."""
     s = run(name)["summary"]
     assert abs(s["radial_force_line_of_centres_mean_n"] / s["radial_force_theory_n"] - 1) < 0.03, (
@@ -126,7 +126,7 @@ def test_radial_force_on_the_line_of_centres_is_din_3975(name):
 def test_efficiency_within_3_percent_of_wedge_at_the_contact_radius(name):
     """The wedge formula evaluated where the contacts are: at each contact's worm radius r the lead angle is
     tan(gamma_r) = tan(gamma) r1 / r; eta_r = tan(gamma_r) / tan(gamma_r + rho') averaged with the contact forces
-    (wormsim.metrics.contact_radius_check). Not a looser check: it moves the theory to the contact, not the bound."""
+    (wormsim.contact3d.metrics.contact_radius_check). Not a looser check: it moves the theory to the contact, not the bound."""
     s = run(name)["summary"]
     assert abs(s["efficiency"] / s["efficiency_theory_at_contact_radius"] - 1) < 0.03, (
         s["efficiency"], s["efficiency_theory_at_contact_radius"], s["worm_contact_radius_mean_m"])

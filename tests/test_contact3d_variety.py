@@ -1,6 +1,6 @@
 """contact3d on gear data that is none of the seeds (INTERFACE.md: any valid gear data must work): multi-start,
 left-hand ZA, and a wide-faced gear whose coarse collision pieces interfere, which must be refused before
-simulating (wormsim.backlash.check_conjugate_interference) with the resolution that works named.
+simulating (wormsim.contact3d.backlash.check_conjugate_interference) with the resolution that works named.
 
 Short runs (0.03 s at 1000 rpm: two mesh periods of a 4-start worm, half a worm turn) at coarse resolution; the ratio
 is checked to the CI tolerance (0.1 %) and torque balance (F_t r2 = load) to 2 %."""
@@ -12,9 +12,9 @@ import pytest
 
 from meshgen.geometry import derive
 from wormsim.cli import main
-from wormsim.model import build_model
+from wormsim.contact3d.mjcf import build_model
 from wormsim.scenario import ScenarioError, load_scenario
-from wormsim.simulate import simulate
+from wormsim.contact3d.runner import simulate
 
 GEAR = Path(__file__).resolve().parent / "assets" / "other_gear.yaml"
 

@@ -1,7 +1,7 @@
 """Issue 5, stability map: the hard cases "near-zero backlash (jamming)" and "friction at the self-locking boundary
 (rho' = gamma)". Measured first (docs/stability_backlash_locking.md), then pinned down here with short runs.
 
-Backlash (wormsim/backlash.py): contact3d checks before it simulates that the flank-normal half backlash
+Backlash (wormsim/contact3d/backlash.py): contact3d checks before it simulates that the flank-normal half backlash
 (j/2) cos(alpha_n) cos(gamma) exceeds the collision pieces' residual bulge (meshgen's piece_error_um); below it the
 pieces interfere at the conjugate pose, a preload that drags on both flanks (measured: involute_41 at coarse with
 j = 0, efficiency 0.571 against 0.655 with j = 0.2 mm). Above it the backlash does not change a loaded forward drive
@@ -21,11 +21,12 @@ import numpy as np
 import pytest
 
 from meshgen.geometry import derive
-from wormsim import cli, torsional
-from wormsim.backlash import UM, flank_clearance_m, min_backlash_m, piece_bulge_m, piece_play
-from wormsim.model import build_model
+from wormsim import cli
+from wormsim.torsional import dynamics as torsional
+from wormsim.contact3d.backlash import UM, flank_clearance_m, min_backlash_m, piece_bulge_m, piece_play
+from wormsim.contact3d.mjcf import build_model
 from wormsim.scenario import ScenarioError, load_scenario
-from wormsim.simulate import run_model, simulate
+from wormsim.contact3d.runner import run_model, simulate
 from wormsim.units import MM
 
 SCEN = Path(__file__).resolve().parent.parent / "scenarios"
@@ -45,7 +46,7 @@ CI = {
                                                                 "seat_motor_demo")] + list(CI.items()))
 def test_seed_scenarios_and_ci_configurations_pass_the_backlash_check(name, overrides):
     """Each seed at its own resolution and in its CI configuration builds; the clearance it reports is (1) and lies
-    above the bulge (2) (wormsim.backlash)."""
+    above the bulge (2) (wormsim.contact3d.backlash)."""
     bm = build_model(load_scenario(SCEN / f"{name}.yaml", overrides))
     g, meta = bm.geometry, bm.meta
     assert meta["flank_clearance_m"] == pytest.approx(0.5 * g.backlash * math.cos(g.alpha_n) * math.cos(g.gamma))
@@ -89,7 +90,7 @@ def test_backlash_below_the_bulge_is_rejected_and_just_above_it_builds():
 
 
 def test_pieces_leave_the_requested_play_and_interfere_at_zero_backlash():
-    """What MuJoCo really collides (wormsim.backlash.piece_play, seat motor demo gear, coarse, 8 worm angles over a
+    """What MuJoCo really collides (wormsim.contact3d.backlash.piece_play, seat motor demo gear, coarse, 8 worm angles over a
     mesh cycle): with j = 0.01 mm the wheel's free play between its flanks is j within 1 um (measured 9.57-10.27 um)
     and nothing touches at the conjugate pose; with j = 0 (check bypassed) the pieces overlap there (measured
     0.21 um): the model cannot represent a zero-clearance pair."""
@@ -216,8 +217,8 @@ def test_contact3d_static_friction_governs_from_rest(demo_geometry, contact3d_fr
 
 
 def test_contact3d_mesh_force_sets_friction_hardness_for_a_torque_driven_wheel():
-    """A torque on the wheel against a free worm loads the mesh (wormsim.model.nominal_normal_force_n): impratio from
-    (3) of wormsim.contact, not 1. With impratio 1 the self-locking pair (mu 0.0877) crept back at 110 rpm instead of
+    """A torque on the wheel against a free worm loads the mesh (wormsim.contact3d.mjcf.nominal_normal_force_n): impratio from
+    (3) of wormsim.contact3d.law, not 1. With impratio 1 the self-locking pair (mu 0.0877) crept back at 110 rpm instead of
     0.16 rpm (the soft cone's viscous branch, slope c_c instead of impratio c_c)."""
     sc = load_scenario(DEMO, [*BACKDRIVE, "simulation.resolution=coarse", *_friction(0.0877)])
     bm = build_model(sc)

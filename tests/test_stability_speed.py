@@ -6,7 +6,7 @@ High speed: what matters is the worm's rotation per step, w1 h. Up to 0.035 rad 
 the seat motor demo keep the ratio (0.1 %) and the torque balance (2 %); from 0.05 rad the seat worm tunnels through
 the wheel (penetration guard: 403 um at 0.050 rad, 565 um at 0.061 rad); the screw jack still runs at 0.07 rad with
 a scattered efficiency (0.54 to 0.64 for timesteps 1 % apart, theory 0.649) and tunnels at 0.21 rad (1143 to
-1269 um). wormsim.simulate therefore picks h <= 0.035 rad / w1 (1-2-5) when the default is larger, refuses a scenario timestep above it (ScenarioError, exit 2) and stops a worm that overspeeds while running (a
+1269 um). wormsim.contact3d.runner therefore picks h <= 0.035 rad / w1 (1-2-5) when the default is larger, refuses a scenario timestep above it (ScenarioError, exit 2) and stops a worm that overspeeds while running (a
 torque drive running away) at 1.25 x that turn per step.
 
 Speculative contacts (simulation.speculative): below the speed limit they change nothing (the time series are
@@ -25,11 +25,11 @@ import numpy as np
 import pytest
 
 from wormsim import cli
-from wormsim import simulate as sim_mod
+from wormsim.contact3d import runner as sim_mod
 from wormsim.errors import ScenarioError, SimulationError
-from wormsim.model import build_model
+from wormsim.contact3d.mjcf import build_model
 from wormsim.scenario import load_scenario
-from wormsim.simulate import MAX_WORM_TURN_PER_STEP_RAD, OVERSPEED_GUARD, run_model, simulate
+from wormsim.contact3d.runner import MAX_WORM_TURN_PER_STEP_RAD, OVERSPEED_GUARD, run_model, simulate
 
 JACK = Path(__file__).resolve().parent.parent / "scenarios" / "screw_jack.yaml"
 COARSE = ["simulation.resolution=coarse"]

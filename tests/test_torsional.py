@@ -1,20 +1,21 @@
-"""The torsional fidelity level (wormsim.torsional) and its mesh stiffness TCA (wormsim.mesh_stiffness).
+"""The torsional fidelity level (wormsim.torsional.dynamics) and its mesh stiffness TCA (wormsim.torsional.mesh_stiffness).
 
 Closed forms checked against: ratio z2 / z1; meshing frequency z1 n1 / 60 (seed 001); torque balance
 F_t2 r2 = load torque (statics); efficiency tan g / tan(g + rho') and tan(g - rho') / tan g with
 rho' = atan(mu / cos alpha_n) (DIN 3975, seed 000); self-locking for rho' > gamma (seed 000).
 """
 import json
+from pathlib import Path
 import math
 
 import numpy as np
 import pytest
 
 from meshgen.geometry import derive
-from wormsim import mesh_stiffness as M
-from wormsim import torsional
-from wormsim.bench import ROOT
-from wormsim.contact import effective_modulus_pa, friction_coefficient
+from wormsim.torsional import mesh_stiffness as M
+from wormsim.torsional import dynamics as torsional
+ROOT = Path(__file__).resolve().parents[1]
+from wormsim.contact3d.law import effective_modulus_pa, friction_coefficient
 from wormsim.errors import SimulationError
 from wormsim.run import run_scenario
 from wormsim.scenario import load_scenario
@@ -211,7 +212,7 @@ def test_variants_hand_profile_starts_direction(overrides):
 
 
 def test_driven_machine_inertia_adds_to_the_loaded_shaft():
-    from wormsim.torsional import inertias
+    from wormsim.torsional.dynamics import inertias
 
     base = load_scenario(ROOT / "scenarios" / "seat_motor.yaml")
     g = derive(base.gear)

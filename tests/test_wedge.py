@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from wormsim import wedge
+from wormsim.wedge import dynamics as wedge
 from wormsim.errors import SimulationError
 from wormsim.recording import recorded_entities
 from wormsim.run import run_scenario

@@ -74,7 +74,7 @@ def _cmd_mesh(args) -> int:
 
 
 def _cmd_model(args) -> int:
-    from wormsim.model import write_model
+    from wormsim.contact3d.mjcf import write_model
     from wormsim.scenario import load_scenario
 
     sc = load_scenario(args.scenario, args.overrides)
@@ -84,7 +84,7 @@ def _cmd_model(args) -> int:
 
 
 def _cmd_bench(args) -> int:
-    from wormsim.bench import run_bench
+    from wormsim.bench.run import run_bench
 
     run_bench(quick=args.quick, out_dir=args.out, repeats=args.repeats,
               scenarios=tuple(args.scenarios) if args.scenarios else None)

@@ -14,17 +14,17 @@ from wormsim.progress import Progress
 from wormsim.result import Result
 from wormsim.scenario import Scenario
 
-# model name -> module with simulate(scenario, progress) -> Result, write_report(result, path),
-# write_recording(result, path)
-MODEL_MODULES = {
+# fidelity level -> its package, which exports simulate(scenario, progress) -> Result, write_report(result, path) and
+# write_recording(result, path). Imported on first use: a wedge run does not load MuJoCo.
+LEVELS = {
     "wedge": "wormsim.wedge",
-    "contact3d": "wormsim.simulate",
     "torsional": "wormsim.torsional",
+    "contact3d": "wormsim.contact3d",
 }
 
 
 def model_module(name: str):
-    return importlib.import_module(MODEL_MODULES[name])
+    return importlib.import_module(LEVELS[name])
 
 
 def simulate(scenario: Scenario, progress: Progress | None = None) -> Result:

@@ -1,7 +1,7 @@
 """Backlash against the collision pieces: the check contact3d makes before it simulates (issue 5, near-zero backlash).
 
 The wheel tooth is thinned by the circumferential backlash j at d2, j / 2 per flank (meshgen.wheel). Along the
-flank normal at the pitch point that is the clearance per flank (DIN 3975 force directions, as wormsim.model.mesh_arms)
+flank normal at the pitch point that is the clearance per flank (DIN 3975 force directions, as wormsim.contact3d.mjcf.mesh_arms)
 
     c = (j / 2) cos(alpha_n) cos(gamma).                                                          (1)
 
@@ -139,7 +139,7 @@ def _depth_probe(bm):
     the wheel window re-posed for theta2) on a scratch MjData; restore() puts the window back."""
     import mujoco
 
-    from wormsim.model import repose_window
+    from wormsim.contact3d.mjcf import repose_window
 
     m = bm.model
     d = mujoco.MjData(m)

@@ -13,7 +13,7 @@ R = (1 - d) / d * A_hat, where A_hat is MuJoCo's approximate constraint-space in
 
 and in motion f = -S/((1-d) A_hat) r - B/((1-d) A_hat) v - R^-1 a1: the same spring and damper plus
 an added mass 1/R = d / ((1 - d) A_hat) in the contact normal, which is small for small d. So we set
-A_hat ourselves (model.body_invweight0, see wormsim.model) and choose
+A_hat ourselves (model.body_invweight0, see wormsim.contact3d.mjcf) and choose
 
     S = k_c (1 - d) A_hat,    B = c_c (1 - d) A_hat                                     (1)
 
@@ -141,7 +141,7 @@ def contact_law(contact: Contact, materials: Materials, face_width_m: float, con
     """Map the scenario's contact block onto per-contact solref/solimp by (1).
 
     `inv_mass_hat` is A_hat = 1 / m_eff, the constraint-space inverse mass the model assigns to every
-    worm-wheel contact (wormsim.model sets body_invweight0 so that it holds).
+    worm-wheel contact (wormsim.contact3d.mjcf sets body_invweight0 so that it holds).
     """
     if contact.stiffness_n_per_m is not None:
         k_pair, source = contact.stiffness_n_per_m, "scenario"

@@ -5,7 +5,7 @@ Built with mujoco.MjSpec from the template `models/worm_pair.xml` (see models/RE
 - bodies in the assembly frame of INTERFACE.md (wheel axis z through the origin, worm axis parallel
   to x at y = -a), placed by meshgen.assembly; one hinge each, no gear or equality constraint;
 - collision geoms: meshgen's convex pieces (meshgen.pieces). All worm pieces; for the wheel only an
-  ACTIVE WINDOW of `window_teeth` tooth slots around the line of centres, which wormsim.simulate
+  ACTIVE WINDOW of `window_teeth` tooth slots around the line of centres, which wormsim.contact3d.runner
   re-poses by whole pitches as the wheel turns (tooth k lives in slot k mod W), so the cost does not
   grow with z2. Contype/conaffinity let worm pieces meet wheel pieces only;
 - visual-only geoms: the smooth watertight meshes (whole worm, whole wheel);
@@ -16,26 +16,27 @@ Built with mujoco.MjSpec from the template `models/worm_pair.xml` (see models/RE
 - load: `motor` on the other shaft, resisting (sign opposite to the expected motion), STEP from
   load.start_s over load.ramp_s; a driven-machine inertia load.inertia_kg_m2 is the loaded hinge's armature
   (rigid on the shaft) and counts in that shaft's effective mass of the contact law;
-- contact law: wormsim.contact (solref/solimp per collision geom; body_invweight0 set to A_hat);
+- contact law: wormsim.contact3d.law (solref/solimp per collision geom; body_invweight0 set to A_hat);
 - a contact sensor (worm against the wheel's subtree, reduce="netforce") gives the resultant tooth force
-  every step, which wormsim.simulate averages over each record interval.
+  every step, which wormsim.contact3d.runner averages over each record interval.
 """
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, replace
+from importlib.resources import files
 from pathlib import Path
 
 import mujoco
 import numpy as np
 
 from meshgen.geometry import GearGeometry, derive
-from wormsim.backlash import check_backlash, check_conjugate_interference
-from wormsim.contact import ContactLaw, contact_law, efficiency_theory, friction_coefficient, friction_impratio
+from wormsim.contact3d.backlash import check_backlash, check_conjugate_interference
+from wormsim.contact3d.law import ContactLaw, contact_law, efficiency_theory, friction_coefficient, friction_impratio
 from wormsim.scenario import Scenario, ScenarioError
 from wormsim.units import rpm_to_rad_s
 
-TEMPLATE = Path(__file__).resolve().parent.parent / "models" / "worm_pair.xml"
+TEMPLATE = files("wormsim.models") / "worm_pair.xml"   # models/, shipped as package data
 MESH_SENSOR_DATA = 1 | 2 | 4 | 16    # contact sensor fields found, force, torque, pos (mjtConDataField bits)
 SPEED_DROOP = 1e-3          # velocity servo: kv = T_expected / (SPEED_DROOP * omega_cmd)
 
@@ -114,7 +115,7 @@ def nominal_normal_force_n(scenario: Scenario, geo: GearGeometry) -> float:
     torque T2 = the load, or the worm load times the ratio when the load is on the worm; a torque driving the WHEEL
     counts too, the larger of the two: it passes through the mesh whatever the worm does, and against a free worm it
     is the only load. A torque driving the worm is not counted: what it does not pass to the wheel load accelerates
-    the worm). Sets the friction rows' hardness (wormsim.contact (3)); with T2 = 0 impratio fell to 1 and a
+    the worm). Sets the friction rows' hardness (wormsim.contact3d.law (3)); with T2 = 0 impratio fell to 1 and a
     self-locking pair crept back at ~110 rpm instead of 0.2 rpm (docs/stability_backlash_locking.md)."""
     load, drv = scenario.load, scenario.drive
     t2 = abs(load.torque_nm) * (1.0 if load.on == "wheel" else geo.ratio)
@@ -149,13 +150,13 @@ def window_teeth_at(theta2: float, z2: int, window: int, tooth0_angle: float) ->
 
 def build_model(scenario: Scenario, gs=None, check_backlash_vs_pieces: bool = True,
                 window_teeth: int | None = None) -> BuiltModel:
-    """The compiled contact3d model. check_backlash_vs_pieces=False skips wormsim.backlash's check (only to measure
+    """The compiled contact3d model. check_backlash_vs_pieces=False skips wormsim.contact3d.backlash's check (only to measure
     what happens below its limit). window_teeth: wheel tooth slots with collision (default window_size; geo.z2 =
     every tooth, for a standalone file that the viewer can turn without re-posing)."""
     if scenario.gear is None or scenario.drive is None:
         raise ScenarioError("model: contact3d needs gear: and drive: blocks")
     geo, gs = (derive(scenario.gear), gs) if gs is not None else gear_set(scenario)
-    # backlash against the pieces' residual bulge (wormsim.backlash (2)): exit 2 before the teeth start jammed
+    # backlash against the pieces' residual bulge (wormsim.contact3d.backlash (2)): exit 2 before the teeth start jammed
     backlash_meta = check_backlash(geo, gs.piece_error_um, scenario.simulation.resolution) \
         if check_backlash_vs_pieces and getattr(gs, "piece_error_um", None) else {}
     mats = scenario.materials
@@ -279,7 +280,7 @@ def build_model(scenario: Scenario, gs=None, check_backlash_vs_pieces: bool = Tr
 
     o = spec.option
     o.timestep = default_timestep(law) if scenario.simulation.timestep_s is None else scenario.simulation.timestep_s
-    o.impratio = law.impratio      # friction rows' hardness, wormsim.contact (3)
+    o.impratio = law.impratio      # friction rows' hardness, wormsim.contact3d.law (3)
     if scenario.simulation.speculative:
         o.enableflags |= int(mujoco.mjtEnableBit.mjENBL_SPECULATIVE)
     o.integrator = {"implicitfast": mujoco.mjtIntegrator.mjINT_IMPLICITFAST, "rk4": mujoco.mjtIntegrator.mjINT_RK4,
@@ -311,7 +312,7 @@ def build_model(scenario: Scenario, gs=None, check_backlash_vs_pieces: bool = Tr
         wheel_slot_geoms=slot_geoms, slot_bodies=slot_bodies,
         window_teeth=W, tooth0_angle_rad=tooth0, direction=direction, drive_sign=drive_sign, pieces=gs, meta=meta)
     if check_backlash_vs_pieces:
-        # the model itself at the rigid-conjugate pose (wormsim.backlash.check_conjugate_interference): exit 2
+        # the model itself at the rigid-conjugate pose (wormsim.contact3d.backlash.check_conjugate_interference): exit 2
         meta["conjugate_interference_m"] = check_conjugate_interference(
             bm, scenario.simulation.resolution, nominal_normal_force_n(scenario, geo))
     return bm
@@ -340,7 +341,7 @@ def _rotz(a: float) -> np.ndarray:
 
 def _set_inv_mass_hat(model: mujoco.MjModel, law: ContactLaw, a_worm: float, a_wheel: float,
                       slot_bodies: np.ndarray) -> None:
-    """Make MuJoCo's diagonal approximation of a worm-wheel contact row equal A_hat (wormsim.contact (1)):
+    """Make MuJoCo's diagonal approximation of a worm-wheel contact row equal A_hat (wormsim.contact3d.law (1)):
     body_invweight0[worm] + body_invweight0[slot body] = A_hat."""
     wb = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "worm")
     gb = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "wheel")

@@ -12,7 +12,7 @@ measures how far the worm leads the wheel. Conjugate flanks with circumferential
 wheel tooth, j / 2 per side, meshgen.wheel) leave an angular gap g = j / (2 r2) each side, so the flank the
 worm pushes in forward drive (side +1) touches for e > g and the opposite flank (side -1) for e < -g;
 in between, no force. The penetration along the line of action is delta = arm0 (|e| - g), arm0 = r2 cos(alpha_n)
-cos(gamma) (wormsim.mesh_stiffness: k(theta1) is computed there, once, from the generated flanks).
+cos(gamma) (wormsim.torsional.mesh_stiffness: k(theta1) is computed there, once, from the generated flanks).
 
 Mesh torque on the wheel (ADAMS IMPACT form with e = 1, damping blended in over the penetration depth d_max
 like IMPACT's STEP, never pulling):
@@ -20,12 +20,12 @@ like IMPACT's STEP, never pulling):
     T2m = side max(0, K_theta,side(theta1) (|e| - g) + C_theta(theta1) STEP(delta, 0, 0, d_max, 1) side e')
 
 C_theta = c arm0^2 K_theta / K_theta,mean: the line-of-action damping c (contact.damping_n_s_per_m, capped at
-wormsim.contact.MAX_DAMPING_RATIO (0.1) of the critical damping of the mesh mode, default DEFAULT_DAMPING_RATIO
+wormsim.contact3d.law.MAX_DAMPING_RATIO (0.1) of the critical damping of the mesh mode, default DEFAULT_DAMPING_RATIO
 (0.1) of it: the constants contact3d uses) scaled with the number of pairs engaged. Seed 001's C = 5e4 N s/m is
 capped to 78 N s/m this way.
 
 Friction: the wedge law (seed 000, DIN 3975 / Niemann-Winter worm gear forces) with the virtual friction angle
-rho' = atan(mu / cos alpha_n), mu = mu(Vs) of wormsim.contact (constant, static/dynamic STEP blend over the
+rho' = atan(mu / cos alpha_n), mu = mu(Vs) of wormsim.contact3d.law (constant, static/dynamic STEP blend over the
 transition velocity v_t, or seed 000's rho(Vs) groups), Vs = omega1 r1 / cos(gamma) (signed). The torque the
 mesh takes from the worm is
 
@@ -45,9 +45,9 @@ Equations of motion:
     I1 omega1' = T_drive,1 + T_load,1 - T1m,     I2 omega2' = T2m + T_drive,2 + T_load,2
 
 Drive: speed-controlled -> a stiff servo on speed T = kv (omega_cmd(t) - omega), kv for a 0.1 % droop at the
-expected torque (as contact3d's MuJoCo velocity actuator, wormsim.model); torque -> T(t). Both follow ADAMS
+expected torque (as contact3d's MuJoCo velocity actuator, wormsim.contact3d.mjcf); torque -> T(t). Both follow ADAMS
 STEP over drive.ramp_s; the load resists the expected motion, STEP from load.start_s over load.ramp_s
-(as wormsim.simulate.commands).
+(as wormsim.contact3d.runner.commands).
 
 Inertias: analytic solid cylinders (not the meshes): worm radius r1 over the threaded length b1, wheel radius
 r2 over the face width b2, from the materials' densities: I = m r^2 / 2, m = density pi r^2 L.
@@ -76,17 +76,17 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from meshgen.geometry import GearGeometry, derive
-from wormsim.contact import (DEFAULT_DAMPING_RATIO, MAX_DAMPING_RATIO, effective_modulus_pa, efficiency_theory,
+from wormsim.contact3d.law import (DEFAULT_DAMPING_RATIO, MAX_DAMPING_RATIO, effective_modulus_pa, efficiency_theory,
                              friction_coefficient_scalar,
                              friction_coefficient, friction_mode)
 from wormsim.errors import SimulationError
-from wormsim.mesh_stiffness import MeshStiffness, mesh_stiffness, per_length_stiffness
+from wormsim.torsional.mesh_stiffness import MeshStiffness, mesh_stiffness, per_length_stiffness
 from wormsim.result import Result
 from wormsim.scenario import Scenario
 from wormsim.units import rad_s_to_rpm, rpm_to_rad_s, step
 
 CHORD_ITER = 4              # backward Euler: Newton iterations that reuse the first Jacobian of a step
-SPEED_DROOP = 1e-3          # speed servo: kv = T_expected / (SPEED_DROOP * omega_cmd) (as wormsim.model)
+SPEED_DROOP = 1e-3          # speed servo: kv = T_expected / (SPEED_DROOP * omega_cmd) (as wormsim.contact3d.mjcf)
 MAX_SAMPLES = 20000
 SAMPLES_PER_MESH_PERIOD = 64
 RTOL, ATOL_ANGLE = 1e-7, 1e-10
@@ -201,7 +201,7 @@ def friction_coefficient_vec(mu_scalar, vs: np.ndarray) -> np.ndarray:
 
 def _commands(scenario: Scenario, g: GearGeometry):
     """Drive command (rad/s or N m) and load torque (N m) as functions of t: ADAMS STEP; the load resists the
-    expected motion, sign(command) * hand (as wormsim.simulate.commands with wormsim.model.expected_direction)."""
+    expected motion, sign(command) * hand (as wormsim.contact3d.runner.commands with wormsim.contact3d.mjcf.expected_direction)."""
     drv, load = scenario.drive, scenario.load
     target = rpm_to_rad_s(drv.speed_rpm) if drv.speed_rpm is not None else drv.torque_nm
     s = (math.copysign(1.0, target) if target != 0 else 1.0) * g.hand
@@ -226,7 +226,7 @@ def _step_scalar(t: float, t0: float, h0: float, t1: float, h1: float) -> float:
 
 
 def _servo_gain(scenario: Scenario, g: GearGeometry) -> float:
-    """kv = T_expected / (SPEED_DROOP omega_cmd), T_expected from the wedge efficiency (as wormsim.model)."""
+    """kv = T_expected / (SPEED_DROOP omega_cmd), T_expected from the wedge efficiency (as wormsim.contact3d.mjcf)."""
     drv, load = scenario.drive, scenario.load
     w_cmd = abs(rpm_to_rad_s(drv.speed_rpm))
     eta = efficiency_theory(g.gamma, g.alpha_n, float(friction_coefficient(scenario.contact, 1.0)),
@@ -461,53 +461,3 @@ def torsional_summary(S: dict, scenario: Scenario, g: GearGeometry, ms: MeshStif
         "force_peak_full_band_hz": f_force,
         "mesh_deflection_mean_um": float(np.mean(S["mesh_deflection_m"][sl]) * 1e6),
     }
-
-
-# ----------------------------------------------------------------------------- report, recording
-
-def write_report(result: Result, path) -> None:
-    """report.png: speeds, forces, transmission error, and k(theta) over one mesh cycle."""
-    import os
-    from pathlib import Path
-
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    S, sm = result.series, result.summary
-    ms: MeshStiffness = result.extra["mesh_stiffness"]
-    t = S["t_s"]
-    fig, ax = plt.subplots(2, 2, figsize=(12, 7), constrained_layout=True)
-    a = ax[0, 0]
-    a.plot(t, S["worm_speed_rpm"], label="worm")
-    a.plot(t, S["wheel_speed_rpm"] * sm["ratio_theory"], "--", label="wheel x ratio")
-    a.set_xlabel("t [s]"); a.set_ylabel("speed [rpm]"); a.legend(); a.set_title("shaft speeds")
-    a = ax[0, 1]
-    for k in ("tangential_force_n", "radial_force_n", "axial_force_n"):
-        a.plot(t, S[k], label=k.replace("_n", " [N]"))
-    w0, w1 = sm["steady_window_s"]
-    a.axvspan(w0, w1, color="0.9", zorder=-1, label="steady window")
-    a.set_xlabel("t [s]"); a.legend(fontsize=8); a.set_title("forces on the wheel")
-    a = ax[1, 0]
-    a.plot(t, S["transmission_error_rad"] * 1e6)
-    a.set_xlabel("t [s]"); a.set_ylabel("transmission error [urad]"); a.set_title("theta2 - hand theta1 z1/z2")
-    a = ax[1, 1]
-    deg = np.degrees(ms.theta1_rad)
-    a.plot(deg, ms.k_mesh_fwd_n_per_m, "o-", ms=3, label="flank side +1 (forward)")
-    a.plot(deg, ms.k_mesh_rev_n_per_m, "s--", ms=3, label="flank side -1")
-    a.set_xlabel("worm angle in the mesh cycle [deg]"); a.set_ylabel("k on the line of action [N/m]")
-    a.set_title(f"mesh stiffness (TCA, {ms.samples} samples)"); a.legend(fontsize=8)
-    fig.suptitle(f"{sm.get('scenario', '')} (torsional): ratio {sm['ratio']:.4g}, F_t {sm['tangential_force_mean_n']:.4g} N, "
-                 f"efficiency {sm['efficiency']:.3f}")
-    path = Path(path)
-    tmp = path.with_name(f".{path.name}.tmp.png")
-    fig.savefig(tmp, dpi=100)
-    plt.close(fig)
-    os.replace(tmp, path)
-
-
-def write_recording(result: Result, path) -> None:
-    from wormsim.recording import save_series_recording
-
-    save_series_recording(path, result.summary.get("scenario", "torsional"), result.series["t_s"], result.series)

@@ -86,7 +86,7 @@ def write_report(result: Result, path) -> None:
 def write_recording(result: Result, path) -> None:
     import rerun as rr
 
-    from wormsim.model import _assembly
+    from wormsim.contact3d.mjcf import _assembly
     from wormsim.recording import log_mesh, log_series, log_transforms, recording
 
     bm = result.extra["built"]

@@ -24,7 +24,7 @@ spread uniformly along it: a linear stiffness k' per unit length.
 
 Stiffness per unit line length k':
     contact.stiffness_n_per_m = K given:  k' = K / b2   (K is one tooth pair whose contact line spans the
-                                          face width, as contact3d reads it: wormsim.contact)
+                                          face width, as contact3d reads it: wormsim.contact3d.law)
     not given (Hertz, seed 001):          k' = pi E* / 4  (K = pi L E* / 4 per length L)
 
 Projection on the line of action. A wheel lag angle e (worm held) closes the normal gap at a contact point by
@@ -38,7 +38,7 @@ The torsional mesh stiffness (wheel torque per wheel lag angle) of one flank sid
     K_theta(theta1) = sum over the contact lines of  integral k' arm(s)^2 ds,                    (4)
 
 reported along the line of action at the pitch point as k_mesh = K_theta / arm0^2, arm0 = r2 cos(alpha_n)
-cos(gamma) (DIN 3975 force components, wormsim.model.mesh_arms). Side +1 is the flank the worm pushes when it
+cos(gamma) (DIN 3975 force components, wormsim.contact3d.mjcf.mesh_arms). Side +1 is the flank the worm pushes when it
 leads (hand theta1 z1 / z2 > theta2: forward drive), side -1 the opposite flank (reverse / back-driven by an
 overrunning wheel).
 

@@ -1,4 +1,4 @@
-"""contact3d runner: steps the MuJoCo model of wormsim.model, reads the tooth forces, guards the run.
+"""contact3d runner: steps the MuJoCo model of wormsim.contact3d.mjcf, reads the tooth forces, guards the run.
 
 `simulate(scenario, progress) -> Result` (the interface of wormsim.run). The loop steps the model one step at a
 time (the drive and load commands follow their STEP ramps at each step's midpoint) and, at every step, adds up
@@ -8,7 +8,7 @@ forces, moment, contact count, torques and powers are the MEANS over those steps
 vibration at 10-80 kHz does not alias into the meshing band, and the box's nulls at multiples of the sampling
 rate cancel exactly what would fold onto 0 Hz), and whose angles and speeds are the values at its end. Then it
 
-- re-poses the wheel's collision window by whole pitches (wormsim.model.repose_window),
+- re-poses the wheel's collision window by whole pitches (wormsim.contact3d.mjcf.repose_window),
 - sets the friction coefficient mu(Vs) from the sliding speed Vs = |omega1| r1 / cos(gamma),
 - resolves the mean resultant on the wheel in the wheel's directions at the pitch point on the line of centres
   (DIN 3975 F_t2, F_r2, F_a2; seed 001's x/y components): tangential, radial (outward), axial; the contact
@@ -34,9 +34,9 @@ import time
 import mujoco
 import numpy as np
 
-from wormsim.contact import efficiency_theory, friction_coefficient, friction_coefficient_scalar, friction_mode
+from wormsim.contact3d.law import efficiency_theory, friction_coefficient, friction_coefficient_scalar, friction_mode
 from wormsim.errors import ScenarioError, SimulationError
-from wormsim.model import BuiltModel, build_model, default_timestep, repose_window, round_down_125
+from wormsim.contact3d.mjcf import BuiltModel, build_model, default_timestep, repose_window, round_down_125
 from wormsim.result import Result
 from wormsim.scenario import Scenario
 from wormsim.units import rad_s_to_rpm, rpm_to_rad_s, step
@@ -64,7 +64,7 @@ def commands(scenario: Scenario, t: np.ndarray, direction: int) -> tuple[np.ndar
     """Drive command (rad/s or N m) and load torque (N m, on the load shaft) at times t: ADAMS STEP.
 
     The load resists: its sign is opposite to the load shaft's expected motion, which is
-    `direction` * sign(drive command) (wormsim.model.expected_direction)."""
+    `direction` * sign(drive command) (wormsim.contact3d.mjcf.expected_direction)."""
     drv, load = scenario.drive, scenario.load
     target = rpm_to_rad_s(drv.speed_rpm) if drv.speed_rpm is not None else drv.torque_nm
     drive = step(t, 0.0, 0.0, drv.ramp_s, target)
@@ -90,7 +90,7 @@ def speed_timestep_limit_s(w1_rad_s: float) -> float:
 
 
 def choose_timestep(scenario: Scenario, bm: BuiltModel) -> tuple[float, str]:
-    """(timestep, timestep_source). The contact's default (wormsim.model.default_timestep: 0.4 x the explicit
+    """(timestep, timestep_source). The contact's default (wormsim.contact3d.mjcf.default_timestep: 0.4 x the explicit
     stability limit, 1-2-5) unless the commanded worm speed needs a smaller one: then h = the speed limit
     MAX_WORM_TURN_PER_STEP_RAD / w1 rounded down to 1-2-5. A timestep set in the scenario above the speed limit is
     refused (ScenarioError naming simulation.timestep_s and its allowed range; a timestep above the contact's
@@ -179,7 +179,7 @@ def _contact_radius_efficiency(F: np.ndarray, pw: np.ndarray, geo, mu: float, wo
 def diverged_error(t: float, dt: float, bm: BuiltModel, what: str) -> SimulationError:
     """Divergence diagnosis. Above the explicit stability limit of the contact spring-damper with three pairs in
     parallel (ContactLaw.stable_timestep_s: h < 2/omega (sqrt(1 + zeta^2) - zeta)) the cure is the timestep: the
-    message names the limit and wormsim's default (wormsim.model.default_timestep, 0.4 x the limit rounded down
+    message names the limit and wormsim's default (wormsim.contact3d.mjcf.default_timestep, 0.4 x the limit rounded down
     to 1-2-5). Within the limit the blow-up comes from a command step the light shafts cannot follow."""
     lim = bm.law.stable_timestep_s(3 * bm.law.contacts_per_pair)
     h0 = default_timestep(bm.law)
@@ -393,7 +393,7 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
         if progress is not None:
             progress.update(t)
     wall = time.perf_counter() - t_wall
-    from wormsim.metrics import contact3d_summary
+    from wormsim.contact3d.metrics import contact3d_summary
 
     summary = contact3d_summary(S, scenario, bm)
     summary.update({
@@ -427,18 +427,3 @@ def simulate(scenario: Scenario, progress=None) -> Result:
     bm.model.opt.timestep = h
     bm.meta["timestep_source"] = src
     return run_model(bm, scenario, progress)
-
-
-def write_report(result: Result, path) -> None:
-    from wormsim.report3d import write_report as _w
-
-    _w(result, path)
-
-
-def write_recording(result: Result, path) -> None:
-    from wormsim.report3d import write_recording as _w
-
-    _w(result, path)
-
-
-__all__ = ["simulate", "write_report", "write_recording", "run_model", "efficiency_theory"]

@@ -1,0 +1,110 @@
+"""The bench grid: seed variants, resolutions and timesteps per level, and relative errors against the reference."""
+from __future__ import annotations
+
+import importlib.util
+from dataclasses import dataclass, field
+from importlib.resources import files
+
+import numpy as np
+
+from wormsim.scenario import ScenarioError, load_scenario
+
+SCENARIOS = files("wormsim.scenarios")     # the seed scenarios, shipped as package data
+ERROR_KEYS = ("ratio", "tangential_force_mean_n", "tangential_force_p2p_n", "mesh_frequency_hz", "efficiency")
+
+
+@dataclass(frozen=True)
+class BenchCase:
+    scenario: str                 # stem of scenarios/<stem>.yaml
+    model: str                    # fidelity level
+    resolution: dict              # free-form description of the level's resolution
+    timestep_s: float | None
+    overrides: tuple[str, ...] = field(default_factory=tuple)
+    reference: bool = False       # the converged reference of its scenario
+    finer: bool = False           # the finer run that checks the reference
+
+
+def _level_available(model: str) -> bool:
+    from wormsim.run import LEVELS
+
+    return importlib.util.find_spec(LEVELS[model]) is not None
+
+
+# Bench variants of the seed scenarios: every level runs the same variant, so errors compare one to one.
+# The seat motor runs its worm at 1800 rpm (seed 001's 36 rpm needs 20 s for 12 mesh periods: about an
+# hour at contact3d fidelity on this machine); ramps are shortened; each run holds >= 5 mesh periods.
+VARIANTS = {
+    "seat_motor": ("drive.speed_rpm=1800", "drive.ramp_s=0.02", "load.ramp_s=0.02"),
+    "screw_jack": ("drive.ramp_s=0.02", "load.ramp_s=0.02"),
+    "involute_41": ("drive.ramp_s=0.02", "load.ramp_s=0.02"),
+}
+DURATION_S = {"seat_motor": 0.25, "screw_jack": 0.3, "involute_41": 0.3}
+QUICK_DURATION_S = 0.15
+
+
+def contact3d_default_timestep(name: str, overrides: tuple[str, ...] = ()) -> float:
+    """The timestep contact3d chooses for this scenario (wormsim.contact3d.mjcf.default_timestep, set on the built model)."""
+    from wormsim.contact3d.mjcf import build_model
+
+    sc = load_scenario(SCENARIOS / f"{name}.yaml", list(overrides))
+    return float(build_model(sc).model.opt.timestep)
+
+
+def bench_cases(quick: bool, models: tuple[str, ...] | None = None,
+                scenarios: tuple[str, ...] | None = None) -> list[BenchCase]:
+    """The grid. contact3d: resolution levels x timesteps of 2, 1 and 1/2 times its default (the default
+    is 0.4 x the explicit stability limit, so 2x probes the edge); the reference is the finest level at
+    the default step, checked against half that step. torsional: k(theta) samples per mesh cycle.
+    quick: the seat motor only, 0.15 s, coarse/medium (a few minutes; CI runs the torsional part only).
+    models: only these levels. scenarios: only these seeds (names of VARIANTS)."""
+    names = ("seat_motor",) if quick else tuple(VARIANTS)
+    if scenarios is not None:
+        unknown = sorted(set(scenarios) - set(VARIANTS))
+        if unknown:
+            raise ScenarioError(f"bench --scenario: {', '.join(unknown)} is not a seed scenario; "
+                                f"allowed: {', '.join(VARIANTS)}")
+        names = tuple(n for n in VARIANTS if n in scenarios)
+    levels = ("coarse", "medium") if quick else ("coarse", "medium", "fine")
+    out: list[BenchCase] = []
+    for name in names:
+        dur = QUICK_DURATION_S if quick else DURATION_S[name]
+        common = VARIANTS[name] + (f"simulation.duration_s={dur}",)
+        if _level_available("contact3d") and (models is None or "contact3d" in models):
+            h = contact3d_default_timestep(name, common)
+            factors = (2.0, 1.0) if quick else (2.0, 1.0, 0.5)
+            for lvl in levels:
+                for f in factors:
+                    dt = float(f"{h * f:.4g}")
+                    out.append(BenchCase(name, "contact3d", {"level": lvl}, dt,
+                                         common + (f"simulation.resolution={lvl}", f"simulation.timestep_s={dt}"),
+                                         reference=(lvl == levels[-1] and f == 1.0)))
+            dt = float(f"{h / 2:.4g}")
+            same = next((i for i, c in enumerate(out) if c.scenario == name and c.model == "contact3d"
+                         and c.resolution == {"level": levels[-1]} and c.timestep_s == dt), None)
+            if same is not None:     # the grid already runs the finest level at h/2: that run is the check
+                out[same] = BenchCase(**{**out[same].__dict__, "finer": True})
+            else:
+                out.append(BenchCase(name, "contact3d", {"level": levels[-1]}, dt,
+                                     common + (f"simulation.resolution={levels[-1]}", f"simulation.timestep_s={dt}"),
+                                     finer=True))
+        if _level_available("torsional"):
+            # resolution = k(theta) samples per mesh cycle; the default timestep is one sample's worth of worm
+            # rotation at full speed (wormsim.torsional.dynamics.default_timestep), so this sweeps both
+            for n in ((16, 64) if quick else (16, 32, 64, 128, 256)):
+                out.append(BenchCase(name, "torsional", {"level": "mesh-stiffness table", "mesh_stiffness_samples": n},
+                                     None, common + ("model=torsional", f"simulation.mesh_stiffness_samples={n}")))
+    if models is not None:
+        out = [c for c in out if c.model in models]
+    return out
+
+
+def relative_errors(summary: dict, reference: dict, keys: tuple[str, ...] = ERROR_KEYS) -> dict:
+    """|x - x_ref| / |x_ref| for each of `keys` both summaries hold (None where undefined)."""
+    err = {}
+    for k in keys:
+        x, r = summary.get(k), reference.get(k)
+        if x is None or r is None or not np.isfinite(x) or not np.isfinite(r) or r == 0:
+            err[k] = None
+        else:
+            err[k] = abs(x - r) / abs(r)
+    return err

@@ -1,0 +1,162 @@
+"""`wormsim bench`: speed against accuracy of the fidelity levels (INTERFACE.md, bench.json).
+
+For each seed scenario, each fidelity level runs across its resolutions and timesteps. Per run:
+
+    wall_s            median wall time of `repeats` runs in this process, after a short warm-up run
+                      that builds the geometry and k(theta) caches
+    realtime_factor   sim_s / wall_s
+    error[key]        |value - reference| / |reference| for key in ERROR_KEYS, against the converged
+                      reference: the finest contact3d run of that scenario. The reference itself is checked
+                      against a finer run (`reference_check` in bench_meta.json).
+
+Outputs, written atomically: bench.json (list of records), bench_meta.json (machine, reference
+check, notes, and "stability": the last stable contact3d timestep per seed and how the next one failed,
+stability_edge), bench.png (error against wall time per simulated second, log axes, one curve per
+level, Pareto front marked).
+"""
+from __future__ import annotations
+
+import os
+import platform
+import statistics
+import time
+from pathlib import Path
+
+import numpy as np
+
+from wormsim.bench.cases import SCENARIOS, BenchCase, _level_available, bench_cases, relative_errors
+from wormsim.bench.stability import stability_map
+from wormsim.output import write_json_atomic
+from wormsim.scenario import ScenarioError, load_scenario
+
+def pareto_front(cost: np.ndarray, error: np.ndarray) -> np.ndarray:
+    """Mask of points not dominated by another (lower-or-equal cost AND error, one strictly lower)."""
+    cost, error = np.asarray(cost, float), np.asarray(error, float)
+    keep = np.ones(len(cost), bool)
+    for i in range(len(cost)):
+        dominated = (cost <= cost[i]) & (error <= error[i]) & ((cost < cost[i]) | (error < error[i]))
+        keep[i] = not dominated.any()
+    return keep
+
+
+def machine_info() -> dict:
+    """Platform, CPU count and the 1-minute load average (wall times are only comparable at the same load)."""
+    return {"platform": platform.platform(), "python": platform.python_version(),
+            "processor": platform.processor() or platform.machine(), "cpu_count": os.cpu_count(),
+            "load_average_1min": os.getloadavg()[0] if hasattr(os, "getloadavg") else None}
+
+
+def _run_case(case: BenchCase, repeats: int) -> tuple[dict, float, float]:
+    from wormsim.run import simulate
+
+    sc = load_scenario(SCENARIOS / f"{case.scenario}.yaml", list(case.overrides))
+    # warm-up: a run of a few steps builds the geometry / k(theta) caches, so the timed runs measure
+    # simulation, not one-off generation (which `wormsim mesh` reports on its own)
+    warm = sc.model_copy(deep=True)
+    warm.simulation.duration_s = 20 * (sc.simulation.timestep_s or 1e-4)
+    try:
+        simulate(warm)
+    except Exception:  # noqa: BLE001  a too-short run may fail its own checks; the timed runs report real failures
+        pass
+    walls, res = [], None
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        res = simulate(sc)
+        walls.append(time.perf_counter() - t0)
+    return res.summary, statistics.median(walls), res.sim_time_s
+
+
+def run_bench(quick: bool, out_dir: str | Path, repeats: int | None = None,
+              models: tuple[str, ...] | None = None, scenarios: tuple[str, ...] | None = None) -> list[dict]:
+    from wormsim.errors import SimulationError
+
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    if repeats is not None and repeats < 1:
+        raise ScenarioError(f"bench --repeats: {repeats} is not allowed; allowed: an integer >= 1")
+    repeats = repeats or (1 if quick else 3)
+    records, summaries, notes = [], {}, []
+    machine_start = machine_info()
+    for case in bench_cases(quick, models, scenarios):
+        try:
+            summary, wall, sim_s = _run_case(case, repeats)
+        except SimulationError as exc:
+            notes.append(f"{case.scenario} {case.model} {case.resolution} dt={case.timestep_s}: failed: {exc}")
+            records.append({"scenario": case.scenario, "model": case.model, "resolution": case.resolution,
+                            "timestep_s": case.timestep_s, "wall_s": None, "sim_s": None, "realtime_factor": None,
+                            "status": "failed", "message": str(exc), "error": {}})
+            continue
+        rec = {"scenario": case.scenario, "model": case.model, "resolution": case.resolution,
+               "timestep_s": summary.get("timestep_s", case.timestep_s), "wall_s": wall, "sim_s": sim_s,
+               "realtime_factor": sim_s / wall if wall > 0 else None,
+               "wall_s_per_sim_s": wall / sim_s if sim_s else None, "status": "ok",
+               "reference": case.reference, "finer": case.finer, "error": {}}
+        summaries[id(rec)] = summary
+        records.append(rec)
+    meta = {"machine": machine_start, "load_average_1min_end": machine_info()["load_average_1min"],
+            "quick": quick, "repeats": repeats, "scenarios": sorted({r["scenario"] for r in records}),
+            "reference_check": {}, "notes": notes}
+    for scen in {r["scenario"] for r in records}:
+        ref = next((r for r in records if r["scenario"] == scen and r.get("reference") and r["status"] == "ok"), None)
+        if ref is None:
+            notes.append(f"{scen}: no converged reference run; errors left empty")
+            continue
+        ref_sum = summaries[id(ref)]
+        for r in records:
+            if r["scenario"] == scen and r["status"] == "ok":
+                r["error"] = relative_errors(summaries[id(r)], ref_sum)
+        finer = next((r for r in records if r["scenario"] == scen and r.get("finer") and r["status"] == "ok"), None)
+        if finer is not None:
+            meta["reference_check"][scen] = finer["error"]
+    if _level_available("contact3d") and (models is None or "contact3d" in models):
+        # the timestep sweep of each seed until a guard fires (stability_edge); quick: the seat motor only
+        meta["stability"] = stability_map(quick, scenarios)
+    write_json_atomic(out / "bench.json", records)
+    write_json_atomic(out / "bench_meta.json", meta)
+    plot_bench(records, out / "bench.png")
+    return records
+
+
+def plot_bench(records: list[dict], path: Path, key: str = "tangential_force_mean_n") -> None:
+    """Error of `key` (and the worst of ERROR_KEYS) against wall time per simulated second, log-log."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    ok = [r for r in records if r["status"] == "ok" and r.get("wall_s_per_sim_s") and not r.get("finer")]
+    fig, axes = plt.subplots(1, 2, figsize=(12, 4.8), constrained_layout=True)
+    for ax, mode in zip(axes, (key, "worst")):
+        pts = []
+        for r in ok:
+            errs = [v for v in r["error"].values() if v is not None]
+            e = r["error"].get(key) if mode == key else (max(errs) if errs else None)
+            if e is None or r.get("reference"):
+                continue
+            pts.append((r["wall_s_per_sim_s"], max(e, 1e-6), f"{r['scenario']}/{r['model']}"))
+        for label in sorted({p[2] for p in pts}):
+            sel = sorted((p for p in pts if p[2] == label), key=lambda p: p[0])
+            ax.plot([p[0] for p in sel], [p[1] for p in sel], "o-", label=label, alpha=0.8)
+        # the Pareto front of each seed (errors of different gears are not comparable with each other)
+        for k, scen in enumerate(sorted({p[2].split("/")[0] for p in pts})):
+            sel = [p for p in pts if p[2].split("/")[0] == scen]
+            c, e = np.array([p[0] for p in sel]), np.array([p[1] for p in sel])
+            m = pareto_front(c, e)
+            order = np.argsort(c[m])
+            ax.plot(c[m][order], e[m][order], "k--", lw=1.2, alpha=0.8,
+                    label="Pareto front (per seed)" if k == 0 else None)
+        ax.set_xscale("log"); ax.set_yscale("log")
+        ax.set_xlabel("wall time per simulated second [s/s]")
+        ax.set_ylabel((f"relative error of {mode}" if mode == key else "worst relative error of the ERROR_KEYS")
+                      + " (floored at 1e-6)")
+        ax.grid(True, which="both", alpha=0.3)
+        if pts:
+            ax.legend(fontsize=7)
+    fig.suptitle("wormsim bench: accuracy against speed (errors vs the finest contact3d run)")
+    tmp = path.with_name(f".{path.name}.tmp.png")
+    fig.savefig(tmp, dpi=110)
+    plt.close(fig)
+    os.replace(tmp, path)
+
+
+# ----------------------------------------------------------------------------- stability edge (issue 5, first slice)

@@ -1,0 +1,8 @@
+"""contact3d: worm and wheel on hinges in MuJoCo, coupled only by tooth contact.
+
+law.py (contact-law mapping), mjcf.py (the MjSpec model), backlash.py (checks before a run), runner.py (stepping,
+guards), metrics.py (summary), report.py (report.png, recording.rrd)."""
+from wormsim.contact3d.report import write_recording, write_report
+from wormsim.contact3d.runner import simulate
+
+__all__ = ["simulate", "write_report", "write_recording"]
