@@ -28,9 +28,72 @@ from __future__ import annotations
 
 import math
 from dataclasses import asdict, dataclass
+from typing import Literal, Protocol
 
-from wormsim.scenario import Gear, ScenarioError
-from wormsim.units import DEG, MM
+# meshgen reads gear data in the units of its field names (mm, deg) and works in SI: these are its conversions
+# (the simulator's are in wormsim.units; meshgen imports nothing from wormsim)
+MM = 1e-3                      # m per mm
+DEG = math.pi / 180.0          # rad per deg
+
+
+class GeometryError(ValueError):
+    """Gear data that cannot be made (pointed or undercut teeth, a too wide face...). The message names the field
+    of the gear data (as in a scenario's `gear:` block, e.g. gear.backlash_mm) and what is allowed."""
+
+
+class GearData(Protocol):
+    """What derive() reads (read-only): the fields of a scenario's `gear:` block (wormsim.scenario.Gear has them,
+    validated), or a GearSpec."""
+
+    @property
+    def profile(self) -> str: ...
+    @property
+    def hand(self) -> str: ...
+    @property
+    def worm_starts(self) -> int: ...
+    @property
+    def wheel_teeth(self) -> int: ...
+    @property
+    def normal_module_mm(self) -> float | None: ...
+    @property
+    def axial_module_mm(self) -> float | None: ...
+    @property
+    def normal_pressure_angle_deg(self) -> float: ...
+    @property
+    def lead_angle_deg(self) -> float | None: ...
+    @property
+    def diameter_quotient(self) -> float | None: ...
+    @property
+    def face_width_mm(self) -> float | None: ...
+    @property
+    def worm_length_mm(self) -> float | None: ...
+    @property
+    def backlash_mm(self) -> float: ...
+    @property
+    def addendum_coef(self) -> float: ...
+    @property
+    def dedendum_coef(self) -> float: ...
+
+
+@dataclass(frozen=True)
+class GearSpec:
+    """Plain gear data for using meshgen on its own (the defaults of a scenario's `gear:` block). Give exactly one
+    of normal_module_mm / axial_module_mm and one of lead_angle_deg / diameter_quotient."""
+
+    wheel_teeth: int
+    normal_module_mm: float | None = None
+    axial_module_mm: float | None = None
+    lead_angle_deg: float | None = None
+    diameter_quotient: float | None = None
+    profile: Literal["ZI", "ZA"] = "ZI"
+    hand: Literal["right", "left"] = "right"
+    worm_starts: int = 1
+    normal_pressure_angle_deg: float = 20.0
+    face_width_mm: float | None = None
+    worm_length_mm: float | None = None
+    backlash_mm: float = 0.05
+    addendum_coef: float = 1.0
+    dedendum_coef: float = 1.2
 
 
 @dataclass(frozen=True)
@@ -97,8 +160,9 @@ class GearGeometry:
         return out
 
 
-def derive(gear: Gear) -> GearGeometry:
-    """All derived quantities from a validated `gear:` block. Raises ScenarioError on impossible data."""
+def derive(gear: GearData) -> GearGeometry:
+    """All derived quantities from gear data (a validated `gear:` block or a GearSpec). Raises GeometryError on
+    impossible data."""
     z1, z2 = gear.worm_starts, gear.wheel_teeth
     alpha_n = gear.normal_pressure_angle_deg * DEG
     if gear.lead_angle_deg is not None:
@@ -108,7 +172,8 @@ def derive(gear: Gear) -> GearGeometry:
         q = gear.diameter_quotient
         gamma = math.atan(z1 / q)
         if not (0 < gamma < 45 * DEG):
-            raise ScenarioError(f"gear.diameter_quotient = {q}: gives lead angle {gamma / DEG:.2f} deg; allowed (0, 45) deg")
+            raise GeometryError(
+                f"gear.diameter_quotient = {q}: gives lead angle {gamma / DEG:.2f} deg; allowed (0, 45) deg")
     if gear.axial_module_mm is not None:
         m_x = gear.axial_module_mm * MM
     else:
@@ -128,13 +193,13 @@ def derive(gear: Gear) -> GearGeometry:
     r_a1, r_f1 = r1 + h_a, r1 - h_f
     r_a2, r_f2 = r2 + h_a, r2 - h_f
     if r_f1 <= 0.2 * r1:
-        raise ScenarioError(
+        raise GeometryError(
             f"gear: worm root radius {r_f1 / MM:.3f} mm is too small for reference radius {r1 / MM:.3f} mm "
             f"(diameter quotient q = {q:.2f}); use a lead angle giving q >= {2.5 * gear.dedendum_coef:.1f}")
     r_e2 = r_a2 + 0.5 * m_x
     b2 = gear.face_width_mm * MM if gear.face_width_mm is not None else (0.75 if z1 <= 3 else 0.67) * 2 * r_a1
     if b2 >= 2 * (a - r_f1) * 0.999 or b2 > 2 * r_a1 * 1.2:
-        raise ScenarioError(
+        raise GeometryError(
             f"gear.face_width_mm = {b2 / MM:.3f}: too wide for this worm; allowed up to {1.2 * 2 * r_a1 / MM:.3f} mm "
             f"(1.2 x worm tip diameter)")
     # the wheel root torus (tube radius a - r_f2) rises towards the face edges; the tooth must keep at least
@@ -144,7 +209,7 @@ def derive(gear: Gear) -> GearGeometry:
     if gear.face_width_mm is None:
         b2 = min(b2, b2_max)        # the DIN guide default, clipped where the root torus would eat the edges
     if b2 > b2_max:
-        raise ScenarioError(
+        raise GeometryError(
             f"gear.face_width_mm = {b2 / MM:.3f}: the wheel root torus leaves no tooth at the face edges; "
             f"allowed up to {b2_max / MM:.3f} mm")
     # threaded length: cover every point of the wheel rim that can reach the worm tip cylinder, plus one pitch
@@ -152,7 +217,7 @@ def derive(gear: Gear) -> GearGeometry:
     b1 = gear.worm_length_mm * MM if gear.worm_length_mm is not None else 2 * math.sqrt(max(reach, 0.0)) + p_x
     s2 = p_x / 2 - gear.backlash_mm * MM
     if s2 <= 0.1 * p_x:
-        raise ScenarioError(
+        raise GeometryError(
             f"gear.backlash_mm = {gear.backlash_mm}: leaves a wheel tooth of {s2 / MM:.3f} mm on d2; "
             f"allowed below {0.4 * p_x / MM:.3f} mm (0.4 axial pitch)")
     return GearGeometry(

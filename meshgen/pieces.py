@@ -432,7 +432,7 @@ def _generate(g: GearGeometry, res: Resolution) -> dict:
 
 
 def build_gear_set(geometry: GearGeometry, resolution: Resolution | str = "medium", use_cache: bool = True) -> GearSet:
-    """Generate (or load from the cache) the gear set. Raises ScenarioError for undercut / pointed teeth."""
+    """Generate (or load from the cache) the gear set. Raises GeometryError for undercut / pointed teeth."""
     res = RESOLUTIONS[resolution] if isinstance(resolution, str) else resolution
     g = geometry
     path = cache_dir() / f"gearset-{cache_key(g, res)}.pkl"

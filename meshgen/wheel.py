@@ -37,8 +37,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from meshgen import worm
-from meshgen.geometry import GearGeometry
-from wormsim.scenario import ScenarioError
+from meshgen.geometry import GearGeometry, GeometryError
 
 
 def hob_radius(g: GearGeometry) -> float:
@@ -139,7 +138,7 @@ def tooth_angle(g: GearGeometry, k: int) -> float:
 
 
 def check_wheel(g: GearGeometry, n: int = 25) -> None:
-    """Pointed wheel tooth or undercut -> ScenarioError (exit 2).
+    """Pointed wheel tooth or undercut -> GeometryError.
 
     Pointed: tooth thickness at the tip (throat, anywhere across the face) below 0.05 m_x.
     Undercut: on the mid-plane, the hob tip edge (not the conjugate flank) cuts the flank above the
@@ -150,12 +149,12 @@ def check_wheel(g: GearGeometry, n: int = 25) -> None:
     a, b = tooth_flanks(g, rt, zeta)
     s_tip = float(np.min((b - a) * rt))
     if s_tip < 0.05 * g.m_x:
-        raise ScenarioError(
+        raise GeometryError(
             f"gear: the wheel tooth is pointed (tip thickness {s_tip * 1e3:.4f} mm, minimum 0.05 m_x); "
             f"lower gear.normal_pressure_angle_deg or gear.backlash_mm, or raise gear.wheel_teeth")
     frac = undercut_fraction(g, n)
     if frac > UNDERCUT_LIMIT:
-        raise ScenarioError(
+        raise GeometryError(
             f"gear: the wheel teeth are undercut: on the mid-plane the hob tip edge removes {100 * frac:.0f} % of "
             f"the working flank below the reference circle (limit {100 * UNDERCUT_LIMIT:.0f} %); raise "
             f"gear.normal_pressure_angle_deg (now {math.degrees(g.alpha_n):.2f}) or gear.wheel_teeth (now {g.z2})")

@@ -36,7 +36,7 @@ import math
 
 import numpy as np
 
-from meshgen.geometry import GearGeometry
+from meshgen.geometry import GearGeometry, GeometryError
 
 
 def _t_of_r(g: GearGeometry, r):
@@ -89,13 +89,11 @@ def flank_points(g: GearGeometry, r, phi, side: int, start: int = 0):
 
 
 def check_worm(g: GearGeometry, hob_tip_radius: float) -> None:
-    """Pointed worm (or hob) thread -> ScenarioError. The hob reaches the wheel root torus radius."""
-    from wormsim.scenario import ScenarioError
-
+    """Pointed worm (or hob) thread -> GeometryError. The hob reaches the wheel root torus radius."""
     for name, r in (("worm tip", g.r_a1), ("hob tip (wheel root)", hob_tip_radius)):
         s = 2 * float(half_thickness(g, r))
         if s < 0.05 * g.m_x:
-            raise ScenarioError(
+            raise GeometryError(
                 f"gear: the worm thread is pointed at the {name} (thickness {s * 1e3:.4f} mm); lower "
                 f"gear.normal_pressure_angle_deg (now {math.degrees(g.alpha_n):.2f}) or gear.dedendum_coef / "
                 f"gear.addendum_coef")

@@ -3,15 +3,13 @@ from __future__ import annotations
 
 import math
 from functools import lru_cache
-from pathlib import Path
 
 import numpy as np
+from conftest import ROOT
 
 from meshgen import assembly, worm
 from meshgen.geometry import GearGeometry, derive
 from wormsim.scenario import load_scenario
-
-ROOT = Path(__file__).resolve().parents[1]
 
 
 @lru_cache(maxsize=None)

@@ -6,14 +6,13 @@ import types
 from pathlib import Path
 
 import numpy as np
-import pytest
+from conftest import ROOT
 
 from wormsim import cli, run
 from wormsim.errors import SimulationError
 from wormsim.result import Result
 from wormsim.scenario import load_scenario
 
-ROOT = Path(__file__).resolve().parents[1]
 MINIMAL = ROOT / "tests" / "assets" / "minimal_contact3d.yaml"
 
 

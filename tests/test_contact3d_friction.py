@@ -10,18 +10,19 @@ from __future__ import annotations
 
 import math
 from dataclasses import replace
-from pathlib import Path
 
 import mujoco
 import numpy as np
 import pytest
+from conftest import SCENARIOS as SCEN
 
-from wormsim.contact3d.law import friction_coefficient, friction_regularisation_velocity_m_s, friction_utilisation
-from wormsim.contact3d.mjcf import build_model, repose_window
+from wormsim.contact3d.law import friction_regularisation_velocity_m_s, friction_utilisation
+from wormsim.contact3d.mjcf import build_model
+from wormsim.contact3d.window import repose_window
+from wormsim.friction import friction_coefficient
+from wormsim.gear_theory import commands, mesh_arms_m
 from wormsim.scenario import ScenarioError, load_scenario
-from wormsim.contact3d.runner import commands
 
-SCEN = Path(__file__).resolve().parent.parent / "scenarios"
 DURATION_S = 0.05           # 10 000 steps of 5 us; contacts read over the last 40 % (after the 0.01 s ramps)
 
 
@@ -41,9 +42,9 @@ def sliding_contacts(rpm: float, impratio: float | None = None) -> tuple[np.ndar
     window = repose_window(bm, 0.0)
     chunk, rows = 20, []
     f_floor = 1e-3 * sc.load.torque_nm / geo.r2
+    cmds = commands(sc, bm.direction)
     for _ in range(int(round(DURATION_S / m.opt.timestep)) // chunk):
-        cmd, load_t = commands(sc, np.array([d.time]), bm.direction)
-        d.ctrl[bm.drive_actuator], d.ctrl[bm.load_actuator] = cmd[0], load_t[0]
+        d.ctrl[bm.drive_actuator], d.ctrl[bm.load_actuator] = cmds.drive(d.time), cmds.load(d.time)
         mujoco.mj_step(m, d, nstep=chunk)
         window = repose_window(bm, float(d.qpos[qa_wheel]), window)
         vs = abs(float(d.qvel[bm.worm_dof])) * geo.r1 / math.cos(geo.gamma)
@@ -98,8 +99,7 @@ def test_impratio_follows_the_working_load():
 
 def test_load_inertia_is_the_loaded_hinge_armature_and_in_the_contact_mass():
     """load.inertia_kg_m2 (driven machine, rigid on the loaded shaft): the wheel hinge's armature, and the contact
-    law's A_hat = arm1^2 / I1 + arm2^2 / (I2 + J) (wormsim.contact3d.mjcf.mesh_arms) uses it; the bare gear is unchanged."""
-    from wormsim.contact3d.mjcf import mesh_arms
+    law's A_hat = arm1^2 / I1 + arm2^2 / (I2 + J) (wormsim.gear_theory.mesh_arms_m) uses it; the bare gear is unchanged."""
 
     over = ["simulation.resolution=coarse"]
     bare = build_model(load_scenario(SCEN / "seat_motor.yaml", over))
@@ -107,7 +107,8 @@ def test_load_inertia_is_the_loaded_hinge_armature_and_in_the_contact_mass():
     assert bare.model.dof_armature[bare.wheel_dof] == 0.0
     assert heavy.model.dof_armature[heavy.wheel_dof] == pytest.approx(1e-4)
     assert heavy.model.dof_armature[heavy.worm_dof] == 0.0
-    a1, a2 = mesh_arms(heavy.geometry)
+    g = heavy.geometry
+    a1, a2 = mesh_arms_m(g.r1, g.r2, g.alpha_n, g.gamma)
     i1, i2 = heavy.meta["worm_inertia_kg_m2"], heavy.meta["wheel_inertia_kg_m2"]
     assert bare.law.inv_mass_hat == pytest.approx(a1 ** 2 / i1 + a2 ** 2 / i2, rel=1e-12)
     assert heavy.law.inv_mass_hat == pytest.approx(a1 ** 2 / i1 + a2 ** 2 / (i2 + 1e-4), rel=1e-12)

@@ -3,17 +3,16 @@ stiffness the MuJoCo model actually shows under a known torque (issue 4: within 
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
 import mujoco
 import numpy as np
 import pytest
+from conftest import SCENARIOS as SCEN
 
-from wormsim.contact3d.law import friction_coefficient, hertz_line_stiffness_n_per_m
+from wormsim.contact3d.law import hertz_line_stiffness_n_per_m
 from wormsim.contact3d.mjcf import build_model
+from wormsim.friction import friction_coefficient
 from wormsim.scenario import Contact, load_scenario
-
-SCEN = Path(__file__).resolve().parent.parent / "scenarios"
 
 
 def test_hertz_default_follows_seed_001_formula():
@@ -94,4 +93,4 @@ def test_static_mesh_stiffness_per_pair_within_5_percent(static_mesh):
     k_theta = (Tb - Ta) / abs(thb - tha)
     arm2 = 0.5 * (np.sum(Ca[Ca[:, 0] > 1e-3, 2] ** 2) + np.sum(Cb[Cb[:, 0] > 1e-3, 2] ** 2))
     k_pair = k_theta * bm.law.contacts_per_pair / arm2
-    assert k_pair == pytest.approx(bm.law.pair_stiffness_n_per_m, rel=0.05), (k_pair, len(loaded))
+    assert k_pair == pytest.approx(bm.law.pair_stiffness_n_per_m, rel=0.05), (k_pair, arm2)

@@ -2,18 +2,18 @@
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
 import mujoco
 import numpy as np
 import pytest
+from conftest import SCENARIOS as SCEN
 
-from wormsim.errors import SimulationError
-from wormsim.contact3d.mjcf import build_model, repose_window, write_model
-from wormsim.scenario import load_scenario
+from wormsim.contact3d.mjcf import build_model, write_model
 from wormsim.contact3d.runner import simulate
+from wormsim.contact3d.window import repose_window
+from wormsim.errors import SimulationError
+from wormsim.scenario import load_scenario
 
-SCEN = Path(__file__).resolve().parent.parent / "scenarios"
 COARSE = ["simulation.resolution=coarse"]
 
 

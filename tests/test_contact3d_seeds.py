@@ -10,15 +10,12 @@ the measured numbers (see docs/contact3d.md).
 """
 from __future__ import annotations
 
-import math
-from pathlib import Path
-
 import pytest
+from conftest import SCENARIOS as SCEN
 
-from wormsim.scenario import load_scenario
 from wormsim.contact3d.runner import simulate
+from wormsim.scenario import load_scenario
 
-SCEN = Path(__file__).resolve().parent.parent / "scenarios"
 CI = {
     "seat_motor": ["drive.speed_rpm=1800", "drive.ramp_s=0.02", "load.ramp_s=0.02", "simulation.duration_s=0.25",
                    "simulation.resolution=medium"],

@@ -13,8 +13,8 @@ import pytest
 from meshgen.geometry import derive
 from wormsim.cli import main
 from wormsim.contact3d.mjcf import build_model
-from wormsim.scenario import ScenarioError, load_scenario
 from wormsim.contact3d.runner import simulate
+from wormsim.scenario import ScenarioError, load_scenario
 
 GEAR = Path(__file__).resolve().parent / "assets" / "other_gear.yaml"
 

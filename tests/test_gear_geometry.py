@@ -3,8 +3,8 @@ import math
 
 import pytest
 
-from meshgen.geometry import derive
-from wormsim.scenario import Gear, ScenarioError
+from meshgen.geometry import GeometryError, derive
+from wormsim.scenario import Gear
 
 
 def test_seed_001_seat_motor():
@@ -38,9 +38,9 @@ def test_left_hand_flips_helix_parameter_only():
 
 
 def test_impossible_gear_data_is_an_input_error():
-    with pytest.raises(ScenarioError, match="backlash_mm"):
+    with pytest.raises(GeometryError, match="backlash_mm"):
         derive(Gear(wheel_teeth=30, axial_module_mm=2, diameter_quotient=10, backlash_mm=2.9))
-    with pytest.raises(ScenarioError, match="worm root radius"):
+    with pytest.raises(GeometryError, match="worm root radius"):
         derive(Gear(wheel_teeth=30, axial_module_mm=2, diameter_quotient=2))
-    with pytest.raises(ScenarioError, match="face_width_mm"):
+    with pytest.raises(GeometryError, match="face_width_mm"):
         derive(Gear(wheel_teeth=30, axial_module_mm=2, diameter_quotient=10, face_width_mm=200))

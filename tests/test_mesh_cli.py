@@ -7,8 +7,8 @@ import math
 import numpy as np
 import pytest
 import trimesh
-
 from _meshgen_common import ROOT
+
 from meshgen import assembly
 from wormsim.cli import main
 

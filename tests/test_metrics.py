@@ -4,7 +4,7 @@ import math
 import numpy as np
 import pytest
 
-from wormsim.contact3d.law import efficiency_theory
+from wormsim.gear_theory import efficiency_theory
 from wormsim.metrics import dominant_frequency, steady_window
 
 

@@ -7,13 +7,13 @@ import math
 import numpy as np
 import pytest
 import trimesh
+from _meshgen_common import clearance_to_worm, face_samples, gear_with, seed_geometry
 from hypothesis import HealthCheck, Phase, given, settings
 from hypothesis import strategies as st
 
-from _meshgen_common import clearance_to_worm, face_samples, gear_with, seed_geometry
 from meshgen import pieces, wheel, worm
-from meshgen.geometry import derive
-from wormsim.scenario import Gear, ScenarioError
+from meshgen.geometry import GeometryError, derive
+from wormsim.scenario import Gear
 
 
 @pytest.fixture(scope="module", autouse=True)
@@ -216,9 +216,9 @@ invalid_gears = st.one_of(
 @settings(max_examples=12, deadline=None, derandomize=True, phases=[Phase.explicit, Phase.generate])
 @given(invalid_gears)
 def test_property_invalid_data_is_a_clear_input_error(case):
-    """Undercut, a too wide face or a backlash leaving no tooth: always ScenarioError naming the field."""
+    """Undercut, a too wide face or a backlash leaving no tooth: always GeometryError naming the field."""
     fields, pattern = case
-    with pytest.raises(ScenarioError, match=pattern):
+    with pytest.raises(GeometryError, match=pattern):
         pieces.build_gear_set(derive(Gear(**fields)), "coarse", use_cache=False)
 
 

@@ -1,13 +1,12 @@
 """Scenario schema: valid files load; each class of bad input is a one-line error naming the field
 and what is allowed (INTERFACE.md, issue 'Foundation')."""
-from pathlib import Path
 
 import pytest
 import yaml
+from conftest import ROOT
 
 from wormsim.scenario import ScenarioError, apply_overrides, json_schema, load_scenario, scenario_from_dict
 
-ROOT = Path(__file__).resolve().parents[1]
 MINIMAL = ROOT / "tests" / "assets" / "minimal_contact3d.yaml"
 
 

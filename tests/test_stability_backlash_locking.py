@@ -15,21 +15,20 @@ from __future__ import annotations
 
 import math
 import re
-from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import SCENARIOS as SCEN
 
 from meshgen.geometry import derive
 from wormsim import cli
-from wormsim.torsional import dynamics as torsional
 from wormsim.contact3d.backlash import UM, flank_clearance_m, min_backlash_m, piece_bulge_m, piece_play
 from wormsim.contact3d.mjcf import build_model
-from wormsim.scenario import ScenarioError, load_scenario
 from wormsim.contact3d.runner import run_model, simulate
+from wormsim.scenario import ScenarioError, load_scenario
+from wormsim.torsional import dynamics as torsional
 from wormsim.units import MM
 
-SCEN = Path(__file__).resolve().parent.parent / "scenarios"
 DEMO = SCEN / "seat_motor_demo.yaml"
 # the CI configurations of tests/test_contact3d_seeds.py (kept in step by hand: that module runs its seeds at import)
 CI = {

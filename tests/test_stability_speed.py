@@ -23,15 +23,17 @@ from pathlib import Path
 import mujoco
 import numpy as np
 import pytest
+from conftest import SCENARIOS
 
 from wormsim import cli
 from wormsim.contact3d import runner as sim_mod
-from wormsim.errors import ScenarioError, SimulationError
 from wormsim.contact3d.mjcf import build_model
+from wormsim.contact3d.runner import OVERSPEED_GUARD, run_model, simulate
+from wormsim.contact3d.timestep import MAX_WORM_TURN_PER_STEP_RAD, choose_timestep
+from wormsim.errors import ScenarioError, SimulationError
 from wormsim.scenario import load_scenario
-from wormsim.contact3d.runner import MAX_WORM_TURN_PER_STEP_RAD, OVERSPEED_GUARD, run_model, simulate
 
-JACK = Path(__file__).resolve().parent.parent / "scenarios" / "screw_jack.yaml"
+JACK = SCENARIOS / "screw_jack.yaml"
 COARSE = ["simulation.resolution=coarse"]
 RPM = 2 * math.pi / 60
 
@@ -77,19 +79,18 @@ def test_a_scenario_timestep_too_large_for_the_speed_is_refused_with_its_allowed
     assert "simulation.speculative does not prevent it" in msg
     seed = _jack(1330, 0.01, "simulation.timestep_s=1e-5")
     bm = build_model(seed)
-    h, src = sim_mod.choose_timestep(seed, bm)
+    h, src = choose_timestep(seed, bm.geometry, bm.law)
     assert h == 1e-5 and src == "scenario"
     # unset: the contact's default (1e-5 s for the screw jack), the speed does not bind
-    h, src = sim_mod.choose_timestep(_jack(1330, 0.01), bm)
+    h, src = choose_timestep(_jack(1330, 0.01), bm.geometry, bm.law)
     assert h == 1e-5 and src.startswith("default"), src
     # a speed-driven wheel: the worm turns ratio x faster (2000 x 24 = 48000 rpm -> 0.035 / 5027 rad/s = 7e-6 -> 5e-6)
     wheel = load_scenario(JACK, COARSE + ["drive.on=wheel", "drive.speed_rpm=2000", "load.on=worm",
                                           "load.torque_nm=0.1"])
-    h, src = sim_mod.choose_timestep(wheel, bm)
+    h, src = choose_timestep(wheel, bm.geometry, bm.law)
     assert h == 5e-6 and src.startswith("worm speed: 48000 rpm"), (h, src)
     # above the contact's stable limit (2.53e-5 s) the divergence guard speaks first (it names that limit)
-    bm.model.opt.timestep = 5e-5
-    assert sim_mod.choose_timestep(_jack(26600, 0.01, "simulation.timestep_s=5e-5"), bm) == (5e-5, "scenario")
+    assert choose_timestep(_jack(26600, 0.01, "simulation.timestep_s=5e-5"), bm.geometry, bm.law) == (5e-5, "scenario")
 
 
 def test_the_refusal_through_the_cli_is_exit_2(tmp_path, capsys):
@@ -150,8 +151,7 @@ def test_speculative_contacts_tunnel_sooner_beyond_the_speed_limit(monkeypatch):
 
     def run(rpm, h, *extra):
         sc = _jack(rpm, 0.02, *extra)
-        bm = build_model(sc)                       # run_model without simulate's choose_timestep
-        bm.model.opt.timestep = h
+        bm = build_model(sc, timestep_s=h)         # past choose_timestep's speed check
         return run_model(bm, sc)
 
     plain = run(66500, 1e-5)

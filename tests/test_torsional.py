@@ -5,20 +5,20 @@ F_t2 r2 = load torque (statics); efficiency tan g / tan(g + rho') and tan(g - rh
 rho' = atan(mu / cos alpha_n) (DIN 3975, seed 000); self-locking for rho' > gamma (seed 000).
 """
 import json
-from pathlib import Path
 import math
 
 import numpy as np
 import pytest
+from conftest import ROOT
 
 from meshgen.geometry import derive
-from wormsim.torsional import mesh_stiffness as M
-from wormsim.torsional import dynamics as torsional
-ROOT = Path(__file__).resolve().parents[1]
-from wormsim.contact3d.law import effective_modulus_pa, friction_coefficient
 from wormsim.errors import SimulationError
+from wormsim.friction import friction_coefficient, friction_coefficient_scalar
+from wormsim.gear_theory import effective_modulus_pa
 from wormsim.run import run_scenario
 from wormsim.scenario import load_scenario
+from wormsim.torsional import dynamics as torsional
+from wormsim.torsional import mesh_stiffness as M
 
 SEEDS = ("seat_motor", "screw_jack", "involute_41")
 SUMMARY_KEYS = ("ratio", "ratio_theory", "mesh_frequency_hz", "mesh_frequency_theory_hz", "tangential_force_mean_n",
@@ -179,7 +179,7 @@ def test_mesh_stiffness_mean_in_expected_range(name):
 def test_fast_friction_matches_contact_module(mode):
     overrides = (("contact.friction_static=null", "contact.friction_dynamic=null") if mode else ()) + mode
     sc = scen("seat_motor", *overrides)
-    mu = torsional._mu_scalar(sc.contact)
+    mu = friction_coefficient_scalar(sc.contact)
     vs = np.array([0.0, 2e-4, 7e-4, 1e-3, 0.01, 0.5, 3.0])
     np.testing.assert_allclose([mu(v) for v in vs], friction_coefficient(sc.contact, vs), rtol=1e-12)
 

@@ -8,19 +8,18 @@ Closed forms used (docs/wedge.md derives them):
 """
 import json
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import ROOT
 from scipy.optimize import brentq
 
-from wormsim.wedge import dynamics as wedge
 from wormsim.errors import SimulationError
 from wormsim.recording import recorded_entities
 from wormsim.run import run_scenario
 from wormsim.scenario import load_scenario, scenario_from_dict
+from wormsim.wedge import dynamics as wedge
 
-ROOT = Path(__file__).resolve().parents[1]
 MOV = sorted((ROOT / "scenarios").glob("mov_*.yaml"))
 G = 4.76 * math.pi / 180          # seed 000's lead angle
 F1_REST = 2 * 2178 * (7.85 / 1.35) / (1 + (7.85 / 1.35) ** 2)   # Kloss at v = 0: 727.6 N

@@ -5,11 +5,11 @@ import math
 
 import numpy as np
 import pytest
-
 from _meshgen_common import clearance_to_worm, gear_with, seed_geometry
+
 from meshgen import assembly, meshes, pieces, wheel, worm
-from meshgen.geometry import derive
-from wormsim.scenario import Gear, ScenarioError
+from meshgen.geometry import GeometryError, derive
+from wormsim.scenario import Gear
 
 SEEDS = ["seat_motor", "involute_41", "screw_jack"]
 
@@ -177,7 +177,7 @@ def test_left_hand_gear_is_conjugate_too():
 ])
 def test_undercut_or_pointed_is_input_error(changes, match):
     g = gear_with("involute_41", **changes)
-    with pytest.raises(ScenarioError, match=match) as exc:
+    with pytest.raises(GeometryError, match=match) as exc:
         pieces.build_gear_set(g, "coarse", use_cache=False)
     assert "gear." in str(exc.value)
 

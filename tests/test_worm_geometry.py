@@ -1,12 +1,13 @@
 """Worm flanks: seed 003's involute helicoid (ZI), the straight axial profile (ZA), lead and pressure angle."""
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
 import pytest
-
 from _meshgen_common import gear_with, seed_geometry
+
 from meshgen import meshes, worm
 from meshgen.geometry import GearGeometry
 
@@ -110,14 +111,14 @@ def test_zi_normal_pressure_angle_at_d1(name, alpha_deg):
     assert _normal_pressure_angle_deg(seed_pt, g.r1) == pytest.approx(alpha_deg, abs=0.01)
     # and the implemented flank (worm.flank_points) agrees, both flanks
     for side in (-1, 1):
-        fn = lambda r, phi: worm.flank_points(g, r, phi, side)  # noqa: E731
+        fn = functools.partial(worm.flank_points, g, side=side)
         assert _normal_pressure_angle_deg(fn, g.r1) == pytest.approx(alpha_deg, abs=0.01)
 
 
 def test_za_normal_pressure_angle_at_d1():
     g = gear_with("involute_41", profile="ZA", normal_pressure_angle_deg=15.0)
     for side in (-1, 1):
-        fn = lambda r, phi: worm.flank_points(g, r, phi, side)  # noqa: E731
+        fn = functools.partial(worm.flank_points, g, side=side)
         assert _normal_pressure_angle_deg(fn, g.r1) == pytest.approx(15.0, abs=0.01)
 
 

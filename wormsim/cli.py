@@ -11,7 +11,11 @@ import sys
 import traceback
 from pathlib import Path
 
+import yaml
+
 from wormsim.errors import ScenarioError, SimulationError
+from wormsim.run import run_scenario
+from wormsim.scenario import json_schema, load_scenario
 
 EXIT_OK, EXIT_INTERNAL, EXIT_INPUT, EXIT_SIM = 0, 1, 2, 3
 
@@ -48,9 +52,6 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def _cmd_run(args) -> int:
-    from wormsim.run import run_scenario
-    from wormsim.scenario import load_scenario
-
     sc = load_scenario(args.scenario, args.overrides)
     summary = run_scenario(sc, args.out, progress=False if args.no_progress else None)
     out = Path(args.out)
@@ -64,9 +65,11 @@ def _cmd_run(args) -> int:
     return EXIT_OK
 
 
+# mesh, model and bench import their machinery on use (the mesh generator, MuJoCo): `wormsim run` of a wedge
+# scenario, `check` and `schema` load neither
+
 def _cmd_mesh(args) -> int:
-    from meshgen.export import write_mesh_outputs
-    from wormsim.scenario import load_scenario
+    from wormsim.mesh_cmd import write_mesh_outputs
 
     sc = load_scenario(args.scenario, args.overrides)
     write_mesh_outputs(sc, args.out)
@@ -75,7 +78,6 @@ def _cmd_mesh(args) -> int:
 
 def _cmd_model(args) -> int:
     from wormsim.contact3d.mjcf import write_model
-    from wormsim.scenario import load_scenario
 
     sc = load_scenario(args.scenario, args.overrides)
     path = write_model(sc, args.out)
@@ -92,8 +94,6 @@ def _cmd_bench(args) -> int:
 
 
 def _cmd_schema(args) -> int:
-    from wormsim.scenario import json_schema
-
     text = json.dumps(json_schema(), indent=2)
     if args.out:
         Path(args.out).write_text(text + "\n")
@@ -103,10 +103,6 @@ def _cmd_schema(args) -> int:
 
 
 def _cmd_check(args) -> int:
-    import yaml
-
-    from wormsim.scenario import load_scenario
-
     sc = load_scenario(args.scenario, args.overrides)
     print(yaml.safe_dump(sc.model_dump(mode="json", exclude_none=True), sort_keys=False), end="")
     return EXIT_OK

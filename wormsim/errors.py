@@ -1,5 +1,20 @@
-"""Exceptions that the CLI maps to exit codes (INTERFACE.md)."""
-from wormsim.scenario import ScenarioError  # noqa: F401  (exit 2: invalid input)
+"""Exceptions that the CLI maps to exit codes (INTERFACE.md): ScenarioError exit 2, SimulationError exit 3.
+
+Each guard of a run raises its own subclass of SimulationError, so that callers (the bench's stability edge)
+sort failures by type, not by the wording of the message.
+"""
+
+from wormsim.scenario import ScenarioError
+
+__all__ = [
+    "ScenarioError",
+    "SimulationError",
+    "DivergedError",
+    "TeethJumpedError",
+    "PenetrationError",
+    "LockedError",
+    "OverspeedError",
+]
 
 
 class SimulationError(RuntimeError):
@@ -7,3 +22,23 @@ class SimulationError(RuntimeError):
 
     The message is a diagnosis that says what to change.
     """
+
+
+class DivergedError(SimulationError):
+    """Non-finite state, a huge acceleration, or a runaway above the stable timestep."""
+
+
+class TeethJumpedError(SimulationError):
+    """The transmission error passed half a pitch within the stable timestep: the load overpowers the mesh."""
+
+
+class PenetrationError(SimulationError):
+    """Penetration (contact3d) or mesh deflection (torsional) beyond 0.4 m_x: the teeth would skip."""
+
+
+class LockedError(SimulationError):
+    """A speed-driven drive held below half its command (self-locking back-drive, or a jammed mesh)."""
+
+
+class OverspeedError(SimulationError):
+    """The worm turns more per step than contact3d resolves: its pieces would pass through the wheel's."""

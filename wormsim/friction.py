@@ -16,7 +16,12 @@ speed to a fractional power, which is not real).
 
 A constant Coulomb coefficient mu gives rho = atan(mu) at every speed.
 
-The 3D contact model imports these functions too.
+The scenario's `contact:` friction keys select mu(Vs) (friction_coefficient, shared by torsional and contact3d):
+  friction: mu                           constant
+  friction_static/_dynamic: mu(Vs) = STEP(|Vs|, 0, mu_s, v_t, mu_d)   (ADAMS-style cubic blend over
+                                          the transition velocity v_t = contact.transition_velocity_m_s)
+  friction_group: mu(Vs) = tan(rho(Vs)), rho of seed 000 above
+  none given: mu = 0.05 (lubricated steel/bronze, DEFAULT_FRICTION).
 """
 from __future__ import annotations
 
@@ -24,7 +29,10 @@ import math
 
 import numpy as np
 
-from wormsim.units import DEG
+from wormsim.scenario import Contact
+from wormsim.units import DEG, step
+
+DEFAULT_FRICTION = 0.05
 
 # group -> (a, b, c) of rho(Vs) = 1 / (a Vs^b + c) deg, Vs in m/s (seed 000)
 GROUPS: dict[str, tuple[float, float, float]] = {
@@ -62,3 +70,44 @@ def rho_static_rad(group: str | None = None, friction: float | None = None) -> f
 def mu_from_rho(rho):
     """Coulomb coefficient mu = tan(rho)."""
     return np.tan(rho)
+
+
+def friction_mode(contact: Contact) -> str:
+    if contact.friction_group is not None:
+        return f"group {contact.friction_group} (seed 000 rho(Vs))"
+    if contact.friction_static is not None:
+        return (f"static {contact.friction_static} -> dynamic {contact.friction_dynamic} "
+                f"over {contact.transition_velocity_m_s} m/s")
+    if contact.friction is not None:
+        return f"constant {contact.friction}"
+    return f"default constant {DEFAULT_FRICTION}"
+
+
+def friction_coefficient(contact: Contact, sliding_speed_m_s) -> float | np.ndarray:
+    """mu(Vs): see the module docstring. Vectorised over Vs."""
+    vs = np.abs(np.asarray(sliding_speed_m_s, dtype=float))
+    if contact.friction_group is not None:
+        out = mu_from_rho(rho_rad(vs, group=contact.friction_group))
+    elif contact.friction_static is not None:
+        out = step(vs, 0.0, contact.friction_static, contact.transition_velocity_m_s, contact.friction_dynamic)
+    elif contact.friction is not None:
+        out = np.full_like(vs, contact.friction)
+    else:
+        out = np.full_like(vs, DEFAULT_FRICTION)
+    return float(out) if np.ndim(out) == 0 else out
+
+
+def friction_coefficient_scalar(contact: Contact):
+    """A float-only mu(Vs) equal to friction_coefficient (fast per step: the torsional ODE's right-hand side and
+    contact3d's runner)."""
+    if contact.friction_group is not None or (contact.friction is None and contact.friction_static is None):
+        mu_c = None if contact.friction_group is not None else float(friction_coefficient(contact, 0.0))
+        if mu_c is not None:
+            return lambda vs: mu_c
+        a, b, c = GROUPS[contact.friction_group]
+        return lambda vs: math.tan(DEG / (a * abs(vs) ** b + c))
+    if contact.friction is not None:
+        mu_c = float(contact.friction)
+        return lambda vs: mu_c
+    ms, md, vt = contact.friction_static, contact.friction_dynamic, contact.transition_velocity_m_s
+    return lambda vs: step(abs(vs), 0.0, ms, vt, md)

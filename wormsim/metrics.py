@@ -26,7 +26,7 @@ import math
 
 import numpy as np
 
-from wormsim.contact3d.law import efficiency_theory
+from wormsim import gear_theory as gt
 from wormsim.units import RPM, rad_s_to_rpm
 
 
@@ -87,12 +87,12 @@ def dominant_frequency(t: np.ndarray, x: np.ndarray, f_max_hz: float = float("in
 def window_of(S: dict, scenario, geo) -> tuple[int, int, float]:
     """Steady window [i0, i1) of a run and the mesh period used to find and trim it."""
     t = S["t_s"]
-    drv, load = scenario.drive, scenario.load
-    w1, w2 = S["worm_speed_rpm"], S["wheel_speed_rpm"]
+    drv = scenario.drive
+    w1 = S["worm_speed_rpm"]
     n1_guess = abs(float(np.mean(w1[len(w1) // 2:]))) if len(w1) else 0.0
     f_mesh_guess = geo.z1 * n1_guess / 60.0
     period = 1.0 / f_mesh_guess if f_mesh_guess > 0 else 0.0
-    ramp_end = max(drv.ramp_s, load.start_s + load.ramp_s)
+    ramp_end = gt.ramps_end_s(scenario)
     ang = S["wheel_angle_rad"] if drv.on == "worm" else S["worm_angle_rad"]
     i0, i1 = steady_window(t, interval_speed_rpm(t, ang), ramp_end, period)
     return i0, i1, period
@@ -123,17 +123,20 @@ def mean_speeds_rpm(S: dict, i0: int, i1: int) -> tuple[float, float]:
     return float(n1), float(n2)
 
 
-def drive_summary(S: dict, scenario, geo, i0: int, i1: int, n1: float, n2: float) -> dict:
+def drive_summary(S: dict, scenario, geo, i0: int, i1: int, n1: float, n2: float,
+                  shaft_powers_w: tuple[np.ndarray, np.ndarray] | None = None) -> dict:
     """The summary keys every gear-level model shares (INTERFACE.md contact3d list, less the meshing
     frequency, which each model takes from its own signal): ratio, forces, torques, speeds, efficiency
-    (output / input power over the window) and its theory tan(g) / tan(g + rho') (or back-driving)."""
+    (output / input power over the window) and its theory tan(g) / tan(g + rho') (or back-driving).
+    shaft_powers_w: (worm, wheel) power series where the level has better ones than the samples' T w (contact3d:
+    interval means over every step)."""
     t = S["t_s"]
     drv, load = scenario.drive, scenario.load
     sl = slice(i0, i1)
     ft = S["tangential_force_n"][sl]
     T1, T2 = S["worm_torque_nm"][sl], S["wheel_torque_nm"][sl]
-    if "worm_power_w" in S:         # contact3d: the interval means of T w over every step
-        p1, p2 = float(np.mean(S["worm_power_w"][sl])), float(np.mean(S["wheel_power_w"][sl]))
+    if shaft_powers_w is not None:
+        p1, p2 = float(np.mean(shaft_powers_w[0][sl])), float(np.mean(shaft_powers_w[1][sl]))
     else:
         p1 = float(np.mean(T1 * S["worm_speed_rpm"][sl] * RPM))
         p2 = float(np.mean(T2 * S["wheel_speed_rpm"][sl] * RPM))
@@ -149,7 +152,8 @@ def drive_summary(S: dict, scenario, geo, i0: int, i1: int, n1: float, n2: float
         "mesh_frequency_theory_hz": geo.z1 * n1 / 60.0,
         "tangential_force_mean_n": abs(float(np.mean(ft))),
         "tangential_force_p2p_n": float(np.ptp(ft)) if len(ft) else float("nan"),
-        "tangential_force_theory_n": abs(load.torque_nm) / geo.r2 if load.on == "wheel" else float("nan"),
+        "tangential_force_theory_n": gt.tangential_force_n(abs(load.torque_nm), geo.r2) if load.on == "wheel"
+        else float("nan"),
         "radial_force_mean_n": abs(float(np.mean(S["radial_force_n"][sl]))),
         "axial_force_mean_n": abs(float(np.mean(S["axial_force_n"][sl]))),
         "worm_torque_mean_nm": abs(float(np.mean(T1))),
@@ -157,7 +161,7 @@ def drive_summary(S: dict, scenario, geo, i0: int, i1: int, n1: float, n2: float
         "worm_speed_mean_rpm": n1,
         "wheel_speed_mean_rpm": n2,
         "efficiency": eff,
-        "efficiency_theory": efficiency_theory(geo.gamma, geo.alpha_n, mu, backdriving=drv.on == "wheel"),
+        "efficiency_theory": gt.efficiency_theory(geo.gamma, geo.alpha_n, mu, backdriving=drv.on == "wheel"),
         "friction_coefficient_mean": mu,
         "steady_window_s": [float(t[i0]), float(t[i1 - 1])],
         "transmission_error_p2p_urad": float(np.ptp(S["transmission_error_rad"][sl]) * 1e6),

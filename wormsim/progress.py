@@ -24,7 +24,8 @@ class Progress:
         self._log = enabled is None and not tty and not off
         self._bar = tqdm(total=round(duration_s, 6), desc=label, unit="s(sim)", delay=2.0,
                          disable=not bar, leave=False, file=self._stream,
-                         bar_format="{desc}: {percentage:3.0f}%|{bar}| {n:.3g}/{total:.3g} s sim [{elapsed}<{remaining}]")
+                         bar_format="{desc}: {percentage:3.0f}%|{bar}| {n:.3g}/{total:.3g} s sim "
+                                    "[{elapsed}<{remaining}]")
         self._duration, self._label = duration_s, label
         self._last = 0.0
         self._t0 = time.perf_counter()

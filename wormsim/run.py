@@ -5,6 +5,7 @@ from __future__ import annotations
 import importlib
 import time
 from pathlib import Path
+from types import ModuleType
 
 import numpy as np
 
@@ -15,7 +16,7 @@ from wormsim.result import Result
 from wormsim.scenario import Scenario
 
 # fidelity level -> its package, which exports simulate(scenario, progress) -> Result, write_report(result, path) and
-# write_recording(result, path). Imported on first use: a wedge run does not load MuJoCo.
+# write_recording(result, path). Imported on first use (importlib, not at the top): a wedge run does not load MuJoCo.
 LEVELS = {
     "wedge": "wormsim.wedge",
     "torsional": "wormsim.torsional",
@@ -23,7 +24,7 @@ LEVELS = {
 }
 
 
-def model_module(name: str):
+def model_module(name: str) -> ModuleType:
     return importlib.import_module(LEVELS[name])
 
 
@@ -42,7 +43,8 @@ def run_scenario(scenario: Scenario, out_dir: str | Path, progress: bool | None 
     base = {"model": scenario.model, "scenario": scenario.name}
     t0 = time.perf_counter()
     try:
-        with Progress(scenario.simulation.duration_s, label=f"{scenario.name} ({scenario.model})", enabled=progress) as bar:
+        with Progress(scenario.simulation.duration_s, label=f"{scenario.name} ({scenario.model})",
+                      enabled=progress) as bar:
             res = mod.simulate(scenario, progress=bar)
         wall = time.perf_counter() - t0
         np.savez_compressed(rd.path("timeseries.npz"), **res.series)

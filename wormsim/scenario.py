@@ -97,7 +97,8 @@ class Contact(_Strict):
             raise ValueError("give one of friction / friction_group / friction_static+friction_dynamic")
         if (self.friction_static is None) != (self.friction_dynamic is None):
             raise ValueError("friction_static and friction_dynamic go together")
-        if self.friction_static is not None and self.friction_dynamic > self.friction_static:
+        if (self.friction_static is not None and self.friction_dynamic is not None
+                and self.friction_dynamic > self.friction_static):
             raise ValueError("friction_dynamic must not exceed friction_static")
         return self
 
@@ -233,7 +234,7 @@ _Loader.add_implicit_resolver(
 
 
 def yaml_load(text: str):
-    return yaml.load(text, Loader=_Loader)  # noqa: S506 (a SafeLoader subclass)
+    return yaml.load(text, Loader=_Loader)  # a SafeLoader subclass
 
 
 def _fmt_loc(loc: tuple) -> str:

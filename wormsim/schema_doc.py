@@ -55,7 +55,8 @@ def _default(field) -> str:
 def markdown() -> str:
     lines = ["# Scenario file reference", "",
              "Generated from `wormsim/scenario.py` by `python -m wormsim.schema_doc`; do not edit by hand.",
-             "Units are in the key names. Unknown keys are errors. `wormsim schema` prints the same as JSON schema.", ""]
+             "Units are in the key names. Unknown keys are errors. "
+             "`wormsim schema` prints the same as JSON schema.", ""]
     for title, model in BLOCKS:
         lines += [f"## `{title}`", ""]
         if model.__doc__:

@@ -7,6 +7,9 @@ from importlib.resources import files
 
 import numpy as np
 
+from wormsim.contact3d.mjcf import prepare
+from wormsim.contact3d.timestep import default_timestep
+from wormsim.run import LEVELS
 from wormsim.scenario import ScenarioError, load_scenario
 
 SCENARIOS = files("wormsim.scenarios")     # the seed scenarios, shipped as package data
@@ -25,8 +28,6 @@ class BenchCase:
 
 
 def _level_available(model: str) -> bool:
-    from wormsim.run import LEVELS
-
     return importlib.util.find_spec(LEVELS[model]) is not None
 
 
@@ -43,11 +44,10 @@ QUICK_DURATION_S = 0.15
 
 
 def contact3d_default_timestep(name: str, overrides: tuple[str, ...] = ()) -> float:
-    """The timestep contact3d chooses for this scenario (wormsim.contact3d.mjcf.default_timestep, set on the built model)."""
-    from wormsim.contact3d.mjcf import build_model
-
+    """The contact's default timestep for this scenario (wormsim.contact3d.timestep.default_timestep, from the contact
+    law; no model is compiled)."""
     sc = load_scenario(SCENARIOS / f"{name}.yaml", list(overrides))
-    return float(build_model(sc).model.opt.timestep)
+    return default_timestep(prepare(sc).law)
 
 
 def bench_cases(quick: bool, models: tuple[str, ...] | None = None,

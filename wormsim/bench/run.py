@@ -26,8 +26,11 @@ import numpy as np
 
 from wormsim.bench.cases import SCENARIOS, BenchCase, _level_available, bench_cases, relative_errors
 from wormsim.bench.stability import stability_map
+from wormsim.errors import SimulationError
 from wormsim.output import write_json_atomic
+from wormsim.run import simulate
 from wormsim.scenario import ScenarioError, load_scenario
+
 
 def pareto_front(cost: np.ndarray, error: np.ndarray) -> np.ndarray:
     """Mask of points not dominated by another (lower-or-equal cost AND error, one strictly lower)."""
@@ -47,8 +50,6 @@ def machine_info() -> dict:
 
 
 def _run_case(case: BenchCase, repeats: int) -> tuple[dict, float, float]:
-    from wormsim.run import simulate
-
     sc = load_scenario(SCENARIOS / f"{case.scenario}.yaml", list(case.overrides))
     # warm-up: a run of a few steps builds the geometry / k(theta) caches, so the timed runs measure
     # simulation, not one-off generation (which `wormsim mesh` reports on its own)
@@ -56,7 +57,7 @@ def _run_case(case: BenchCase, repeats: int) -> tuple[dict, float, float]:
     warm.simulation.duration_s = 20 * (sc.simulation.timestep_s or 1e-4)
     try:
         simulate(warm)
-    except Exception:  # noqa: BLE001  a too-short run may fail its own checks; the timed runs report real failures
+    except Exception:   # a too-short run may fail its own checks (or its metrics); the timed runs report real failures
         pass
     walls, res = [], None
     for _ in range(repeats):
@@ -68,8 +69,6 @@ def _run_case(case: BenchCase, repeats: int) -> tuple[dict, float, float]:
 
 def run_bench(quick: bool, out_dir: str | Path, repeats: int | None = None,
               models: tuple[str, ...] | None = None, scenarios: tuple[str, ...] | None = None) -> list[dict]:
-    from wormsim.errors import SimulationError
-
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     if repeats is not None and repeats < 1:
@@ -157,6 +156,3 @@ def plot_bench(records: list[dict], path: Path, key: str = "tangential_force_mea
     fig.savefig(tmp, dpi=110)
     plt.close(fig)
     os.replace(tmp, path)
-
-
-# ----------------------------------------------------------------------------- stability edge (issue 5, first slice)

@@ -1,9 +1,22 @@
 """Stability edge of contact3d: the timestep doubled until a guard fires; failures classified."""
 from __future__ import annotations
 
+import time
+
 import numpy as np
 
 from wormsim.bench.cases import SCENARIOS, VARIANTS, relative_errors
+from wormsim.contact3d.mjcf import prepare
+from wormsim.contact3d.runner import simulate
+from wormsim.contact3d.timestep import default_timestep
+from wormsim.errors import (
+    DivergedError,
+    LockedError,
+    OverspeedError,
+    PenetrationError,
+    SimulationError,
+    TeethJumpedError,
+)
 from wormsim.scenario import load_scenario
 
 STABILITY_FACTORS = (1, 2, 4, 8, 16, 32)
@@ -16,17 +29,17 @@ STABILITY_TOLERANCES = {"ratio_angles": 1e-3, "tangential_force_mean_n": 0.02}
 # docs/contact3d.md "Validation")
 STABILITY_RESOLUTION = {"seat_motor": "coarse", "screw_jack": "coarse", "involute_41": "fine"}
 STABILITY_DURATION_S = 0.05
-# the guards' messages (wormsim.contact3d.runner) start with these words; the class names are what bench_meta.json holds
-FAILURE_CLASSES = (("diverged", "diverged"), ("teeth jumped", "teeth_jumped"), ("penetration", "penetration"),
-                   ("the drive locked", "locked"), ("worm overspeed", "overspeed"))
+# each guard's exception (wormsim.errors) -> the class name bench_meta.json holds
+FAILURE_CLASSES: tuple[tuple[type[SimulationError], str], ...] = (
+    (DivergedError, "diverged"), (TeethJumpedError, "teeth_jumped"), (PenetrationError, "penetration"),
+    (LockedError, "locked"), (OverspeedError, "overspeed"))
 
 
-def classify_failure(message: str) -> str:
-    """Class of a contact3d guard message (wormsim.contact3d.runner): diverged | teeth_jumped | penetration | locked,
-    else "other"."""
-    for head, cls in FAILURE_CLASSES:
-        if message.startswith(head):
-            return cls
+def classify_failure(exc: BaseException) -> str:
+    """Class of a guard's exception: diverged | teeth_jumped | penetration | locked | overspeed, else "other"."""
+    for klass, name in FAILURE_CLASSES:
+        if isinstance(exc, klass):
+            return name
     return "other"
 
 
@@ -45,31 +58,26 @@ def angle_ratio(series: dict, window_s) -> float | None:
 def stability_edge(scenario_name: str, factors: tuple[float, ...] = STABILITY_FACTORS,
                    duration_s: float = STABILITY_DURATION_S, overrides: tuple[str, ...] = (),
                    resolution: str | None = None, tolerances: dict | None = None) -> dict:
-    """Sweep the contact3d timestep upward from its default h0 (wormsim.contact3d.mjcf.default_timestep: 0.4 x the explicit
-    limit of the contact spring-damper, rounded down to 1-2-5) by `factors` on a short run of
+    """Sweep the contact3d timestep upward from its default h0 (wormsim.contact3d.timestep.default_timestep: 0.4 x
+    the explicit limit of the contact spring-damper, rounded down to 1-2-5) by `factors` on a short run of
     scenarios/<scenario_name>.yaml, until a run fails.
 
     Each run is classified: "ok"; "inaccurate" when the ratio (from the shaft angles over the steady window,
-    angle_ratio) or the mean tangential force drifts from the run at the first factor by more than `tolerances` (relative; also when a checked value is missing); or the guard
+    angle_ratio) or the mean tangential force drifts from the run at the first factor by more than `tolerances`
+    (relative; also when a checked value is missing); or the guard
     that stopped it (classify_failure: diverged, teeth_jumped, penetration, locked). The sweep stops at the first
     run that is not "ok". Returns a JSON-ready record: the default and limit timesteps, every run (factor,
     timestep_s, dt / limit, status, failure, message, ratio, tangential_force_mean_n, drift), the last stable
     timestep (the largest "ok" one, None if the first fails) and how the next one failed.
     Wall times are measured, never judged."""
-    import time as _time
-
-    from wormsim.errors import SimulationError
-    from wormsim.contact3d.mjcf import build_model, default_timestep
-    from wormsim.contact3d.runner import simulate
-
     tol = dict(STABILITY_TOLERANCES if tolerances is None else tolerances)
     base = tuple(overrides) + (f"simulation.duration_s={duration_s}",)
     if resolution is not None:
         base += (f"simulation.resolution={resolution}",)
     sc0 = load_scenario(SCENARIOS / f"{scenario_name}.yaml", list(base))
-    law = build_model(sc0).law
+    law = prepare(sc0).law
     h0 = default_timestep(law)
-    limit = law.stable_timestep_s(3 * law.contacts_per_pair)
+    limit = law.stable_limit_s
     runs: list[dict] = []
     ref: dict | None = None
     for f in factors:
@@ -78,11 +86,11 @@ def stability_edge(scenario_name: str, factors: tuple[float, ...] = STABILITY_FA
         run = {"factor": f, "timestep_s": dt, "timestep_over_limit": dt / limit, "status": "ok", "failure": None,
                "message": "", "ratio": None, "ratio_angles": None, "tangential_force_mean_n": None, "drift": {},
                "wall_s": None}
-        t0 = _time.perf_counter()
+        t0 = time.perf_counter()
         try:
             res = simulate(sc)
         except SimulationError as exc:
-            run.update(status="failed", failure=classify_failure(str(exc)), message=str(exc))
+            run.update(status="failed", failure=classify_failure(exc), message=str(exc))
         else:
             s = dict(res.summary, ratio_angles=angle_ratio(res.series, res.summary.get("steady_window_s")))
             run["ratio"], run["tangential_force_mean_n"] = s.get("ratio"), s.get("tangential_force_mean_n")
@@ -94,7 +102,7 @@ def stability_edge(scenario_name: str, factors: tuple[float, ...] = STABILITY_FA
             if bad:
                 run.update(status="inaccurate", failure="inaccurate",
                            message="drift beyond tolerance (or no steady value) in " + ", ".join(bad))
-        run["wall_s"] = _time.perf_counter() - t0
+        run["wall_s"] = time.perf_counter() - t0
         runs.append(run)
         if run["status"] != "ok":
             break
@@ -117,6 +125,6 @@ def stability_map(quick: bool, scenarios: tuple[str, ...] | None = None) -> dict
     names = ("seat_motor",) if quick else tuple(VARIANTS)
     if scenarios is not None:
         names = tuple(n for n in names if n in scenarios)
-    dur = STABILITY_DURATION_S          # 1.5 mesh periods of the seat motor at 1800 rpm; shorter runs have no steady window
+    dur = STABILITY_DURATION_S     # 1.5 mesh periods of the seat motor at 1800 rpm; shorter runs: no steady window
     return {n: stability_edge(n, duration_s=dur, overrides=VARIANTS[n], resolution=STABILITY_RESOLUTION[n])
             for n in names}

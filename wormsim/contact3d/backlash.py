@@ -1,7 +1,8 @@
-"""Backlash against the collision pieces: the check contact3d makes before it simulates (issue 5, near-zero backlash).
+"""Backlash against the collision pieces: the check contact3d makes before it simulates (near-zero backlash).
 
 The wheel tooth is thinned by the circumferential backlash j at d2, j / 2 per flank (meshgen.wheel). Along the
-flank normal at the pitch point that is the clearance per flank (DIN 3975 force directions, as wormsim.contact3d.mjcf.mesh_arms)
+flank normal at the pitch point that is the clearance per flank (DIN 3975 force directions, as
+wormsim.gear_theory.mesh_arms_m)
 
     c = (j / 2) cos(alpha_n) cos(gamma).                                                          (1)
 
@@ -29,9 +30,11 @@ from __future__ import annotations
 
 import math
 
+import mujoco
 import numpy as np
 
 from meshgen.geometry import GearGeometry
+from wormsim.contact3d.window import repose_window
 from wormsim.scenario import ScenarioError
 from wormsim.units import MM
 
@@ -137,10 +140,6 @@ def _conjugate_poses(g: GearGeometry, n_angles: int):
 def _depth_probe(bm):
     """(depth(theta1, theta2), restore()): the deepest piece penetration at a pose (MuJoCo's collision, margin 0;
     the wheel window re-posed for theta2) on a scratch MjData; restore() puts the window back."""
-    import mujoco
-
-    from wormsim.contact3d.mjcf import repose_window
-
     m = bm.model
     d = mujoco.MjData(m)
     q1 = int(m.jnt_qposadr[m.dof_jntid[bm.worm_dof]])

@@ -66,22 +66,20 @@ efficiency came out 0.92 against 0.62 (docs/contact3d.md, "Friction at low slidi
 with F_n the whole mesh's nominal normal force at the working load (DIN 3975: T2 / (r2 cos(alpha_n)
 cos(gamma))), mu_max = max(mu(0), mu(1 m/s)) and v_t = contact.transition_velocity_m_s: even a contact
 carrying the whole load saturates once it slips faster than the static -> dynamic transition velocity (the
-stiction range of ADAMS's friction), so friction is Coulomb's wherever mu(Vs) is dynamic. Only the friction rows change: the
-normal rows and the stiffness mapping (1) are untouched.
+stiction range of ADAMS's friction), so friction is Coulomb's wherever mu(Vs) is dynamic. Only the friction rows
+change: the normal rows and the stiffness mapping (1) are untouched.
 """
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 
 import numpy as np
 
+from wormsim.gear_theory import DEFAULT_DAMPING_RATIO, MAX_DAMPING_RATIO, effective_modulus_pa
 from wormsim.scenario import Contact, Materials
-from wormsim.units import GPA, step
 
-DEFAULT_FRICTION = 0.05
-DEFAULT_DAMPING_RATIO = 0.1
-MAX_DAMPING_RATIO = 0.1   # of one tooth pair; see the docstring
+STABLE_LIMIT_PAIRS = 3      # tooth pairs in contact at once that the stable limit allows for
 IMPEDANCE = 0.01            # d: added mass in the contact normal is d/(1-d) = 1 % of the mesh's effective mass
 
 
@@ -115,20 +113,16 @@ class ContactLaw:
         return 2.0 / w * (math.sqrt(1 + zeta * zeta) - zeta)
 
     @property
+    def stable_limit_s(self) -> float:
+        """The stable limit contact3d works to: stable_timestep_s with STABLE_LIMIT_PAIRS tooth pairs' contacts in
+        parallel (the timestep default, the divergence diagnosis and the bench's stability map use it)."""
+        return self.stable_timestep_s(STABLE_LIMIT_PAIRS * self.contacts_per_pair)
+
+    @property
     def damping_ratio(self) -> float:
         """zeta of one tooth pair (n_ref contacts) against the mesh's effective mass."""
         return self.contact_damping_n_s_per_m * self.contacts_per_pair / (
             2 * math.sqrt(self.pair_stiffness_n_per_m * self.effective_mass_kg))
-
-    def as_dict(self) -> dict:
-        return asdict(self)
-
-
-def effective_modulus_pa(materials: Materials) -> float:
-    """E* with 1/E* = (1 - nu1^2)/E1 + (1 - nu2^2)/E2 (Hertz; seeds 001, 002)."""
-    w, g = materials.worm, materials.wheel
-    return 1.0 / ((1 - w.poisson_ratio ** 2) / (w.youngs_modulus_gpa * GPA)
-                  + (1 - g.poisson_ratio ** 2) / (g.youngs_modulus_gpa * GPA))
 
 
 def hertz_line_stiffness_n_per_m(materials: Materials, contact_length_m: float) -> float:
@@ -195,67 +189,3 @@ def friction_utilisation(model, data) -> np.ndarray:
     adr, mu = adr[ok], mu[ok]
     f, v = data.efc_force, data.efc_vel
     return np.stack([f[adr], np.hypot(f[adr + 1], f[adr + 2]), mu, np.hypot(v[adr + 1], v[adr + 2])], axis=1)
-
-
-# ----------------------------------------------------------------------------- friction
-
-def friction_mode(contact: Contact) -> str:
-    if contact.friction_group is not None:
-        return f"group {contact.friction_group} (seed 000 rho(Vs))"
-    if contact.friction_static is not None:
-        return (f"static {contact.friction_static} -> dynamic {contact.friction_dynamic} "
-                f"over {contact.transition_velocity_m_s} m/s")
-    if contact.friction is not None:
-        return f"constant {contact.friction}"
-    return f"default constant {DEFAULT_FRICTION}"
-
-
-def friction_coefficient(contact: Contact, sliding_speed_m_s) -> float | np.ndarray:
-    """mu(Vs): see the module docstring. Vectorised over Vs."""
-    vs = np.abs(np.asarray(sliding_speed_m_s, dtype=float))
-    if contact.friction_group is not None:
-        from wormsim.friction import mu_from_rho, rho_rad
-
-        out = mu_from_rho(rho_rad(vs, group=contact.friction_group))
-    elif contact.friction_static is not None:
-        out = step(vs, 0.0, contact.friction_static, contact.transition_velocity_m_s, contact.friction_dynamic)
-    elif contact.friction is not None:
-        out = np.full_like(vs, contact.friction)
-    else:
-        out = np.full_like(vs, DEFAULT_FRICTION)
-    return float(out) if np.ndim(out) == 0 else out
-
-
-def friction_coefficient_scalar(contact: Contact):
-    """A float-only mu(Vs) equal to friction_coefficient (fast per step: the torsional ODE's right-hand side and
-    contact3d's runner)."""
-    if contact.friction_group is not None or (contact.friction is None and contact.friction_static is None):
-        mu_c = None if contact.friction_group is not None else float(friction_coefficient(contact, 0.0))
-        if mu_c is not None:
-            return lambda vs: mu_c
-        from wormsim.friction import GROUPS
-        from wormsim.units import DEG
-        a, b, c = GROUPS[contact.friction_group]
-        return lambda vs: math.tan(DEG / (a * abs(vs) ** b + c))
-    if contact.friction is not None:
-        mu_c = float(contact.friction)
-        return lambda vs: mu_c
-    ms, md, vt = contact.friction_static, contact.friction_dynamic, contact.transition_velocity_m_s
-
-    def mu(vs):
-        x = abs(vs) / vt
-        if x >= 1.0:
-            return md
-        return ms + (md - ms) * x * x * (3.0 - 2.0 * x)
-    return mu
-
-
-def efficiency_theory(lead_angle_rad: float, normal_pressure_angle_rad: float, mu: float,
-                      backdriving: bool = False) -> float:
-    """Wedge efficiencies with the virtual friction angle rho' = atan(mu / cos(alpha_n)) (DIN 3975):
-    forward eta = tan(g) / tan(g + rho'), backward eta' = tan(g - rho') / tan(g) (0 when self-locking)."""
-    rho = math.atan(mu / math.cos(normal_pressure_angle_rad))
-    g = lead_angle_rad
-    if backdriving:
-        return max(math.tan(g - rho) / math.tan(g), 0.0)
-    return math.tan(g) / math.tan(g + rho)

@@ -3,10 +3,9 @@ half the piece-passing frequency, contact statistics, the radial force on the li
 at the contacts' radius and the start-up peak."""
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
+from wormsim import gear_theory as gt
 from wormsim.metrics import dominant_frequency, drive_summary, mean_speeds_rpm, window_of
 
 
@@ -18,13 +17,14 @@ def contact3d_summary(S: dict, scenario, bm) -> dict:
     sl = slice(i0, i1)
     n1, n2 = mean_speeds_rpm(S, i0, i1)
     # the convex pieces' facets excite the force at (segments per turn) x (worm speed): search below half that
-    segs = getattr(getattr(bm.pieces, "resolution", None), "worm_segments_per_turn", None)
+    segs = bm.pieces.resolution.worm_segments_per_turn
     f_max = 0.5 * segs * n1 / 60.0 if segs else float("inf")
     f_peak, df, _, _ = dominant_frequency(t[sl], S["tangential_force_n"][sl], f_max)
     f_full, _, _, _ = dominant_frequency(t[sl], S["tangential_force_n"][sl])
     f_rad, _, _, _ = dominant_frequency(t[sl], S["radial_force_n"][sl], f_max)
     return {
-        **drive_summary(S, scenario, geo, i0, i1, n1, n2),
+        # shaft powers: the interval means of T w over every step (the runner's worm_power_w, wheel_power_w)
+        **drive_summary(S, scenario, geo, i0, i1, n1, n2, shaft_powers_w=(S["worm_power_w"], S["wheel_power_w"])),
         "mesh_frequency_hz": f_peak,
         "mesh_frequency_resolution_hz": df,
         "mesh_frequency_search_max_hz": f_max,
@@ -42,7 +42,7 @@ def contact3d_summary(S: dict, scenario, bm) -> dict:
 def contact_radius_check(S: dict, sl: slice) -> dict:
     """worm_contact_radius_mean_m: force-weighted worm radius of the contacts over the window, and
     efficiency_theory_at_contact_radius: the wedge efficiency evaluated at each contact's own radius (local lead
-    angle tan(gamma_r) = tan(gamma) r1 / r; wormsim.contact3d.runner._contact_radius_efficiency), where efficiency_theory
+    angle tan(gamma_r) = tan(gamma) r1 / r; gear_theory.efficiency_at_radius), where efficiency_theory
     takes the pitch radius r1 (DIN 3975). Measured (seat motor, coarse, 1800 rpm): contacts at 4.40 mm against
     r1 4.19 mm, 0.609 against 0.620 at r1, measured 0.605."""
     if "worm_contact_radius_m" not in S:
@@ -65,11 +65,11 @@ def radial_force_check(S: dict, scenario, geo, sl: slice) -> dict:
     if "radial_force_line_of_centres_n" not in S or not len(S["tangential_force_n"][sl]):
         return {}
     mu = float(np.mean(S["friction_coefficient"][sl]))
-    rho = math.atan(mu / math.cos(geo.alpha_n))
+    rho = gt.virtual_friction_angle_rad(mu, geo.alpha_n)
     s = -1.0 if scenario.drive.on == "wheel" else 1.0
     ft = abs(float(np.mean(S["tangential_force_n"][sl])))
     return {"radial_force_line_of_centres_mean_n": abs(float(np.mean(S["radial_force_line_of_centres_n"][sl]))),
-            "radial_force_theory_n": ft * math.tan(geo.alpha_n) * math.cos(rho) / math.cos(geo.gamma + s * rho)}
+            "radial_force_theory_n": gt.radial_force_n(ft, geo.alpha_n, geo.gamma, s * rho)}
 
 
 def startup_peak(S: dict, i0: int, i1: int) -> dict:

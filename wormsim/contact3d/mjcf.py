@@ -17,6 +17,7 @@ Built with mujoco.MjSpec from the template `models/worm_pair.xml` (see models/RE
   load.start_s over load.ramp_s; a driven-machine inertia load.inertia_kg_m2 is the loaded hinge's armature
   (rigid on the shaft) and counts in that shaft's effective mass of the contact law;
 - contact law: wormsim.contact3d.law (solref/solimp per collision geom; body_invweight0 set to A_hat);
+- timestep: chosen before the model is built (wormsim.contact3d.timestep.choose_timestep) and written once;
 - a contact sensor (worm against the wheel's subtree, reduce="netforce") gives the resultant tooth force
   every step, which wormsim.contact3d.runner averages over each record interval.
 """
@@ -29,16 +30,25 @@ from pathlib import Path
 
 import mujoco
 import numpy as np
+import trimesh
 
-from meshgen.geometry import GearGeometry, derive
+from meshgen import assembly
+from meshgen.geometry import GearGeometry
+from meshgen.pieces import GearSet
+from wormsim import gear_theory as gt
 from wormsim.contact3d.backlash import check_backlash, check_conjugate_interference
-from wormsim.contact3d.law import ContactLaw, contact_law, efficiency_theory, friction_coefficient, friction_impratio
+from wormsim.contact3d.law import ContactLaw, contact_law, friction_impratio
+from wormsim.contact3d.timestep import choose_timestep
+from wormsim.contact3d.window import slot_quat, window_size, window_teeth_at
+from wormsim.friction import friction_coefficient
+from wormsim.geometry import derive, gear_set
 from wormsim.scenario import Scenario, ScenarioError
-from wormsim.units import rpm_to_rad_s
 
 TEMPLATE = files("wormsim.models") / "worm_pair.xml"   # models/, shipped as package data
 MESH_SENSOR_DATA = 1 | 2 | 4 | 16    # contact sensor fields found, force, torque, pos (mjtConDataField bits)
-SPEED_DROOP = 1e-3          # velocity servo: kv = T_expected / (SPEED_DROOP * omega_cmd)
+INTEGRATORS = {"implicitfast": mujoco.mjtIntegrator.mjINT_IMPLICITFAST, "rk4": mujoco.mjtIntegrator.mjINT_RK4,
+               "euler": mujoco.mjtIntegrator.mjINT_EULER, "implicit": mujoco.mjtIntegrator.mjINT_IMPLICIT,
+               "discrete": mujoco.mjtIntegrator.mjINT_DISCRETE}
 
 
 @dataclass
@@ -62,28 +72,38 @@ class BuiltModel:
     tooth0_angle_rad: float             # angle of tooth 0's centre in the wheel frame at theta2 = 0
     direction: int                      # +1/-1: expected sign of (load shaft speed) / (drive command)
     drive_sign: int                     # sign of the drive command
-    pieces: object = None               # meshgen GearSet
+    pieces: GearSet
+    timestep_s: float                   # the model's timestep (model.opt.timestep), chosen before the build
+    timestep_source: str
     meta: dict = field(default_factory=dict)
 
 
+@dataclass(frozen=True)
+class Inertias:
+    """Shaft masses and axial moments (from the visual meshes and the densities) and the driven machine's
+    inertia load.inertia_kg_m2 on the loaded shaft (the hinge's armature)."""
+
+    worm_mass_kg: float
+    worm_inertia_kg_m2: float
+    wheel_mass_kg: float
+    wheel_inertia_kg_m2: float
+    worm_load_inertia_kg_m2: float
+    wheel_load_inertia_kg_m2: float
+
+
+@dataclass(frozen=True)
+class Prepared:
+    """What is known before the model is built: geometry, pieces, inertias and the contact law."""
+
+    geometry: GearGeometry
+    pieces: GearSet
+    inertias: Inertias
+    law: ContactLaw
+    inv_mass_worm: float     # arm1^2 / (I1 + J1): the worm's share of A_hat
+    inv_mass_wheel: float    # arm2^2 / (I2 + J2)
+
+
 # ----------------------------------------------------------------------------- geometry helpers
-
-def gear_set(scenario: Scenario):
-    from meshgen.pieces import build_gear_set
-
-    geo = derive(scenario.gear)
-    return geo, build_gear_set(geo, resolution=scenario.simulation.resolution)
-
-
-def _assembly(geo: GearGeometry, part: str, theta: float) -> np.ndarray:
-    import inspect
-
-    from meshgen import assembly
-
-    fn = getattr(assembly, f"{part}_to_assembly")
-    n = len(inspect.signature(fn).parameters)
-    return np.asarray(fn(theta) if n == 1 else fn(theta, geo), dtype=float)
-
 
 def _mat2quat(R: np.ndarray) -> np.ndarray:
     q = np.zeros(4)
@@ -97,31 +117,16 @@ def _axial_inertia(mesh, density: float, r_in: float, r_out: float, length: floa
         m = mesh.copy()
         m.density = density
         mp = m.mass_properties
-        return float(mp["mass"]), float(mp["inertia"][2, 2] + mp["mass"] * 0.0)
+        return float(mp["mass"]), float(mp["inertia"][2, 2])
     mass = density * math.pi * (r_out ** 2 - r_in ** 2) * length
     return mass, 0.5 * mass * (r_out ** 2 + r_in ** 2)
 
 
-def mesh_arms(geo: GearGeometry) -> tuple[float, float]:
-    """Moment arms of a unit normal force at the pitch point about the worm and wheel axes:
-    worm r1 cos(alpha_n) sin(gamma), wheel r2 cos(alpha_n) cos(gamma) (normal direction of the
-    flank at the pitch point, DIN 3975 force components)."""
-    ca = math.cos(geo.alpha_n)
-    return geo.r1 * ca * math.sin(geo.gamma), geo.r2 * ca * math.cos(geo.gamma)
-
-
 def nominal_normal_force_n(scenario: Scenario, geo: GearGeometry) -> float:
-    """Whole-mesh normal force at the working load, F_n = T2 / (r2 cos(alpha_n) cos(gamma)) (DIN 3975; wheel
-    torque T2 = the load, or the worm load times the ratio when the load is on the worm; a torque driving the WHEEL
-    counts too, the larger of the two: it passes through the mesh whatever the worm does, and against a free worm it
-    is the only load. A torque driving the worm is not counted: what it does not pass to the wheel load accelerates
-    the worm). Sets the friction rows' hardness (wormsim.contact3d.law (3)); with T2 = 0 impratio fell to 1 and a
-    self-locking pair crept back at ~110 rpm instead of 0.2 rpm (docs/stability_backlash_locking.md)."""
-    load, drv = scenario.load, scenario.drive
-    t2 = abs(load.torque_nm) * (1.0 if load.on == "wheel" else geo.ratio)
-    if drv.torque_nm is not None and drv.on == "wheel":
-        t2 = max(t2, abs(drv.torque_nm))
-    return t2 / (geo.r2 * math.cos(geo.alpha_n) * math.cos(geo.gamma))
+    """Whole-mesh normal force at the working load (gear_theory.normal_force_n of working_wheel_torque_nm). Sets
+    the friction rows' hardness (wormsim.contact3d.law (3)); with T2 = 0 impratio fell to 1 and a self-locking pair
+    crept back at ~110 rpm instead of 0.2 rpm (docs/stability_backlash_locking.md)."""
+    return gt.normal_force_n(gt.working_wheel_torque_nm(scenario, geo.ratio), geo.r2, geo.alpha_n, geo.gamma)
 
 
 def expected_direction(scenario: Scenario, geo: GearGeometry) -> int:
@@ -130,110 +135,172 @@ def expected_direction(scenario: Scenario, geo: GearGeometry) -> int:
     return geo.hand
 
 
-def window_size(geo: GearGeometry) -> int:
-    """Wheel teeth with collision: those the threaded length can reach, plus one each side."""
-    reach = min(geo.worm_length / 2, geo.r_e2)
-    half = math.asin(min(reach / geo.r_e2, 1.0)) * geo.z2 / (2 * math.pi)
-    return int(min(geo.z2, 2 * math.ceil(half) + 2))
+def _slabs_per_flank(gs: GearSet) -> int:
+    """n_ref: wheel-tooth pieces across the face width on one flank (meshgen may split a tooth
+    into flank pieces; a piece spanning both flanks counts once per flank)."""
+    if gs.resolution.wheel_slabs:
+        return int(gs.resolution.wheel_slabs)
+    zs = [round(float(np.mean(p.vertices[:, 2])), 9) for p in gs.wheel_tooth_pieces]
+    return len(set(zs))
 
 
-def window_teeth_at(theta2: float, z2: int, window: int, tooth0_angle: float) -> np.ndarray:
-    """Unwrapped tooth indices k of the window at wheel angle theta2: the W teeth nearest the line of
-    centres (angle -pi/2 in the assembly frame), tooth k at angle tooth0 + 2 pi k / z2 + theta2."""
-    pitch = 2 * math.pi / z2
-    c = math.floor((-math.pi / 2 - tooth0_angle - theta2) / pitch)
-    h = window // 2
-    return np.arange(c - h + 1, c - h + 1 + window)
+def _tooth0_angle(gs: GearSet) -> float:
+    """Angle of tooth 0's centre (mean of its pieces' centroids) in the wheel frame."""
+    c = np.mean([p.centroid for p in gs.wheel_tooth_pieces], axis=0)
+    return math.atan2(c[1], c[0])
 
 
-# ----------------------------------------------------------------------------- build
+# ----------------------------------------------------------------------------- before the build
 
-def build_model(scenario: Scenario, gs=None, check_backlash_vs_pieces: bool = True,
-                window_teeth: int | None = None) -> BuiltModel:
-    """The compiled contact3d model. check_backlash_vs_pieces=False skips wormsim.contact3d.backlash's check (only to measure
-    what happens below its limit). window_teeth: wheel tooth slots with collision (default window_size; geo.z2 =
-    every tooth, for a standalone file that the viewer can turn without re-posing)."""
+def shaft_inertias(scenario: Scenario, geo: GearGeometry, gs: GearSet) -> Inertias:
+    mats = scenario.materials
+    m1, I1 = _axial_inertia(gs.worm_visual, mats.worm.density_kg_m3, 0.0, geo.r1, geo.worm_length)
+    m2, I2 = _axial_inertia(gs.wheel_visual, mats.wheel.density_kg_m3, 0.0, geo.r2, geo.face_width)
+    j_load = scenario.load.inertia_kg_m2
+    J1, J2 = (j_load, 0.0) if scenario.load.on == "worm" else (0.0, j_load)
+    return Inertias(m1, I1, m2, I2, J1, J2)
+
+
+def prepare(scenario: Scenario, gs: GearSet | None = None) -> Prepared:
+    """Geometry, pieces (built or cached unless given), inertias and the contact law with its friction hardness:
+    everything the timestep and the model need, without compiling anything."""
     if scenario.gear is None or scenario.drive is None:
         raise ScenarioError("model: contact3d needs gear: and drive: blocks")
     geo, gs = (derive(scenario.gear), gs) if gs is not None else gear_set(scenario)
-    # backlash against the pieces' residual bulge (wormsim.contact3d.backlash (2)): exit 2 before the teeth start jammed
-    backlash_meta = check_backlash(geo, gs.piece_error_um, scenario.simulation.resolution) \
-        if check_backlash_vs_pieces and getattr(gs, "piece_error_um", None) else {}
-    mats = scenario.materials
-    spec = mujoco.MjSpec.from_file(str(TEMPLATE))
-    spec.modelname = scenario.name
-
-    # inertias from densities
-    m1, I1 = _axial_inertia(gs.worm_visual, mats.worm.density_kg_m3, 0.0, geo.r1, geo.worm_length)
-    m2, I2 = _axial_inertia(gs.wheel_visual, mats.wheel.density_kg_m3, 0.0, geo.r2, geo.face_width)
-    arm1, arm2 = mesh_arms(geo)
+    ine = shaft_inertias(scenario, geo, gs)
+    arm1, arm2 = gt.mesh_arms_m(geo.r1, geo.r2, geo.alpha_n, geo.gamma)
     # driven-machine inertia J on the loaded shaft (joint armature) belongs to that shaft's effective mass
-    j_load = scenario.load.inertia_kg_m2
-    J1, J2 = (j_load, 0.0) if scenario.load.on == "worm" else (0.0, j_load)
-    inv_mass_hat = arm1 ** 2 / (I1 + J1) + arm2 ** 2 / (I2 + J2)
-    slabs = max(1, _slabs_per_flank(gs))
-    law = contact_law(scenario.contact, mats, geo.face_width, slabs, inv_mass_hat)
+    a1 = arm1 ** 2 / (ine.worm_inertia_kg_m2 + ine.worm_load_inertia_kg_m2)
+    a2 = arm2 ** 2 / (ine.wheel_inertia_kg_m2 + ine.wheel_load_inertia_kg_m2)
+    law = contact_law(scenario.contact, scenario.materials, geo.face_width, max(1, _slabs_per_flank(gs)), a1 + a2)
     mu0 = float(friction_coefficient(scenario.contact, 0.0))
     mu_max = max(mu0, float(friction_coefficient(scenario.contact, 1.0)))
     law = replace(law, impratio=friction_impratio(law, mu_max, nominal_normal_force_n(scenario, geo),
                                                   scenario.contact.transition_velocity_m_s))
+    return Prepared(geo, gs, ine, law, a1, a2)
 
+
+# ----------------------------------------------------------------------------- build
+
+def build_model(scenario: Scenario, gs: GearSet | None = None, check_backlash_vs_pieces: bool = True,
+                window_teeth: int | None = None, timestep_s: float | None = None) -> BuiltModel:
+    """The compiled contact3d model. check_backlash_vs_pieces=False skips wormsim.contact3d.backlash's checks (only
+    to measure what happens below their limit). window_teeth: wheel tooth slots with collision (default
+    window_size; geo.z2 = every tooth, for a standalone file that the viewer can turn without re-posing).
+    timestep_s: the timestep to build with (default: choose_timestep's)."""
+    p = prepare(scenario, gs)
+    geo, gs, law = p.geometry, p.pieces, p.law
+    # backlash against the pieces' residual bulge (wormsim.contact3d.backlash (2)): exit 2 before the teeth start jammed
+    backlash_meta = check_backlash(geo, gs.piece_error_um, scenario.simulation.resolution) \
+        if check_backlash_vs_pieces and gs.piece_error_um else {}
+    h, h_source = choose_timestep(scenario, geo, law) if timestep_s is None else (timestep_s, "given to build_model")
+
+    spec = mujoco.MjSpec.from_file(str(TEMPLATE))
+    spec.modelname = scenario.name
+    _place_bodies(spec, geo, p.inertias)
+    worm_names, slot_names, W = _add_geoms(spec, geo, gs, law, float(friction_coefficient(scenario.contact, 0.0)),
+                                           window_teeth)
+    kv, drive_sign = _add_actuators(spec, scenario, geo)
+    _set_options(spec, scenario, law, h)
+    _add_mesh_sensor(spec)
+    model = spec.compile()
+
+    ine = p.inertias
+    meta = {"worm_mass_kg": ine.worm_mass_kg, "wheel_mass_kg": ine.wheel_mass_kg,
+            "worm_inertia_kg_m2": ine.worm_inertia_kg_m2, "wheel_inertia_kg_m2": ine.wheel_inertia_kg_m2,
+            "window_teeth": W, "worm_pieces": len(gs.worm_pieces), "tooth_pieces": len(gs.wheel_tooth_pieces),
+            **backlash_meta}
+    if kv is not None:
+        meta["drive_kv_nm_s"] = kv
+    meta["load_inertia_kg_m2"] = scenario.load.inertia_kg_m2
+
+    def oid(kind: mujoco.mjtObj, name: str) -> int:
+        return mujoco.mj_name2id(model, kind, name)
+
+    slot_geoms = np.array([[oid(mujoco.mjtObj.mjOBJ_GEOM, n) for n in row] for row in slot_names], dtype=int)
+    slot_bodies = np.array([oid(mujoco.mjtObj.mjOBJ_BODY, f"slot{i}") for i in range(W)])
+    _set_inv_mass_hat(model, law, p.inv_mass_worm, p.inv_mass_wheel, slot_bodies)
+    bm = BuiltModel(
+        model=model, spec=spec, geometry=geo, law=law,
+        worm_body=oid(mujoco.mjtObj.mjOBJ_BODY, "worm"), wheel_body=oid(mujoco.mjtObj.mjOBJ_BODY, "wheel"),
+        worm_dof=int(model.jnt_dofadr[oid(mujoco.mjtObj.mjOBJ_JOINT, "worm_hinge")]),
+        wheel_dof=int(model.jnt_dofadr[oid(mujoco.mjtObj.mjOBJ_JOINT, "wheel_hinge")]),
+        drive_actuator=oid(mujoco.mjtObj.mjOBJ_ACTUATOR, "drive"),
+        load_actuator=oid(mujoco.mjtObj.mjOBJ_ACTUATOR, "load"),
+        worm_geoms=np.array([oid(mujoco.mjtObj.mjOBJ_GEOM, n) for n in worm_names], dtype=int),
+        wheel_slot_geoms=slot_geoms, slot_bodies=slot_bodies, window_teeth=W, tooth0_angle_rad=_tooth0_angle(gs),
+        direction=expected_direction(scenario, geo), drive_sign=drive_sign, pieces=gs,
+        timestep_s=h, timestep_source=h_source, meta=meta)
+    if check_backlash_vs_pieces:
+        # the model itself at the rigid-conjugate pose (wormsim.contact3d.backlash.check_conjugate_interference): exit 2
+        meta["conjugate_interference_m"] = check_conjugate_interference(
+            bm, scenario.simulation.resolution, nominal_normal_force_n(scenario, geo))
+    return bm
+
+
+def _place_bodies(spec: mujoco.MjSpec, geo: GearGeometry, ine: Inertias) -> None:
+    """Worm and wheel bodies in the assembly frame (meshgen.assembly) with their masses and inertias."""
     worm_b, wheel_b = spec.body("worm"), spec.body("wheel")
-    Tw = _assembly(geo, "worm", 0.0)
-    Tg = _assembly(geo, "wheel", 0.0)
+    Tw = np.asarray(assembly.worm_to_assembly(0.0, geo), dtype=float)
+    Tg = np.asarray(assembly.wheel_to_assembly(0.0), dtype=float)
     if not np.allclose(Tg, np.eye(4), atol=1e-12):
         raise RuntimeError("meshgen.assembly: the wheel frame must coincide with the assembly frame at theta2 = 0")
     worm_b.pos = Tw[:3, 3]
     worm_b.quat = _mat2quat(Tw[:3, :3])
     # transverse moments of a solid cylinder of the part's length, Izz / 2 + m L^2 / 12: irrelevant on a hinge,
     # but they must satisfy the triangle inequality with a margin that survives the 6 digits of a written MJCF
-    for body, mass, izz, length in ((worm_b, m1, I1, geo.worm_length), (wheel_b, m2, I2, geo.face_width)):
+    for body, mass, izz, length in ((worm_b, ine.worm_mass_kg, ine.worm_inertia_kg_m2, geo.worm_length),
+                                    (wheel_b, ine.wheel_mass_kg, ine.wheel_inertia_kg_m2, geo.face_width)):
         body.explicitinertial = True
         body.mass = mass
         body.ipos = [0, 0, 0]
         ixx = izz / 2 + mass * length ** 2 / 12
         body.inertia = [ixx, ixx, izz]
 
-    def add_mesh(name, mesh):
-        me = spec.add_mesh()
-        me.name = name
-        me.uservert = np.asarray(mesh.vertices, dtype=np.float32).ravel()
-        me.userface = np.asarray(mesh.faces, dtype=np.int32).ravel()
-        me.inertia = mujoco.mjtMeshInertia.mjMESH_INERTIA_CONVEX
-        return me
 
-    def set_contact(g):
+def _add_mesh(spec: mujoco.MjSpec, name: str, mesh: trimesh.Trimesh) -> None:
+    me = spec.add_mesh()
+    me.name = name
+    me.uservert = np.asarray(mesh.vertices, dtype=np.float32).ravel()
+    me.userface = np.asarray(mesh.faces, dtype=np.int32).ravel()
+    me.inertia = mujoco.mjtMeshInertia.mjMESH_INERTIA_CONVEX
+
+
+def _add_geoms(spec: mujoco.MjSpec, geo: GearGeometry, gs: GearSet, law: ContactLaw, mu0: float,
+               window_teeth: int | None) -> tuple[list[str], list[list[str]], int]:
+    """Visual meshes, the worm's collision pieces and the wheel's window of W slots (one rigid child body per
+    slot, no joint: re-posing a slot moves its body, so MuJoCo's per-body bounding-volume hierarchy, built at
+    compile time in the body frame, stays valid). Returns (worm geom names, slot geom names, W)."""
+    worm_b, wheel_b = spec.body("worm"), spec.body("wheel")
+
+    def set_contact(g: mujoco.MjsGeom) -> None:
         g.solref = law.solref
         g.solimp = law.solimp
         g.friction = [mu0, 0.0, 0.0]
         g.margin = 0.0
 
-    add_mesh("worm_visual", gs.worm_visual)
-    add_mesh("wheel_visual", gs.wheel_visual)
-    for b, name, rgba in ((worm_b, "worm_visual", (0.55, 0.6, 0.7, 1)), (wheel_b, "wheel_visual", (0.85, 0.65, 0.3, 1))):
+    _add_mesh(spec, "worm_visual", gs.worm_visual)
+    _add_mesh(spec, "wheel_visual", gs.wheel_visual)
+    for b, name, rgba in ((worm_b, "worm_visual", (0.55, 0.6, 0.7, 1)),
+                          (wheel_b, "wheel_visual", (0.85, 0.65, 0.3, 1))):
         g = b.add_geom(default=spec.find_default("visual"))
         g.name, g.meshname, g.rgba = name, name, rgba
     worm_names = []
     for i, piece in enumerate(gs.worm_pieces):
-        add_mesh(f"worm_piece_{i}", piece)
+        _add_mesh(spec, f"worm_piece_{i}", piece)
         g = worm_b.add_geom(default=spec.find_default("worm_collision"))
         g.name = g.meshname = f"worm_piece_{i}"
         set_contact(g)
         worm_names.append(g.name)
     for j, piece in enumerate(gs.wheel_tooth_pieces):
-        add_mesh(f"tooth_piece_{j}", piece)
+        _add_mesh(spec, f"tooth_piece_{j}", piece)
     W = window_size(geo) if window_teeth is None else int(min(max(window_teeth, 1), geo.z2))
-    tooth0 = _tooth0_angle(gs)
-    ks = window_teeth_at(0.0, geo.z2, W, tooth0)
-    slot_names = [[None] * len(gs.wheel_tooth_pieces) for _ in range(W)]
-    for k in ks:
+    slot_names = [[""] * len(gs.wheel_tooth_pieces) for _ in range(W)]
+    for k in window_teeth_at(0.0, geo.z2, W, _tooth0_angle(gs)):
         s = int(k % W)
-        ang = 2 * math.pi * k / geo.z2
-        # one rigid child body per slot (no joint): re-posing a slot moves its body, so MuJoCo's per-body
-        # bounding-volume hierarchy (built at compile time in the body frame) stays valid
         sb = wheel_b.add_body()
         sb.name = f"slot{s}"
-        sb.quat = [math.cos(ang / 2), 0, 0, math.sin(ang / 2)]
+        sb.quat = slot_quat(int(k), geo.z2)
         sb.explicitinertial = True
         sb.mass = 1e-9
         sb.inertia = [1e-15, 1e-15, 1e-15]
@@ -243,100 +310,51 @@ def build_model(scenario: Scenario, gs=None, check_backlash_vs_pieces: bool = Tr
             g.meshname = f"tooth_piece_{j}"
             set_contact(g)
             slot_names[s][j] = g.name
+    return worm_names, slot_names, W
 
-    # drive and load
+
+def _add_actuators(spec: mujoco.MjSpec, scenario: Scenario, geo: GearGeometry) -> tuple[float | None, int]:
+    """Drive (speed: velocity servo with gear_theory.servo_gain_nm_s; torque: motor) and load (motor) on their
+    hinges; the driven machine's inertia is the loaded hinge's armature. Returns (kv or None, drive sign)."""
     drv, load = scenario.drive, scenario.load
-    direction = expected_direction(scenario, geo)
-    drive_joint = f"{drv.on}_hinge"
-    load_joint = f"{load.on}_hinge"
     a = spec.add_actuator()
-    a.name, a.target, a.trntype = "drive", drive_joint, mujoco.mjtTrn.mjTRN_JOINT
-    meta = {"worm_mass_kg": m1, "wheel_mass_kg": m2, "worm_inertia_kg_m2": I1, "wheel_inertia_kg_m2": I2,
-            "window_teeth": W, "worm_pieces": len(gs.worm_pieces), "tooth_pieces": len(gs.wheel_tooth_pieces),
-            **backlash_meta}
+    a.name, a.target, a.trntype = "drive", f"{drv.on}_hinge", mujoco.mjtTrn.mjTRN_JOINT
+    kv = None
     if drv.speed_rpm is not None:
-        w_cmd = abs(rpm_to_rad_s(drv.speed_rpm))
-        eta = efficiency_theory(geo.gamma, geo.alpha_n, float(friction_coefficient(scenario.contact, 1.0)),
-                                backdriving=drv.on == "wheel")
-        if drv.on == "worm":
-            t_exp = abs(load.torque_nm) / geo.ratio / max(eta, 0.05)
-        else:
-            t_exp = abs(load.torque_nm) * geo.ratio / max(eta, 0.05)
-        t_exp = max(t_exp, 1e-3)
-        kv = t_exp / (SPEED_DROOP * max(w_cmd, 1e-3))
+        kv = gt.servo_gain_nm_s(scenario, geo.ratio, geo.gamma, geo.alpha_n,
+                                float(friction_coefficient(scenario.contact, 1.0)))
         a.set_to_velocity(kv=kv)
-        meta["drive_kv_nm_s"] = kv
         drive_sign = int(np.sign(drv.speed_rpm)) or 1
     else:
         a.set_to_motor()
         drive_sign = int(np.sign(drv.torque_nm)) or 1
     a.ctrllimited = False
     lo = spec.add_actuator()
-    lo.name, lo.target, lo.trntype = "load", load_joint, mujoco.mjtTrn.mjTRN_JOINT
+    lo.name, lo.target, lo.trntype = "load", f"{load.on}_hinge", mujoco.mjtTrn.mjTRN_JOINT
     lo.set_to_motor()
     lo.ctrllimited = False
-    spec.joint(load_joint).armature = j_load
-    meta["load_inertia_kg_m2"] = j_load
+    spec.joint(f"{load.on}_hinge").armature = load.inertia_kg_m2
+    return kv, drive_sign
 
+
+def _set_options(spec: mujoco.MjSpec, scenario: Scenario, law: ContactLaw, timestep_s: float) -> None:
     o = spec.option
-    o.timestep = default_timestep(law) if scenario.simulation.timestep_s is None else scenario.simulation.timestep_s
+    o.timestep = timestep_s
     o.impratio = law.impratio      # friction rows' hardness, wormsim.contact3d.law (3)
     if scenario.simulation.speculative:
         o.enableflags |= int(mujoco.mjtEnableBit.mjENBL_SPECULATIVE)
-    o.integrator = {"implicitfast": mujoco.mjtIntegrator.mjINT_IMPLICITFAST, "rk4": mujoco.mjtIntegrator.mjINT_RK4,
-                    "euler": mujoco.mjtIntegrator.mjINT_EULER, "implicit": mujoco.mjtIntegrator.mjINT_IMPLICIT,
-                    "discrete": mujoco.mjtIntegrator.mjINT_DISCRETE}[scenario.simulation.integrator]
+    o.integrator = INTEGRATORS[scenario.simulation.integrator]
 
+
+def _add_mesh_sensor(spec: mujoco.MjSpec) -> None:
+    """Contact sensor: worm against the wheel's subtree (XBODY: the wheel and its slots), net force."""
     sen = spec.add_sensor()
     sen.name, sen.type = "mesh_force", mujoco.mjtSensor.mjSENS_CONTACT
     sen.objtype, sen.objname = mujoco.mjtObj.mjOBJ_BODY, "worm"
-    sen.reftype, sen.refname = mujoco.mjtObj.mjOBJ_XBODY, "wheel"   # XBODY: the wheel's subtree (its slots)
+    sen.reftype, sen.refname = mujoco.mjtObj.mjOBJ_XBODY, "wheel"
     sen.intprm[0] = MESH_SENSOR_DATA
     sen.intprm[1] = 3       # reduce = netforce
     sen.intprm[2] = 1       # num
-
-    model = spec.compile()
-    geom_id = lambda n: mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, n)  # noqa: E731
-    slot_geoms = np.array([[geom_id(n) for n in row] for row in slot_names], dtype=int)
-    slot_bodies = np.array([mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, f"slot{i}") for i in range(W)])
-    _set_inv_mass_hat(model, law, arm1 ** 2 / (I1 + J1), arm2 ** 2 / (I2 + J2), slot_bodies)
-    jid = lambda n: mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, n)  # noqa: E731
-    bm = BuiltModel(
-        model=model, spec=spec, geometry=geo, law=law,
-        worm_body=mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "worm"),
-        wheel_body=mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "wheel"),
-        worm_dof=int(model.jnt_dofadr[jid("worm_hinge")]), wheel_dof=int(model.jnt_dofadr[jid("wheel_hinge")]),
-        drive_actuator=mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, "drive"),
-        load_actuator=mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, "load"),
-        worm_geoms=np.array([geom_id(n) for n in worm_names], dtype=int),
-        wheel_slot_geoms=slot_geoms, slot_bodies=slot_bodies,
-        window_teeth=W, tooth0_angle_rad=tooth0, direction=direction, drive_sign=drive_sign, pieces=gs, meta=meta)
-    if check_backlash_vs_pieces:
-        # the model itself at the rigid-conjugate pose (wormsim.contact3d.backlash.check_conjugate_interference): exit 2
-        meta["conjugate_interference_m"] = check_conjugate_interference(
-            bm, scenario.simulation.resolution, nominal_normal_force_n(scenario, geo))
-    return bm
-
-
-def _slabs_per_flank(gs) -> int:
-    """n_ref: wheel-tooth pieces across the face width on one flank (meshgen may split a tooth
-    into flank pieces; a piece spanning both flanks counts once per flank)."""
-    res = getattr(gs, "resolution", None)
-    if getattr(res, "wheel_slabs", None):
-        return int(res.wheel_slabs)
-    zs = [round(float(np.mean(p.vertices[:, 2])), 9) for p in gs.wheel_tooth_pieces]
-    return len(set(zs))
-
-
-def _tooth0_angle(gs) -> float:
-    """Angle of tooth 0's centre (mean of its pieces' centroids) in the wheel frame."""
-    c = np.mean([p.centroid for p in gs.wheel_tooth_pieces], axis=0)
-    return math.atan2(c[1], c[0])
-
-
-def _rotz(a: float) -> np.ndarray:
-    c, s = math.cos(a), math.sin(a)
-    return np.array([[c, -s, 0], [s, c, 0], [0, 0, 1.0]])
 
 
 def _set_inv_mass_hat(model: mujoco.MjModel, law: ContactLaw, a_worm: float, a_wheel: float,
@@ -349,36 +367,6 @@ def _set_inv_mass_hat(model: mujoco.MjModel, law: ContactLaw, a_worm: float, a_w
     model.body_invweight0[gb, 0] = a_wheel
     model.body_invweight0[slot_bodies, 0] = a_wheel
     assert abs(a_worm + a_wheel - law.inv_mass_hat) <= 1e-9 * law.inv_mass_hat
-
-
-def repose_window(bm: BuiltModel, theta2: float, current: np.ndarray | None = None) -> np.ndarray:
-    """Place the window slots on the W teeth nearest the line of centres; returns the tooth indices."""
-    ks = window_teeth_at(theta2, bm.geometry.z2, bm.window_teeth, bm.tooth0_angle_rad)
-    if current is not None and np.array_equal(ks, current):
-        return current
-    m = bm.model
-    for k in ks:
-        if current is not None and k in current:
-            continue
-        ang = 2 * math.pi * k / bm.geometry.z2
-        m.body_quat[bm.slot_bodies[int(k % bm.window_teeth)]] = [math.cos(ang / 2), 0, 0, math.sin(ang / 2)]
-    return ks
-
-
-def round_down_125(h: float) -> float:
-    """Largest 1, 2 or 5 x 10^e not above h, as the decimal value (5e-06, not 5 * 10.0 ** -6 = 4.9999999999999996e-06)."""
-    e = math.floor(math.log10(h))
-    for mant in (5, 2, 1):
-        if float(f"{mant}e{e}") <= h * (1 + 1e-12):
-            return float(f"{mant}e{e}")
-    return float(f"1e{e}")
-
-
-def default_timestep(law: ContactLaw, contacts: int | None = None) -> float:
-    """0.4 x the explicit stability limit with `contacts` (default 3 pairs' worth) in parallel,
-    rounded down to 1-2-5 steps."""
-    n = contacts if contacts is not None else 3 * law.contacts_per_pair
-    return round_down_125(0.4 * law.stable_timestep_s(n))
 
 
 # ----------------------------------------------------------------------------- standalone MJCF
@@ -395,8 +383,6 @@ def write_model(scenario: Scenario, out_dir: str | Path) -> Path:
     geo = derive(scenario.gear) if scenario.gear is not None else None
     bm = build_model(scenario, window_teeth=geo.z2 if geo is not None else None)
     spec = bm.spec
-    import trimesh
-
     for me in spec.meshes:
         v = np.asarray(me.uservert, dtype=float).reshape(-1, 3)
         f = np.asarray(me.userface, dtype=int).reshape(-1, 3)

@@ -12,10 +12,12 @@ wheel meshes under /assembly/worm and /assembly/wheel moved by their 4x4 transfo
 """
 from __future__ import annotations
 
-import math
-
 import numpy as np
+import rerun as rr
 
+from meshgen import assembly
+from wormsim.metrics import dominant_frequency
+from wormsim.recording import log_mesh, log_series, log_transforms, recording
 from wormsim.result import Result
 
 MAX_FRAMES = 1500
@@ -27,8 +29,6 @@ def write_report(result: Result, path) -> None:
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-
-    from wormsim.metrics import dominant_frequency
 
     S, s = result.series, result.summary
     t = S["t_s"]
@@ -55,8 +55,10 @@ def write_report(result: Result, path) -> None:
     _, df, fr, sp = dominant_frequency(t[sl], S["tangential_force_n"][sl])
     if len(fr):
         a.semilogy(fr[1:], np.maximum(sp[1:], 1e-9), lw=0.7)
-        a.axvline(s["mesh_frequency_theory_hz"], color="r", ls="--", lw=0.8, label=f"z1 n1/60 = {s['mesh_frequency_theory_hz']:.4g} Hz")
-        a.axvline(s["mesh_frequency_hz"], color="g", ls=":", lw=1.0, label=f"peak {s['mesh_frequency_hz']:.4g} Hz (bin {df:.3g} Hz)")
+        a.axvline(s["mesh_frequency_theory_hz"], color="r", ls="--", lw=0.8,
+                  label=f"z1 n1/60 = {s['mesh_frequency_theory_hz']:.4g} Hz")
+        a.axvline(s["mesh_frequency_hz"], color="g", ls=":", lw=1.0,
+                  label=f"peak {s['mesh_frequency_hz']:.4g} Hz (bin {df:.3g} Hz)")
         a.set_xlim(0, min(fr[-1], 10 * max(s["mesh_frequency_theory_hz"], df)))
     a.set(xlabel="frequency [Hz]", ylabel="|F_t| amplitude [N]", title="spectrum of the tangential force (Hann)")
     a.legend(fontsize=8)
@@ -84,11 +86,6 @@ def write_report(result: Result, path) -> None:
 
 
 def write_recording(result: Result, path) -> None:
-    import rerun as rr
-
-    from wormsim.contact3d.mjcf import _assembly
-    from wormsim.recording import log_mesh, log_series, log_transforms, recording
-
     bm = result.extra["built"]
     geo = bm.geometry
     S = result.series
@@ -99,8 +96,8 @@ def write_recording(result: Result, path) -> None:
         log_mesh(rec, "assembly/worm/mesh", gs.worm_visual.vertices, gs.worm_visual.faces, color=(150, 160, 180))
         log_mesh(rec, "assembly/wheel/mesh", gs.wheel_visual.vertices, gs.wheel_visual.faces, color=(220, 165, 80))
         idx = np.unique(np.linspace(0, len(t) - 1, min(len(t), MAX_FRAMES)).astype(int))
-        Tw = np.stack([_assembly(geo, "worm", float(a)) for a in S["worm_angle_rad"][idx]])
-        Tg = np.stack([_assembly(geo, "wheel", float(a)) for a in S["wheel_angle_rad"][idx]])
+        Tw = np.stack([assembly.worm_to_assembly(float(a), geo) for a in S["worm_angle_rad"][idx]])
+        Tg = np.stack([assembly.wheel_to_assembly(float(a)) for a in S["wheel_angle_rad"][idx]])
         log_transforms(rec, "assembly/worm", t[idx], Tw)
         log_transforms(rec, "assembly/wheel", t[idx], Tg)
         P, F = result.extra["points_world"], result.extra["forces_world"]

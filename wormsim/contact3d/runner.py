@@ -8,7 +8,7 @@ forces, moment, contact count, torques and powers are the MEANS over those steps
 vibration at 10-80 kHz does not alias into the meshing band, and the box's nulls at multiples of the sampling
 rate cancel exactly what would fold onto 0 Hz), and whose angles and speeds are the values at its end. Then it
 
-- re-poses the wheel's collision window by whole pitches (wormsim.contact3d.mjcf.repose_window),
+- re-poses the wheel's collision window by whole pitches (wormsim.contact3d.window.repose_window),
 - sets the friction coefficient mu(Vs) from the sliding speed Vs = |omega1| r1 / cos(gamma),
 - resolves the mean resultant on the wheel in the wheel's directions at the pitch point on the line of centres
   (DIN 3975 F_t2, F_r2, F_a2; seed 001's x/y components): tangential, radial (outward), axial; the contact
@@ -19,12 +19,11 @@ rate cancel exactly what would fold onto 0 Hz), and whose angles and speeds are 
   `penetration_limit_m`, the transmission error passing half a pitch (teeth jumped; divergence when the
   timestep is above the contact's stable limit), a speed-driven drive stuck below half its command (locked;
   self-locking named when the wheel drives), the worm turning more than 1.25 x MAX_WORM_TURN_PER_STEP_RAD per
-  step (overspeed: its pieces would tunnel through the wheel's). Each raises SimulationError with what to change
-  (diverged_error, jump_error, locked_error, overspeed_error; docs/contact3d.md "Failure modes and guards").
+  step (overspeed: its pieces would tunnel through the wheel's). Each raises its subclass of SimulationError
+  (wormsim.errors) with what to change (diverged_error, jump_error, locked_error, overspeed_error, penetration_error;
+  docs/contact3d.md "Failure modes and guards").
 
-Before the loop, simulate() sets the timestep (choose_timestep): the contact's default, unless the commanded worm
-speed w1 needs h <= MAX_WORM_TURN_PER_STEP_RAD / w1 (measured, docs/stability_speed.md); a scenario timestep above
-that is refused with ScenarioError.
+The timestep is the model's, chosen before it was built (wormsim.contact3d.timestep.choose_timestep).
 """
 from __future__ import annotations
 
@@ -34,23 +33,34 @@ import time
 import mujoco
 import numpy as np
 
-from wormsim.contact3d.law import efficiency_theory, friction_coefficient, friction_coefficient_scalar, friction_mode
-from wormsim.errors import ScenarioError, SimulationError
-from wormsim.contact3d.mjcf import BuiltModel, build_model, default_timestep, repose_window, round_down_125
+from wormsim import gear_theory as gt
+from wormsim.contact3d.metrics import contact3d_summary
+from wormsim.contact3d.mjcf import BuiltModel, build_model
+from wormsim.contact3d.timestep import (
+    MAX_WORM_TURN_PER_STEP_RAD,
+    OVERSPEED_GUARD,
+    default_timestep,
+    speed_timestep_limit_s,
+)
+from wormsim.contact3d.window import repose_window
+from wormsim.errors import (
+    DivergedError,
+    LockedError,
+    OverspeedError,
+    PenetrationError,
+    SimulationError,
+    TeethJumpedError,
+)
+from wormsim.friction import friction_coefficient, friction_coefficient_scalar, friction_mode
 from wormsim.result import Result
 from wormsim.scenario import Scenario
-from wormsim.units import rad_s_to_rpm, rpm_to_rad_s, step
+from wormsim.units import rad_s_to_rpm
 
 MAX_POINTS = 48             # contact points kept per sample (for the pattern and the recording)
 TARGET_SAMPLES = 20000      # automatic record_every aims at about this many samples per run (each the mean
                             # over its interval, so decimation does not alias the contact vibration)
 _ROWS3 = np.arange(3)       # the normal and two tangent rows of an elliptic-cone contact
 JUMP_PITCH = 0.5            # transmission error (in pitches) that counts as teeth jumping
-MAX_WORM_TURN_PER_STEP_RAD = 0.035   # largest worm rotation per step contact3d resolves (2.0 deg; measured on the
-                            # seat motor and screw jack gears, docs/stability_speed.md: <= 0.035 rad holds ratio and
-                            # torque balance; 0.050 rad tunnels the seat worm through the wheel, at 0.07 rad the
-                            # screw jack's efficiency scatters from 0.54 to 0.64 (theory 0.65), 0.21 rad tunnels it)
-OVERSPEED_GUARD = 1.25      # the running check fires at this multiple of MAX_WORM_TURN_PER_STEP_RAD
 
 
 def _record_every(scenario: Scenario, dt: float, n_steps: int) -> int:
@@ -58,70 +68,6 @@ def _record_every(scenario: Scenario, dt: float, n_steps: int) -> int:
     if "record_every" in sim.model_fields_set:
         return sim.record_every
     return max(1, n_steps // TARGET_SAMPLES)
-
-
-def commands(scenario: Scenario, t: np.ndarray, direction: int) -> tuple[np.ndarray, np.ndarray]:
-    """Drive command (rad/s or N m) and load torque (N m, on the load shaft) at times t: ADAMS STEP.
-
-    The load resists: its sign is opposite to the load shaft's expected motion, which is
-    `direction` * sign(drive command) (wormsim.contact3d.mjcf.expected_direction)."""
-    drv, load = scenario.drive, scenario.load
-    target = rpm_to_rad_s(drv.speed_rpm) if drv.speed_rpm is not None else drv.torque_nm
-    drive = step(t, 0.0, 0.0, drv.ramp_s, target)
-    s = (np.sign(target) or 1.0) * direction
-    load_t = step(t, load.start_s, 0.0, load.start_s + load.ramp_s, -s * load.torque_nm)
-    return np.atleast_1d(drive), np.atleast_1d(load_t)
-
-
-def worm_speed_command_rad_s(scenario: Scenario, bm: BuiltModel) -> float | None:
-    """Worm speed the drive commands: |speed_rpm| when the worm is speed-driven, ratio x |speed_rpm| when the wheel
-    is (kinematics z2 / z1); None for a torque drive (its speed is known only while running)."""
-    drv = scenario.drive
-    if drv.speed_rpm is None:
-        return None
-    w = abs(rpm_to_rad_s(drv.speed_rpm))
-    return w if drv.on == "worm" else w * bm.geometry.ratio
-
-
-def speed_timestep_limit_s(w1_rad_s: float) -> float:
-    """Largest timestep at worm speed w1: h <= MAX_WORM_TURN_PER_STEP_RAD / w1 (the worm turns at most 0.035 rad
-    per step; measured, docs/stability_speed.md)."""
-    return MAX_WORM_TURN_PER_STEP_RAD / w1_rad_s
-
-
-def choose_timestep(scenario: Scenario, bm: BuiltModel) -> tuple[float, str]:
-    """(timestep, timestep_source). The contact's default (wormsim.contact3d.mjcf.default_timestep: 0.4 x the explicit
-    stability limit, 1-2-5) unless the commanded worm speed needs a smaller one: then h = the speed limit
-    MAX_WORM_TURN_PER_STEP_RAD / w1 rounded down to 1-2-5. A timestep set in the scenario above the speed limit is
-    refused (ScenarioError naming simulation.timestep_s and its allowed range; a timestep above the contact's
-    stable limit is left to the divergence guard, whose message names that limit): beyond it the worm's convex pieces
-    jump through the wheel's between steps, and simulation.speculative does not prevent it (measured: it fails
-    earlier; docs/stability_speed.md)."""
-    h = float(bm.model.opt.timestep)
-    w1 = worm_speed_command_rad_s(scenario, bm)
-    if scenario.simulation.timestep_s is not None:
-        # above the contact's stable limit the divergence guard's diagnosis (which names that limit) comes first
-        stable = h <= bm.law.stable_timestep_s(3 * bm.law.contacts_per_pair)
-        if stable and w1 is not None and w1 * h > MAX_WORM_TURN_PER_STEP_RAD:
-            lim = speed_timestep_limit_s(w1)
-            raise ScenarioError(
-                f"simulation.timestep_s = {h:.3g} s is too large for the worm speed {rad_s_to_rpm(w1):.0f} rpm: the "
-                f"worm would turn {w1 * h:.3g} rad per step, contact3d resolves at most {MAX_WORM_TURN_PER_STEP_RAD} "
-                f"rad (beyond it the thread passes through the wheel's teeth between steps); allowed range: 0 < "
-                f"simulation.timestep_s <= {lim:.3g} s, or leave it unset (the default then follows the speed). "
-                f"simulation.speculative does not prevent it (measured: it tunnels sooner, docs/stability_speed.md)")
-        return h, "scenario"
-    src = "default: 0.4 x the stable limit, rounded down to 1-2-5 (docs/bench.md, stability map)"
-    if w1 is not None and w1 * h > MAX_WORM_TURN_PER_STEP_RAD:
-        h = round_down_125(speed_timestep_limit_s(w1))
-        src = (f"worm speed: {rad_s_to_rpm(w1):.0f} rpm needs <= {MAX_WORM_TURN_PER_STEP_RAD} rad of worm rotation "
-               f"per step, rounded down to 1-2-5 (below the contact's default; docs/stability_speed.md)")
-    return h, src
-
-
-def penetration_limit_m(bm: BuiltModel) -> float:
-    """Largest allowed penetration: 40 % of the axial module (beyond it teeth are about to skip)."""
-    return 0.4 * bm.geometry.m_x
 
 
 def contact_details(bm: BuiltModel, d: mujoco.MjData, window_ks: np.ndarray):
@@ -161,35 +107,31 @@ def contact_details(bm: BuiltModel, d: mujoco.MjData, window_ks: np.ndarray):
 
 
 def _contact_radius_efficiency(F: np.ndarray, pw: np.ndarray, geo, mu: float, worm_drives: bool):
-    """Force-weighted worm radius of the contacts and the wedge efficiency at each contact's own radius: the local
-    lead angle of a helicoid is tan(gamma_r) = tan(gamma) r1 / r (same lead, DIN 3975), so
-    eta_r = tan(gamma_r) / tan(gamma_r + rho') driving (tan(gamma_r - rho') / tan(gamma_r) back-driving, >= 0),
-    rho' = atan(mu / cos alpha_n), averaged with the contact forces as weights. (nan, nan) without contacts."""
+    """Force-weighted worm radius of the contacts and the wedge efficiency at each contact's own radius
+    (gear_theory.efficiency_at_radius), averaged with the contact forces as weights. (nan, nan) without contacts."""
     w = np.linalg.norm(F, axis=1)
     W = float(w.sum())
     if W <= 0:
         return float("nan"), float("nan")
     r = np.hypot(pw[:, 1] + geo.a, pw[:, 2])
-    g = np.arctan(math.tan(geo.gamma) * geo.r1 / np.maximum(r, 1e-12))
-    rho = math.atan(mu / math.cos(geo.alpha_n))
-    eta = np.tan(g) / np.tan(g + rho) if worm_drives else np.maximum(np.tan(g - rho), 0.0) / np.tan(g)
+    eta = gt.efficiency_at_radius(geo.gamma, geo.r1, r, mu, geo.alpha_n, backdriving=not worm_drives)
     return float((w * r).sum() / W), float((w * eta).sum() / W)
 
 
 def diverged_error(t: float, dt: float, bm: BuiltModel, what: str) -> SimulationError:
     """Divergence diagnosis. Above the explicit stability limit of the contact spring-damper with three pairs in
     parallel (ContactLaw.stable_timestep_s: h < 2/omega (sqrt(1 + zeta^2) - zeta)) the cure is the timestep: the
-    message names the limit and wormsim's default (wormsim.contact3d.mjcf.default_timestep, 0.4 x the limit rounded down
-    to 1-2-5). Within the limit the blow-up comes from a command step the light shafts cannot follow."""
-    lim = bm.law.stable_timestep_s(3 * bm.law.contacts_per_pair)
+    message names the limit and wormsim's default (wormsim.contact3d.timestep.default_timestep, 0.4 x the limit
+    rounded down to 1-2-5). Within the limit the blow-up comes from a command step the light shafts cannot follow."""
+    lim = bm.law.stable_limit_s
     h0 = default_timestep(bm.law)
     if dt > lim:
-        return SimulationError(
+        return DivergedError(
             f"diverged at t = {t:.4g} s ({what}): timestep {dt:.3g} s is above the contact's stable limit "
             f"{lim:.3g} s (contact stiffness {bm.law.pair_stiffness_n_per_m:.3g} N/m per tooth pair); set "
             f"simulation.timestep_s <= {h0:.3g} s (the default for this contact: leave it unset) or lower "
             f"contact.stiffness_n_per_m")
-    return SimulationError(
+    return DivergedError(
         f"diverged at t = {t:.4g} s ({what}) at timestep {dt:.3g} s, within the contact's stable limit {lim:.3g} s: "
         f"a torque or speed step the light shafts cannot follow; lengthen drive.ramp_s / load.ramp_s, lower "
         f"load.torque_nm")
@@ -199,10 +141,10 @@ def jump_error(t: float, te_pitch: float, dt: float, bm: BuiltModel, scenario: S
     """Transmission error beyond half a pitch. Above the stable timestep this is the integration running away
     (reported as divergence: a stiffer contact would make it worse); within it the teeth really passed each
     other: the load overpowers the mesh."""
-    lim = bm.law.stable_timestep_s(3 * bm.law.contacts_per_pair)
+    lim = bm.law.stable_limit_s
     if dt > lim:
         return diverged_error(t, dt, bm, f"the transmission error ran away to {te_pitch:.2f} pitch")
-    return SimulationError(
+    return TeethJumpedError(
         f"teeth jumped a pitch at t = {t:.4g} s (transmission error {te_pitch:.2f} pitch) at timestep {dt:.3g} s, "
         f"within the contact's stable limit {lim:.3g} s: the load overpowers the mesh (load {scenario.load.torque_nm} "
         f"N m over {scenario.load.ramp_s} s, contact stiffness {bm.law.pair_stiffness_n_per_m:.3g} N/m per tooth "
@@ -214,7 +156,7 @@ def overspeed_error(t: float, w1: float, dt: float) -> SimulationError:
     """The worm turns more than OVERSPEED_GUARD x MAX_WORM_TURN_PER_STEP_RAD per step (a torque drive running away,
     or a timestep set past the speed check): its pieces would pass through the wheel's between steps."""
     lim = speed_timestep_limit_s(abs(w1))
-    return SimulationError(
+    return OverspeedError(
         f"worm overspeed at t = {t:.4g} s: the worm turns {rad_s_to_rpm(abs(w1)):.0f} rpm, {abs(w1) * dt:.3g} rad per "
         f"step of {dt:.3g} s, beyond the {MAX_WORM_TURN_PER_STEP_RAD} rad contact3d resolves (the thread passes "
         f"through the wheel's teeth between steps); set simulation.timestep_s <= {lim:.3g} s (or leave it unset for "
@@ -230,18 +172,27 @@ def locked_error(t: float, w_drive: float, w_cmd: float, bm: BuiltModel, scenari
     head = (f"the drive locked at t = {t:.4g} s: the {scenario.drive.on} turns at {rad_s_to_rpm(w_drive):.3g} rpm "
             f"against a command of {rad_s_to_rpm(w_cmd):.3g} rpm")
     mu0 = float(friction_coefficient(scenario.contact, 0.0))
-    rho = math.atan(mu0 / math.cos(geo.alpha_n))
+    rho = gt.virtual_friction_angle_rad(mu0, geo.alpha_n)
     if scenario.drive.on == "wheel" and rho >= geo.gamma:
         mu_max = math.tan(geo.gamma) * math.cos(geo.alpha_n)
-        return SimulationError(
+        return LockedError(
             f"{head}: the pair is self-locking (rho' = atan(mu / cos alpha_n) = {math.degrees(rho):.2f} deg at "
             f"standstill friction mu = {mu0:.3g} >= lead angle gamma = {math.degrees(geo.gamma):.2f} deg), so the "
             f"wheel cannot turn the worm; drive the worm (drive.on=worm, load.on=wheel), or, to back-drive, lower "
             f"the friction below mu = tan(gamma) cos(alpha_n) = {mu_max:.3g} or raise gear.lead_angle_deg above "
             f"{math.degrees(rho):.2f} deg")
-    return SimulationError(
+    return LockedError(
         f"{head}: the mesh is jammed; check gear.backlash_mm, the load torque {scenario.load.torque_nm} N m "
         f"against what the drive can deliver, and the friction")
+
+
+def penetration_error(t: float, pen: float, pen_lim: float, dt: float, bm: BuiltModel) -> SimulationError:
+    """Penetration beyond gear_theory.penetration_limit_m (0.4 m_x): the teeth are about to skip."""
+    return PenetrationError(
+        f"penetration {pen * 1e6:.1f} um at t = {t:.4g} s exceeds the tolerance {pen_lim * 1e6:.1f} um "
+        f"(0.4 m_x): contact too soft for the load or timestep {dt:.3g} s too large (stable limit "
+        f"~{bm.law.stable_limit_s:.2g} s); raise contact.stiffness_n_per_m, lower simulation.timestep_s or lower "
+        f"load.torque_nm")
 
 
 _SLOT_CACHE: dict[int, np.ndarray] = {}
@@ -262,7 +213,7 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
     m = bm.model
     d = mujoco.MjData(m)
     geo = bm.geometry
-    dt = float(m.opt.timestep)
+    dt = bm.timestep_s
     duration = scenario.simulation.duration_s
     n_steps = int(round(duration / dt))
     rec = _record_every(scenario, dt, n_steps)
@@ -271,10 +222,10 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
     qa_worm = int(m.jnt_qposadr[m.dof_jntid[bm.worm_dof]])
     qa_wheel = int(m.jnt_qposadr[m.dof_jntid[bm.wheel_dof]])
     coll = np.concatenate([bm.worm_geoms, bm.wheel_slot_geoms.ravel()])
-    pen_lim = penetration_limit_m(bm)
+    pen_lim = gt.penetration_limit_m(geo.m_x)
     pitch_angle = 2 * math.pi / geo.z2
-    ramp_end = max(drv.ramp_s, scenario.load.start_s + scenario.load.ramp_s)
-    dt_limit = bm.law.stable_timestep_s(3 * bm.law.contacts_per_pair)
+    lock_start = gt.lock_check_start_s(scenario)
+    dt_limit = bm.law.stable_limit_s
 
     names = ["t_s", "worm_angle_rad", "wheel_angle_rad", "worm_speed_rpm", "wheel_speed_rpm",
              "worm_torque_nm", "wheel_torque_nm", "drive_command", "tangential_force_n", "radial_force_n",
@@ -301,11 +252,12 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
     mu_of = friction_coefficient_scalar(scenario.contact)
     mu_set = None
     # the commands at each step's midpoint, evaluated for blocks of about 4096 steps at once
+    cmds = gt.commands(scenario, bm.direction)
     block = max(1, 4096 // rec)
     for i in range(n_rec):
         if i % block == 0:
             t_blk = (i * rec + np.arange(min(block, n_rec - i) * rec) + 0.5) * dt
-            cmd_blk, load_blk = (a.tolist() for a in commands(scenario, t_blk, bm.direction))
+            cmd_blk, load_blk = cmds.drive(t_blk).tolist(), cmds.load(t_blk).tolist()
         o = (i % block) * rec
         fx = fy = fz = mz = nc = t1 = t2 = p1 = p2 = fpk = 0.0
         for j in range(o, o + rec):
@@ -356,15 +308,12 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
         fr_lc = float(-(F[:, 1] * np.cos(phi) + F[:, 2] * np.sin(phi)).sum())
         r_c, eta_c = _contact_radius_efficiency(F, pw, geo, mu, worm_is_drive)
         if pen > pen_lim:
-            raise SimulationError(
-                f"penetration {pen * 1e6:.1f} um at t = {t:.4g} s exceeds the tolerance {pen_lim * 1e6:.1f} um "
-                f"(0.4 m_x): contact too soft for the load or timestep {dt:.3g} s too large (stable limit "
-                f"~{dt_limit:.2g} s); raise contact.stiffness_n_per_m, lower simulation.timestep_s or lower load.torque_nm")
-        if drv.speed_rpm is not None and t > ramp_end + 0.02:
+            raise penetration_error(t, pen, pen_lim, dt, bm)
+        if drv.speed_rpm is not None and t > lock_start:
             w_drive = w1 if worm_is_drive else w2
-            if abs(w_drive) < 0.5 * abs(cmd):
+            if gt.drive_stuck(w_drive, cmd):
                 locked_since = t if locked_since is None else locked_since
-                if t - locked_since > max(0.05, 20 * rec * dt):
+                if t - locked_since > max(gt.LOCK_HOLD_S, 20 * rec * dt):
                     raise locked_error(t, w_drive, cmd, bm, scenario)
             else:
                 locked_since = None
@@ -393,14 +342,10 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
         if progress is not None:
             progress.update(t)
     wall = time.perf_counter() - t_wall
-    from wormsim.contact3d.metrics import contact3d_summary
-
     summary = contact3d_summary(S, scenario, bm)
     summary.update({
         "scenario": scenario.name, "timestep_s": dt, "timestep_stable_limit_s": dt_limit,
-        "timestep_source": bm.meta.get("timestep_source") or (
-            "scenario" if scenario.simulation.timestep_s is not None else
-            "default: 0.4 x the stable limit, rounded down to 1-2-5 (docs/bench.md, stability map)"),
+        "timestep_source": bm.timestep_source,
         "worm_turn_per_step_max_rad": turn_max,
         "speculative": scenario.simulation.speculative, "resolution": scenario.simulation.resolution,
         "integrator": scenario.simulation.integrator, "record_every": rec,
@@ -415,15 +360,12 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
         "friction_impratio": bm.law.impratio,
         "window_teeth": bm.window_teeth, "collision_geoms": int(len(coll)),
         "step_wall_us": 1e6 * wall / max(n_rec * rec, 1),
-        "piece_error_um": getattr(bm.pieces, "piece_error_um", None),
+        "piece_error_um": bm.pieces.piece_error_um,
     })
     return Result(model="contact3d", summary=summary, series=S, steps=n_rec * rec, sim_time_s=float(d.time),
                   extra={"points_tooth0": pts, "points_world": pts_world, "forces_world": forces, "built": bm})
 
 
 def simulate(scenario: Scenario, progress=None) -> Result:
-    bm = build_model(scenario)
-    h, src = choose_timestep(scenario, bm)
-    bm.model.opt.timestep = h
-    bm.meta["timestep_source"] = src
-    return run_model(bm, scenario, progress)
+    """Build the model (its timestep chosen before the build) and run it."""
+    return run_model(build_model(scenario), scenario, progress)

@@ -75,18 +75,18 @@ import time
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from meshgen.geometry import GearGeometry, derive
-from wormsim.contact3d.law import (DEFAULT_DAMPING_RATIO, MAX_DAMPING_RATIO, effective_modulus_pa, efficiency_theory,
-                             friction_coefficient_scalar,
-                             friction_coefficient, friction_mode)
-from wormsim.errors import SimulationError
-from wormsim.torsional.mesh_stiffness import MeshStiffness, mesh_stiffness, per_length_stiffness
+from meshgen.geometry import GearGeometry
+from wormsim import gear_theory as gt
+from wormsim.errors import DivergedError, LockedError, PenetrationError, SimulationError
+from wormsim.friction import friction_coefficient, friction_coefficient_scalar, friction_mode
+from wormsim.geometry import derive
+from wormsim.metrics import dominant_frequency, drive_summary, mean_speeds_rpm, window_of
 from wormsim.result import Result
 from wormsim.scenario import Scenario
-from wormsim.units import rad_s_to_rpm, rpm_to_rad_s, step
+from wormsim.torsional.mesh_stiffness import MeshStiffness, mesh_stiffness, per_length_stiffness
+from wormsim.units import rad_s_to_rpm, step
 
 CHORD_ITER = 4              # backward Euler: Newton iterations that reuse the first Jacobian of a step
-SPEED_DROOP = 1e-3          # speed servo: kv = T_expected / (SPEED_DROOP * omega_cmd) (as wormsim.contact3d.mjcf)
 MAX_SAMPLES = 20000
 SAMPLES_PER_MESH_PERIOD = 64
 RTOL, ATOL_ANGLE = 1e-7, 1e-10
@@ -102,9 +102,6 @@ def inertias(scenario: Scenario, g: GearGeometry) -> tuple[float, float]:
     j = scenario.load.inertia_kg_m2
     j1, j2 = (j, 0.0) if scenario.load.on == "worm" else (0.0, j)
     return 0.5 * m1 * g.r1 ** 2 + j1, 0.5 * m2 * g.r2 ** 2 + j2
-
-
-_mu_scalar = friction_coefficient_scalar     # (kept for tests/test_torsional.py)
 
 
 class _Mesh:
@@ -125,15 +122,14 @@ class _Mesh:
         k_lin = self.k_mean / self.arm0 ** 2
         m_eff = 1.0 / (self.arm0 ** 2 / I2 + (self.hz * self.arm0) ** 2 / I1)   # mesh mode mass on the line of action
         self.c_crit = 2.0 * math.sqrt(k_lin * m_eff)
-        c_req = c.damping_n_s_per_m if c.damping_n_s_per_m is not None else DEFAULT_DAMPING_RATIO * self.c_crit
+        c_req = c.damping_n_s_per_m if c.damping_n_s_per_m is not None else gt.DEFAULT_DAMPING_RATIO * self.c_crit
         self.c_req = c_req
-        self.c_lin = min(c_req, MAX_DAMPING_RATIO * self.c_crit)
+        self.c_lin = min(c_req, gt.MAX_DAMPING_RATIO * self.c_crit)
         self.c_theta_per_k = self.c_lin * self.arm0 ** 2 / self.k_mean
         self.d_max = c.penetration_depth_m
         self.vt = c.transition_velocity_m_s
         self.v_sign = SIGN_VELOCITY_FRACTION * self.vt
-        self.mu = _mu_scalar(c)
-        self.cos_an = math.cos(g.alpha_n)
+        self.mu = friction_coefficient_scalar(c)
         self.omega_mesh = math.sqrt(self.k_mean * (1.0 / I2 + self.hz ** 2 / I1))
 
     def k_at(self, th1: float, table: list) -> float:
@@ -152,19 +148,16 @@ class _Mesh:
             side, dlt, ddlt, K = -1.0, -e - self.gap, -de, self.k_at(th1, self.kr)
         else:
             return 0.0, 0.0
-        pen = self.arm0 * dlt
-        x = pen / self.d_max
-        blend = 1.0 if x >= 1.0 else x * x * (3.0 - 2.0 * x)
+        blend = step(self.arm0 * dlt, 0.0, 0.0, self.d_max, 1.0)    # IMPACT's damping ramp over d_max
         T = K * dlt + self.c_theta_per_k * K * blend * ddlt
         if T <= 0.0:
             return 0.0, 0.0
         T2m = side * T
         g = self.g
         vs = w1 * g.r1 / math.cos(g.gamma)
-        rho = math.atan(self.mu(vs) / self.cos_an)
+        rho = gt.virtual_friction_angle_rad(self.mu(vs), g.alpha_n)
         s = side * g.hand * math.tanh(vs / self.v_sign)
-        T1m = g.hand * (T2m / g.r2) * g.r1 * math.tan(g.gamma + s * rho)
-        return T2m, T1m
+        return T2m, gt.worm_torque_nm(T2m, g.hand, g.r1, g.r2, g.gamma, s * rho)
 
     def outputs(self, th1, w1, th2, w2) -> dict:
         """Vectorised over samples: forces on the wheel and the mesh state."""
@@ -175,18 +168,18 @@ class _Mesh:
             T2m[i], T1m[i] = self.torques(th1[i], w1[i], th2[i], w2[i])
         e = self.hz * th1 - th2
         vs = w1 * g.r1 / math.cos(g.gamma)
-        mu = np.asarray(friction_coefficient_vec(self.mu, vs))
-        rho = np.arctan(mu / self.cos_an)
+        mu = np.array([self.mu(float(v)) for v in vs])
+        rho = gt.virtual_friction_angle_rad(mu, g.alpha_n)
         s = np.sign(T2m) * g.hand * np.tanh(vs / self.v_sign)
-        ft = T2m / g.r2
+        ft = gt.tangential_force_n(T2m, g.r2)
         phase = np.mod(th1, self.period) / self.period * self.N
         kf = np.interp(phase, np.arange(self.N + 1), self.kf + self.kf[:1])
         kr = np.interp(phase, np.arange(self.N + 1), self.kr + self.kr[:1])
         k = np.where(e >= 0, kf, kr) / self.arm0 ** 2
         return {
             "tangential_force_n": ft,
-            "axial_force_n": ft * np.tan(g.gamma + s * rho),
-            "radial_force_n": np.abs(ft) * math.tan(g.alpha_n) * np.cos(s * rho) / np.cos(g.gamma + s * rho),
+            "axial_force_n": gt.axial_force_n(ft, g.gamma, s * rho),
+            "radial_force_n": gt.radial_force_n(np.abs(ft), g.alpha_n, g.gamma, s * rho),
             "mesh_torque_worm_nm": T1m,
             "friction_coefficient": mu,
             "transmission_error_rad": -e,
@@ -195,54 +188,11 @@ class _Mesh:
         }
 
 
-def friction_coefficient_vec(mu_scalar, vs: np.ndarray) -> np.ndarray:
-    return np.array([mu_scalar(float(v)) for v in vs])
-
-
-def _commands(scenario: Scenario, g: GearGeometry):
-    """Drive command (rad/s or N m) and load torque (N m) as functions of t: ADAMS STEP; the load resists the
-    expected motion, sign(command) * hand (as wormsim.contact3d.runner.commands with wormsim.contact3d.mjcf.expected_direction)."""
-    drv, load = scenario.drive, scenario.load
-    target = rpm_to_rad_s(drv.speed_rpm) if drv.speed_rpm is not None else drv.torque_nm
-    s = (math.copysign(1.0, target) if target != 0 else 1.0) * g.hand
-    t_load = -s * load.torque_nm
-    rd, l0, l1 = drv.ramp_s, load.start_s, load.start_s + load.ramp_s
-
-    def drive(t: float) -> float:
-        return _step_scalar(t, 0.0, 0.0, rd, target)
-
-    def load_t(t: float) -> float:
-        return _step_scalar(t, l0, 0.0, l1, t_load)
-    return drive, load_t, target
-
-
-def _step_scalar(t: float, t0: float, h0: float, t1: float, h1: float) -> float:
-    """wormsim.units.step (ADAMS STEP) for floats, without numpy (inside the ODE right-hand side)."""
-    if t1 <= t0:
-        return h1 if t >= t0 else h0
-    x = (t - t0) / (t1 - t0)
-    x = 0.0 if x < 0.0 else (1.0 if x > 1.0 else x)
-    return h0 + (h1 - h0) * x * x * (3.0 - 2.0 * x)
-
-
-def _servo_gain(scenario: Scenario, g: GearGeometry) -> float:
-    """kv = T_expected / (SPEED_DROOP omega_cmd), T_expected from the wedge efficiency (as wormsim.contact3d.mjcf)."""
-    drv, load = scenario.drive, scenario.load
-    w_cmd = abs(rpm_to_rad_s(drv.speed_rpm))
-    eta = efficiency_theory(g.gamma, g.alpha_n, float(friction_coefficient(scenario.contact, 1.0)),
-                            backdriving=drv.on == "wheel")
-    t_exp = abs(load.torque_nm) / g.ratio / max(eta, 0.05) if drv.on == "worm" else abs(load.torque_nm) * g.ratio / max(eta, 0.05)
-    return max(t_exp, 1e-3) / (SPEED_DROOP * max(w_cmd, 1e-3))
-
-
 def default_timestep(g: GearGeometry, ms: MeshStiffness, w1_full_rad_s: float, duration_s: float) -> float:
     """One k(theta) sample's worth of worm rotation at full speed, period / (N omega1), rounded down to 1-2-5,
     and at least duration / MAX_SAMPLES."""
     h = ms.period_rad / ms.samples / max(w1_full_rad_s, 1e-9)
-    h = min(h, duration_s / 50)
-    e = math.floor(math.log10(h))
-    h = next(m * 10 ** e for m in (5, 2, 1) if m * 10 ** e <= h)
-    return max(h, duration_s / MAX_SAMPLES)
+    return max(gt.round_down_125(min(h, duration_s / 50)), duration_s / MAX_SAMPLES)
 
 
 def integrate_backward_euler(acc, duration: float, h: float, max_iter: int = 30):
@@ -274,10 +224,18 @@ def integrate_backward_euler(acc, duration: float, h: float, max_iter: int = 30)
             a1, a2 = acc(t1, x1, u1, x2, u2)
             nfev += 1
             if it == 0 or it >= CHORD_ITER:     # chord (simplified) Newton first, full Newton if it stalls
-                d = FD_TH + 1e-9 * abs(x1); b1, b2 = acc(t1, x1 + d, u1, x2, u2); j10, j30 = (b1 - a1) / d, (b2 - a2) / d
-                d = FD_W + 1e-9 * abs(u1); b1, b2 = acc(t1, x1, u1 + d, x2, u2); j11, j31 = (b1 - a1) / d, (b2 - a2) / d
-                d = FD_TH + 1e-9 * abs(x2); b1, b2 = acc(t1, x1, u1, x2 + d, u2); j12, j32 = (b1 - a1) / d, (b2 - a2) / d
-                d = FD_W + 1e-9 * abs(u2); b1, b2 = acc(t1, x1, u1, x2, u2 + d); j13, j33 = (b1 - a1) / d, (b2 - a2) / d
+                d = FD_TH + 1e-9 * abs(x1)
+                b1, b2 = acc(t1, x1 + d, u1, x2, u2)
+                j10, j30 = (b1 - a1) / d, (b2 - a2) / d
+                d = FD_W + 1e-9 * abs(u1)
+                b1, b2 = acc(t1, x1, u1 + d, x2, u2)
+                j11, j31 = (b1 - a1) / d, (b2 - a2) / d
+                d = FD_TH + 1e-9 * abs(x2)
+                b1, b2 = acc(t1, x1, u1, x2 + d, u2)
+                j12, j32 = (b1 - a1) / d, (b2 - a2) / d
+                d = FD_W + 1e-9 * abs(u2)
+                b1, b2 = acc(t1, x1, u1, x2, u2 + d)
+                j13, j33 = (b1 - a1) / d, (b2 - a2) / d
                 nfev += 4
             r0, r1 = p1 + hh * u1 - x1, v1 + hh * a1 - u1
             r2, r3 = p2 + hh * u2 - x2, v2 + hh * a2 - u2
@@ -313,7 +271,7 @@ def integrate_backward_euler(acc, duration: float, h: float, max_iter: int = 30)
 
 
 def _integrate_scipy(rhs, duration: float, h: float, ms: MeshStiffness, w1_full: float, method: str):
-    """scipy solve_ivp LSODA (error-controlled, resolves the mesh vibration): the accuracy reference."""
+    """scipy solve_ivp LSODA, BDF or Radau (error-controlled, resolves the mesh vibration): the accuracy reference."""
     n = int(math.floor(duration / h + 1e-9))
     t_eval = np.arange(n + 1) * h
     max_step = min(ms.period_rad / ms.samples / max(w1_full, 1e-9), duration / 20)
@@ -321,25 +279,34 @@ def _integrate_scipy(rhs, duration: float, h: float, ms: MeshStiffness, w1_full:
     sol = solve_ivp(rhs, (0.0, duration), [0.0, 0.0, 0.0, 0.0], method=method, t_eval=t_eval,
                     rtol=RTOL, atol=atol, max_step=max_step)
     if sol.status != 0:
-        raise SimulationError(f"torsional integration (LSODA) failed at t = {sol.t[-1]:.4g} s: {sol.message}")
+        raise DivergedError(f"torsional integration ({method}) failed at t = {sol.t[-1]:.4g} s: {sol.message}")
     return sol.t, sol.y, sol.nfev
 
 
+SCIPY_METHODS = {"lsoda": "LSODA", "bdf": "BDF", "radau": "Radau"}
+
+
 def simulate(scenario: Scenario, progress=None, method: str = "implicit") -> Result:
-    """method: "implicit" (default, fixed-step backward Euler) or "lsoda" (scipy, error-controlled)."""
+    """method: "implicit" (default, fixed-step backward Euler) or one of scipy's error-controlled solvers
+    "LSODA", "BDF", "Radau" (any case)."""
+    scipy_method = SCIPY_METHODS.get(method.lower())
+    if scipy_method is None and method != "implicit":
+        raise ValueError(f"torsional method {method!r}: allowed implicit, {', '.join(SCIPY_METHODS.values())}")
     g = derive(scenario.gear)
     kp, src = per_length_stiffness(scenario.contact.stiffness_n_per_m, g.face_width,
-                                   effective_modulus_pa(scenario.materials))
+                                   gt.effective_modulus_pa(scenario.materials))
     t_ms = time.perf_counter()
     ms = mesh_stiffness(g, kp, src, scenario.simulation.mesh_stiffness_samples)
     t_ms = time.perf_counter() - t_ms
     I1, I2 = inertias(scenario, g)
     mesh = _Mesh(scenario, g, ms, I1, I2)
     drv = scenario.drive
-    drive_f, load_f, target = _commands(scenario, g)
+    cmds = gt.commands(scenario, g.hand)
     speed_driven = drv.speed_rpm is not None
-    kv = _servo_gain(scenario, g) if speed_driven else 0.0
+    kv = gt.servo_gain_nm_s(scenario, g.ratio, g.gamma, g.alpha_n, float(friction_coefficient(scenario.contact, 1.0))) \
+        if speed_driven else 0.0
     worm_drive = drv.on == "worm"
+    drive_f, load_f = cmds.drive, cmds.load
 
     def shaft_torques(t, w1, w2):
         cmd = drive_f(t)
@@ -357,24 +324,26 @@ def simulate(scenario: Scenario, progress=None, method: str = "implicit") -> Res
         return (y[1], a1, y[3], a2)
 
     duration = scenario.simulation.duration_s
-    w_full = abs(target) if speed_driven else 2 * math.pi
+    w_full = abs(cmds.drive_target) if speed_driven else 2 * math.pi
     w1_full = w_full * (g.ratio if (speed_driven and not worm_drive) else 1.0)
     h = scenario.simulation.timestep_s or default_timestep(g, ms, w1_full, duration)
     t_wall = time.perf_counter()
-    if method in ("LSODA", "BDF", "Radau"):
-        t, Y, nfev = _integrate_scipy(rhs, duration, h, ms, w1_full, method)
+    if scipy_method is not None:
+        t, Y, nfev = _integrate_scipy(rhs, duration, h, ms, w1_full, scipy_method)
+        solver = f"scipy {scipy_method} rtol {RTOL}"
     else:
         t, Y, nfev = integrate_backward_euler(acc, duration, h)
+        solver = "backward Euler (fixed step, Newton)"
     wall = time.perf_counter() - t_wall
     if progress is not None:
         progress.update(duration)
     th1, w1, th2, w2 = Y
     if not np.all(np.isfinite(Y)):
-        raise SimulationError(
+        raise DivergedError(
             f"torsional integration diverged (timestep {h:.3g} s); lower simulation.timestep_s")
     out = mesh.outputs(th1, w1, th2, w2)
-    _guards(scenario, g, t, w1, w2, out, drive_f, target)
     cmd = np.array([drive_f(x) for x in t])
+    _guards(scenario, g, t, w1, w2, out, cmd)
     tq = np.array([shaft_torques(ti, a, b) for ti, a, b in zip(t, w1, w2)])
     S = {
         "t_s": t, "worm_angle_rad": th1, "wheel_angle_rad": th2,
@@ -388,10 +357,11 @@ def simulate(scenario: Scenario, progress=None, method: str = "implicit") -> Res
     summary = torsional_summary(S, scenario, g, ms)
     summary.update({
         "scenario": scenario.name, "timestep_s": h,
-        "solver": "backward Euler (fixed step, Newton)" if method != "lsoda" else f"scipy LSODA rtol {RTOL}",
+        "solver": solver,
         "solver_rhs_evaluations": int(nfev),
         "solve_wall_s": wall, "mesh_stiffness_wall_s": t_ms,
-        "worm_inertia_kg_m2": I1, "wheel_inertia_kg_m2": I2, "inertia_source": "solid cylinders r1 x b1, r2 x b2 (+ load.inertia_kg_m2 on the loaded shaft)",
+        "worm_inertia_kg_m2": I1, "wheel_inertia_kg_m2": I2,
+        "inertia_source": "solid cylinders r1 x b1, r2 x b2 (+ load.inertia_kg_m2 on the loaded shaft)",
         "mesh_natural_frequency_hz": mesh.omega_mesh / (2 * math.pi),
         "contact_damping_requested_n_s_per_m": mesh.c_req, "contact_damping_used_n_s_per_m": mesh.c_lin,
         "contact_damping_ratio": mesh.c_lin / mesh.c_crit, "drive_kv_nm_s": kv if speed_driven else None,
@@ -402,41 +372,41 @@ def simulate(scenario: Scenario, progress=None, method: str = "implicit") -> Res
                   extra={"mesh_stiffness": ms})
 
 
-def _guards(scenario, g, t, w1, w2, out, drive_f, target) -> None:
-    """Teeth would skip (deflection past 0.4 m_x, contact3d's penetration limit); a speed-driven drive stuck
-    below half its command for 0.05 s after the ramps (locked: self-locking back-drive or jam)."""
-    drv, load = scenario.drive, scenario.load
+def _guards(scenario, g, t, w1, w2, out, cmd) -> None:
+    """Teeth would skip (deflection past 0.4 m_x, gear_theory.penetration_limit_m, contact3d's penetration limit);
+    a speed-driven drive stuck below half its command for 0.05 s after the ramps (locked: self-locking back-drive
+    or jam; gear_theory's lock constants)."""
+    drv = scenario.drive
     if drv.speed_rpm is not None:
-        _locked_guard(scenario, t, w1, w2, drive_f)
+        _locked_guard(scenario, t, w1, w2, cmd)
     dmax = float(np.max(out["mesh_deflection_m"]))
-    if dmax > 0.4 * g.m_x:
-        i = int(np.argmax(out["mesh_deflection_m"] > 0.4 * g.m_x))
+    lim = gt.penetration_limit_m(g.m_x)
+    if dmax > lim:
+        i = int(np.argmax(out["mesh_deflection_m"] > lim))
         why = "raise contact.stiffness_n_per_m or lower load.torque_nm"
         vs = abs(float(w1[i])) * g.r1 / math.cos(g.gamma)
         if drv.on == "wheel" and vs < 10 * scenario.contact.transition_velocity_m_s:
-            rho = math.atan(float(out["friction_coefficient"][i]) / math.cos(g.alpha_n))
-            why = (f"the pair is self-locking (rho' = {math.degrees(rho):.2f} deg > gamma = {math.degrees(g.gamma):.2f} "
+            rho = gt.virtual_friction_angle_rad(float(out["friction_coefficient"][i]), g.alpha_n)
+            why = (f"the pair is self-locking (rho' = {math.degrees(rho):.2f} deg > "
+                   f"gamma = {math.degrees(g.gamma):.2f} "
                    f"deg): the wheel cannot drive the worm, which creeps at Vs = {vs * 1e3:.2g} mm/s")
-        raise SimulationError(
-            f"mesh deflection {dmax * 1e6:.1f} um at t = {t[i]:.4g} s exceeds 0.4 m_x = {0.4 * g.m_x * 1e6:.1f} um: "
+        raise PenetrationError(
+            f"mesh deflection {dmax * 1e6:.1f} um at t = {t[i]:.4g} s exceeds 0.4 m_x = {lim * 1e6:.1f} um: "
             f"the teeth would skip; {why}")
 
 
-def _locked_guard(scenario, t, w1, w2, drive_f) -> None:
-    drv, load = scenario.drive, scenario.load
-    ramp_end = max(drv.ramp_s, load.start_s + load.ramp_s) + 0.02
-    w_drive = w1 if drv.on == "worm" else w2
-    cmd = np.array([drive_f(x) for x in t])
-    bad = (t > ramp_end) & (np.abs(w_drive) < 0.5 * np.abs(cmd))
+def _locked_guard(scenario, t, w1, w2, cmd) -> None:
+    w_drive = w1 if scenario.drive.on == "worm" else w2
+    bad = (t > gt.lock_check_start_s(scenario)) & gt.drive_stuck(w_drive, cmd)
     if bad.any():
         i0 = int(np.argmax(bad))
         run = np.nonzero(~bad[i0:])[0]
         i1 = i0 + (int(run[0]) if len(run) else len(bad) - i0) - 1
-        if t[i1] - t[i0] >= 0.05 or (not len(run) and t[-1] - t[i0] > 0):
-            raise SimulationError(
+        if t[i1] - t[i0] >= gt.LOCK_HOLD_S or (not len(run) and t[-1] - t[i0] > 0):
+            raise LockedError(
                 f"the drive locked at t = {t[i0]:.4g} s: {rad_s_to_rpm(float(w_drive[i0])):.3g} rpm against a "
                 f"command of {rad_s_to_rpm(float(cmd[i0])):.3g} rpm (self-locking: the wheel cannot drive the worm "
-                f"when rho' > gamma; or the load {load.torque_nm} N m is too high)")
+                f"when rho' > gamma; or the load {scenario.load.torque_nm} N m is too high)")
 
 
 def torsional_summary(S: dict, scenario: Scenario, g: GearGeometry, ms: MeshStiffness) -> dict:
@@ -445,8 +415,6 @@ def torsional_summary(S: dict, scenario: Scenario, g: GearGeometry, ms: MeshStif
     force is quasi-static: its fluctuation is the inertial part, the 2nd time derivative of the
     transmission error, which weights the harmonics of k(theta)'s tooth-entry kinks by n^2 and puts the
     force's peak on a harmonic (reported as force_peak_full_band_hz)."""
-    from wormsim.metrics import dominant_frequency, drive_summary, mean_speeds_rpm, window_of
-
     t = S["t_s"]
     i0, i1, _ = window_of(S, scenario, g)
     sl = slice(i0, i1)

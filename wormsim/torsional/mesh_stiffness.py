@@ -63,6 +63,7 @@ import numpy as np
 
 from meshgen import wheel
 from meshgen.geometry import GearGeometry
+from meshgen.pieces import cache_dir
 
 CODE_VERSION = "mesh-stiffness-2"
 GRID_ZETA = 121             # TCA grid across the face width (mean k within ~1.5 % of a 241 x 161 grid)
@@ -229,8 +230,6 @@ def _cache_key(g: GearGeometry, kp: float, source: str, samples: int) -> str:
 def mesh_stiffness(g: GearGeometry, stiffness_per_length: float, source: str, samples: int,
                    use_cache: bool = True) -> MeshStiffness:
     """compute(), cached in process and on disk (module docstring)."""
-    from meshgen.pieces import cache_dir
-
     path = cache_dir() / f"meshk-{_cache_key(g, stiffness_per_length, source, samples)}.pkl"
     if use_cache and path.exists():
         try:

@@ -1,19 +1,19 @@
 """torsional report.png and recording.rrd."""
 from __future__ import annotations
 
+import os
+from pathlib import Path
+
 import numpy as np
 
+from wormsim.recording import save_series_recording
 from wormsim.result import Result
 from wormsim.torsional.mesh_stiffness import MeshStiffness
-
 
 # ----------------------------------------------------------------------------- report, recording
 
 def write_report(result: Result, path) -> None:
     """report.png: speeds, forces, transmission error, and k(theta) over one mesh cycle."""
-    import os
-    from pathlib import Path
-
     import matplotlib
 
     matplotlib.use("Agg")
@@ -42,7 +42,8 @@ def write_report(result: Result, path) -> None:
     a.plot(deg, ms.k_mesh_rev_n_per_m, "s--", ms=3, label="flank side -1")
     a.set_xlabel("worm angle in the mesh cycle [deg]"); a.set_ylabel("k on the line of action [N/m]")
     a.set_title(f"mesh stiffness (TCA, {ms.samples} samples)"); a.legend(fontsize=8)
-    fig.suptitle(f"{sm.get('scenario', '')} (torsional): ratio {sm['ratio']:.4g}, F_t {sm['tangential_force_mean_n']:.4g} N, "
+    fig.suptitle(f"{sm.get('scenario', '')} (torsional): ratio {sm['ratio']:.4g}, "
+                 f"F_t {sm['tangential_force_mean_n']:.4g} N, "
                  f"efficiency {sm['efficiency']:.3f}")
     path = Path(path)
     tmp = path.with_name(f".{path.name}.tmp.png")
@@ -52,6 +53,4 @@ def write_report(result: Result, path) -> None:
 
 
 def write_recording(result: Result, path) -> None:
-    from wormsim.recording import save_series_recording
-
     save_series_recording(path, result.summary.get("scenario", "torsional"), result.series["t_s"], result.series)

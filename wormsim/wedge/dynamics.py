@@ -49,6 +49,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.integrate import solve_ivp, trapezoid
 
+from wormsim import gear_theory as gt
 from wormsim.errors import SimulationError
 from wormsim.friction import rho_rad
 from wormsim.result import Result
@@ -167,9 +168,9 @@ def efficiencies(gamma: float, rho: float) -> dict:
     rho >= g); mu_SL = tan(rho - g) / tan g when rho > g (motor power still needed per unit of
     assisting load power, inverse regime of a self-locking pair), else 0."""
     return {
-        "efficiency_forward": math.tan(gamma) / math.tan(gamma + rho),
-        "efficiency_backward": max(0.0, math.tan(gamma - rho) / math.tan(gamma)),
-        "efficiency_self_locking": max(0.0, math.tan(rho - gamma) / math.tan(gamma)),
+        "efficiency_forward": gt.efficiency_forward(gamma, rho),
+        "efficiency_backward": gt.efficiency_backward(gamma, rho),
+        "efficiency_self_locking": gt.efficiency_self_locking(gamma, rho),
     }
 
 

@@ -1,9 +1,9 @@
 """wedge report.png and recording.rrd."""
 from __future__ import annotations
 
+from wormsim.recording import save_series_recording
 from wormsim.result import Result
 from wormsim.wedge.dynamics import INVERSE, LOCKED, TRACTIVE
-
 
 # ----------------------------------------------------------------------------- report, recording
 
@@ -48,8 +48,6 @@ def write_report(result: Result, path) -> None:
 
 def write_recording(result: Result, path) -> None:
     """recording.rrd: the same time series on the sim_time timeline (wormsim.recording layout)."""
-    from wormsim.recording import save_series_recording
-
     s = result.series
     save_series_recording(path, result.extra.get("name", "wedge"), s["t_s"],
                           {k: v for k, v in s.items() if k != "t_s"})

@@ -1,0 +1,154 @@
+"""wormsim.gear_theory: each shared formula pinned against values computed by hand from its source (DIN 3975-2,
+seed 000, ADAMS STEP), so that a level that calls it and a copy that drifts both show here."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from wormsim import gear_theory as gt
+from wormsim.scenario import Material, Materials, load_scenario
+
+DEG = math.pi / 180
+
+
+def test_virtual_friction_angle_float_and_array():
+    # rho' = atan(mu / cos alpha_n): mu 0.05, alpha_n 20 deg -> atan(0.05 / 0.93969) = 3.04577 deg
+    assert gt.virtual_friction_angle_rad(0.05, 20 * DEG) / DEG == pytest.approx(3.04577, abs=1e-5)
+    arr = gt.virtual_friction_angle_rad(np.array([0.0, 0.05]), 20 * DEG)
+    assert isinstance(arr, np.ndarray) and arr[0] == 0.0 and arr[1] / DEG == pytest.approx(3.04577, abs=1e-5)
+    assert gt.virtual_friction_angle_rad(0.05, 0.0) == pytest.approx(math.atan(0.05))  # alpha_n 0: rho = atan(mu)
+
+
+def test_efficiencies_forward_backward_self_locking():
+    g, rho = 10 * DEG, 3 * DEG
+    # tan 10 / tan 13 = 0.176327 / 0.230868 = 0.763756; tan 7 / tan 10 = 0.122785 / 0.176327 = 0.696346
+    assert gt.efficiency_forward(g, rho) == pytest.approx(0.763756, abs=1e-6)
+    assert gt.efficiency_backward(g, rho) == pytest.approx(0.696346, abs=1e-6)
+    assert gt.efficiency_self_locking(g, rho) == 0.0
+    # self-locking: rho 12 deg > gamma 10 deg -> backward 0, self-locking tan 2 / tan 10 = 0.198046
+    assert gt.efficiency_backward(g, 12 * DEG) == 0.0
+    assert gt.efficiency_self_locking(g, 12 * DEG) == pytest.approx(0.198046, abs=1e-6)
+    # frictionless: 1 both ways
+    assert gt.efficiency_forward(g, 0.0) == pytest.approx(1.0) and gt.efficiency_backward(g, 0.0) == pytest.approx(1.0)
+    # arrays take the same formulas
+    arr = gt.efficiency_forward(np.array([g, g]), np.array([rho, 0.0]))
+    assert arr == pytest.approx([0.763756, 1.0], abs=1e-6)
+
+
+def test_efficiency_theory_uses_rho_prime():
+    g, an, mu = 4.79 * DEG, 10 * DEG, 0.05
+    rho = math.atan(mu / math.cos(an))
+    assert gt.efficiency_theory(g, an, mu) == pytest.approx(math.tan(g) / math.tan(g + rho), rel=1e-15)
+    assert gt.efficiency_theory(g, an, mu, backdriving=True) == pytest.approx(
+        math.tan(g - rho) / math.tan(g), rel=1e-15
+    )
+
+
+def test_efficiency_at_radius_is_the_pitch_value_at_r1_and_rises_outward():
+    g, an, mu, r1 = 4.79 * DEG, 10 * DEG, 0.05, 4.19e-3
+    at_r1 = gt.efficiency_at_radius(g, r1, np.array([r1]), mu, an)
+    assert at_r1[0] == pytest.approx(gt.efficiency_theory(g, an, mu), rel=1e-12)
+    # local lead angle: tan(gamma_r) = tan(gamma) r1 / r -> at 2 r1, tan halves
+    assert math.tan(gt.lead_angle_at_radius_rad(g, r1, np.array([2 * r1]))[0]) == pytest.approx(math.tan(g) / 2)
+    eta = gt.efficiency_at_radius(g, r1, np.array([0.9 * r1, 1.1 * r1]), mu, an)
+    assert eta[0] > at_r1[0] > eta[1]  # a smaller radius has a steeper thread: higher efficiency
+
+
+def test_din_3975_force_components():
+    # T2 = 24 N m on r2 = 18.55 mm, alpha_n 20 deg, gamma 5 deg, rho' = 3 deg (worm driving, s = +1)
+    T2, r2, an, g, rho = 24.0, 18.55e-3, 20 * DEG, 5 * DEG, 3 * DEG
+    ft = gt.tangential_force_n(T2, r2)
+    assert ft == pytest.approx(1293.80, abs=0.01)  # 24 / 0.01855
+    assert gt.axial_force_n(ft, g, rho) == pytest.approx(ft * math.tan(8 * DEG))
+    assert gt.radial_force_n(ft, an, g, rho) == pytest.approx(ft * math.tan(an) * math.cos(rho) / math.cos(8 * DEG))
+    assert gt.radial_force_n(ft, an, g, -rho) == pytest.approx(ft * math.tan(an) * math.cos(rho) / math.cos(2 * DEG))
+    # frictionless normal force: F_n = F_t2 / (cos alpha_n cos gamma) = 1293.80 / (0.939693 * 0.996195) = 1382.09 N
+    assert gt.normal_force_n(T2, r2, an, g) == pytest.approx(1382.09, abs=0.01)
+    # worm torque T1 = (T2 / r2) r1 tan(gamma + rho'), signed by the hand
+    r1 = 4.19e-3
+    assert gt.worm_torque_nm(T2, 1, r1, r2, g, rho) == pytest.approx(ft * r1 * math.tan(8 * DEG))
+    assert gt.worm_torque_nm(T2, -1, r1, r2, g, rho) == pytest.approx(-ft * r1 * math.tan(8 * DEG))
+    # frictionless: power balance T1 omega1 = T2 omega2 with omega1 / omega2 = r2 tan(gamma) / r1 ... = z2 / z1
+    t1 = gt.worm_torque_nm(T2, 1, r1, r2, g, 0.0)
+    assert t1 / T2 == pytest.approx(r1 * math.tan(g) / r2)
+    arm1, arm2 = gt.mesh_arms_m(r1, r2, an, g)
+    assert arm1 == pytest.approx(r1 * math.cos(an) * math.sin(g)) and arm2 == pytest.approx(
+        r2 * math.cos(an) * math.cos(g)
+    )
+
+
+def test_working_wheel_torque_of_the_seat_motor(scenario_dir):
+    sc = load_scenario(scenario_dir / "seat_motor.yaml")
+    assert gt.working_wheel_torque_nm(sc, 53.0) == 24.0  # the load on the wheel
+    on_worm = sc.model_copy(update={"load": sc.load.model_copy(update={"on": "worm", "torque_nm": 0.5})})
+    assert gt.working_wheel_torque_nm(on_worm, 53.0) == pytest.approx(26.5)  # 0.5 N m x ratio 53
+
+
+def test_commands_follow_adams_step_and_the_load_resists(scenario_dir):
+    sc = load_scenario(scenario_dir / "seat_motor.yaml")  # 36 rpm over 0.3 s; 24 N m from 0 over 0.3 s
+    c = gt.commands(sc, direction=1)
+    w = 36 * 2 * math.pi / 60
+    assert c.drive(0.0) == 0.0 and c.drive(0.3) == pytest.approx(w) and c.drive(1.0) == pytest.approx(w)
+    assert c.drive(0.15) == pytest.approx(w / 2)  # STEP is half way at mid-ramp
+    assert c.load(0.3) == pytest.approx(-24.0)  # resists the positive motion
+    assert gt.commands(sc, direction=-1).load(0.3) == pytest.approx(24.0)
+    t = np.array([0.0, 0.075, 0.15, 0.3])
+    # STEP: s^2 (3 - 2 s) at s = 0.25 -> 0.15625; float and array paths agree exactly
+    assert c.drive(t)[1] == pytest.approx(0.15625 * w)
+    assert list(c.drive(t)) == [c.drive(float(x)) for x in t]
+    assert gt.ramps_end_s(sc) == 0.3 and gt.lock_check_start_s(sc) == pytest.approx(0.32)
+
+
+def test_servo_gain_gives_the_speed_droop_at_the_expected_torque(scenario_dir):
+    sc = load_scenario(scenario_dir / "seat_motor.yaml")
+    g, an, mu, i = 4.79 * DEG, 10 * DEG, 0.05, 53.0
+    eta = gt.efficiency_theory(g, an, mu)
+    t_exp = gt.expected_drive_torque_nm(sc, i, g, an, mu)
+    assert t_exp == pytest.approx(24.0 / i / eta)
+    kv = gt.servo_gain_nm_s(sc, i, g, an, mu)
+    w = 36 * 2 * math.pi / 60
+    assert kv * gt.SPEED_DROOP * w == pytest.approx(t_exp)  # the torque at a 0.1 % droop
+    # back-driving a self-locking pair (eta 0): the efficiency floor keeps the gain finite
+    back = sc.model_copy(update={"drive": sc.drive.model_copy(update={"on": "wheel"})})
+    assert gt.expected_drive_torque_nm(back, i, g, an, 0.2) == pytest.approx(24.0 * i / gt.MIN_EFFICIENCY)
+
+
+def test_guards_penetration_limit_and_stuck_drive():
+    assert gt.penetration_limit_m(0.7e-3) == pytest.approx(0.28e-3)  # 0.4 m_x
+    assert gt.drive_stuck(0.4, 1.0) and not gt.drive_stuck(0.6, 1.0) and gt.drive_stuck(-0.4, -1.0)
+    assert list(gt.drive_stuck(np.array([0.1, 0.9]), np.array([1.0, 1.0]))) == [True, False]
+
+
+@pytest.mark.parametrize(
+    "h, expected",
+    [
+        (7.3e-6, 5e-6),
+        (5e-6, 5e-6),
+        (4.99e-6, 2e-6),
+        (1.9e-4, 1e-4),
+        (2.5e-3, 2e-3),
+        (1.0, 1.0),
+        (9.99, 5.0),
+        (5e-6 * (1 - 1e-13), 5e-6),  # a hair below 5e-6 (a float computed as 5e-6) still rounds to it
+    ],
+)
+def test_round_down_125(h, expected):
+    assert gt.round_down_125(h) == expected
+
+
+def test_round_down_125_avoids_the_float_trap():
+    # 5 * 10.0 ** -6 is 4.9999999999999996e-06, not the decimal 5e-06 a user would type or a summary would print
+    assert 5 * 10.0**-6 != 5e-6
+    assert repr(gt.round_down_125(6e-6)) == "5e-06"
+
+
+def test_effective_modulus_steel_on_nylon():
+    m = Materials(
+        worm=Material(youngs_modulus_gpa=210, poisson_ratio=0.3, density_kg_m3=7850),
+        wheel=Material(youngs_modulus_gpa=3.1, poisson_ratio=0.39, density_kg_m3=1410),
+    )
+    # 1 / E* = (1 - 0.09) / 210e9 + (1 - 0.1521) / 3.1e9 -> E* = 3.5991 GPa
+    assert gt.effective_modulus_pa(m) / 1e9 == pytest.approx(3.5991, abs=1e-4)

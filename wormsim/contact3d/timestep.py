@@ -1,0 +1,71 @@
+"""contact3d's timestep, chosen once before the model is built (choose_timestep) and passed to it.
+
+Two limits bind: the contact spring-damper's explicit stability limit (ContactLaw.stable_limit_s, three tooth pairs'
+contacts in parallel; the default is 0.4 x it, rounded down to 1-2-5), and the worm's rotation per step: contact3d
+resolves at most MAX_WORM_TURN_PER_STEP_RAD (beyond it the thread's convex pieces pass through the wheel's between
+steps; docs/stability_speed.md). A scenario timestep above the speed limit is refused (ScenarioError naming
+simulation.timestep_s and its allowed range); one above the stable limit is left to the divergence guard, whose
+message names that limit. simulation.speculative does not prevent tunnelling (measured: it fails earlier).
+"""
+
+from __future__ import annotations
+
+from meshgen.geometry import GearGeometry
+from wormsim.contact3d.law import ContactLaw
+from wormsim.gear_theory import round_down_125
+from wormsim.scenario import Scenario, ScenarioError
+from wormsim.units import rad_s_to_rpm, rpm_to_rad_s
+
+DEFAULT_FRACTION = 0.4  # default timestep: this fraction of the stable limit, rounded down to 1-2-5
+MAX_WORM_TURN_PER_STEP_RAD = 0.035  # largest worm rotation per step contact3d resolves (2.0 deg;
+# docs/stability_speed.md has the measurements behind it)
+OVERSPEED_GUARD = 1.25  # the running check fires at this multiple of MAX_WORM_TURN_PER_STEP_RAD
+DEFAULT_SOURCE = "default: 0.4 x the stable limit, rounded down to 1-2-5 (docs/bench.md, stability map)"
+
+
+def default_timestep(law: ContactLaw, contacts: int | None = None) -> float:
+    """DEFAULT_FRACTION x the explicit stability limit with `contacts` in parallel (default: three tooth pairs'
+    worth, ContactLaw.stable_limit_s), rounded down to 1-2-5."""
+    limit = law.stable_limit_s if contacts is None else law.stable_timestep_s(contacts)
+    return round_down_125(DEFAULT_FRACTION * limit)
+
+
+def worm_speed_command_rad_s(scenario: Scenario, ratio: float) -> float | None:
+    """Worm speed the drive commands: |speed_rpm| when the worm is speed-driven, ratio x |speed_rpm| when the wheel
+    is (kinematics z2 / z1); None for a torque drive (its speed is known only while running)."""
+    drv = scenario.drive
+    if drv.speed_rpm is None:
+        return None
+    w = abs(rpm_to_rad_s(drv.speed_rpm))
+    return w if drv.on == "worm" else w * ratio
+
+
+def speed_timestep_limit_s(w1_rad_s: float) -> float:
+    """Largest timestep at worm speed w1: h <= MAX_WORM_TURN_PER_STEP_RAD / w1."""
+    return MAX_WORM_TURN_PER_STEP_RAD / w1_rad_s
+
+
+def choose_timestep(scenario: Scenario, geo: GearGeometry, law: ContactLaw) -> tuple[float, str]:
+    """(timestep, timestep_source): the scenario's (checked against the speed limit), else the contact's default
+    unless the commanded worm speed needs a smaller one: then the speed limit rounded down to 1-2-5."""
+    w1 = worm_speed_command_rad_s(scenario, geo.ratio)
+    h = scenario.simulation.timestep_s
+    if h is not None:
+        # above the contact's stable limit the divergence guard's diagnosis (which names that limit) comes first
+        if h <= law.stable_limit_s and w1 is not None and w1 * h > MAX_WORM_TURN_PER_STEP_RAD:
+            lim = speed_timestep_limit_s(w1)
+            raise ScenarioError(
+                f"simulation.timestep_s = {h:.3g} s is too large for the worm speed {rad_s_to_rpm(w1):.0f} rpm: the "
+                f"worm would turn {w1 * h:.3g} rad per step, contact3d resolves at most {MAX_WORM_TURN_PER_STEP_RAD} "
+                f"rad (beyond it the thread passes through the wheel's teeth between steps); allowed range: 0 < "
+                f"simulation.timestep_s <= {lim:.3g} s, or leave it unset (the default then follows the speed). "
+                f"simulation.speculative does not prevent it (measured: it tunnels sooner, docs/stability_speed.md)"
+            )
+        return h, "scenario"
+    h = default_timestep(law)
+    if w1 is not None and w1 * h > MAX_WORM_TURN_PER_STEP_RAD:
+        return round_down_125(speed_timestep_limit_s(w1)), (
+            f"worm speed: {rad_s_to_rpm(w1):.0f} rpm needs <= {MAX_WORM_TURN_PER_STEP_RAD} rad of worm rotation "
+            f"per step, rounded down to 1-2-5 (below the contact's default; docs/stability_speed.md)"
+        )
+    return h, DEFAULT_SOURCE
