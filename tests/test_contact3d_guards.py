@@ -1,4 +1,4 @@
-"""contact3d's guards (wormsim.contact3d.runner, issue 5): each failure mode stops the run with SimulationError (CLI exit 3,
+"""contact3d's guards (wormsim.contact3d.runner): each failure mode stops the run with SimulationError (CLI exit 3,
 summary.json "failed") and a diagnosis that says what to change; a valid run trips none; the timestep stability
 edge (wormsim.bench.stability_edge) records the last stable timestep and classifies how the next one failed.
 

@@ -1,5 +1,5 @@
 """Contact law of contact3d (wormsim.contact3d.law): the mapping's numbers, friction, and the static mesh
-stiffness the MuJoCo model actually shows under a known torque (issue 4: within 5 % of the specified)."""
+stiffness the MuJoCo model actually shows under a known torque (within 5 % of the specified)."""
 from __future__ import annotations
 
 import math

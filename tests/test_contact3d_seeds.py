@@ -1,4 +1,4 @@
-"""Validation of contact3d on the three seed gears (issue 4), CI-sized: same gear, materials, contact law
+"""Validation of contact3d on the three seed gears, CI-sized: same gear, materials, contact law
 and load as scenarios/*.yaml; shorter ramps and durations (>= 5 meshing periods in the steady window); resolution fine
 enough that meshgen's piece bulge stays inside half the backlash (involute_41 needs `fine`).
 seat_motor runs its worm at 1800 rpm instead of 36 rpm (a 0.6 Hz mesh would need 20 s of 2 us steps).

@@ -1,4 +1,4 @@
-"""contact3d stability hard cases (issue 5): high worm speed (tunnelling; MuJoCo's speculative contacts) and the
+"""contact3d stability hard cases: high worm speed (tunnelling; MuJoCo's speculative contacts) and the
 start-up impact. Measured first on the screw jack gear (seed 002, coarse pieces, contact default timestep 1e-5 s);
 the numbers are in docs/stability_speed.md.
 

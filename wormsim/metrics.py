@@ -1,4 +1,4 @@
-"""Summary metrics of a contact3d run (INTERFACE.md keys), from its time series.
+"""Summary metrics shared by the gear-level models (torsional, contact3d; INTERFACE.md keys), from the time series.
 
 - steady window: starts after the last ramp (drive.ramp_s, load.start_s + load.ramp_s) plus settling,
   the first time from which a one-mesh-period moving mean of the driven shaft's speed (from its angle increments,
