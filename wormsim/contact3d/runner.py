@@ -209,41 +209,80 @@ def _slot_lookup(bm: BuiltModel) -> np.ndarray:
     return _SLOT_CACHE[key]
 
 
+SERIES = ("t_s", "worm_angle_rad", "wheel_angle_rad", "worm_speed_rpm", "wheel_speed_rpm",
+          "worm_torque_nm", "wheel_torque_nm", "drive_command", "tangential_force_n", "radial_force_n",
+          "axial_force_n", "contacts", "teeth_in_contact", "max_penetration_m", "friction_coefficient",
+          "transmission_error_rad", "wheel_contact_torque_nm", "worm_power_w", "wheel_power_w",
+          "tangential_force_abs_max_n", "radial_force_line_of_centres_n", "worm_contact_radius_m",
+          "efficiency_theory_at_contact_radius")
+
+
+class _Guards:
+    """The checks after every record interval (module docstring); each raises its SimulationError subclass."""
+
+    def __init__(self, bm: BuiltModel, scenario: Scenario, dt: float, rec: int):
+        self.bm, self.scenario, self.dt = bm, scenario, dt
+        geo = bm.geometry
+        self.pen_lim = gt.penetration_limit_m(geo.m_x)
+        self.pitch_angle = 2 * math.pi / geo.z2
+        self.lock_start = gt.lock_check_start_s(scenario)
+        self.lock_hold = max(gt.LOCK_HOLD_S, 20 * rec * dt)
+        self.speed_driven = scenario.drive.speed_rpm is not None
+        self.locked_since: float | None = None
+        self.turn_max = 0.0
+
+    def state(self, d: mujoco.MjData, t: float, th1: float, th2: float, w1: float, w2: float) -> float:
+        """Divergence, overspeed, teeth jumped; returns the transmission error (rad)."""
+        bm, dt = self.bm, self.dt
+        if not math.isfinite(th1 + th2 + w1 + w2) or d.warning[mujoco.mjtWarning.mjWARN_BADQACC].number:
+            raise diverged_error(t, dt, bm, "non-finite state or huge acceleration (MuJoCo's bad-qacc warning)")
+        turn = abs(w1) * dt
+        self.turn_max = max(self.turn_max, turn)
+        if turn > OVERSPEED_GUARD * MAX_WORM_TURN_PER_STEP_RAD:
+            if dt > bm.law.stable_limit_s:
+                raise diverged_error(t, dt, bm, f"the worm ran away to {rad_s_to_rpm(abs(w1)):.0f} rpm")
+            raise overspeed_error(t, w1, dt)
+        te = th2 - bm.direction * th1 / bm.geometry.ratio
+        if abs(te) > JUMP_PITCH * self.pitch_angle:
+            raise jump_error(t, te / self.pitch_angle, dt, bm, self.scenario)
+        return te
+
+    def contact(self, t: float, pen: float, w_drive: float, cmd: float) -> None:
+        """Penetration beyond the limit; a speed-driven drive stuck below half its command (locked)."""
+        if pen > self.pen_lim:
+            raise penetration_error(t, pen, self.pen_lim, self.dt, self.bm)
+        if self.speed_driven and t > self.lock_start:
+            if gt.drive_stuck(w_drive, cmd):
+                self.locked_since = t if self.locked_since is None else self.locked_since
+                if t - self.locked_since > self.lock_hold:
+                    raise locked_error(t, w_drive, cmd, self.bm, self.scenario)
+            else:
+                self.locked_since = None
+
+
 def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
+    """Step the built model over simulation.duration_s at its timestep; sample, guard, summarise (module docstring)."""
     m = bm.model
     d = mujoco.MjData(m)
     geo = bm.geometry
     dt = bm.timestep_s
-    duration = scenario.simulation.duration_s
-    n_steps = int(round(duration / dt))
+    n_steps = int(round(scenario.simulation.duration_s / dt))
     rec = _record_every(scenario, dt, n_steps)
     n_rec = n_steps // rec
-    drv = scenario.drive
     qa_worm = int(m.jnt_qposadr[m.dof_jntid[bm.worm_dof]])
     qa_wheel = int(m.jnt_qposadr[m.dof_jntid[bm.wheel_dof]])
     coll = np.concatenate([bm.worm_geoms, bm.wheel_slot_geoms.ravel()])
-    pen_lim = gt.penetration_limit_m(geo.m_x)
-    pitch_angle = 2 * math.pi / geo.z2
-    lock_start = gt.lock_check_start_s(scenario)
-    dt_limit = bm.law.stable_limit_s
+    guards = _Guards(bm, scenario, dt, rec)
 
-    names = ["t_s", "worm_angle_rad", "wheel_angle_rad", "worm_speed_rpm", "wheel_speed_rpm",
-             "worm_torque_nm", "wheel_torque_nm", "drive_command", "tangential_force_n", "radial_force_n",
-             "axial_force_n", "contacts", "teeth_in_contact", "max_penetration_m", "friction_coefficient",
-             "transmission_error_rad", "wheel_contact_torque_nm", "worm_power_w", "wheel_power_w",
-             "tangential_force_abs_max_n", "radial_force_line_of_centres_n", "worm_contact_radius_m",
-             "efficiency_theory_at_contact_radius"]
-    S = {k: np.zeros(n_rec) for k in names}
+    S = {k: np.zeros(n_rec) for k in SERIES}
     pts = np.full((n_rec, MAX_POINTS, 3), np.nan, dtype=np.float32)
     pts_world = np.full((n_rec, MAX_POINTS, 3), np.nan, dtype=np.float32)
     forces = np.full((n_rec, MAX_POINTS, 3), np.nan, dtype=np.float32)
 
     window = repose_window(bm, 0.0)
     mujoco.mj_forward(m, d)
-    locked_since = None
-    turn_max = 0.0
     t_wall = time.perf_counter()
-    worm_is_drive = drv.on == "worm"
+    worm_is_drive = scenario.drive.on == "worm"
     sd, act, qv, ctrl = d.sensordata, d.actuator_force, d.qvel, d.ctrl
     s0 = int(m.sensor_adr[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SENSOR, "mesh_force")])
     ia_drv, ia_load, dof1, dof2 = bm.drive_actuator, bm.load_actuator, bm.worm_dof, bm.wheel_dof
@@ -284,18 +323,7 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
         th1, th2 = float(d.qpos[qa_worm]), float(d.qpos[qa_wheel])
         w1, w2 = float(qv[dof1]), float(qv[dof2])
         t = float(d.time)
-        # guards
-        if not math.isfinite(th1 + th2 + w1 + w2) or d.warning[mujoco.mjtWarning.mjWARN_BADQACC].number:
-            raise diverged_error(t, dt, bm, "non-finite state or huge acceleration (MuJoCo's bad-qacc warning)")
-        turn = abs(w1) * dt
-        turn_max = max(turn_max, turn)
-        if turn > OVERSPEED_GUARD * MAX_WORM_TURN_PER_STEP_RAD:
-            if dt > dt_limit:
-                raise diverged_error(t, dt, bm, f"the worm ran away to {rad_s_to_rpm(abs(w1)):.0f} rpm")
-            raise overspeed_error(t, w1, dt)
-        te = th2 - bm.direction * th1 / geo.ratio
-        if abs(te) > JUMP_PITCH * pitch_angle:
-            raise jump_error(t, te / pitch_angle, dt, bm, scenario)
+        te = guards.state(d, t, th1, th2, w1, w2)
         window = repose_window(bm, th2, window)
         vs = abs(w1) * geo.r1 / math.cos(geo.gamma)
         mu = mu_of(vs)
@@ -307,16 +335,7 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
         phi = np.arctan2(pw[:, 2], pw[:, 1] + geo.a)
         fr_lc = float(-(F[:, 1] * np.cos(phi) + F[:, 2] * np.sin(phi)).sum())
         r_c, eta_c = _contact_radius_efficiency(F, pw, geo, mu, worm_is_drive)
-        if pen > pen_lim:
-            raise penetration_error(t, pen, pen_lim, dt, bm)
-        if drv.speed_rpm is not None and t > lock_start:
-            w_drive = w1 if worm_is_drive else w2
-            if gt.drive_stuck(w_drive, cmd):
-                locked_since = t if locked_since is None else locked_since
-                if t - locked_since > max(gt.LOCK_HOLD_S, 20 * rec * dt):
-                    raise locked_error(t, w_drive, cmd, bm, scenario)
-            else:
-                locked_since = None
+        guards.contact(t, pen, w1 if worm_is_drive else w2, cmd)
         S["t_s"][i] = t
         S["worm_angle_rad"][i], S["wheel_angle_rad"][i] = th1, th2
         S["worm_speed_rpm"][i], S["wheel_speed_rpm"][i] = rad_s_to_rpm(w1), rad_s_to_rpm(w2)
@@ -342,28 +361,35 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
         if progress is not None:
             progress.update(t)
     wall = time.perf_counter() - t_wall
-    summary = contact3d_summary(S, scenario, bm)
-    summary.update({
-        "scenario": scenario.name, "timestep_s": dt, "timestep_stable_limit_s": dt_limit,
+    summary = _run_summary(S, scenario, bm, rec, guards.turn_max, len(coll), 1e6 * wall / max(n_rec * rec, 1))
+    return Result(model="contact3d", summary=summary, series=S, steps=n_rec * rec, sim_time_s=float(d.time),
+                  extra={"points_tooth0": pts, "points_world": pts_world, "forces_world": forces, "built": bm})
+
+
+def _run_summary(S: dict, scenario: Scenario, bm: BuiltModel, rec: int, turn_max: float, collision_geoms: int,
+                 step_wall_us: float) -> dict:
+    """contact3d_summary plus what the run used: timestep, contact law, friction, window, cost."""
+    law = bm.law
+    return {
+        **contact3d_summary(S, scenario, bm),
+        "scenario": scenario.name, "timestep_s": bm.timestep_s, "timestep_stable_limit_s": law.stable_limit_s,
         "timestep_source": bm.timestep_source,
         "worm_turn_per_step_max_rad": turn_max,
         "speculative": scenario.simulation.speculative, "resolution": scenario.simulation.resolution,
         "integrator": scenario.simulation.integrator, "record_every": rec,
-        "contact_pair_stiffness_n_per_m": bm.law.pair_stiffness_n_per_m,
-        "contact_stiffness_source": bm.law.stiffness_source,
-        "contact_exponent_reported": bm.law.exponent,
-        "contacts_per_pair_ref": bm.law.contacts_per_pair,
-        "contact_damping_requested_n_s_per_m": bm.law.contact_damping_requested_n_s_per_m * bm.law.contacts_per_pair,
-        "contact_damping_used_n_s_per_m": bm.law.contact_damping_n_s_per_m * bm.law.contacts_per_pair,
-        "contact_damping_ratio": bm.law.damping_ratio,
+        "contact_pair_stiffness_n_per_m": law.pair_stiffness_n_per_m,
+        "contact_stiffness_source": law.stiffness_source,
+        "contact_exponent_reported": law.exponent,
+        "contacts_per_pair_ref": law.contacts_per_pair,
+        "contact_damping_requested_n_s_per_m": law.contact_damping_requested_n_s_per_m * law.contacts_per_pair,
+        "contact_damping_used_n_s_per_m": law.contact_damping_n_s_per_m * law.contacts_per_pair,
+        "contact_damping_ratio": law.damping_ratio,
         "friction": friction_mode(scenario.contact),
-        "friction_impratio": bm.law.impratio,
-        "window_teeth": bm.window_teeth, "collision_geoms": int(len(coll)),
-        "step_wall_us": 1e6 * wall / max(n_rec * rec, 1),
+        "friction_impratio": law.impratio,
+        "window_teeth": bm.window_teeth, "collision_geoms": collision_geoms,
+        "step_wall_us": step_wall_us,
         "piece_error_um": bm.pieces.piece_error_um,
-    })
-    return Result(model="contact3d", summary=summary, series=S, steps=n_rec * rec, sim_time_s=float(d.time),
-                  extra={"points_tooth0": pts, "points_world": pts_world, "forces_world": forces, "built": bm})
+    }
 
 
 def simulate(scenario: Scenario, progress=None) -> Result:
