@@ -19,20 +19,15 @@ piece_error_um = {"worm"|"wheel"[|"wheel_undercut_zone"]: {"max": max |d|, "rms"
 from __future__ import annotations
 
 import functools
-import hashlib
-import json
 import math
-import os
-import pickle
-import tempfile
 from dataclasses import asdict, dataclass, field
-from pathlib import Path
 from typing import Callable
 
 import numpy as np
 import trimesh
 
 from meshgen import meshes, wheel, worm
+from meshgen.cache import cache_key, cached
 from meshgen.geometry import GearGeometry
 
 CODE_VERSION = "meshgen-14"
@@ -398,13 +393,8 @@ def measure_piece_error(g: GearGeometry, res: Resolution, worm_pieces, wheel_pie
 
 # ----------------------------------------------------------------------------- gear set + cache
 
-def cache_dir() -> Path:
-    return Path(os.environ.get("WORMSIM_CACHE", Path.home() / ".cache" / "wormsim"))
-
-
-def cache_key(g: GearGeometry, res: Resolution) -> str:
-    blob = json.dumps({"g": asdict(g), "r": asdict(res), "v": CODE_VERSION}, sort_keys=True, default=float)
-    return hashlib.sha256(blob.encode()).hexdigest()[:24]
+def gear_set_key(g: GearGeometry, res: Resolution) -> dict:
+    return {"g": asdict(g), "r": asdict(res), "v": CODE_VERSION}
 
 
 def _pack(m: trimesh.Trimesh):
@@ -435,25 +425,7 @@ def build_gear_set(geometry: GearGeometry, resolution: Resolution | str = "mediu
     """Generate (or load from the cache) the gear set. Raises GeometryError for undercut / pointed teeth."""
     res = RESOLUTIONS[resolution] if isinstance(resolution, str) else resolution
     g = geometry
-    path = cache_dir() / f"gearset-{cache_key(g, res)}.pkl"
-    data = None
-    if use_cache and path.exists():
-        try:
-            with open(path, "rb") as fh:
-                data = pickle.load(fh)
-        except Exception:
-            data = None
-    if data is None:
-        data = _generate(g, res)
-        if use_cache:
-            try:
-                path.parent.mkdir(parents=True, exist_ok=True)
-                fd, tmp = tempfile.mkstemp(prefix=".gearset-", dir=path.parent)
-                with os.fdopen(fd, "wb") as fh:
-                    pickle.dump(data, fh, protocol=pickle.HIGHEST_PROTOCOL)
-                os.replace(tmp, path)
-            except OSError:
-                pass
+    data = cached("gearset", gear_set_key(g, res), lambda: _generate(g, res), use_cache)
     return GearSet(
         geometry=g, resolution=res,
         worm_pieces=[_unpack(t) for t in data["worm_pieces"]],
@@ -462,4 +434,4 @@ def build_gear_set(geometry: GearGeometry, resolution: Resolution | str = "mediu
         worm_visual=_unpack(data["worm_visual"]), wheel_visual=_unpack(data["wheel_visual"]),
         worm_core_radius_m=g.r_f1, piece_error_um=data["piece_error_um"],
         undercut_fraction=data["undercut_fraction"],
-        info={"cache_key": cache_key(g, res), "code_version": CODE_VERSION})
+        info={"cache_key": cache_key(gear_set_key(g, res)), "code_version": CODE_VERSION})

@@ -12,6 +12,7 @@ from hypothesis import HealthCheck, Phase, given, settings
 from hypothesis import strategies as st
 
 from meshgen import pieces, wheel, worm
+from meshgen.cache import cache_key
 from meshgen.geometry import GeometryError, derive
 from wormsim.scenario import Gear
 
@@ -157,9 +158,10 @@ def test_cache_roundtrip_and_key(tmp_path, monkeypatch):
     b = pieces.build_gear_set(g, "coarse")
     assert np.array_equal(a.worm_visual.vertices, b.worm_visual.vertices)
     assert a.piece_error_um == b.piece_error_um
-    assert pieces.cache_key(g, pieces.RESOLUTIONS["coarse"]) != pieces.cache_key(g, pieces.RESOLUTIONS["medium"])
+    coarse, medium = pieces.RESOLUTIONS["coarse"], pieces.RESOLUTIONS["medium"]
+    assert cache_key(pieces.gear_set_key(g, coarse)) != cache_key(pieces.gear_set_key(g, medium))
     g2 = gear_with("screw_jack", backlash_mm=0.1)
-    assert pieces.cache_key(g, pieces.RESOLUTIONS["coarse"]) != pieces.cache_key(g2, pieces.RESOLUTIONS["coarse"])
+    assert cache_key(pieces.gear_set_key(g, coarse)) != cache_key(pieces.gear_set_key(g2, coarse))
 
 
 # ----------------------------------------------------------------------------- property tests

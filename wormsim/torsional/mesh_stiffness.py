@@ -45,25 +45,20 @@ overrunning wheel).
 Periodicity: the pattern of space k at theta2 is that of space k + 1 at theta2 + 2 pi / z2, i.e. one mesh cycle
 is 2 pi / z1 of worm rotation; samples are taken at theta1 = i (2 pi / z1) / N, i = 0 .. N - 1.
 
-Cache: in-process (functools) and on disk next to meshgen's gear sets (meshgen.pieces.cache_dir, env
+Cache: in-process (functools) and on disk next to meshgen's gear sets (meshgen.cache, env
 WORMSIM_CACHE), keyed by the gear geometry, the per-length stiffness, the sample count and CODE_VERSION.
 """
 from __future__ import annotations
 
 import functools
-import hashlib
-import json
 import math
-import os
-import pickle
-import tempfile
 from dataclasses import asdict, dataclass
 
 import numpy as np
 
 from meshgen import wheel
+from meshgen.cache import cached
 from meshgen.geometry import GearGeometry
-from meshgen.pieces import cache_dir
 
 CODE_VERSION = "mesh-stiffness-2"
 GRID_ZETA = 121             # TCA grid across the face width (mean k within ~1.5 % of a 241 x 161 grid)
@@ -220,31 +215,10 @@ def stiffness_at(g: GearGeometry, stiffness_per_length: float, theta1_rad, side:
                      for t1 in th])
 
 
-def _cache_key(g: GearGeometry, kp: float, source: str, samples: int) -> str:
-    blob = json.dumps({"g": asdict(g), "kp": kp, "src": source, "n": samples, "v": CODE_VERSION,
-                       "grid": (GRID_ZETA, GRID_S)}, sort_keys=True, default=str)
-    return hashlib.sha256(blob.encode()).hexdigest()[:20]
-
-
 @functools.lru_cache(maxsize=32)
 def mesh_stiffness(g: GearGeometry, stiffness_per_length: float, source: str, samples: int,
                    use_cache: bool = True) -> MeshStiffness:
     """compute(), cached in process and on disk (module docstring)."""
-    path = cache_dir() / f"meshk-{_cache_key(g, stiffness_per_length, source, samples)}.pkl"
-    if use_cache and path.exists():
-        try:
-            with open(path, "rb") as fh:
-                return pickle.load(fh)
-        except Exception:  # a corrupt or stale cache file: recompute
-            pass
-    ms = compute(g, stiffness_per_length, source, samples)
-    if use_cache:
-        try:
-            path.parent.mkdir(parents=True, exist_ok=True)
-            fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".tmp")
-            with os.fdopen(fd, "wb") as fh:
-                pickle.dump(ms, fh)
-            os.replace(tmp, path)
-        except OSError:
-            pass
-    return ms
+    parts = {"g": asdict(g), "kp": stiffness_per_length, "src": source, "n": samples, "v": CODE_VERSION,
+             "grid": (GRID_ZETA, GRID_S)}
+    return cached("meshk", parts, lambda: compute(g, stiffness_per_length, source, samples), use_cache)
