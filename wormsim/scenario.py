@@ -189,6 +189,34 @@ class Wedge(_Strict):
         return self
 
 
+# ----------------------------------------------------------------------------- assembly and manufacturing errors
+
+class Errors(_Strict):
+    """Assembly errors and manufacturing deviations of the gear pair (issue 12), every key 0 by default.
+    Their geometry, limits and signs: meshgen.displaced and docs/errors.md. The limits that depend on the gear
+    (backlash, tooth depth, face width, threaded length) are checked against the derived geometry (exit 2)."""
+
+    center_distance_mm: float = Field(0.0, ge=-100, le=100, description="a - a_nominal; a larger centre distance is positive")
+    shaft_angle_deg: float = Field(0.0, ge=-10, le=10, description=(
+        "deviation of the shaft angle from 90 deg, a rotation of the wheel axis about the line of centres "
+        "(right-hand rule about the line from the worm axis to the wheel centre)"))
+    wheel_axial_offset_mm: float = Field(0.0, ge=-100, le=100, description="the wheel mid-plane off the worm axis, along the wheel axis")
+    worm_axial_offset_mm: float = Field(0.0, ge=-100, le=100, description="the worm shifted along its own axis (a phase only)")
+    wheel_runout_mm: NonNegFloat = Field(0.0, le=10, description="eccentricity of the wheel's pitch circle to its axis of rotation")
+    wheel_runout_phase_deg: float = Field(0.0, ge=-360, le=360, description=(
+        "wheel-frame polar angle of the pitch-circle centre, from the line of centres towards the worm at theta2 = 0"))
+    worm_runout_mm: NonNegFloat = Field(0.0, le=10, description="eccentricity of the worm's thread axis to its axis of rotation")
+    wheel_pitch_deviation_um: list[Annotated[float, Field(ge=-10000, le=10000)]] = Field(
+        default_factory=list, max_length=200, description=(
+            "per wheel tooth from tooth 0: the tooth shifted along the reference circle, positive in the wheel's positive "
+            "sense (single pitch deviation f_pt,k = entry k - entry k-1); missing teeth 0"))
+
+    def is_zero(self) -> bool:
+        """No deviation at all (the phase alone, without a runout, is none)."""
+        return not (self.center_distance_mm or self.shaft_angle_deg or self.wheel_axial_offset_mm
+                    or self.worm_axial_offset_mm or self.wheel_runout_mm or self.worm_runout_mm
+                    or any(self.wheel_pitch_deviation_um))
+
 # ----------------------------------------------------------------------------- scenario
 
 class Scenario(_Strict):
@@ -203,12 +231,16 @@ class Scenario(_Strict):
     load: Load = Load()
     simulation: Simulation = Simulation()
     wedge: Wedge | None = None
+    errors: Errors = Errors()
 
     @model_validator(mode="after")
     def _blocks(self) -> "Scenario":
         if self.model == "wedge":
             if self.wedge is None:
                 raise ValueError("model: wedge needs a wedge: block")
+            if not self.errors.is_zero():
+                raise ValueError("errors: the wedge model has no gear geometry to displace; use model: torsional or "
+                                 "contact3d, or set every errors key to 0")
         else:
             if self.gear is None:
                 raise ValueError(f"model: {self.model} needs a gear: block")

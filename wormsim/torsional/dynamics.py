@@ -107,11 +107,17 @@ def inertias(scenario: Scenario, g: GearGeometry) -> tuple[float, float]:
 class _Mesh:
     """The force element (module docstring); scalar call for the ODE, array call for the outputs."""
 
-    def __init__(self, scenario: Scenario, g: GearGeometry, ms: MeshStiffness, I1: float, I2: float):
+    def __init__(self, scenario: Scenario, g: GearGeometry, ms: MeshStiffness, I1: float, I2: float, kin=None):
         c = scenario.contact
         self.g, self.ms = g, ms
         self.hz = g.hand * g.z1 / g.z2
         self.gap = g.backlash / (2 * g.r2)
+        # assembly errors (issue 12): the gaps of the displaced flanks from the kinematic TCA, per side, as tables
+        # over its period of worm angle (meshgen.kinematic_tca); None: the perfect pair's constant gap
+        self.kin = kin
+        if kin is not None:
+            self.kP, self.kN = kin.period_rad, len(kin.theta1_rad)
+            self.gf, self.gr = kin.gap_fwd_rad.tolist(), kin.gap_rev_rad.tolist()
         self.arm0 = ms.arm0_m
         self.N = ms.samples
         self.period = ms.period_rad
@@ -138,16 +144,40 @@ class _Mesh:
         f = x - i
         return table[i % self.N] * (1.0 - f) + table[(i + 1) % self.N] * f
 
+    def gap_at(self, th1: float, table: list) -> tuple[float, float]:
+        """(gap, d gap / d theta1) of a displaced-flank table (periodic, linear between samples)."""
+        x = (th1 % self.kP) / self.kP * self.kN
+        i = int(x)
+        f = x - i
+        a, b = table[i % self.kN], table[(i + 1) % self.kN]
+        return a * (1.0 - f) + b * f, (b - a) * self.kN / self.kP
+
     def torques(self, th1: float, w1: float, th2: float, w2: float) -> tuple[float, float]:
         """(T2m on the wheel, T1m taken from the worm), N m."""
         e = self.hz * th1 - th2
         de = self.hz * w1 - w2
+        if self.kin is not None:
+            return self._torques_displaced(th1, w1, e, de)
         if e > self.gap:
             side, dlt, ddlt, K = 1.0, e - self.gap, de, self.k_at(th1, self.kf)
         elif e < -self.gap:
             side, dlt, ddlt, K = -1.0, -e - self.gap, -de, self.k_at(th1, self.kr)
         else:
             return 0.0, 0.0
+        return self._torque(th1, w1, side, dlt, ddlt, K)
+
+    def _torques_displaced(self, th1: float, w1: float, e: float, de: float) -> tuple[float, float]:
+        """torques() with the displaced flanks' gaps g_side(theta1): side +1 touches for e > g_+1, side -1 for
+        e < -g_-1; the penetration rate includes the gap's change with the worm angle."""
+        gf, dgf = self.gap_at(th1, self.gf)
+        gr, dgr = self.gap_at(th1, self.gr)
+        if e > gf:
+            return self._torque(th1, w1, 1.0, e - gf, de - dgf * w1, self.k_at(th1, self.kf))
+        if e < -gr:
+            return self._torque(th1, w1, -1.0, -e - gr, -de - dgr * w1, self.k_at(th1, self.kr))
+        return 0.0, 0.0
+
+    def _torque(self, th1, w1, side, dlt, ddlt, K) -> tuple[float, float]:
         blend = step(self.arm0 * dlt, 0.0, 0.0, self.d_max, 1.0)    # IMPACT's damping ramp over d_max
         T = K * dlt + self.c_theta_per_k * K * blend * ddlt
         if T <= 0.0:
@@ -176,6 +206,13 @@ class _Mesh:
         kf = np.interp(phase, np.arange(self.N + 1), self.kf + self.kf[:1])
         kr = np.interp(phase, np.arange(self.N + 1), self.kr + self.kr[:1])
         k = np.where(e >= 0, kf, kr) / self.arm0 ** 2
+        if self.kin is None:
+            deflection = self.arm0 * np.maximum(np.abs(e) - self.gap, 0.0)
+        else:
+            x = np.mod(th1, self.kP) / self.kP * self.kN
+            gf = np.interp(x, np.arange(self.kN + 1), self.gf + self.gf[:1])
+            gr = np.interp(x, np.arange(self.kN + 1), self.gr + self.gr[:1])
+            deflection = self.arm0 * np.maximum(np.maximum(e - gf, -e - gr), 0.0)
         return {
             "tangential_force_n": ft,
             "axial_force_n": gt.axial_force_n(ft, g.gamma, s * rho),
@@ -183,7 +220,7 @@ class _Mesh:
             "mesh_torque_worm_nm": T1m,
             "friction_coefficient": mu,
             "transmission_error_rad": -e,
-            "mesh_deflection_m": self.arm0 * np.maximum(np.abs(e) - self.gap, 0.0),
+            "mesh_deflection_m": deflection,
             "mesh_stiffness_n_per_m": k,
         }
 
@@ -299,7 +336,8 @@ def simulate(scenario: Scenario, progress=None, method: str = "implicit") -> Res
     ms = mesh_stiffness(g, kp, src, scenario.simulation.mesh_stiffness_samples)
     t_ms = time.perf_counter() - t_ms
     I1, I2 = inertias(scenario, g)
-    mesh = _Mesh(scenario, g, ms, I1, I2)
+    kin = displaced_flanks(scenario, g)
+    mesh = _Mesh(scenario, g, ms, I1, I2, kin)
     drv = scenario.drive
     cmds = gt.commands(scenario, g.hand)
     speed_driven = drv.speed_rpm is not None
@@ -368,8 +406,34 @@ def simulate(scenario: Scenario, progress=None, method: str = "implicit") -> Res
         "backlash_angle_rad": 2 * mesh.gap, "friction": friction_mode(scenario.contact),
         **ms.summary(),
     })
+    if kin is not None:
+        side = working_flank(scenario, g)
+        summary.update(kin.summary(g, side))
+        S["transmission_error_kinematic_rad"] = np.interp(
+            np.mod(th1, kin.period_rad), np.append(kin.theta1_rad, kin.period_rad), np.append(kin.te_rad(side), kin.te_rad(side)[0]))
     return Result(model="torsional", summary=summary, series=S, steps=len(t) - 1, sim_time_s=float(t[-1]),
                   extra={"mesh_stiffness": ms})
+
+
+def displaced_flanks(scenario: Scenario, g: GearGeometry):
+    """The kinematic TCA of the displaced pair (meshgen.kinematic_tca) when the scenario has errors, else None.
+    Errors beyond the limits of meshgen.displaced, or flanks that leave no play anywhere, raise ScenarioError."""
+    if scenario.errors.is_zero():
+        return None
+    from meshgen.displaced import check_limits
+    from meshgen.kinematic_tca import check_play, kinematic_tca
+
+    dev = check_limits(g, scenario.errors)
+    return check_play(g, kinematic_tca(g, dev))
+
+
+def working_flank(scenario: Scenario, g: GearGeometry) -> int:
+    """+1 when the mesh torque on the wheel is positive in the intended running (the worm drives against a resisting
+    load, hand sign(command)), -1 otherwise (the wheel drives: the mesh resists its motion)."""
+    drv = scenario.drive
+    cmd = drv.speed_rpm if drv.speed_rpm is not None else drv.torque_nm
+    s = 1 if cmd >= 0 else -1
+    return s * g.hand if drv.on == "worm" else -s
 
 
 def _guards(scenario, g, t, w1, w2, out, cmd) -> None:
