@@ -4,7 +4,7 @@ The nominal frames are meshgen.assembly's (assembly frame: wheel axis z through 
 at y = -a, z = 0). The errors enter as rigid transforms of each part's BODY (the frame its surfaces are written in:
 meshgen.worm, meshgen.wheel) into the assembly:
 
-    worm body  -> assembly:  Trans(0, -(a + da), 0) R0 Trans(0, 0, dw) Rz(theta1) Trans(e1, 0, 0)          (1)
+    worm body  -> assembly:  Trans(0, -(a + da), 0) R0 Trans(0, 0, dw) Rz(dw / p) Rz(theta1) Trans(e1, 0, 0) (1)
     wheel body -> assembly:  Trans(0, 0, dz) Ry(dS) Rz(theta2) Trans(e2 cos(ph2), e2 sin(ph2), 0)          (2)
 
 with R0 of meshgen.assembly and
@@ -13,7 +13,11 @@ with R0 of meshgen.assembly and
                                           axis to the wheel centre); the worm's +z axis and the wheel's +z axis then
                                           make Sigma = 90 deg + dS;
     dz  errors.wheel_axial_offset_mm      the wheel mid-plane moved along the wheel axis (+z);
-    dw  errors.worm_axial_offset_mm       the worm moved along its own axis (worm +z = assembly -x): a phase only;
+    dw  errors.worm_axial_offset_mm       the worm moved along its own axis (worm +z = assembly -x): a phase only,
+                                          since the helicoid z = p phi + const is invariant under the screw motion
+                                          Trans(0, 0, p t) Rz(t); the turn Rz(dw / p) in (1) takes the phase out, so
+                                          theta1 = 0 still puts a thread centred in a tooth space (the angle counts
+                                          from the thread), and what remains is where the threaded length ends;
     e1  errors.worm_runout_mm             the thread's axis off the worm's axis of rotation, towards worm +x (which
                                           points at the wheel centre at theta1 = 0);
     e2, ph2  errors.wheel_runout_mm/_phase_deg   the pitch circle's centre off the wheel's axis of rotation, at
@@ -23,7 +27,8 @@ with R0 of meshgen.assembly and
                                           f_pt,k = f_k - f_(k-1) (DIN 3960 / ISO 1328-1 names).
 Zero errors give exactly meshgen.assembly's transforms.
 
-Limits (each derived in docs/errors.md; `check_limits` raises ScenarioError, exit 2, naming the key and the limit).
+Limits (each derived in docs/errors.md; `check_limits` raises meshgen's GeometryError naming the key and the limit;
+wormsim.geometry turns it into ScenarioError, exit 2).
 j is the circumferential backlash at d2 (j / 2 per flank), alpha_x the axial pressure angle, c = h_f - h_a the tip
 clearance. In the worm's axial section through the pitch point the thread is a rack of flank angle alpha_x (ZA
 exactly; ZI: the slope of its axial profile at r1 is tan(alpha_x) as well), so a radial approach dr of the worm
@@ -46,16 +51,38 @@ play of the displaced flanks, and a play <= 0 anywhere over the analysed period 
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Protocol
 
 import numpy as np
 
 from meshgen import assembly, wheel
-from meshgen.geometry import GearGeometry
-from wormsim.scenario import ScenarioError
-from wormsim.units import DEG, MM
+from meshgen.geometry import DEG, MM, GearGeometry, GeometryError
 
-UM = 1e-6
+UM = 1e-6                      # m per um
+
+
+class ErrorsData(Protocol):
+    """What Deviations.from_data reads (read-only): the fields of a scenario's `errors:` block
+    (wormsim.scenario.Errors has them, validated), in the units of their names."""
+
+    @property
+    def center_distance_mm(self) -> float: ...
+    @property
+    def shaft_angle_deg(self) -> float: ...
+    @property
+    def wheel_axial_offset_mm(self) -> float: ...
+    @property
+    def worm_axial_offset_mm(self) -> float: ...
+    @property
+    def wheel_runout_mm(self) -> float: ...
+    @property
+    def wheel_runout_phase_deg(self) -> float: ...
+    @property
+    def worm_runout_mm(self) -> float: ...
+    @property
+    def wheel_pitch_deviation_um(self) -> Sequence[float]: ...
 
 
 @dataclass(frozen=True)
@@ -72,7 +99,7 @@ class Deviations:
     tooth_shift: tuple = ()             # f_k, m, tooth 0, 1, ... (missing teeth 0)
 
     @classmethod
-    def from_scenario(cls, errors) -> "Deviations":
+    def from_data(cls, errors: ErrorsData) -> Deviations:
         return cls(center_distance=errors.center_distance_mm * MM, shaft_angle=errors.shaft_angle_deg * DEG,
                    wheel_axial_offset=errors.wheel_axial_offset_mm * MM,
                    worm_axial_offset=errors.worm_axial_offset_mm * MM, wheel_runout=errors.wheel_runout_mm * MM,
@@ -111,13 +138,15 @@ def worm_mount(g: GearGeometry, dev: Deviations) -> tuple[np.ndarray, np.ndarray
     """(M, E): worm body -> assembly = M Rz(theta1) E, (1). M places the axis of rotation, E the thread's axis on it."""
     M = _trans(0.0, -(g.a + dev.center_distance), 0.0)
     M[:3, :3] = assembly.R0
-    return M @ _trans(0.0, 0.0, dev.worm_axial_offset), _trans(dev.worm_runout, 0.0, 0.0)
+    return M @ _trans(0.0, 0.0, dev.worm_axial_offset) @ assembly._rz(dev.worm_axial_offset / g.p), \
+        _trans(dev.worm_runout, 0.0, 0.0)
 
 
 def wheel_mount(g: GearGeometry, dev: Deviations) -> tuple[np.ndarray, np.ndarray]:
     """(M, E): wheel body -> assembly = M Rz(theta2) E, (2)."""
     e, ph = dev.wheel_runout, dev.wheel_runout_phase
-    return _trans(0.0, 0.0, dev.wheel_axial_offset) @ _ry(dev.shaft_angle), _trans(e * math.cos(ph), e * math.sin(ph), 0.0)
+    M = _trans(0.0, 0.0, dev.wheel_axial_offset) @ _ry(dev.shaft_angle)
+    return M, _trans(e * math.cos(ph), e * math.sin(ph), 0.0)
 
 
 def worm_to_assembly(g: GearGeometry, dev: Deviations, theta1: float) -> np.ndarray:
@@ -162,47 +191,52 @@ def limits(g: GearGeometry) -> dict:
     }
 
 
-def check_limits(g: GearGeometry, errors) -> Deviations:
-    """Validate a scenario's errors: block against the gear ((3)-(8)); ScenarioError (exit 2) naming the key and the
-    limit. Returns the Deviations."""
-    dev = Deviations.from_scenario(errors)
+def check_limits(g: GearGeometry, errors: ErrorsData) -> Deviations:
+    """Validate an errors: block against the gear ((3)-(8)); GeometryError naming the key and the limit. Returns
+    the Deviations."""
+    dev = Deviations.from_data(errors)
     if dev.is_zero():
         return dev
     lim = limits(g)
-    um = lambda x: f"{x / UM:.4g} um"           # noqa: E731
-    mm = lambda x: f"{x / MM:.4g} mm"           # noqa: E731
+
+    def um(x: float) -> str:
+        return f"{x / UM:.4g} um"
+
+    def mm(x: float) -> str:
+        return f"{x / MM:.4g} mm"
+
     if len(dev.tooth_shift) > g.z2:
-        raise ScenarioError(f"errors.wheel_pitch_deviation_um: {len(dev.tooth_shift)} entries for a wheel of "
+        raise GeometryError(f"errors.wheel_pitch_deviation_um: {len(dev.tooth_shift)} entries for a wheel of "
                             f"{g.z2} teeth; allowed at most {g.z2}")
     if dev.center_distance >= lim["center_distance_opening_m"]:
-        raise ScenarioError(
+        raise GeometryError(
             f"errors.center_distance_mm = {errors.center_distance_mm}: opens the mesh beyond the addendum h_a = "
             f"{mm(g.h_a)} (the worm tip would no longer reach the wheel's reference circle); allowed below {mm(g.h_a)}")
     r_close = max(0.0, -dev.center_distance) + dev.worm_runout + dev.wheel_runout
     if r_close >= lim["radial_closing_m"]:
         which = "the backlash" if lim["radial_closing_backlash_m"] <= lim["tip_clearance_m"] else "the tip clearance"
-        raise ScenarioError(
+        raise GeometryError(
             f"errors: the radial approach max(0, -center_distance_mm) + worm_runout_mm + wheel_runout_mm = "
             f"{mm(r_close)} closes the mesh into interference with {which}: allowed below "
             f"min(j / (2 tan(alpha_x)), h_f - h_a) = min({mm(lim['radial_closing_backlash_m'])}, "
             f"{mm(lim['tip_clearance_m'])}) for gear.backlash_mm = {g.backlash / MM:.4g}")
     if abs(dev.shaft_angle) >= lim["shaft_angle_rad"]:
-        raise ScenarioError(
+        raise GeometryError(
             f"errors.shaft_angle_deg = {errors.shaft_angle_deg}: twists the face edges by (b2 / 2) sin(dS) beyond "
             f"the flank clearance j / 2; allowed |dS| < asin(j / b2) = {lim['shaft_angle_rad'] / DEG:.4g} deg "
             f"(gear.backlash_mm = {g.backlash / MM:.4g}, face width {mm(g.face_width)})")
     if abs(dev.wheel_axial_offset) >= lim["wheel_axial_offset_m"]:
-        raise ScenarioError(
+        raise GeometryError(
             f"errors.wheel_axial_offset_mm = {errors.wheel_axial_offset_mm}: the wheel throat would hit the worm root "
             f"cylinder at a face edge; allowed |offset| < {mm(lim['wheel_axial_offset_m'])}")
     if abs(dev.worm_axial_offset) >= lim["worm_axial_offset_m"] and dev.worm_axial_offset:
-        raise ScenarioError(
+        raise GeometryError(
             f"errors.worm_axial_offset_mm = {errors.worm_axial_offset_mm}: the threaded length ({mm(g.worm_length)}) "
             f"would no longer cover the wheel's reach on the worm axis; allowed |offset| < "
             f"{mm(lim['worm_axial_offset_m'])} (or raise gear.worm_length_mm)")
     if dev.tooth_shift and max(abs(f) for f in dev.tooth_shift) >= lim["tooth_shift_m"]:
         k = int(np.argmax(np.abs(dev.tooth_shift)))
-        raise ScenarioError(
+        raise GeometryError(
             f"errors.wheel_pitch_deviation_um[{k}] = {errors.wheel_pitch_deviation_um[k]}: shifts the tooth beyond "
             f"its flank clearance j / 2; allowed |deviation| < {um(lim['tooth_shift_m'])} "
             f"(gear.backlash_mm = {g.backlash / MM:.4g})")

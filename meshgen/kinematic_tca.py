@@ -10,8 +10,7 @@ wheel flank point's distance from the thread, d = meshgen.worm.thread_gap of the
 Side +1 is the flank the worm pushes when it leads (the wheel lags: theta2 < hand theta1 z1 / z2), side -1 the
 other (as wormsim.torsional.mesh_stiffness). At the conjugate wheel angle theta2c = hand theta1 z1 / z2 every point
 i has a clearance d_i; turning the wheel by -side Delta closes it at the rate r_i = -dd_i / dDelta (a finite
-difference). A worm axial offset dw is a turn of the worm by -dw / p (the helicoid z = p phi + const is invariant under
-the screw motion), so theta2c = hand (theta1 - dw / p) z1 / z2 (exact without worm runout). The first touch is
+difference). The first touch is
 
     g_side(theta1) = min_i d_i / r_i                                                                       (1)
 
@@ -38,7 +37,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from meshgen import assembly, displaced, wheel, worm
-from meshgen.geometry import GearGeometry
+from meshgen.geometry import GearGeometry, GeometryError
 
 GRID_ZETA = 33              # flank grid across the face
 GRID_RHO = 33               # flank grid root .. tip
@@ -166,9 +165,8 @@ def analyse(g: GearGeometry, dev: displaced.Deviations, samples_per_mesh: int = 
     where = {1: np.zeros((n, 2)), -1: np.zeros((n, 2))}
     pats = {1: [], -1: []}
 
-    phase = -dev.worm_axial_offset / g.p     # the worm's axial shift is a turn of its helicoid (module docstring)
     for m, th1 in enumerate(th1s):
-        th2c = hz * (th1 + phase)
+        th2c = hz * th1
         # worm body <- assembly (inverse of (1))
         Tw_inv = np.linalg.inv(Mw @ assembly._rz(th1) @ Ew)
         # teeth within the window around the line of centres (tooth k's centre at tooth0 + k pitch + theta2)
@@ -219,8 +217,8 @@ def analyse(g: GearGeometry, dev: displaced.Deviations, samples_per_mesh: int = 
         w = np.concatenate([c for _, _, c in items])
         if not len(z):
             return {"centroid_face_m": float("nan"), "centroid_radius_m": float("nan"), "extent_face_m": 0.0}
-        return {"centroid_face_m": float(np.sum(w * z) / np.sum(w)), "centroid_radius_m": float(np.sum(w * r) / np.sum(w)),
-                "extent_face_m": float(np.ptp(z))}
+        return {"centroid_face_m": float(np.sum(w * z) / np.sum(w)),
+                "centroid_radius_m": float(np.sum(w * r) / np.sum(w)), "extent_face_m": float(np.ptp(z))}
 
     return KinematicTCA(theta1_rad=th1s, period_rad=period, gap_fwd_rad=gaps[1], gap_rev_rad=gaps[-1],
                         contact_fwd=where[1], contact_rev=where[-1], pattern_fwd=pattern(pats[1]),
@@ -234,15 +232,15 @@ def kinematic_tca(g: GearGeometry, dev: displaced.Deviations, samples_per_mesh: 
 
 
 def check_play(g: GearGeometry, kin: KinematicTCA) -> KinematicTCA:
-    """ScenarioError (exit 2) when the displaced flanks leave no play at some worm angle (they interfere: the sum of
-    the errors exceeds the backlash budget even where each is within its own limit, meshgen.displaced)."""
-    from wormsim.scenario import ScenarioError
-
+    """GeometryError (wormsim: ScenarioError, exit 2) when the displaced flanks leave no play at some worm angle
+    (they interfere: the sum of the errors exceeds the backlash budget even where each is within its own limit,
+    meshgen.displaced)."""
     play = kin.play_m(g)
     if np.min(play) <= 0:
         i = int(np.argmin(play))
-        raise ScenarioError(
+        raise GeometryError(
             f"errors: together the errors close the play between the flanks to {play[i] * 1e6:.3g} um at worm angle "
             f"{math.degrees(kin.theta1_rad[i]):.1f} deg (gear.backlash_mm = {g.backlash * 1e3:.4g}): the flanks "
             f"interfere; reduce the errors (the play must stay above 0; docs/errors.md) or raise gear.backlash_mm")
     return kin
+

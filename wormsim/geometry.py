@@ -6,9 +6,13 @@ from __future__ import annotations
 from collections.abc import Iterator
 from contextlib import contextmanager
 
+from meshgen import displaced as _displaced
 from meshgen import geometry as _geometry
+from meshgen import kinematic_tca as _kinematic_tca
 from meshgen import pieces as _pieces
+from meshgen.displaced import Deviations, ErrorsData
 from meshgen.geometry import GearData, GearGeometry, GeometryError
+from meshgen.kinematic_tca import KinematicTCA
 from meshgen.pieces import GearSet
 from wormsim.scenario import Scenario, ScenarioError
 
@@ -35,3 +39,15 @@ def gear_set(scenario: Scenario, resolution: str | None = None) -> tuple[GearGeo
     geo = derive(scenario.gear)
     with geometry_errors():
         return geo, _pieces.build_gear_set(geo, resolution=resolution or scenario.simulation.resolution)
+
+
+def displaced_pair(errors: ErrorsData, geo: GearGeometry) -> tuple[Deviations, KinematicTCA] | None:
+    """The errors: block as meshgen.displaced's Deviations, checked against its limits, and the kinematic TCA of the
+    displaced flanks (meshgen.kinematic_tca, with its play check); None without errors (the perfect pair's path).
+    Errors beyond a limit, or flanks that leave no play, raise ScenarioError (exit 2)."""
+    dev = _displaced.Deviations.from_data(errors)
+    if dev.is_zero():
+        return None
+    with geometry_errors():
+        dev = _displaced.check_limits(geo, errors)
+        return dev, _kinematic_tca.check_play(geo, _kinematic_tca.kinematic_tca(geo, dev))

@@ -33,7 +33,9 @@ import numpy as np
 import trimesh
 
 from meshgen import assembly
+from meshgen.displaced import Deviations, wheel_mount, worm_mount
 from meshgen.geometry import GearGeometry
+from meshgen.kinematic_tca import KinematicTCA
 from meshgen.pieces import GearSet
 from wormsim import gear_theory as gt
 from wormsim.contact3d.backlash import check_backlash, check_conjugate_interference
@@ -41,7 +43,7 @@ from wormsim.contact3d.law import ContactLaw, contact_law, friction_impratio
 from wormsim.contact3d.timestep import choose_timestep
 from wormsim.contact3d.window import slot_quat, window_size, window_teeth_at
 from wormsim.friction import friction_coefficient
-from wormsim.geometry import derive, gear_set
+from wormsim.geometry import derive, displaced_pair, gear_set
 from wormsim.scenario import Scenario, ScenarioError
 
 TEMPLATE = files("wormsim.models") / "worm_pair.xml"   # models/, shipped as package data
@@ -76,6 +78,8 @@ class BuiltModel:
     timestep_s: float                   # the model's timestep (model.opt.timestep), chosen before the build
     timestep_source: str
     meta: dict = field(default_factory=dict)
+    tooth_shift_rad: np.ndarray | None = None   # (z2,) pitch deviations f_k / r2 (errors:, meshgen.displaced)
+    kinematic_tca: KinematicTCA | None = None   # of the displaced pair (errors: only)
 
 
 @dataclass(frozen=True)
@@ -195,11 +199,15 @@ def build_model(scenario: Scenario, gs: GearSet | None = None, check_backlash_vs
         if check_backlash_vs_pieces and gs.piece_error_um else {}
     h, h_source = choose_timestep(scenario, geo, law) if timestep_s is None else (timestep_s, "given to build_model")
 
+    pair = displaced_pair(scenario.errors, geo)      # errors: (issue 12), None for the perfect pair
+    dev, kin = pair if pair is not None else (None, None)
+    shift = dev.tooth_angle_shift(geo, np.arange(geo.z2)) if dev is not None and any(dev.tooth_shift) else None
+
     spec = mujoco.MjSpec.from_file(str(TEMPLATE))
     spec.modelname = scenario.name
-    _place_bodies(spec, geo, p.inertias)
+    _place_bodies(spec, geo, p.inertias, dev)
     worm_names, slot_names, W = _add_geoms(spec, geo, gs, law, float(friction_coefficient(scenario.contact, 0.0)),
-                                           window_teeth)
+                                           window_teeth, shift)
     kv, drive_sign = _add_actuators(spec, scenario, geo)
     _set_options(spec, scenario, law, h)
     _add_mesh_sensor(spec)
@@ -230,7 +238,7 @@ def build_model(scenario: Scenario, gs: GearSet | None = None, check_backlash_vs
         worm_geoms=np.array([oid(mujoco.mjtObj.mjOBJ_GEOM, n) for n in worm_names], dtype=int),
         wheel_slot_geoms=slot_geoms, slot_bodies=slot_bodies, window_teeth=W, tooth0_angle_rad=_tooth0_angle(gs),
         direction=expected_direction(scenario, geo), drive_sign=drive_sign, pieces=gs,
-        timestep_s=h, timestep_source=h_source, meta=meta)
+        timestep_s=h, timestep_source=h_source, meta=meta, tooth_shift_rad=shift, kinematic_tca=kin)
     if check_backlash_vs_pieces:
         # the model itself at the rigid-conjugate pose (wormsim.contact3d.backlash.check_conjugate_interference): exit 2
         meta["conjugate_interference_m"] = check_conjugate_interference(
@@ -238,8 +246,9 @@ def build_model(scenario: Scenario, gs: GearSet | None = None, check_backlash_vs
     return bm
 
 
-def _place_bodies(spec: mujoco.MjSpec, geo: GearGeometry, ine: Inertias) -> None:
-    """Worm and wheel bodies in the assembly frame (meshgen.assembly) with their masses and inertias."""
+def _place_bodies(spec: mujoco.MjSpec, geo: GearGeometry, ine: Inertias, dev: Deviations | None = None) -> None:
+    """Worm and wheel bodies in the assembly frame (meshgen.assembly) with their masses and inertias; with assembly
+    errors (dev) displaced as _place_displaced puts them."""
     worm_b, wheel_b = spec.body("worm"), spec.body("wheel")
     Tw = np.asarray(assembly.worm_to_assembly(0.0, geo), dtype=float)
     Tg = np.asarray(assembly.wheel_to_assembly(0.0), dtype=float)
@@ -247,6 +256,8 @@ def _place_bodies(spec: mujoco.MjSpec, geo: GearGeometry, ine: Inertias) -> None
         raise RuntimeError("meshgen.assembly: the wheel frame must coincide with the assembly frame at theta2 = 0")
     worm_b.pos = Tw[:3, 3]
     worm_b.quat = _mat2quat(Tw[:3, :3])
+    if dev is not None:
+        _place_displaced(spec, geo, dev)
     # transverse moments of a solid cylinder of the part's length, Izz / 2 + m L^2 / 12: irrelevant on a hinge,
     # but they must satisfy the triangle inequality with a margin that survives the 6 digits of a written MJCF
     for body, mass, izz, length in ((worm_b, ine.worm_mass_kg, ine.worm_inertia_kg_m2, geo.worm_length),
@@ -258,6 +269,18 @@ def _place_bodies(spec: mujoco.MjSpec, geo: GearGeometry, ine: Inertias) -> None
         body.inertia = [ixx, ixx, izz]
 
 
+def _place_displaced(spec: mujoco.MjSpec, geo: GearGeometry, dev: Deviations) -> None:
+    """Assembly errors (issue 12): move and tilt the bodies and put each hinge on its axis of rotation, off the part's
+    own axis by the runout, as meshgen.displaced (1), (2) gives them: body -> assembly = M Rz(theta) E, i.e. the body
+    at M E and the hinge at E^-1's origin in the body frame."""
+    for part, (M, E) in (("worm", worm_mount(geo, dev)), ("wheel", wheel_mount(geo, dev))):
+        X = M @ E
+        body = spec.body(part)
+        body.pos = X[:3, 3]
+        body.quat = _mat2quat(X[:3, :3])
+        spec.joint(f"{part}_hinge").pos = -E[:3, 3]
+
+
 def _add_mesh(spec: mujoco.MjSpec, name: str, mesh: trimesh.Trimesh) -> None:
     me = spec.add_mesh()
     me.name = name
@@ -267,7 +290,8 @@ def _add_mesh(spec: mujoco.MjSpec, name: str, mesh: trimesh.Trimesh) -> None:
 
 
 def _add_geoms(spec: mujoco.MjSpec, geo: GearGeometry, gs: GearSet, law: ContactLaw, mu0: float,
-               window_teeth: int | None) -> tuple[list[str], list[list[str]], int]:
+               window_teeth: int | None, tooth_shift_rad: np.ndarray | None = None
+               ) -> tuple[list[str], list[list[str]], int]:
     """Visual meshes, the worm's collision pieces and the wheel's window of W slots (one rigid child body per
     slot, no joint: re-posing a slot moves its body, so MuJoCo's per-body bounding-volume hierarchy, built at
     compile time in the body frame, stays valid). Returns (worm geom names, slot geom names, W)."""
@@ -300,7 +324,7 @@ def _add_geoms(spec: mujoco.MjSpec, geo: GearGeometry, gs: GearSet, law: Contact
         s = int(k % W)
         sb = wheel_b.add_body()
         sb.name = f"slot{s}"
-        sb.quat = slot_quat(int(k), geo.z2)
+        sb.quat = slot_quat(int(k), geo.z2, tooth_shift_rad)
         sb.explicitinertial = True
         sb.mass = 1e-9
         sb.inertia = [1e-15, 1e-15, 1e-15]

@@ -362,6 +362,9 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
             progress.update(t)
     wall = time.perf_counter() - t_wall
     summary = _run_summary(S, scenario, bm, rec, guards.turn_max, len(coll), 1e6 * wall / max(n_rec * rec, 1))
+    if bm.kinematic_tca is not None:       # errors: the displaced exact flanks' kinematic TE and play (issue 12)
+        kin = bm.kinematic_tca.summary(bm.geometry, gt.working_flank(scenario, bm.geometry.hand))
+        summary.update({k: v for k, v in kin.items() if not k.startswith("contact_pattern")})
     return Result(model="contact3d", summary=summary, series=S, steps=n_rec * rec, sim_time_s=float(d.time),
                   extra={"points_tooth0": pts, "points_world": pts_world, "forces_world": forces, "built": bm})
 

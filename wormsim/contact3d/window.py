@@ -20,6 +20,7 @@ class Windowed(Protocol):
     window_teeth: int
     tooth0_angle_rad: float
     slot_bodies: np.ndarray
+    tooth_shift_rad: np.ndarray | None  # (z2,) pitch deviations f_k / r2 (errors:), None for the perfect pair
 
 
 def window_size(geo: GearGeometry) -> int:
@@ -38,9 +39,12 @@ def window_teeth_at(theta2: float, z2: int, window: int, tooth0_angle: float) ->
     return np.arange(c - h + 1, c - h + 1 + window)
 
 
-def slot_quat(k: int, z2: int) -> list[float]:
-    """Orientation of the slot that holds tooth k: a rotation by 2 pi k / z2 about the wheel axis."""
+def slot_quat(k: int, z2: int, tooth_shift_rad: np.ndarray | None = None) -> list[float]:
+    """Orientation of the slot that holds tooth k: a rotation by 2 pi k / z2 about the wheel axis, plus the tooth's
+    pitch deviation f_k / r2 (meshgen.displaced) when given."""
     ang = 2 * math.pi * k / z2
+    if tooth_shift_rad is not None:
+        ang += tooth_shift_rad[k % z2]
     return [math.cos(ang / 2), 0, 0, math.sin(ang / 2)]
 
 
@@ -53,5 +57,5 @@ def repose_window(bm: Windowed, theta2: float, current: np.ndarray | None = None
     for k in ks:
         if current is not None and k in current:
             continue
-        m.body_quat[bm.slot_bodies[int(k % bm.window_teeth)]] = slot_quat(int(k), bm.geometry.z2)
+        m.body_quat[bm.slot_bodies[int(k % bm.window_teeth)]] = slot_quat(int(k), bm.geometry.z2, bm.tooth_shift_rad)
     return ks

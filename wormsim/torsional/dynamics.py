@@ -79,7 +79,7 @@ from meshgen.geometry import GearGeometry
 from wormsim import gear_theory as gt
 from wormsim.errors import DivergedError, LockedError, PenetrationError, SimulationError
 from wormsim.friction import friction_coefficient, friction_coefficient_scalar, friction_mode
-from wormsim.geometry import derive
+from wormsim.geometry import derive, displaced_pair
 from wormsim.metrics import dominant_frequency, drive_summary, mean_speeds_rpm, window_of
 from wormsim.result import Result
 from wormsim.scenario import Scenario
@@ -336,7 +336,8 @@ def simulate(scenario: Scenario, progress=None, method: str = "implicit") -> Res
     ms = mesh_stiffness(g, kp, src, scenario.simulation.mesh_stiffness_samples)
     t_ms = time.perf_counter() - t_ms
     I1, I2 = inertias(scenario, g)
-    kin = displaced_flanks(scenario, g)
+    pair = displaced_pair(scenario.errors, g)
+    kin = pair[1] if pair is not None else None
     mesh = _Mesh(scenario, g, ms, I1, I2, kin)
     drv = scenario.drive
     cmds = gt.commands(scenario, g.hand)
@@ -407,33 +408,13 @@ def simulate(scenario: Scenario, progress=None, method: str = "implicit") -> Res
         **ms.summary(),
     })
     if kin is not None:
-        side = working_flank(scenario, g)
+        side = gt.working_flank(scenario, g.hand)
         summary.update(kin.summary(g, side))
+        te = kin.te_rad(side)
         S["transmission_error_kinematic_rad"] = np.interp(
-            np.mod(th1, kin.period_rad), np.append(kin.theta1_rad, kin.period_rad), np.append(kin.te_rad(side), kin.te_rad(side)[0]))
+            np.mod(th1, kin.period_rad), np.append(kin.theta1_rad, kin.period_rad), np.append(te, te[0]))
     return Result(model="torsional", summary=summary, series=S, steps=len(t) - 1, sim_time_s=float(t[-1]),
                   extra={"mesh_stiffness": ms})
-
-
-def displaced_flanks(scenario: Scenario, g: GearGeometry):
-    """The kinematic TCA of the displaced pair (meshgen.kinematic_tca) when the scenario has errors, else None.
-    Errors beyond the limits of meshgen.displaced, or flanks that leave no play anywhere, raise ScenarioError."""
-    if scenario.errors.is_zero():
-        return None
-    from meshgen.displaced import check_limits
-    from meshgen.kinematic_tca import check_play, kinematic_tca
-
-    dev = check_limits(g, scenario.errors)
-    return check_play(g, kinematic_tca(g, dev))
-
-
-def working_flank(scenario: Scenario, g: GearGeometry) -> int:
-    """+1 when the mesh torque on the wheel is positive in the intended running (the worm drives against a resisting
-    load, hand sign(command)), -1 otherwise (the wheel drives: the mesh resists its motion)."""
-    drv = scenario.drive
-    cmd = drv.speed_rpm if drv.speed_rpm is not None else drv.torque_nm
-    s = 1 if cmd >= 0 else -1
-    return s * g.hand if drv.on == "worm" else -s
 
 
 def _guards(scenario, g, t, w1, w2, out, cmd) -> None:
