@@ -233,3 +233,23 @@ def test_resume_after_ctrl_c_skips_finished_points(tmp_path, capsys):
     # a third run has nothing to do and starts no cluster
     assert cli.main(["sweep", str(sweep), "--out", str(out), "--no-progress"]) == 0
     assert "(6 done earlier, 0 run now)" in capsys.readouterr().out
+
+
+def test_a_lost_worker_is_a_failed_row(tmp_path, monkeypatch):
+    """A point whose worker process dies (os._exit, as a segfault or the OOM killer would) is a failed row; the
+    others finish. allowed-failures 0: the scheduler gives the task up after the first lost worker."""
+    import dask
+
+    from wormsim.sweep import runner
+
+    # a lambda is pickled by value (cloudpickle), so the worker runs this one; it calls the real run_point
+    dying = lambda sc, keep: os._exit(1) if sc["load"]["torque_nm"] > 1000 else real(sc, keep)  # noqa: E731
+    real = runner.run_point
+    monkeypatch.setattr(runner, "run_point", dying)
+    with dask.config.set({"distributed.scheduler.allowed-failures": 0}):
+        sw = load_sweep(SWEEP)
+        counts = runner.run_sweep(sw, tmp_path / "out", workers=2, progress=False)
+    assert counts["ok"] == 2 and counts["failed"] == 1
+    rows = _rows(tmp_path / "out")
+    assert [r["status"] for r in rows] == ["ok", "ok", "failed"]
+    assert rows[2]["message"].startswith("worker lost: KilledWorker")
