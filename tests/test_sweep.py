@@ -76,6 +76,14 @@ def test_points_are_validated_and_hashed():
     assert load_sweep(SWEEP).points[0].scenario_hash == sw.points[0].scenario_hash
 
 
+@pytest.mark.parametrize("path", sorted((ROOT / "sweeps").glob("*.yaml")), ids=lambda p: p.stem)
+def test_shipped_sweeps_validate(path):
+    """Every study in sweeps/ expands into valid points (they run for minutes, so CI only validates them)."""
+    sw = load_sweep(path)
+    assert sw.spec.name == path.stem and len(sw.points) >= 3
+    assert len({p.scenario_hash for p in sw.points}) == len(sw.points)
+
+
 BAD = {
     "bad_point": ("set: {model: torsional}\ngrid: {gear.wheel_teeth: [24, 5]}",
                   "point 1 (gear.wheel_teeth=5): gear.wheel_teeth = 5: Input should be greater than or equal to 10"),
