@@ -25,6 +25,10 @@ MAIN_OUTPUTS = {
     "S2_peak_n": ("S2 peak [N]", None),
     "efficiency_forward": ("efficiency forward", None),
 }
+# labels of other keys a sweep file's plot.outputs may name
+LABELS = {"tangential_force_max_n": "tangential force max (steady) [N]",
+          "startup_tangential_force_peak_n": "start-up tangential force peak [N]",
+          "worm_torque_mean_nm": "worm torque mean [N m]", "wheel_speed_fluctuation": "wheel speed fluctuation"}
 MAX_PANELS = 6
 MAX_LINES = 8
 
@@ -77,7 +81,7 @@ def write_sweep_png(rows: list[dict], swept: list[str], plot: Plot | None, path:
     nrow = math.ceil(n / ncol)
     fig, axes = plt.subplots(nrow, ncol, figsize=(5.2 * ncol, 3.6 * nrow), constrained_layout=True, squeeze=False)
     for ax, key in zip(axes.flat, keys):
-        label, theory = MAIN_OUTPUTS.get(key, (key, None))
+        label, theory = MAIN_OUTPUTS.get(key, (LABELS.get(key, key), None))
         if continuous:
             x = [xpos(r) for r in ok]
             y = [_num(r.get(key)) for r in ok]
