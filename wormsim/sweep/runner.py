@@ -243,7 +243,7 @@ def open_client(scheduler: str | None, workers: int | None):
         cluster, kind = None, "existing scheduler"
     else:
         n = workers or default_workers()
-        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
+        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0",
                                silence_logs=logging.ERROR)
         client = Client(cluster)
         kind = "LocalCluster (processes)"
