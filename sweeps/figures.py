@@ -35,34 +35,41 @@ def rows(runs: Path, name: str) -> list[dict]:
     return [{k: parse_value(v) for k, v in r.items()} for r in read_csv(src)]
 
 
+def _f(v) -> str:
+    return "-" if v is None else f"{v:.0f}"
+
+
 def screw_jack(runs: Path) -> None:
-    fig, axes = plt.subplots(1, 2, figsize=(12, 4.4), constrained_layout=True)
-    for ax, name, key, seed, xlabel in ((axes[0], "screw_jack_stiffness", "contact.stiffness_n_per_m", SEED_K, "K [N/m]"),
-                                        (axes[1], "screw_jack_speed", "drive.speed_rpm", SEED_N, "worm speed [rpm]")):
-        rs = [r for r in rows(runs, name) if r["status"] == "ok"]
-        if not rs:
-            continue
-        print(f"\n{name}\n| {xlabel} | seed mean / p2p / max [N] | ours F_t mean | F_t p2p | F_t max (steady) "
-              "| start-up peak | TE p2p [urad] | efficiency |\n| --- | --- | --- | --- | --- | --- | --- | --- |")
-        for r in rs:
-            s = seed.get(r[key])
-            print(f"| {r[key]:.4g} | {' / '.join(str(v) for v in s) if s else '-'} | {r['tangential_force_mean_n']:.1f} | "
-                  f"{r['tangential_force_p2p_n']:.0f} | {r['tangential_force_max_n']:.0f} | "
-                  f"{r['startup_tangential_force_peak_n']:.0f} | {r['transmission_error_p2p_urad']:.1f} | "
-                  f"{r['efficiency']:.3f} |")
-        x = [r[key] for r in rs]
+    fig, axes = plt.subplots(1, 2, figsize=(12, 4.6), constrained_layout=True)
+    panels = ((axes[0], "screw_jack_stiffness", "contact.stiffness_n_per_m", SEED_K, "K [N/m]"),
+              (axes[1], "screw_jack_speed", "drive.speed_rpm", SEED_N, "worm speed [rpm]"))
+    for ax, name, key, seed, xlabel in panels:
         sx = sorted(seed)
         ax.plot(sx, [seed[v][0] for v in sx], "s--", color="0.5", label="seed 002: mean")
         ax.plot(sx, [seed[v][2] for v in sx], "^--", color="0.3", label="seed 002: maximum (p2p alike)")
-        ax.plot(x, [r["tangential_force_mean_n"] for r in rs], "o-", label="ours: F_t mean")
-        ax.plot(x, [r["tangential_force_p2p_n"] for r in rs], "o-", label="ours: F_t p2p (steady)")
-        ax.plot(x, [r["tangential_force_max_n"] for r in rs], "o-", label="ours: F_t max (steady)")
-        ax.plot(x, [r["startup_tangential_force_peak_n"] for r in rs], "o-", label="ours: start-up peak")
+        for level, suffix, style in (("contact3d", "", "o-"), ("torsional", "_torsional", "x:")):
+            rs = [r for r in rows(runs, name + suffix) if r["status"] == "ok"]
+            if not rs:
+                continue
+            print(f"\n{name}{suffix}\n| {xlabel} | seed mean / p2p / max [N] | F_t mean | F_t p2p | F_t max (steady) "
+                  "| start-up peak | TE p2p [urad] | efficiency |\n| --- | --- | --- | --- | --- | --- | --- | --- |")
+            for r in rs:
+                s = seed.get(r[key])
+                print(f"| {r[key]:.4g} | {' / '.join(str(v) for v in s) if s else '-'} | "
+                      f"{r['tangential_force_mean_n']:.1f} | {r['tangential_force_p2p_n']:.3g} | "
+                      f"{_f(r.get('tangential_force_max_n'))} | {_f(r.get('startup_tangential_force_peak_n'))} | "
+                      f"{r['transmission_error_p2p_urad']:.1f} | {r['efficiency']:.3f} |")
+            x = [r[key] for r in rs]
+            for k, lab in (("tangential_force_mean_n", "F_t mean"), ("tangential_force_p2p_n", "F_t p2p"),
+                           ("tangential_force_max_n", "F_t max"), ("startup_tangential_force_peak_n", "start-up peak")):
+                y = [r.get(k) for r in rs]
+                if all(isinstance(v, float) for v in y):
+                    ax.plot(x, y, style, label=f"{level}: {lab}")
         ax.set_yscale("log")
         ax.set_xlabel(xlabel)
         ax.set_ylabel("tangential force on the wheel [N]")
         ax.grid(alpha=0.3, which="both")
-        ax.legend(fontsize=7)
+        ax.legend(fontsize=7, ncol=2)
     axes[0].set_title("seed 002 Table 3: contact stiffness (1330 rpm)")
     axes[1].set_title("seed 002 Table 4: worm speed (K 4.39e8 N/m)")
     fig.savefig(IMG / "sweep_screw_jack.png", dpi=100)
@@ -125,7 +132,7 @@ def resonance(runs: Path) -> None:
     for ax in axes:
         for h in range(1, 200):
             nh = 60 * fn / (z1 * h)
-            if min(n) <= nh <= max(n) and (h <= 20 or h % 10 == 0):
+            if min(n) <= nh <= max(n) and (h <= 20 or h in (30, 40, 50, 100)):
                 ax.axvline(nh, color="red", lw=0.6, alpha=0.5)
                 if ax is axes[0]:
                     ax.text(nh, 1.02, f"{h}", transform=ax.get_xaxis_transform(), ha="center", fontsize=6, color="red")
