@@ -1,4 +1,4 @@
-"""`wormsim` console script (INTERFACE.md): run, mesh, model, bench, schema, check.
+"""`wormsim` console script (INTERFACE.md): run, mesh, model, bench, sweep, schema, check.
 
 Exit codes: 0 ok, 2 invalid input (the message names the field), 3 the simulation failed
 (with a diagnosis), 1 an internal error (a bug: rerun with --debug for the traceback).
@@ -44,6 +44,14 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--scenario", action="append", default=None, dest="scenarios",
                    help="only this seed scenario (repeatable): seat_motor, screw_jack, involute_41")
     p.add_argument("--out", required=True)
+    p = sub.add_parser("sweep", help="parameter study on dask.distributed: sweep.csv, sweep.json, sweep.png; resumes")
+    p.add_argument("sweep", help="sweep YAML file")
+    p.add_argument("--out", required=True, help="output directory (rerun into it to resume)")
+    p.add_argument("--scheduler", help="address of an existing dask scheduler (default: $DASK_SCHEDULER_ADDRESS, "
+                   "else a local cluster)")
+    p.add_argument("--workers", type=int, help="local workers (default: one per core); with --scheduler: wait for them")
+    p.add_argument("--keep-runs", action="store_true", help="also write each point's result folder into DIR/runs/")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar or progress lines")
     p = sub.add_parser("schema", help="print the scenario JSON schema (for editors)")
     p.add_argument("--out", help="write to this file instead of stdout")
     p = sub.add_parser("check", help="validate a scenario and print it with defaults filled in")
@@ -93,6 +101,19 @@ def _cmd_bench(args) -> int:
     return EXIT_OK
 
 
+def _cmd_sweep(args) -> int:
+    from wormsim.sweep import load_sweep, run_sweep
+
+    sw = load_sweep(args.sweep)
+    c = run_sweep(sw, args.out, scheduler=args.scheduler, workers=args.workers, keep_runs=args.keep_runs,
+                  progress=False if args.no_progress else None)
+    out = Path(args.out)
+    print(f"sweep {sw.spec.name}: {c['points']} points: {c['ok']} ok, {c['failed']} failed "
+          f"({c['resumed']} done earlier, {c['ran']} run now)")
+    print(f"wrote {out / 'sweep.csv'}, {out / 'sweep.json'}, {out / 'sweep.png'}")
+    return EXIT_OK
+
+
 def _cmd_schema(args) -> int:
     text = json.dumps(json_schema(), indent=2)
     if args.out:
@@ -108,7 +129,7 @@ def _cmd_check(args) -> int:
     return EXIT_OK
 
 
-COMMANDS = {"run": _cmd_run, "mesh": _cmd_mesh, "model": _cmd_model, "bench": _cmd_bench,
+COMMANDS = {"run": _cmd_run, "mesh": _cmd_mesh, "model": _cmd_model, "bench": _cmd_bench, "sweep": _cmd_sweep,
             "schema": _cmd_schema, "check": _cmd_check}
 
 

@@ -305,18 +305,24 @@ def parse_override(text: str) -> tuple[list[str], Any]:
     return path, value
 
 
+def set_path(data: dict, path: list[str], value: Any, source: str) -> dict:
+    """data[path[0]][path[1]]... = value, creating missing blocks; `source` starts the error message."""
+    node = data
+    for i, key in enumerate(path[:-1]):
+        nxt = node.get(key)
+        if nxt is None:
+            nxt = node[key] = {}
+        if not isinstance(nxt, dict):
+            raise ScenarioError(f"{source}: '{'.'.join(path[:i + 1])}' is not a block")
+        node = nxt
+    node[path[-1]] = value
+    return data
+
+
 def apply_overrides(data: dict, overrides: list[str]) -> dict:
     for text in overrides:
         path, value = parse_override(text)
-        node = data
-        for i, key in enumerate(path[:-1]):
-            nxt = node.get(key)
-            if nxt is None:
-                nxt = node[key] = {}
-            if not isinstance(nxt, dict):
-                raise ScenarioError(f"--set {text}: '{'.'.join(path[:i + 1])}' is not a block")
-            node = nxt
-        node[path[-1]] = value
+        set_path(data, path, value, f"--set {text}")
     return data
 
 

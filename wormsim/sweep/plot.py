@@ -1,0 +1,120 @@
+"""sweep.png: the main outputs of the finished points against the first swept value, one line per value of a
+second swept path (a colour scale when it takes many values), theory dashed where the summary has it, failed
+points marked on the x axis."""
+from __future__ import annotations
+
+import math
+import os
+from pathlib import Path
+
+import numpy as np
+
+from wormsim.sweep.spec import Plot
+
+# summary key -> (axis label, theory key); the first six present are drawn
+MAIN_OUTPUTS = {
+    "tangential_force_mean_n": ("tangential force mean [N]", "tangential_force_theory_n"),
+    "tangential_force_p2p_n": ("tangential force p2p [N]", None),
+    "efficiency": ("efficiency", "efficiency_theory"),
+    "ratio": ("ratio", "ratio_theory"),
+    "transmission_error_p2p_urad": ("transmission error p2p [urad]", None),
+    "mesh_frequency_hz": ("meshing frequency [Hz]", "mesh_frequency_theory_hz"),
+    # wedge summaries (seed 000)
+    "speed_steady_m_s": ("steady speed [m/s]", None),
+    "S1_peak_n": ("S1 peak [N]", None),
+    "S2_peak_n": ("S2 peak [N]", None),
+    "efficiency_forward": ("efficiency forward", None),
+}
+# labels of other keys a sweep file's plot.outputs may name
+LABELS = {"tangential_force_max_n": "tangential force max (steady) [N]",
+          "startup_tangential_force_peak_n": "start-up tangential force peak [N]",
+          "worm_torque_mean_nm": "worm torque mean [N m]", "wheel_speed_fluctuation": "wheel speed fluctuation"}
+MAX_PANELS = 6
+MAX_LINES = 8
+
+
+def _num(v):
+    from wormsim.sweep.runner import parse_value
+
+    v = parse_value(v)
+    if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+        return None
+    return float(v)
+
+
+def _label(v) -> str:
+    return f"{v:.4g}" if isinstance(v, float) else str(v)
+
+
+def write_sweep_png(rows: list[dict], swept: list[str], plot: Plot | None, path: str | Path, title: str = "") -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from wormsim.sweep.runner import parse_value
+
+    plot = plot or Plot()
+    ok = [r for r in rows if r.get("status") == "ok"]
+    failed = [r for r in rows if r.get("status") != "ok"]
+    keys = plot.outputs or [k for k in MAIN_OUTPUTS if any(_num(r.get(k)) is not None for r in ok)]
+    keys = keys[:MAX_PANELS] or ["wall_time_s"]
+    xkey = plot.x or swept[0]
+    skey = plot.series or next((p for p in swept if p != xkey), None)
+    xs_all = [parse_value(r.get(xkey)) for r in rows]
+    numeric_x = all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in xs_all if x is not None)
+    cats = sorted({str(x) for x in xs_all}) if not numeric_x else []
+
+    def xpos(r):
+        x = parse_value(r.get(xkey))
+        return float(x) if numeric_x else float(cats.index(str(x)))
+
+    pos = [xpos(r) for r in rows]
+    log_x = plot.log_x if plot.log_x is not None else (
+        numeric_x and len(pos) > 1 and min(pos) > 0 and max(pos) / min(pos) > 50)
+    svals = [parse_value(r.get(skey)) for r in ok] if skey else []
+    groups = sorted(set(svals), key=lambda v: (isinstance(v, str), v)) if skey else [None]
+    continuous = skey is not None and len(groups) > MAX_LINES and all(isinstance(v, (int, float)) for v in groups)
+
+    n = len(keys)
+    ncol = 1 if n == 1 else 2 if n <= 4 else 3
+    nrow = math.ceil(n / ncol)
+    fig, axes = plt.subplots(nrow, ncol, figsize=(5.2 * ncol, 3.6 * nrow), constrained_layout=True, squeeze=False)
+    for ax, key in zip(axes.flat, keys):
+        label, theory = MAIN_OUTPUTS.get(key, (LABELS.get(key, key), None))
+        if continuous:
+            x = [xpos(r) for r in ok]
+            y = [_num(r.get(key)) for r in ok]
+            sc = ax.scatter(x, [np.nan if v is None else v for v in y], c=[float(v) for v in svals], s=14, cmap="viridis")
+            fig.colorbar(sc, ax=ax, label=skey)
+        else:
+            for g in groups:
+                sel = sorted((r for r in ok if not skey or parse_value(r.get(skey)) == g), key=xpos)
+                x = [xpos(r) for r in sel]
+                y = [_num(r.get(key)) for r in sel]
+                ax.plot(x, [np.nan if v is None else v for v in y], "o-", ms=3,
+                        label=f"{skey} = {_label(g)}" if skey else None)
+                if theory and any(_num(r.get(theory)) is not None for r in sel):
+                    yt = [_num(r.get(theory)) for r in sel]
+                    ax.plot(x, [np.nan if v is None else v for v in yt], "--", color=ax.lines[-1].get_color(),
+                            lw=1, label="theory" if g == groups[0] else None)
+        if failed:
+            ax.plot([xpos(r) for r in failed], [0.02] * len(failed), "x", color="red", ms=7,
+                    transform=ax.get_xaxis_transform(), clip_on=False, label=f"failed ({len(failed)})")
+        ax.set_xlabel(xkey)
+        ax.set_ylabel(label)
+        if log_x:
+            ax.set_xscale("log")
+        if not numeric_x:
+            ax.set_xticks(range(len(cats)), cats)
+        ax.grid(alpha=0.3)
+        if ax.get_legend_handles_labels()[0]:
+            ax.legend(fontsize=7)
+    for ax in list(axes.flat)[n:]:
+        ax.set_visible(False)
+    fig.suptitle(f"sweep {title}: {len(ok)} ok, {len(failed)} failed of {len(rows)} points")
+    path = Path(path)
+    tmp = path.with_name(f".{path.name}.tmp.png")
+    fig.savefig(tmp, dpi=100)
+    plt.close(fig)
+    os.replace(tmp, path)

@@ -1,0 +1,377 @@
+"""`wormsim sweep`: run a sweep's points on dask.distributed and write DIR/sweep.csv, sweep.json, sweep.png.
+
+Cluster: a LocalCluster of processes, one single-threaded worker per core (or `workers`), unless a scheduler
+address is given (`--scheduler`, or DASK_SCHEDULER_ADDRESS). Workers get the validated scenario and return the
+summary (and, with keep_runs, the result files as bytes) through the client, so they need the same wormsim
+installed but no shared file system.
+
+Rows are written as points finish (distributed.as_completed), each time by an atomic rewrite of sweep.csv, so an
+interrupted sweep leaves a consistent table of the finished points. Resume: a point whose scenario_hash already
+has an "ok" row in DIR/sweep.csv is not run again. A point that fails (SimulationError, a ScenarioError found
+during the build, an internal error, a lost worker) is a row with status "failed" and its message.
+"""
+from __future__ import annotations
+
+import csv
+import io
+import logging
+import os
+import platform
+import shutil
+import sys
+import tempfile
+import time
+from importlib import metadata
+from pathlib import Path
+
+from tqdm import tqdm
+
+from wormsim.output import ResultDir, write_json_atomic
+from wormsim.scenario import ScenarioError
+from wormsim.sweep.spec import Point, Sweep
+
+CSV_NAME, JSON_NAME, PNG_NAME, RUNS_DIR = "sweep.csv", "sweep.json", "sweep.png", "runs"
+SCHEDULER_ENV = "DASK_SCHEDULER_ADDRESS"
+CONNECT_TIMEOUT_S = 20.0        # to reach an existing scheduler
+WORKER_WAIT_S = 60.0            # for the first worker of an existing cluster
+_FIRST = ("point",)
+_AFTER_SWEPT = ("status", "message")
+_LAST = ("wall_time_s", "scenario_hash")
+_NOT_COLUMNS = {"status", "message", "wall_time_s"}
+
+
+# ----------------------------------------------------------------------------- on the worker
+
+def run_point(scenario: dict, keep_files: bool) -> dict:
+    """One point, on a worker: simulate (and with keep_files write the result folder into a temporary directory
+    and return its files). Never raises for a failed simulation: returns status "failed" and the message."""
+    t_start = time.time()
+    from wormsim.errors import SimulationError
+    from wormsim.run import run_scenario, simulate
+    from wormsim.scenario import Scenario
+
+    sc = Scenario.model_validate(scenario)
+    t_setup = time.time() - t_start
+    base = {"model": sc.model, "scenario": sc.name}
+    files: dict[str, bytes] = {}
+    t0 = time.perf_counter()
+    try:
+        if keep_files:
+            tmp = Path(tempfile.mkdtemp(prefix="wormsim-point-"))
+            try:
+                try:
+                    summary = run_scenario(sc, tmp, progress=False)
+                finally:
+                    files = {f.name: f.read_bytes() for f in tmp.iterdir() if f.is_file()}
+            finally:
+                shutil.rmtree(tmp, ignore_errors=True)
+        else:
+            res = simulate(sc)
+            summary = {"status": "ok", "message": "", **base, "wall_time_s": time.perf_counter() - t0,
+                       "sim_time_s": res.sim_time_s, "steps": res.steps, **res.summary}
+    except SimulationError as exc:
+        summary = {"status": "failed", "message": str(exc), **base, "wall_time_s": time.perf_counter() - t0}
+    except ScenarioError as exc:
+        summary = {"status": "failed", "message": f"invalid input: {exc}", **base,
+                   "wall_time_s": time.perf_counter() - t0}
+    except Exception as exc:  # noqa: BLE001  (a bug in one point must not stop the sweep)
+        summary = {"status": "failed", "message": f"internal error: {exc.__class__.__name__}: {exc}", **base,
+                   "wall_time_s": time.perf_counter() - t0}
+    return {"summary": summary, "files": files,
+            "timing": {"worker": _worker_name(), "start": t_start, "end": time.time(), "setup_s": t_setup}}
+
+
+def _worker_name() -> str:
+    try:
+        from distributed import get_worker
+
+        return str(get_worker().address)
+    except (ImportError, ValueError):
+        return "local"
+
+
+# ----------------------------------------------------------------------------- table
+
+def _scalar(v) -> bool:
+    return v is None or isinstance(v, (bool, int, float, str))
+
+
+def row_of(point: Point, summary: dict) -> dict:
+    row = {"point": point.index, **point.values, "status": summary.get("status", "failed"),
+           "message": summary.get("message", "")}
+    row.update({k: v for k, v in summary.items() if k not in _NOT_COLUMNS and _scalar(v)})
+    row["wall_time_s"] = summary.get("wall_time_s")
+    row["scenario_hash"] = point.scenario_hash
+    return row
+
+
+def columns(rows: list[dict], swept: list[str]) -> list[str]:
+    cols = [*_FIRST, *swept, *_AFTER_SWEPT]
+    seen = set(cols) | set(_LAST)
+    for r in rows:
+        for k in r:
+            if k not in seen:
+                seen.add(k)
+                cols.append(k)
+    return cols + list(_LAST)
+
+
+def write_csv_atomic(path: Path, rows: list[dict], cols: list[str]) -> None:
+    """The whole table into a temporary file beside `path`, then os.replace (as wormsim.output.write_json_atomic)."""
+    buf = io.StringIO()
+    w = csv.DictWriter(buf, fieldnames=cols, extrasaction="ignore", lineterminator="\n")
+    w.writeheader()
+    for r in rows:
+        w.writerow({k: ("" if r.get(k) is None else r.get(k)) for k in cols})
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
+    try:
+        with os.fdopen(fd, "w", newline="") as fh:
+            fh.write(buf.getvalue())
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def read_csv(path: Path) -> list[dict]:
+    """Rows of an earlier sweep.csv with values as text ("" for none); [] when there is none."""
+    if not path.is_file():
+        return []
+    with path.open(newline="") as fh:
+        return list(csv.DictReader(fh))
+
+
+def parse_value(text):
+    """A csv cell back to a number / bool / None where it is one."""
+    if not isinstance(text, str):
+        return text
+    if text == "":
+        return None
+    if text in ("True", "False"):
+        return text == "True"
+    for cast in (int, float):
+        try:
+            return cast(text)
+        except ValueError:
+            pass
+    return text
+
+
+# ----------------------------------------------------------------------------- progress
+
+class SweepProgress:
+    """Points done / total: a tqdm bar on a terminal; otherwise a log line per 10 % of the points (house style of
+    wormsim.progress; both off with WORMSIM_NO_PROGRESS)."""
+
+    def __init__(self, name: str, total: int, done: int, enabled: bool | None = None, stream=None):
+        self._stream = stream or sys.stderr
+        off = bool(os.environ.get("WORMSIM_NO_PROGRESS"))
+        tty = self._stream.isatty() if hasattr(self._stream, "isatty") else False
+        bar = bool(enabled) if enabled is not None else (tty and not off)
+        self._log = enabled is None and not tty and not off
+        self._bar = tqdm(total=total, initial=done, desc=f"sweep {name}", unit="point", disable=not bar,
+                         file=self._stream, leave=False)
+        self._name, self._total, self._done0, self._done, self._failed = name, total, done, done, 0
+        self._t0 = time.perf_counter()
+        self._next = 0.1
+
+    def say(self, text: str) -> None:
+        if self._log or not self._bar.disable:
+            tqdm.write(text, file=self._stream)
+
+    def point_done(self, failed: bool) -> None:
+        self._done += 1
+        self._failed += failed
+        self._bar.update(1)
+        frac = self._done / max(self._total, 1)
+        if self._log and (frac >= self._next or self._done == self._total):
+            wall = time.perf_counter() - self._t0
+            ran = self._done - self._done0
+            left = wall / ran * (self._total - self._done) if ran else 0.0
+            print(f"sweep {self._name}: {self._done}/{self._total} points done ({self._failed} failed), "
+                  f"{wall / 60:.1f} min elapsed, about {left / 60:.1f} min left", file=self._stream, flush=True)
+            while self._next <= frac:
+                self._next += 0.1
+
+    def close(self) -> None:
+        self._bar.close()
+
+
+# ----------------------------------------------------------------------------- cluster
+
+def machine_info() -> dict:
+    def ver(pkg):
+        try:
+            return metadata.version(pkg)
+        except metadata.PackageNotFoundError:
+            return None
+
+    return {"hostname": platform.node(), "platform": platform.platform(), "python": platform.python_version(),
+            "cpu_count": os.cpu_count(), "load_average": list(os.getloadavg()) if hasattr(os, "getloadavg") else None,
+            "versions": {p: ver(p) for p in ("wormsim", "dask", "distributed", "numpy", "scipy", "mujoco")}}
+
+
+def default_workers() -> int:
+    """One worker per core this process may use."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:
+        return max(1, os.cpu_count() or 1)
+
+
+def open_client(scheduler: str | None, workers: int | None):
+    """(client, cluster or None, info). scheduler None: a LocalCluster of `workers` single-threaded processes."""
+    from distributed import Client, LocalCluster
+
+    t0 = time.perf_counter()
+    if scheduler:
+        try:
+            client = Client(scheduler, timeout=CONNECT_TIMEOUT_S)
+        except (OSError, TimeoutError) as exc:
+            raise ScenarioError(f"--scheduler {scheduler}: no dask scheduler answered within {CONNECT_TIMEOUT_S:g} s "
+                                f"({exc.__class__.__name__}); start one with `dask scheduler` or leave "
+                                f"--scheduler and {SCHEDULER_ENV} unset for a local cluster") from None
+        try:
+            client.wait_for_workers(workers or 1, timeout=WORKER_WAIT_S)
+        except TimeoutError:
+            client.close()
+            raise ScenarioError(f"--scheduler {scheduler}: fewer than {workers or 1} workers connected within "
+                                f"{WORKER_WAIT_S:g} s (start them with `dask worker {scheduler}`)") from None
+        cluster, kind = None, "existing scheduler"
+    else:
+        n = workers or default_workers()
+        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0",
+                               silence_logs=logging.ERROR)
+        client = Client(cluster)
+        kind = "LocalCluster (processes)"
+    ws = client.scheduler_info().get("workers", {})
+    info = {"kind": kind, "scheduler": client.scheduler.address, "start_s": time.perf_counter() - t0,
+            "workers": len(ws), "threads": sum(w.get("nthreads", 0) for w in ws.values()),
+            "worker_list": [{"address": a, "nthreads": w.get("nthreads"), "memory_limit": w.get("memory_limit")}
+                            for a, w in ws.items()]}
+    return client, cluster, info
+
+
+# ----------------------------------------------------------------------------- the sweep
+
+def _run_dir_name(p: Point) -> str:
+    return f"p{p.index:04d}_{p.scenario_hash[:8]}"
+
+
+def _json_doc(sweep: Sweep, rows: dict, timing: dict, machine: dict, cluster: dict | None, state: dict) -> dict:
+    return {
+        "name": sweep.spec.name, "sweep_file": str(sweep.path), "base": str(sweep.base_path),
+        "sweep": sweep.raw, "swept_paths": sweep.swept_paths, **state,
+        "machine": machine, "cluster": cluster,
+        "points": [{"point": p.index, "values": p.values, "scenario_hash": p.scenario_hash,
+                    "status": rows[p.index]["status"] if p.index in rows else "not run",
+                    "timing": timing.get(p.index), "scenario": p.scenario.model_dump(mode="json")}
+                   for p in sweep.points],
+    }
+
+
+def run_sweep(sweep: Sweep, out_dir: str | Path, scheduler: str | None = None, workers: int | None = None,
+              keep_runs: bool = False, progress: bool | None = None) -> dict:
+    """Run (or resume) the sweep into out_dir. Returns counts {points, ok, failed, resumed, ran}.
+    KeyboardInterrupt propagates after sweep.csv / sweep.json hold the finished points."""
+    from wormsim.sweep.plot import write_sweep_png
+
+    if workers is not None and workers < 1:
+        raise ScenarioError(f"--workers {workers}: allowed an integer >= 1")
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    csv_path = out / CSV_NAME
+    swept = sweep.swept_paths
+    earlier = read_csv(csv_path)
+    ok_rows = {r.get("scenario_hash"): r for r in earlier if r.get("status") == "ok"}
+    rows: dict[int, dict] = {}
+    todo: list[Point] = []
+    for p in sweep.points:
+        old = ok_rows.get(p.scenario_hash)
+        if old is not None:
+            kept = {k: v for k, v in old.items() if "." not in k}    # dotted names: swept paths of that sweep
+            rows[p.index] = {**kept, "point": p.index, **p.values}
+        else:
+            todo.append(p)
+    resumed = len(rows)
+    machine = machine_info()
+    state = {"started": time.strftime("%Y-%m-%dT%H:%M:%S%z"), "finished": None, "interrupted": False,
+             "resumed_points": resumed, "keep_runs": keep_runs}
+    timing: dict[int, dict] = {}
+    bar = SweepProgress(sweep.spec.name, len(sweep.points), resumed, enabled=progress)
+    dropped = len({r.get("scenario_hash") for r in earlier} - {p.scenario_hash for p in sweep.points})
+    if dropped:
+        bar.say(f"sweep {sweep.spec.name}: {dropped} rows of {csv_path} belong to points no longer in this sweep "
+                f"and are left out of the new table")
+
+    def flush_csv():
+        ordered = [rows[i] for i in sorted(rows)]
+        write_csv_atomic(csv_path, ordered, columns(ordered, swept))
+
+    flush_csv()
+    client = cluster = cluster_info = None
+    interrupted = False
+    t_sweep = time.perf_counter()
+    try:
+        if todo:
+            scheduler = scheduler or os.environ.get(SCHEDULER_ENV) or None
+            client, cluster, cluster_info = open_client(scheduler, workers)
+            bar.say(f"sweep {sweep.spec.name}: {len(sweep.points)} points, {resumed} done earlier, {len(todo)} to run "
+                    f"on {cluster_info['workers']} workers ({cluster_info['kind']} {cluster_info['scheduler']})")
+            write_json_atomic(out / JSON_NAME, _json_doc(sweep, rows, timing, machine, cluster_info, state))
+            from distributed import as_completed
+
+            futures = {}
+            for p in todo:
+                fut = client.submit(run_point, p.scenario.model_dump(mode="json"), keep_runs, pure=False,
+                                    key=f"wormsim-point-{p.index}-{p.scenario_hash}")
+                futures[fut] = (p, time.time())
+            for fut in as_completed(list(futures)):
+                p, t_submit = futures[fut]
+                try:
+                    res = fut.result()
+                except Exception as exc:  # noqa: BLE001  (the worker died or the task could not run)
+                    res = {"summary": {"status": "failed", "wall_time_s": None, "model": p.scenario.model,
+                                       "message": f"worker lost: {exc.__class__.__name__}: {exc}"},
+                           "files": {}, "timing": None}
+                summary = res["summary"]
+                if keep_runs and res["files"]:
+                    _write_run_dir(out / RUNS_DIR / _run_dir_name(p), res["files"], summary)
+                rows[p.index] = row_of(p, summary)
+                timing[p.index] = {**(res["timing"] or {}), "submitted": t_submit, "received": time.time(),
+                                   "result_bytes": sum(len(b) for b in res["files"].values())}
+                flush_csv()
+                bar.point_done(summary.get("status") != "ok")
+    except KeyboardInterrupt:
+        interrupted = True
+    finally:
+        bar.close()
+        state.update(finished=time.strftime("%Y-%m-%dT%H:%M:%S%z"), interrupted=interrupted,
+                     wall_s=time.perf_counter() - t_sweep)
+        try:
+            if client is not None:
+                client.close()
+            if cluster is not None:
+                cluster.close()
+        except Exception:  # noqa: BLE001  (closing a cluster after Ctrl-C may fail; the tables are written)
+            pass
+        write_json_atomic(out / JSON_NAME, _json_doc(sweep, rows, timing, machine, cluster_info, state))
+        ordered = [rows[i] for i in sorted(rows)]
+        if not interrupted:
+            write_sweep_png(ordered, swept, sweep.spec.plot, out / PNG_NAME, title=sweep.spec.name)
+    if interrupted:
+        raise KeyboardInterrupt
+    n_ok = sum(1 for r in rows.values() if r.get("status") == "ok")
+    return {"points": len(sweep.points), "ok": n_ok, "failed": len(rows) - n_ok, "resumed": resumed,
+            "ran": len(todo), "cluster": cluster_info}
+
+
+def _write_run_dir(path: Path, files: dict[str, bytes], summary: dict) -> None:
+    rd = ResultDir(path)
+    for name, data in files.items():
+        if name != "summary.json":
+            rd.path(name).write_bytes(data)
+    (rd.commit if summary.get("status") == "ok" else rd.fail)(summary)
