@@ -11,7 +11,7 @@ DEMO   ?= scenarios/seat_motor_demo.yaml
 TYPED  := wormsim/__init__.py wormsim/scenario.py wormsim/run.py wormsim/result.py wormsim/errors.py \
           wormsim/gear_theory.py wormsim/cli.py wormsim/geometry.py
 # files held to `ruff format`; the rest follows once the parallel restructuring branches have merged
-FORMATTED := meshgen/cache.py wormsim/gear_theory.py wormsim/errors.py wormsim/geometry.py wormsim/mesh_cmd.py wormsim/__init__.py \
+FORMATTED := meshgen/cache.py wormsim/sweep/*.py sweeps/*.py tests/test_sweep.py wormsim/gear_theory.py wormsim/errors.py wormsim/geometry.py wormsim/mesh_cmd.py wormsim/__init__.py \
           wormsim/contact3d/window.py wormsim/contact3d/timestep.py tests/conftest.py tests/test_gear_theory.py \
           tests/test_packaging.py
 

@@ -5,6 +5,7 @@
 
 Copies each sweep.csv to docs/sweeps/NAME.csv, draws docs/img/sweep_*.png and prints the markdown tables.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -41,8 +42,10 @@ def _f(v) -> str:
 
 def screw_jack(runs: Path) -> None:
     fig, axes = plt.subplots(1, 2, figsize=(12, 4.6), constrained_layout=True)
-    panels = ((axes[0], "screw_jack_stiffness", "contact.stiffness_n_per_m", SEED_K, "K [N/m]"),
-              (axes[1], "screw_jack_speed", "drive.speed_rpm", SEED_N, "worm speed [rpm]"))
+    panels = (
+        (axes[0], "screw_jack_stiffness", "contact.stiffness_n_per_m", SEED_K, "K [N/m]"),
+        (axes[1], "screw_jack_speed", "drive.speed_rpm", SEED_N, "worm speed [rpm]"),
+    )
     for ax, name, key, seed, xlabel in panels:
         sx = sorted(seed)
         ax.plot(sx, [seed[v][0] for v in sx], "s--", color="0.5", label="seed 002: mean")
@@ -51,17 +54,25 @@ def screw_jack(runs: Path) -> None:
             rs = [r for r in rows(runs, name + suffix) if r["status"] == "ok"]
             if not rs:
                 continue
-            print(f"\n{name}{suffix}\n| {xlabel} | seed mean / p2p / max [N] | F_t mean | F_t p2p | F_t max (steady) "
-                  "| start-up peak | TE p2p [urad] | efficiency |\n| --- | --- | --- | --- | --- | --- | --- | --- |")
+            print(
+                f"\n{name}{suffix}\n| {xlabel} | seed mean / p2p / max [N] | F_t mean | F_t p2p | F_t max (steady) "
+                "| start-up peak | TE p2p [urad] | efficiency |\n| --- | --- | --- | --- | --- | --- | --- | --- |"
+            )
             for r in rs:
                 s = seed.get(r[key])
-                print(f"| {r[key]:.4g} | {' / '.join(str(v) for v in s) if s else '-'} | "
-                      f"{r['tangential_force_mean_n']:.1f} | {r['tangential_force_p2p_n']:.3g} | "
-                      f"{_f(r.get('tangential_force_max_n'))} | {_f(r.get('startup_tangential_force_peak_n'))} | "
-                      f"{r['transmission_error_p2p_urad']:.1f} | {r['efficiency']:.3f} |")
+                print(
+                    f"| {r[key]:.4g} | {' / '.join(str(v) for v in s) if s else '-'} | "
+                    f"{r['tangential_force_mean_n']:.1f} | {r['tangential_force_p2p_n']:.3g} | "
+                    f"{_f(r.get('tangential_force_max_n'))} | {_f(r.get('startup_tangential_force_peak_n'))} | "
+                    f"{r['transmission_error_p2p_urad']:.1f} | {r['efficiency']:.3f} |"
+                )
             x = [r[key] for r in rs]
-            for k, lab in (("tangential_force_mean_n", "F_t mean"), ("tangential_force_p2p_n", "F_t p2p"),
-                           ("tangential_force_max_n", "F_t max"), ("startup_tangential_force_peak_n", "start-up peak")):
+            for k, lab in (
+                ("tangential_force_mean_n", "F_t mean"),
+                ("tangential_force_p2p_n", "F_t p2p"),
+                ("tangential_force_max_n", "F_t max"),
+                ("startup_tangential_force_peak_n", "start-up peak"),
+            ):
                 y = [r.get(k) for r in rs]
                 if all(isinstance(v, float) for v in y):
                     ax.plot(x, y, style, label=f"{level}: {lab}")
@@ -140,8 +151,11 @@ def resonance(runs: Path) -> None:
         ax.grid(alpha=0.3, which="both")
         ax.set_xscale("log")
     axes[1].set_xlabel("worm speed [rpm]")
-    axes[0].set_title(f"screw jack, torsional: h x meshing frequency = mesh mode {fn:.0f} Hz at the red lines (h above); "
-                      "green: seed 002's speeds", fontsize=9)
+    axes[0].set_title(
+        f"screw jack, torsional: h x meshing frequency = mesh mode {fn:.0f} Hz at the red lines (h above); "
+        "green: seed 002's speeds",
+        fontsize=9,
+    )
     fig.savefig(IMG / "sweep_screw_jack_resonance.png", dpi=100)
     plt.close(fig)
 

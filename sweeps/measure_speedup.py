@@ -10,6 +10,7 @@ Overhead per point, from sweep.json's timing records (worker and client clocks a
 - model build: the torsional level's mesh stiffness (TCA, summary key mesh_stiffness_wall_s) per point, and the
   worker's first-task imports (first task's wall time minus the median of the others on that worker).
 """
+
 from __future__ import annotations
 
 import argparse
@@ -48,8 +49,10 @@ def overheads(out: Path) -> dict:
     transfer = [t["received"] - t["end"] for t in tim.values()]
     task = [t["end"] - t["start"] for t in tim.values()]
     return {
-        "sweep_wall_s": doc["wall_s"], "cluster_start_s": doc["cluster"]["start_s"],
-        "points": len(tim), "workers": doc["cluster"]["workers"],
+        "sweep_wall_s": doc["wall_s"],
+        "cluster_start_s": doc["cluster"]["start_s"],
+        "points": len(tim),
+        "workers": doc["cluster"]["workers"],
         "task_wall_median_s": statistics.median(task),
         "simulate_wall_median_s": statistics.median(r["wall_time_s"] for r in rows.values()),
         "solve_wall_median_s": statistics.median(r["solve_wall_s"] for r in rows.values()),
@@ -82,10 +85,12 @@ def main() -> None:
         res[n] = {"command_wall_s": time.perf_counter() - t0, **overheads(d)}
     rec = {
         "what": "8 torsional screw-jack points (0.3 s at 20 us steps, 1000-2400 rpm), LocalCluster, 1 then 2 workers",
-        "cpu_count": os.cpu_count(), "load_average_after": list(os.getloadavg()),
+        "cpu_count": os.cpu_count(),
+        "load_average_after": list(os.getloadavg()),
         "speedup_command": res[1]["command_wall_s"] / res[2]["command_wall_s"],
-        "speedup_excluding_cluster_start": ((res[1]["sweep_wall_s"] - res[1]["cluster_start_s"])
-                                            / (res[2]["sweep_wall_s"] - res[2]["cluster_start_s"])),
+        "speedup_excluding_cluster_start": (
+            (res[1]["sweep_wall_s"] - res[1]["cluster_start_s"]) / (res[2]["sweep_wall_s"] - res[2]["cluster_start_s"])
+        ),
         "runs": res,
     }
     (ROOT / "docs").mkdir(exist_ok=True)

@@ -1,6 +1,7 @@
 """`wormsim sweep` (INTERFACE.md, "Sweep file"): point expansion, validation (exit 2), a 2-worker LocalCluster, an
 external `dask scheduler` / `dask worker` pair, a failing point, resume after Ctrl-C. Points are torsional
 screw-jack runs of 0.12 s (about a second each)."""
+
 import csv
 import json
 import os
@@ -46,19 +47,23 @@ def _write(path: Path, text: str) -> Path:
 
 # ----------------------------------------------------------------------------- the sweep file
 
+
 def test_expand_grid_zip_random_in_order():
-    spec = SweepFile.model_validate({
-        "name": "t", "base": "x.yaml",
-        "grid": {"a.b": [1, 2], "c.d": {"linspace": [0.0, 1.0, 3]}},
-        "zip": {"e.f": [10, 20], "g.h": [30, 40]},
-        "random": {"n": 2, "seed": 7, "vary": {"i.j": {"uniform": [0.0, 1.0]}}},
-    })
+    spec = SweepFile.model_validate(
+        {
+            "name": "t",
+            "base": "x.yaml",
+            "grid": {"a.b": [1, 2], "c.d": {"linspace": [0.0, 1.0, 3]}},
+            "zip": {"e.f": [10, 20], "g.h": [30, 40]},
+            "random": {"n": 2, "seed": 7, "vary": {"i.j": {"uniform": [0.0, 1.0]}}},
+        }
+    )
     pts = expand(spec)
     assert len(pts) == 2 * 3 * 2 * 2
     assert pts[0] == {"a.b": 1, "c.d": 0.0, "e.f": 10, "g.h": 30, "i.j": pts[0]["i.j"]}
-    assert [p["c.d"] for p in pts[:12:4]] == [0.0, 0.5, 1.0]        # the last axes vary fastest
+    assert [p["c.d"] for p in pts[:12:4]] == [0.0, 0.5, 1.0]  # the last axes vary fastest
     assert {(p["e.f"], p["g.h"]) for p in pts} == {(10, 30), (20, 40)}  # zip: side by side, not crossed
-    assert pts == expand(spec)                                       # the seed fixes the draws
+    assert pts == expand(spec)  # the seed fixes the draws
     assert all(0.0 <= p["i.j"] <= 1.0 for p in pts)
     log = SweepFile.model_validate({"name": "t", "base": "x", "grid": {"a": {"logspace": [1.0e2, 1.0e4, 3]}}})
     assert [p["a"] for p in expand(log)] == pytest.approx([100.0, 1000.0, 10000.0])
@@ -69,7 +74,8 @@ def test_points_are_validated_and_hashed():
     assert [p.values for p in sw.points] == [
         {"contact.stiffness_n_per_m": 2.0e8, "load.torque_nm": 12},
         {"contact.stiffness_n_per_m": 6.0e8, "load.torque_nm": 12},
-        {"contact.stiffness_n_per_m": 4.39e8, "load.torque_nm": 30000}]
+        {"contact.stiffness_n_per_m": 4.39e8, "load.torque_nm": 30000},
+    ]
     assert all(p.scenario.model == "torsional" and p.scenario.simulation.duration_s == 0.12 for p in sw.points)
     assert sw.points[1].scenario.contact.stiffness_n_per_m == 6.0e8
     assert len({p.scenario_hash for p in sw.points}) == 3
@@ -85,18 +91,25 @@ def test_shipped_sweeps_validate(path):
 
 
 BAD = {
-    "bad_point": ("set: {model: torsional}\ngrid: {gear.wheel_teeth: [24, 5]}",
-                  "point 1 (gear.wheel_teeth=5): gear.wheel_teeth = 5: Input should be greater than or equal to 10"),
+    "bad_point": (
+        "set: {model: torsional}\ngrid: {gear.wheel_teeth: [24, 5]}",
+        "point 1 (gear.wheel_teeth=5): gear.wheel_teeth = 5: Input should be greater than or equal to 10",
+    ),
     "unknown_path": ("grid: {contact.stifness_n_per_m: [1.0e8]}", "unknown key 'contact.stifness_n_per_m'"),
     "not_a_block": ("grid: {gear.wheel_teeth.x: [1]}", "'gear.wheel_teeth' is not a block"),
-    "linspace_short": ("grid: {drive.speed_rpm: {linspace: [1, 2]}}", "grid.drive.speed_rpm.linspace = [1, 2]: expected [a, b, n]"),
+    "linspace_short": (
+        "grid: {drive.speed_rpm: {linspace: [1, 2]}}",
+        "grid.drive.speed_rpm.linspace = [1, 2]: expected [a, b, n]",
+    ),
     "logspace_zero": ("grid: {drive.speed_rpm: {logspace: [0, 2, 3]}}", "must be > 0"),
     "scalar_axis": ("grid: {drive.speed_rpm: 5}", "grid.drive.speed_rpm = 5: expected a list of values"),
     "zip_lengths": ("zip: {drive.speed_rpm: [1, 2], load.torque_nm: [1]}", "zip: every path needs the same number"),
     "swept_and_set": ("set: {drive.speed_rpm: 3}\ngrid: {drive.speed_rpm: [1]}", "a path may be swept once"),
     "no_axes": ("set: {drive.speed_rpm: 3}", "at least one of grid / zip / random"),
-    "bad_distribution": ("random: {n: 3, vary: {drive.speed_rpm: {gauss: [1, 2]}}}",
-                         "random.vary.drive.speed_rpm = {'gauss': [1, 2]}: expected {uniform"),
+    "bad_distribution": (
+        "random: {n: 3, vary: {drive.speed_rpm: {gauss: [1, 2]}}}",
+        "random.vary.drive.speed_rpm = {'gauss': [1, 2]}: expected {uniform",
+    ),
     "unknown_top_key": ("grids: {drive.speed_rpm: [1]}", "unknown key 'grids'"),
     "missing_base": ("grid: {drive.speed_rpm: [1]}", "base = nope.yaml: no such scenario file"),
 }
@@ -111,10 +124,11 @@ def test_invalid_sweep_file_exits_2_naming_the_field(case, tmp_path, capsys):
     assert cli.main(["sweep", str(f), "--out", str(out)]) == 2
     err = capsys.readouterr().err
     assert expected in err and "Traceback" not in err
-    assert not out.exists()                      # nothing ran
+    assert not out.exists()  # nothing ran
 
 
 # ----------------------------------------------------------------------------- running
+
 
 @pytest.fixture(scope="module")
 def local_run(tmp_path_factory):
@@ -130,14 +144,14 @@ def local_run(tmp_path_factory):
 
 def test_local_cluster_two_workers_with_a_failing_point(local_run):
     code, out = local_run
-    assert code == 0                                            # the sweep ran; the failed point is a row
+    assert code == 0  # the sweep ran; the failed point is a row
     head = _header(out)
     assert head[:5] == ["point", "contact.stiffness_n_per_m", "load.torque_nm", "status", "message"]
     assert head[-2:] == ["wall_time_s", "scenario_hash"]
     rows = _rows(out)
     assert [r["status"] for r in rows] == ["ok", "ok", "failed"]
     assert "teeth would skip" in rows[2]["message"]
-    for r in rows[:2]:      # under a fixed load torque the mean tangential force is T2 / r2 = 12 N m / 30 mm
+    for r in rows[:2]:  # under a fixed load torque the mean tangential force is T2 / r2 = 12 N m / 30 mm
         assert float(r["tangential_force_mean_n"]) == pytest.approx(400.0, rel=1e-4)
         assert float(r["contact.stiffness_n_per_m"]) in (2.0e8, 6.0e8)
     doc = json.loads((out / "sweep.json").read_text())
@@ -146,9 +160,9 @@ def test_local_cluster_two_workers_with_a_failing_point(local_run):
     assert [p["status"] for p in doc["points"]] == ["ok", "ok", "failed"]
     assert doc["points"][1]["scenario"]["contact"]["stiffness_n_per_m"] == 6.0e8
     assert doc["sweep"]["name"] == "test_torsional" and doc["machine"]["cpu_count"] >= 1
-    assert len({p["timing"]["worker"] for p in doc["points"]}) == 2      # both workers took points
+    assert len({p["timing"]["worker"] for p in doc["points"]}) == 2  # both workers took points
     assert (out / "sweep.png").stat().st_size > 10_000
-    assert not (out / "runs").exists()                          # per-point folders only with --keep-runs
+    assert not (out / "runs").exists()  # per-point folders only with --keep-runs
 
 
 def _start(args: list[str], log: Path) -> subprocess.Popen:
@@ -169,8 +183,20 @@ def _stop(proc: subprocess.Popen) -> None:
 def test_external_scheduler_gives_the_same_table(local_run, tmp_path, capsys):
     _, local = local_run
     sched_file = tmp_path / "scheduler.json"
-    sched = _start([str(BIN / "dask"), "scheduler", "--host", "127.0.0.1", "--port", "0", "--no-dashboard",
-                    "--scheduler-file", str(sched_file)], tmp_path / "scheduler.log")
+    sched = _start(
+        [
+            str(BIN / "dask"),
+            "scheduler",
+            "--host",
+            "127.0.0.1",
+            "--port",
+            "0",
+            "--no-dashboard",
+            "--scheduler-file",
+            str(sched_file),
+        ],
+        tmp_path / "scheduler.log",
+    )
     worker = None
     try:
         t0 = time.monotonic()
@@ -179,11 +205,25 @@ def test_external_scheduler_gives_the_same_table(local_run, tmp_path, capsys):
         assert sched_file.exists(), (tmp_path / "scheduler.log").read_text()
         address = json.loads(sched_file.read_text())["address"]
         assert address.startswith("tcp://127.0.0.1:")
-        worker = _start([str(BIN / "dask"), "worker", address, "--nthreads", "1", "--nworkers", "1",
-                         "--no-dashboard", "--host", "127.0.0.1"], tmp_path / "worker.log")
+        worker = _start(
+            [
+                str(BIN / "dask"),
+                "worker",
+                address,
+                "--nthreads",
+                "1",
+                "--nworkers",
+                "1",
+                "--no-dashboard",
+                "--host",
+                "127.0.0.1",
+            ],
+            tmp_path / "worker.log",
+        )
         out = tmp_path / "remote"
-        code = cli.main(["sweep", str(SWEEP), "--out", str(out), "--scheduler", address, "--keep-runs",
-                         "--no-progress"])
+        code = cli.main(
+            ["sweep", str(SWEEP), "--out", str(out), "--scheduler", address, "--keep-runs", "--no-progress"]
+        )
         assert code == 0, capsys.readouterr().err
     finally:
         for p in (worker, sched):
@@ -205,20 +245,29 @@ def test_external_scheduler_gives_the_same_table(local_run, tmp_path, capsys):
 
 
 def test_resume_after_ctrl_c_skips_finished_points(tmp_path, capsys):
-    sweep = _write(tmp_path / "resume.yaml", (
-        f"name: resume\nbase: {SCREW_JACK}\nset: {{model: torsional, simulation.duration_s: 0.12}}\n"
-        "grid: {drive.speed_rpm: {linspace: [1000, 1500, 6]}}\n"))
+    sweep = _write(
+        tmp_path / "resume.yaml",
+        (
+            f"name: resume\nbase: {SCREW_JACK}\nset: {{model: torsional, simulation.duration_s: 0.12}}\n"
+            "grid: {drive.speed_rpm: {linspace: [1000, 1500, 6]}}\n"
+        ),
+    )
     out = tmp_path / "out"
     env = {**os.environ, "WORMSIM_NO_PROGRESS": "1"}
-    proc = subprocess.Popen([str(BIN / "wormsim"), "sweep", str(sweep), "--out", str(out), "--workers", "1"],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+    proc = subprocess.Popen(
+        [str(BIN / "wormsim"), "sweep", str(sweep), "--out", str(out), "--workers", "1"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=env,
+    )
     try:
         t0 = time.monotonic()
         while time.monotonic() - t0 < 120 and proc.poll() is None:
             if (out / "sweep.csv").exists() and len(_rows(out)) >= 2:
                 break
             time.sleep(0.05)
-        proc.send_signal(signal.SIGINT)                 # Ctrl-C
+        proc.send_signal(signal.SIGINT)  # Ctrl-C
         _, err = proc.communicate(timeout=60)
     finally:
         if proc.poll() is None:
@@ -229,13 +278,13 @@ def test_resume_after_ctrl_c_skips_finished_points(tmp_path, capsys):
     assert 2 <= len(first) < 6, "the sweep should have been interrupted midway"
     assert all(r["status"] == "ok" for r in first)
     assert json.loads((out / "sweep.json").read_text())["interrupted"] is True
-    assert not [f for f in out.iterdir() if f.name.startswith(".")]       # no temporary files left
+    assert not [f for f in out.iterdir() if f.name.startswith(".")]  # no temporary files left
 
     assert cli.main(["sweep", str(sweep), "--out", str(out), "--workers", "2", "--no-progress"]) == 0
     assert f"({len(first)} done earlier, {6 - len(first)} run now)" in capsys.readouterr().out
     rows = _rows(out)
     assert [int(r["point"]) for r in rows] == list(range(6)) and all(r["status"] == "ok" for r in rows)
-    for r in first:                                      # the finished points were not run again
+    for r in first:  # the finished points were not run again
         assert rows[int(r["point"])]["wall_time_s"] == r["wall_time_s"]
     assert [float(r["drive.speed_rpm"]) for r in rows] == pytest.approx([1000, 1100, 1200, 1300, 1400, 1500])
     # a third run has nothing to do and starts no cluster

@@ -1,5 +1,6 @@
 """Parameter sweeps on dask.distributed (`wormsim sweep`): spec (the sweep file and its points), runner (the
 cluster, resume, sweep.csv / sweep.json), plot (sweep.png)."""
+
 from wormsim.sweep.runner import run_sweep
 from wormsim.sweep.spec import Point, Sweep, SweepFile, load_sweep
 

@@ -1,6 +1,7 @@
 """sweep.png: the main outputs of the finished points against the first swept value, one line per value of a
 second swept path (a colour scale when it takes many values), theory dashed where the summary has it, failed
 points marked on the x axis."""
+
 from __future__ import annotations
 
 import math
@@ -26,9 +27,12 @@ MAIN_OUTPUTS = {
     "efficiency_forward": ("efficiency forward", None),
 }
 # labels of other keys a sweep file's plot.outputs may name
-LABELS = {"tangential_force_max_n": "tangential force max (steady) [N]",
-          "startup_tangential_force_peak_n": "start-up tangential force peak [N]",
-          "worm_torque_mean_nm": "worm torque mean [N m]", "wheel_speed_fluctuation": "wheel speed fluctuation"}
+LABELS = {
+    "tangential_force_max_n": "tangential force max (steady) [N]",
+    "startup_tangential_force_peak_n": "start-up tangential force peak [N]",
+    "worm_torque_mean_nm": "worm torque mean [N m]",
+    "wheel_speed_fluctuation": "wheel speed fluctuation",
+}
 MAX_PANELS = 6
 MAX_LINES = 8
 
@@ -70,8 +74,11 @@ def write_sweep_png(rows: list[dict], swept: list[str], plot: Plot | None, path:
         return float(x) if numeric_x else float(cats.index(str(x)))
 
     pos = [xpos(r) for r in rows]
-    log_x = plot.log_x if plot.log_x is not None else (
-        numeric_x and len(pos) > 1 and min(pos) > 0 and max(pos) / min(pos) > 50)
+    log_x = (
+        plot.log_x
+        if plot.log_x is not None
+        else (numeric_x and len(pos) > 1 and min(pos) > 0 and max(pos) / min(pos) > 50)
+    )
     svals = [parse_value(r.get(skey)) for r in ok] if skey else []
     groups = sorted(set(svals), key=lambda v: (isinstance(v, str), v)) if skey else [None]
     continuous = skey is not None and len(groups) > MAX_LINES and all(isinstance(v, (int, float)) for v in groups)
@@ -85,22 +92,43 @@ def write_sweep_png(rows: list[dict], swept: list[str], plot: Plot | None, path:
         if continuous:
             x = [xpos(r) for r in ok]
             y = [_num(r.get(key)) for r in ok]
-            sc = ax.scatter(x, [np.nan if v is None else v for v in y], c=[float(v) for v in svals], s=14, cmap="viridis")
+            sc = ax.scatter(
+                x, [np.nan if v is None else v for v in y], c=[float(v) for v in svals], s=14, cmap="viridis"
+            )
             fig.colorbar(sc, ax=ax, label=skey)
         else:
             for g in groups:
                 sel = sorted((r for r in ok if not skey or parse_value(r.get(skey)) == g), key=xpos)
                 x = [xpos(r) for r in sel]
                 y = [_num(r.get(key)) for r in sel]
-                ax.plot(x, [np.nan if v is None else v for v in y], "o-", ms=3,
-                        label=f"{skey} = {_label(g)}" if skey else None)
+                ax.plot(
+                    x,
+                    [np.nan if v is None else v for v in y],
+                    "o-",
+                    ms=3,
+                    label=f"{skey} = {_label(g)}" if skey else None,
+                )
                 if theory and any(_num(r.get(theory)) is not None for r in sel):
                     yt = [_num(r.get(theory)) for r in sel]
-                    ax.plot(x, [np.nan if v is None else v for v in yt], "--", color=ax.lines[-1].get_color(),
-                            lw=1, label="theory" if g == groups[0] else None)
+                    ax.plot(
+                        x,
+                        [np.nan if v is None else v for v in yt],
+                        "--",
+                        color=ax.lines[-1].get_color(),
+                        lw=1,
+                        label="theory" if g == groups[0] else None,
+                    )
         if failed:
-            ax.plot([xpos(r) for r in failed], [0.02] * len(failed), "x", color="red", ms=7,
-                    transform=ax.get_xaxis_transform(), clip_on=False, label=f"failed ({len(failed)})")
+            ax.plot(
+                [xpos(r) for r in failed],
+                [0.02] * len(failed),
+                "x",
+                color="red",
+                ms=7,
+                transform=ax.get_xaxis_transform(),
+                clip_on=False,
+                label=f"failed ({len(failed)})",
+            )
         ax.set_xlabel(xkey)
         ax.set_ylabel(label)
         if log_x:

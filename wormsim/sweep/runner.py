@@ -10,6 +10,7 @@ interrupted sweep leaves a consistent table of the finished points. Resume: a po
 has an "ok" row in DIR/sweep.csv is not run again. A point that fails (SimulationError, a ScenarioError found
 during the build, an internal error, a lost worker) is a row with status "failed" and its message.
 """
+
 from __future__ import annotations
 
 import csv
@@ -32,8 +33,8 @@ from wormsim.sweep.spec import Point, Sweep
 
 CSV_NAME, JSON_NAME, PNG_NAME, RUNS_DIR = "sweep.csv", "sweep.json", "sweep.png", "runs"
 SCHEDULER_ENV = "DASK_SCHEDULER_ADDRESS"
-CONNECT_TIMEOUT_S = 20.0        # to reach an existing scheduler
-WORKER_WAIT_S = 60.0            # for the first worker of an existing cluster
+CONNECT_TIMEOUT_S = 20.0  # to reach an existing scheduler
+WORKER_WAIT_S = 60.0  # for the first worker of an existing cluster
 _FIRST = ("point",)
 _AFTER_SWEPT = ("status", "message")
 _LAST = ("wall_time_s", "scenario_hash")
@@ -41,6 +42,7 @@ _NOT_COLUMNS = {"status", "message", "wall_time_s"}
 
 
 # ----------------------------------------------------------------------------- on the worker
+
 
 def run_point(scenario: dict, keep_files: bool) -> dict:
     """One point, on a worker: simulate (and with keep_files write the result folder into a temporary directory
@@ -67,18 +69,36 @@ def run_point(scenario: dict, keep_files: bool) -> dict:
                 shutil.rmtree(tmp, ignore_errors=True)
         else:
             res = simulate(sc)
-            summary = {"status": "ok", "message": "", **base, "wall_time_s": time.perf_counter() - t0,
-                       "sim_time_s": res.sim_time_s, "steps": res.steps, **res.summary}
+            summary = {
+                "status": "ok",
+                "message": "",
+                **base,
+                "wall_time_s": time.perf_counter() - t0,
+                "sim_time_s": res.sim_time_s,
+                "steps": res.steps,
+                **res.summary,
+            }
     except SimulationError as exc:
         summary = {"status": "failed", "message": str(exc), **base, "wall_time_s": time.perf_counter() - t0}
     except ScenarioError as exc:
-        summary = {"status": "failed", "message": f"invalid input: {exc}", **base,
-                   "wall_time_s": time.perf_counter() - t0}
+        summary = {
+            "status": "failed",
+            "message": f"invalid input: {exc}",
+            **base,
+            "wall_time_s": time.perf_counter() - t0,
+        }
     except Exception as exc:  # noqa: BLE001  (a bug in one point must not stop the sweep)
-        summary = {"status": "failed", "message": f"internal error: {exc.__class__.__name__}: {exc}", **base,
-                   "wall_time_s": time.perf_counter() - t0}
-    return {"summary": summary, "files": files,
-            "timing": {"worker": _worker_name(), "start": t_start, "end": time.time(), "setup_s": t_setup}}
+        summary = {
+            "status": "failed",
+            "message": f"internal error: {exc.__class__.__name__}: {exc}",
+            **base,
+            "wall_time_s": time.perf_counter() - t0,
+        }
+    return {
+        "summary": summary,
+        "files": files,
+        "timing": {"worker": _worker_name(), "start": t_start, "end": time.time(), "setup_s": t_setup},
+    }
 
 
 def _worker_name() -> str:
@@ -92,13 +112,18 @@ def _worker_name() -> str:
 
 # ----------------------------------------------------------------------------- table
 
+
 def _scalar(v) -> bool:
     return v is None or isinstance(v, (bool, int, float, str))
 
 
 def row_of(point: Point, summary: dict) -> dict:
-    row = {"point": point.index, **point.values, "status": summary.get("status", "failed"),
-           "message": summary.get("message", "")}
+    row = {
+        "point": point.index,
+        **point.values,
+        "status": summary.get("status", "failed"),
+        "message": summary.get("message", ""),
+    }
     row.update({k: v for k, v in summary.items() if k not in _NOT_COLUMNS and _scalar(v)})
     row["wall_time_s"] = summary.get("wall_time_s")
     row["scenario_hash"] = point.scenario_hash
@@ -162,6 +187,7 @@ def parse_value(text):
 
 # ----------------------------------------------------------------------------- progress
 
+
 class SweepProgress:
     """Points done / total: a tqdm bar on a terminal; otherwise a log line per 10 % of the points (house style of
     wormsim.progress; both off with WORMSIM_NO_PROGRESS)."""
@@ -172,8 +198,15 @@ class SweepProgress:
         tty = self._stream.isatty() if hasattr(self._stream, "isatty") else False
         bar = bool(enabled) if enabled is not None else (tty and not off)
         self._log = enabled is None and not tty and not off
-        self._bar = tqdm(total=total, initial=done, desc=f"sweep {name}", unit="point", disable=not bar,
-                         file=self._stream, leave=False)
+        self._bar = tqdm(
+            total=total,
+            initial=done,
+            desc=f"sweep {name}",
+            unit="point",
+            disable=not bar,
+            file=self._stream,
+            leave=False,
+        )
         self._name, self._total, self._done0, self._done, self._failed = name, total, done, done, 0
         self._t0 = time.perf_counter()
         self._next = 0.1
@@ -191,8 +224,12 @@ class SweepProgress:
             wall = time.perf_counter() - self._t0
             ran = self._done - self._done0
             left = wall / ran * (self._total - self._done) if ran else 0.0
-            print(f"sweep {self._name}: {self._done}/{self._total} points done ({self._failed} failed), "
-                  f"{wall / 60:.1f} min elapsed, about {left / 60:.1f} min left", file=self._stream, flush=True)
+            print(
+                f"sweep {self._name}: {self._done}/{self._total} points done ({self._failed} failed), "
+                f"{wall / 60:.1f} min elapsed, about {left / 60:.1f} min left",
+                file=self._stream,
+                flush=True,
+            )
             while self._next <= frac:
                 self._next += 0.1
 
@@ -202,6 +239,7 @@ class SweepProgress:
 
 # ----------------------------------------------------------------------------- cluster
 
+
 def machine_info() -> dict:
     def ver(pkg):
         try:
@@ -209,9 +247,14 @@ def machine_info() -> dict:
         except metadata.PackageNotFoundError:
             return None
 
-    return {"hostname": platform.node(), "platform": platform.platform(), "python": platform.python_version(),
-            "cpu_count": os.cpu_count(), "load_average": list(os.getloadavg()) if hasattr(os, "getloadavg") else None,
-            "versions": {p: ver(p) for p in ("wormsim", "dask", "distributed", "numpy", "scipy", "mujoco")}}
+    return {
+        "hostname": platform.node(),
+        "platform": platform.platform(),
+        "python": platform.python_version(),
+        "cpu_count": os.cpu_count(),
+        "load_average": list(os.getloadavg()) if hasattr(os, "getloadavg") else None,
+        "versions": {p: ver(p) for p in ("wormsim", "dask", "distributed", "numpy", "scipy", "mujoco")},
+    }
 
 
 def default_workers() -> int:
@@ -231,31 +274,43 @@ def open_client(scheduler: str | None, workers: int | None):
         try:
             client = Client(scheduler, timeout=CONNECT_TIMEOUT_S)
         except (OSError, TimeoutError) as exc:
-            raise ScenarioError(f"--scheduler {scheduler}: no dask scheduler answered within {CONNECT_TIMEOUT_S:g} s "
-                                f"({exc.__class__.__name__}); start one with `dask scheduler` or leave "
-                                f"--scheduler and {SCHEDULER_ENV} unset for a local cluster") from None
+            raise ScenarioError(
+                f"--scheduler {scheduler}: no dask scheduler answered within {CONNECT_TIMEOUT_S:g} s "
+                f"({exc.__class__.__name__}); start one with `dask scheduler` or leave "
+                f"--scheduler and {SCHEDULER_ENV} unset for a local cluster"
+            ) from None
         try:
             client.wait_for_workers(workers or 1, timeout=WORKER_WAIT_S)
         except TimeoutError:
             client.close()
-            raise ScenarioError(f"--scheduler {scheduler}: fewer than {workers or 1} workers connected within "
-                                f"{WORKER_WAIT_S:g} s (start them with `dask worker {scheduler}`)") from None
+            raise ScenarioError(
+                f"--scheduler {scheduler}: fewer than {workers or 1} workers connected within "
+                f"{WORKER_WAIT_S:g} s (start them with `dask worker {scheduler}`)"
+            ) from None
         cluster, kind = None, "existing scheduler"
     else:
         n = workers or default_workers()
-        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0",
-                               silence_logs=logging.ERROR)
+        cluster = LocalCluster(
+            n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0", silence_logs=logging.ERROR
+        )
         client = Client(cluster)
         kind = "LocalCluster (processes)"
     ws = client.scheduler_info().get("workers", {})
-    info = {"kind": kind, "scheduler": client.scheduler.address, "start_s": time.perf_counter() - t0,
-            "workers": len(ws), "threads": sum(w.get("nthreads", 0) for w in ws.values()),
-            "worker_list": [{"address": a, "nthreads": w.get("nthreads"), "memory_limit": w.get("memory_limit")}
-                            for a, w in ws.items()]}
+    info = {
+        "kind": kind,
+        "scheduler": client.scheduler.address,
+        "start_s": time.perf_counter() - t0,
+        "workers": len(ws),
+        "threads": sum(w.get("nthreads", 0) for w in ws.values()),
+        "worker_list": [
+            {"address": a, "nthreads": w.get("nthreads"), "memory_limit": w.get("memory_limit")} for a, w in ws.items()
+        ],
+    }
     return client, cluster, info
 
 
 # ----------------------------------------------------------------------------- the sweep
+
 
 def _run_dir_name(p: Point) -> str:
     return f"p{p.index:04d}_{p.scenario_hash[:8]}"
@@ -263,18 +318,36 @@ def _run_dir_name(p: Point) -> str:
 
 def _json_doc(sweep: Sweep, rows: dict, timing: dict, machine: dict, cluster: dict | None, state: dict) -> dict:
     return {
-        "name": sweep.spec.name, "sweep_file": str(sweep.path), "base": str(sweep.base_path),
-        "sweep": sweep.raw, "swept_paths": sweep.swept_paths, **state,
-        "machine": machine, "cluster": cluster,
-        "points": [{"point": p.index, "values": p.values, "scenario_hash": p.scenario_hash,
-                    "status": rows[p.index]["status"] if p.index in rows else "not run",
-                    "timing": timing.get(p.index), "scenario": p.scenario.model_dump(mode="json")}
-                   for p in sweep.points],
+        "name": sweep.spec.name,
+        "sweep_file": str(sweep.path),
+        "base": str(sweep.base_path),
+        "sweep": sweep.raw,
+        "swept_paths": sweep.swept_paths,
+        **state,
+        "machine": machine,
+        "cluster": cluster,
+        "points": [
+            {
+                "point": p.index,
+                "values": p.values,
+                "scenario_hash": p.scenario_hash,
+                "status": rows[p.index]["status"] if p.index in rows else "not run",
+                "timing": timing.get(p.index),
+                "scenario": p.scenario.model_dump(mode="json"),
+            }
+            for p in sweep.points
+        ],
     }
 
 
-def run_sweep(sweep: Sweep, out_dir: str | Path, scheduler: str | None = None, workers: int | None = None,
-              keep_runs: bool = False, progress: bool | None = None) -> dict:
+def run_sweep(
+    sweep: Sweep,
+    out_dir: str | Path,
+    scheduler: str | None = None,
+    workers: int | None = None,
+    keep_runs: bool = False,
+    progress: bool | None = None,
+) -> dict:
     """Run (or resume) the sweep into out_dir. Returns counts {points, ok, failed, resumed, ran}.
     KeyboardInterrupt propagates after sweep.csv / sweep.json hold the finished points."""
     from wormsim.sweep.plot import write_sweep_png
@@ -292,20 +365,27 @@ def run_sweep(sweep: Sweep, out_dir: str | Path, scheduler: str | None = None, w
     for p in sweep.points:
         old = ok_rows.get(p.scenario_hash)
         if old is not None:
-            kept = {k: v for k, v in old.items() if "." not in k}    # dotted names: swept paths of that sweep
+            kept = {k: v for k, v in old.items() if "." not in k}  # dotted names: swept paths of that sweep
             rows[p.index] = {**kept, "point": p.index, **p.values}
         else:
             todo.append(p)
     resumed = len(rows)
     machine = machine_info()
-    state = {"started": time.strftime("%Y-%m-%dT%H:%M:%S%z"), "finished": None, "interrupted": False,
-             "resumed_points": resumed, "keep_runs": keep_runs}
+    state = {
+        "started": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
+        "finished": None,
+        "interrupted": False,
+        "resumed_points": resumed,
+        "keep_runs": keep_runs,
+    }
     timing: dict[int, dict] = {}
     bar = SweepProgress(sweep.spec.name, len(sweep.points), resumed, enabled=progress)
     dropped = len({r.get("scenario_hash") for r in earlier} - {p.scenario_hash for p in sweep.points})
     if dropped:
-        bar.say(f"sweep {sweep.spec.name}: {dropped} rows of {csv_path} belong to points no longer in this sweep "
-                f"and are left out of the new table")
+        bar.say(
+            f"sweep {sweep.spec.name}: {dropped} rows of {csv_path} belong to points no longer in this sweep "
+            f"and are left out of the new table"
+        )
 
     def flush_csv():
         ordered = [rows[i] for i in sorted(rows)]
@@ -319,38 +399,57 @@ def run_sweep(sweep: Sweep, out_dir: str | Path, scheduler: str | None = None, w
         if todo:
             scheduler = scheduler or os.environ.get(SCHEDULER_ENV) or None
             client, cluster, cluster_info = open_client(scheduler, workers)
-            bar.say(f"sweep {sweep.spec.name}: {len(sweep.points)} points, {resumed} done earlier, {len(todo)} to run "
-                    f"on {cluster_info['workers']} workers ({cluster_info['kind']} {cluster_info['scheduler']})")
+            bar.say(
+                f"sweep {sweep.spec.name}: {len(sweep.points)} points, {resumed} done earlier, {len(todo)} to run "
+                f"on {cluster_info['workers']} workers ({cluster_info['kind']} {cluster_info['scheduler']})"
+            )
             write_json_atomic(out / JSON_NAME, _json_doc(sweep, rows, timing, machine, cluster_info, state))
             from distributed import as_completed
 
             futures = {}
             for p in todo:
-                fut = client.submit(run_point, p.scenario.model_dump(mode="json"), keep_runs, pure=False,
-                                    key=f"wormsim-point-{p.index}-{p.scenario_hash}")
+                fut = client.submit(
+                    run_point,
+                    p.scenario.model_dump(mode="json"),
+                    keep_runs,
+                    pure=False,
+                    key=f"wormsim-point-{p.index}-{p.scenario_hash}",
+                )
                 futures[fut] = (p, time.time())
             for fut in as_completed(list(futures)):
                 p, t_submit = futures[fut]
                 try:
                     res = fut.result()
                 except Exception as exc:  # noqa: BLE001  (the worker died or the task could not run)
-                    res = {"summary": {"status": "failed", "wall_time_s": None, "model": p.scenario.model,
-                                       "message": f"worker lost: {exc.__class__.__name__}: {exc}"},
-                           "files": {}, "timing": None}
+                    res = {
+                        "summary": {
+                            "status": "failed",
+                            "wall_time_s": None,
+                            "model": p.scenario.model,
+                            "message": f"worker lost: {exc.__class__.__name__}: {exc}",
+                        },
+                        "files": {},
+                        "timing": None,
+                    }
                 summary = res["summary"]
                 if keep_runs and res["files"]:
                     _write_run_dir(out / RUNS_DIR / _run_dir_name(p), res["files"], summary)
                 rows[p.index] = row_of(p, summary)
-                timing[p.index] = {**(res["timing"] or {}), "submitted": t_submit, "received": time.time(),
-                                   "result_bytes": sum(len(b) for b in res["files"].values())}
+                timing[p.index] = {
+                    **(res["timing"] or {}),
+                    "submitted": t_submit,
+                    "received": time.time(),
+                    "result_bytes": sum(len(b) for b in res["files"].values()),
+                }
                 flush_csv()
                 bar.point_done(summary.get("status") != "ok")
     except KeyboardInterrupt:
         interrupted = True
     finally:
         bar.close()
-        state.update(finished=time.strftime("%Y-%m-%dT%H:%M:%S%z"), interrupted=interrupted,
-                     wall_s=time.perf_counter() - t_sweep)
+        state.update(
+            finished=time.strftime("%Y-%m-%dT%H:%M:%S%z"), interrupted=interrupted, wall_s=time.perf_counter() - t_sweep
+        )
         try:
             if client is not None:
                 client.close()
@@ -365,8 +464,14 @@ def run_sweep(sweep: Sweep, out_dir: str | Path, scheduler: str | None = None, w
     if interrupted:
         raise KeyboardInterrupt
     n_ok = sum(1 for r in rows.values() if r.get("status") == "ok")
-    return {"points": len(sweep.points), "ok": n_ok, "failed": len(rows) - n_ok, "resumed": resumed,
-            "ran": len(todo), "cluster": cluster_info}
+    return {
+        "points": len(sweep.points),
+        "ok": n_ok,
+        "failed": len(rows) - n_ok,
+        "resumed": resumed,
+        "ran": len(todo),
+        "cluster": cluster_info,
+    }
 
 
 def _write_run_dir(path: Path, files: dict[str, bytes], summary: dict) -> None:

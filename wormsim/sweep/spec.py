@@ -17,6 +17,7 @@ Every point is validated as a scenario (wormsim.scenario.scenario_from_dict) bef
 raises ScenarioError naming the point, its swept values and the field (exit 2). Each point carries the hash of
 its validated scenario (scenario_hash), which `wormsim sweep` uses to resume.
 """
+
 from __future__ import annotations
 
 import copy
@@ -32,8 +33,7 @@ import numpy as np
 import yaml
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
-from wormsim.scenario import (Scenario, ScenarioError, format_validation_error, scenario_from_dict, set_path,
-                              yaml_load)
+from wormsim.scenario import Scenario, ScenarioError, format_validation_error, scenario_from_dict, set_path, yaml_load
 
 MAX_POINTS = 100_000
 _PATH = r"^[A-Za-z_][A-Za-z0-9_]*(\.[A-Za-z_][A-Za-z0-9_]*)*$"
@@ -58,13 +58,17 @@ class Linspace(_Strict):
 
 
 class Logspace(_Strict):
-    logspace: tuple[float, float, int] = Field(..., description="[a, b, n]: n values from a to b, even in log (a, b > 0)")
+    logspace: tuple[float, float, int] = Field(
+        ..., description="[a, b, n]: n values from a to b, even in log (a, b > 0)"
+    )
 
     @model_validator(mode="after")
     def _n(self) -> "Logspace":
         a, b, n = self.logspace
         if a <= 0 or b <= 0:
-            raise ValueError(f"logspace [{a}, {b}, {n}]: the end values a and b must be > 0 (they are values, not exponents)")
+            raise ValueError(
+                f"logspace [{a}, {b}, {n}]: the end values a and b must be > 0 (they are values, not exponents)"
+            )
         if not 1 <= n <= MAX_POINTS:
             raise ValueError(f"logspace n = {n}: allowed 1 to {MAX_POINTS}")
         return self
@@ -96,8 +100,10 @@ def _parse_axes(section: str, axes: Any) -> dict:
         try:
             out[p] = (Linspace if kind == "linspace" else Logspace).model_validate(ax)
         except ValidationError as err:
-            raise ValueError(f"{section}.{p}.{kind} = {ab_n!r}: "
-                             + "; ".join(e["msg"].removeprefix("Value error, ") for e in err.errors())) from None
+            raise ValueError(
+                f"{section}.{p}.{kind} = {ab_n!r}: "
+                + "; ".join(e["msg"].removeprefix("Value error, ") for e in err.errors())
+            ) from None
     return out
 
 
@@ -124,7 +130,9 @@ class Normal(_Strict):
 class Random(_Strict):
     n: int = Field(..., ge=1, le=MAX_POINTS, description="number of draws")
     seed: int = Field(0, ge=0, description="numpy.random.default_rng seed")
-    vary: dict[str, Uniform | Normal] = Field(..., min_length=1, description="PATH: {uniform: [a, b]} | {normal: [mean, sd]}")
+    vary: dict[str, Uniform | Normal] = Field(
+        ..., min_length=1, description="PATH: {uniform: [a, b]} | {normal: [mean, sd]}"
+    )
 
     @field_validator("vary", mode="before")
     @classmethod
@@ -135,12 +143,16 @@ class Random(_Strict):
         for p, d in v.items():
             kind = next(iter(d), None) if isinstance(d, dict) and len(d) == 1 else None
             if kind not in ("uniform", "normal"):
-                raise ValueError(f"random.vary.{p} = {d!r}: expected {{uniform: [low, high]}} or {{normal: [mean, sd]}}")
+                raise ValueError(
+                    f"random.vary.{p} = {d!r}: expected {{uniform: [low, high]}} or {{normal: [mean, sd]}}"
+                )
             try:
                 out[p] = (Uniform if kind == "uniform" else Normal).model_validate(d)
             except ValidationError as err:
-                raise ValueError(f"random.vary.{p}.{kind} = {d[kind]!r}: "
-                                 + "; ".join(e["msg"].removeprefix("Value error, ") for e in err.errors())) from None
+                raise ValueError(
+                    f"random.vary.{p}.{kind} = {d[kind]!r}: "
+                    + "; ".join(e["msg"].removeprefix("Value error, ") for e in err.errors())
+                ) from None
         return out
 
 
@@ -185,8 +197,10 @@ class SweepFile(_Strict):
                     raise ValueError(f"{section}.{p}: an empty list of values")
         lens = {p: len(_values(ax)) for p, ax in self.zip.items()}
         if len(set(lens.values())) > 1:
-            raise ValueError("zip: every path needs the same number of values; got "
-                             + ", ".join(f"{p}: {n}" for p, n in lens.items()))
+            raise ValueError(
+                "zip: every path needs the same number of values; got "
+                + ", ".join(f"{p}: {n}" for p, n in lens.items())
+            )
         for key in ("x", "series"):
             v = getattr(self.plot, key)
             if v is not None and v not in swept:
@@ -204,7 +218,7 @@ def _values(ax: Axis) -> list:
 @dataclass
 class Point:
     index: int
-    values: dict[str, Any]          # swept path -> value
+    values: dict[str, Any]  # swept path -> value
     scenario: Scenario
     scenario_hash: str
 
@@ -225,9 +239,9 @@ def scenario_hash(sc: Scenario) -> str:
 @dataclass
 class Sweep:
     spec: SweepFile
-    path: Path              # the sweep file
+    path: Path  # the sweep file
     base_path: Path
-    raw: dict               # the sweep file as written
+    raw: dict  # the sweep file as written
     points: list[Point]
 
     @property
@@ -284,8 +298,9 @@ def load_sweep(path: str | Path, max_errors: int = 5) -> Sweep:
         spec = SweepFile.model_validate(raw)
     except ValidationError as err:
         # the messages of this module's validators name their field; drop the "block = {...}: " before them
-        raise ScenarioError(re.sub(r"(?m)^(\S+: )(\(top level\)|[\w.]+) = \{\.\.\.\}: ", r"\1",
-                                   format_validation_error(err, path.name))) from None
+        raise ScenarioError(
+            re.sub(r"(?m)^(\S+: )(\(top level\)|[\w.]+) = \{\.\.\.\}: ", r"\1", format_validation_error(err, path.name))
+        ) from None
     base_path = (path.parent / spec.base).resolve()
     if not base_path.is_file():
         raise ScenarioError(f"{path.name}: base = {spec.base}: no such scenario file ({base_path})")
@@ -301,7 +316,7 @@ def load_sweep(path: str | Path, max_errors: int = 5) -> Sweep:
     points, errors = [], []
     for i, values in enumerate(expand(spec)):
         data = copy.deepcopy(base)
-        label = Point(i, values, None, "").label()     # type: ignore[arg-type]
+        label = Point(i, values, None, "").label()  # type: ignore[arg-type]
         try:
             for p, v in values.items():
                 set_path(data, p.split("."), v, f"{path.name}: {label}")
@@ -315,4 +330,3 @@ def load_sweep(path: str | Path, max_errors: int = 5) -> Sweep:
     if errors:
         raise ScenarioError("\n".join(errors))
     return Sweep(spec=spec, path=path, base_path=base_path, raw=raw, points=points)
-
