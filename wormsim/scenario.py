@@ -182,7 +182,7 @@ class Wedge(_Strict):
 
     @model_validator(mode="after")
     def _friction(self) -> "Wedge":
-        if self.friction is not None and "friction_group" in self.model_fields_set:
+        if self.friction is not None and self.friction_group is not None and "friction_group" in self.model_fields_set:
             raise ValueError("give one of friction_group / friction")
         if self.friction is not None:
             self.friction_group = None

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 from wormsim.recording import save_series_recording
 from wormsim.result import Result
-from wormsim.wedge.dynamics import INVERSE, LOCKED, TRACTIVE
+from wormsim.wedge.dynamics import INVERSE, LOCKED, TRACTIVE, UNLOADED
 
 # ----------------------------------------------------------------------------- report, recording
 
@@ -29,8 +29,8 @@ def write_report(result: Result, path) -> None:
     ax[2].plot(t_ms, s["vs_m_s"], ":", lw=1, label="Vs (sliding)")
     ax[2].set_ylabel("speed [m/s]")
     ax[3].step(t_ms, s["regime_code"], where="post")
-    ax[3].set_yticks([0, 1, 2], [LOCKED, TRACTIVE, INVERSE])
-    ax[3].set_ylim(-0.5, 2.5)
+    ax[3].set_yticks([0, 1, 2, 3], [LOCKED, TRACTIVE, INVERSE, UNLOADED])
+    ax[3].set_ylim(-0.5, 3.5)
     ax[3].set_xlabel("time [ms]")
     for a in ax[:3]:
         a.legend(loc="best", fontsize=8)
