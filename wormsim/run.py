@@ -36,7 +36,9 @@ def simulate(scenario: Scenario, progress: Progress | None = None) -> Result:
 def run_scenario(scenario: Scenario, out_dir: str | Path, progress: bool | None = None) -> dict:
     """Simulate and write DIR/{summary.json, timeseries.npz, report.png, recording.rrd}.
 
-    Returns the summary. Raises SimulationError after writing a "failed" summary.
+    Returns the summary. Raises SimulationError / ScenarioError after writing a "failed" summary (which replaces
+    an earlier result); an interrupt (KeyboardInterrupt, SIGTERM via the CLI) leaves DIR as it was
+    (wormsim.output).
     """
     mod = model_module(scenario.model)
     rd = ResultDir(out_dir)
@@ -53,6 +55,9 @@ def run_scenario(scenario: Scenario, out_dir: str | Path, progress: bool | None 
     except (SimulationError, ScenarioError) as exc:     # a diagnosis (exit 3) or input found invalid (exit 2)
         rd.fail({"status": "failed", "message": str(exc), **base,
                  "wall_time_s": time.perf_counter() - t0, "sim_time_s": None, "steps": None})
+        raise
+    except KeyboardInterrupt:       # Ctrl-C / SIGTERM: not a failure of the run; an earlier result stays
+        rd.abandon()
         raise
     except BaseException as exc:  # never leave a result that looks complete
         rd.fail({"status": "failed", "message": f"internal error: {exc.__class__.__name__}: {exc}", **base,
