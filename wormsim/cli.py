@@ -19,23 +19,12 @@ from pathlib import Path
 
 import yaml
 
+from wormsim import interrupt
 from wormsim.errors import ScenarioError, SimulationError
 from wormsim.run import run_scenario
 from wormsim.scenario import json_schema, load_scenario
 
 EXIT_OK, EXIT_INTERNAL, EXIT_INPUT, EXIT_SIM = 0, 1, 2, 3
-
-
-class Interrupted(KeyboardInterrupt):
-    """SIGTERM (or SIGINT) as an exception: handled exactly like Ctrl-C; exit 128 + signal number."""
-
-    def __init__(self, signum: int):
-        super().__init__(signal.Signals(signum).name)
-        self.signum = signum
-
-
-def _raise_interrupted(signum, frame):
-    raise Interrupted(signum)
 
 
 def _add_scenario_args(p: argparse.ArgumentParser, out_required: bool = True) -> None:
@@ -155,16 +144,12 @@ def _is_under(filename, root: Path | None) -> bool:
 
 def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
-    old_term = None
-    if signal.getsignal(signal.SIGTERM) in (signal.SIG_DFL, None):
-        try:
-            old_term = signal.signal(signal.SIGTERM, _raise_interrupted)
-        except ValueError:          # not the main thread (an embedding application): leave signals alone
-            old_term = None
+    old_handlers = interrupt.install()
     caught: list[warnings.WarningMessage] = []
     try:
         with warnings.catch_warnings(record=True) as caught:
             code = COMMANDS[args.command](args)
+        interrupt.check()           # an interrupt that a library swallowed
         for w in caught:            # a successful command: show what numpy/scipy warned about, after the work
             warnings.showwarning(w.message, w.category, w.filename, w.lineno)
         return code
@@ -175,21 +160,27 @@ def main(argv: list[str] | None = None) -> int:
         print(f"simulation failed: {exc}", file=sys.stderr)
         return EXIT_SIM
     except KeyboardInterrupt as exc:
-        signum = getattr(exc, "signum", signal.SIGINT)
-        name = "" if signum == signal.SIGINT else f" ({signal.Signals(signum).name})"
-        print(f"interrupted{name}" + ("; the earlier result in --out is unchanged" if args.command == "run" else ""),
-              file=sys.stderr)
-        return 128 + int(signum)
+        return _interrupted(getattr(exc, "signum", signal.SIGINT), args)
     except OSError as exc:
+        if interrupt.pending():
+            return _interrupted(interrupt.pending(), args)
         if _is_under(exc.filename, _out_path(args)):    # disk full, permissions changed under a running command
             print(f"error: cannot write to {exc.filename}: {exc.strerror or exc}", file=sys.stderr)
             return EXIT_INPUT
         return _internal(exc, args)
-    except Exception as exc:  # a bug, not a user error
+    except Exception as exc:  # a bug, not a user error (unless an interrupt was swallowed and resurfaced as one)
+        if interrupt.pending():
+            return _interrupted(interrupt.pending(), args)
         return _internal(exc, args)
     finally:
-        if old_term is not None:
-            signal.signal(signal.SIGTERM, old_term)
+        interrupt.restore(old_handlers)
+
+
+def _interrupted(signum: int, args) -> int:
+    name = "" if signum == signal.SIGINT else f" ({signal.Signals(signum).name})"
+    print(f"interrupted{name}" + ("; the earlier result in --out is unchanged" if args.command == "run" else ""),
+          file=sys.stderr)
+    return 128 + int(signum)
 
 
 def _internal(exc: BaseException, args) -> int:
