@@ -39,8 +39,10 @@ def write_report(result: Result, path) -> None:
     name = result.extra.get("name", "wedge")
     fig.suptitle(f"{name}: wedge model (monitor {m['monitor']}), Kd1 {m['Kd1']:.2f}, Kd2 {m['Kd2']:.2f}, "
                  f"stalled {m['stalled']}, self-locking {m['self_locking']}\n"
-                 f"regimes: {' -> '.join(m['regimes'])};  eta {m['efficiency_forward']:.3f}, "
-                 f"mu {m['efficiency_backward']:.3f} at rho {m['rho_steady_deg']:.2f} deg", fontsize=9)
+                 f"regimes: {' -> '.join(m['regimes'])};  efficiency forward {m['efficiency_forward']:.3f}, "
+                 f"backward {m['efficiency_backward']:.3f}"
+                 + (" (self-locking at rest)" if m["self_locking"] else "")
+                 + f", friction angle rho {m['rho_steady_deg']:.2f} deg at the steady speed", fontsize=9)
     fig.tight_layout()
     fig.savefig(path, dpi=100, format="png")
     plt.close(fig)
