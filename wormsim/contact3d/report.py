@@ -66,7 +66,9 @@ def write_report(result: Result, path) -> None:
            label=f"wheel (mean of {t[-1] / SPEED_INTERVALS * 1e3:.3g} ms intervals)")
     a.plot(tm, worm_m, "--", color="C0", lw=1.6, label="worm / (z2/z1) (interval means)")
     a.axvspan(w0, w1, color="0.9", zorder=-1)
-    a.set(xlabel="time [s]", ylabel="speed [rpm]",
+    top = 1.6 * max(float(np.max(worm_m)), float(np.max(wheel_m)), 1e-9)
+    a.set_ylim(min(0.0, 1.2 * float(min(np.min(worm_m), np.min(wheel_m)))), top)   # the raw rattle is clipped
+    a.set(xlabel="time [s]", ylabel="speed [rpm] (raw traces faint, clipped)",
           title=f"speeds: ratio {s['ratio']:.4g} (theory {s['ratio_theory']:.4g}), efficiency {s['efficiency']:.3f} "
                 f"(theory {s['efficiency_theory']:.3f})")
     a.legend(fontsize=8)
