@@ -2,14 +2,14 @@
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
 import mujoco
 import pytest
+from conftest import ROOT
 
 from wormsim import cli
 
-MINIMAL = Path(__file__).resolve().parents[1] / "tests" / "assets" / "minimal_contact3d.yaml"
+MINIMAL = ROOT / "tests" / "assets" / "minimal_contact3d.yaml"
 
 
 def test_mesh_prints_words_not_codes(tmp_path, capsys):

@@ -11,12 +11,12 @@ import typing
 from pathlib import Path
 
 import pytest
+from conftest import ROOT
 from pydantic import BaseModel
 
 from wormsim import cli
 from wormsim.scenario import MAX_PROBLEMS, Scenario
 
-ROOT = Path(__file__).resolve().parents[1]
 SEAT = ROOT / "scenarios" / "seat_motor.yaml"
 MOV = ROOT / "scenarios" / "mov_1.yaml"
 WORMSIM = Path(sys.executable).with_name("wormsim")

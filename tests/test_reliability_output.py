@@ -11,13 +11,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import ROOT
 
 from wormsim import cli, output, run
 from wormsim.errors import SimulationError
 from wormsim.output import FolderLock
 from wormsim.result import Result
 
-ROOT = Path(__file__).resolve().parents[1]
 MINIMAL = ROOT / "tests" / "assets" / "minimal_contact3d.yaml"
 MOV = ROOT / "scenarios" / "mov_1.yaml"
 

@@ -1,12 +1,13 @@
 """recording.rrd of two identical runs (issue 10): the content is identical; the bytes are not, because rerun
 stamps rows and chunks with time-based ids (wormsim.recording.recorded_data, docs/recording.md)."""
-from pathlib import Path
+
+from conftest import SCENARIOS
 
 from wormsim.recording import recorded_data
 from wormsim.run import run_scenario
 from wormsim.scenario import load_scenario
 
-MOV = Path(__file__).resolve().parents[1] / "scenarios" / "mov_1.yaml"
+MOV = SCENARIOS / "mov_1.yaml"
 
 
 def test_identical_runs_record_identical_content(tmp_path):

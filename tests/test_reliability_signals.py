@@ -11,10 +11,10 @@ import time
 from pathlib import Path
 
 import pytest
+from conftest import ROOT
 
 from wormsim.output import RESULT_FILES
 
-ROOT = Path(__file__).resolve().parents[1]
 SEAT = ROOT / "scenarios" / "seat_motor.yaml"
 WORMSIM = Path(sys.executable).with_name("wormsim")
 TORSIONAL = ["--set", "model=torsional", "--no-progress"]

@@ -8,22 +8,19 @@ tests/test_contact3d_*.py."""
 from __future__ import annotations
 
 import json
-import random
 import resource
 import signal
 import subprocess
 import sys
 from contextlib import contextmanager
-from pathlib import Path
 
-import pytest
 import yaml
+from conftest import ROOT
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from wormsim import cli
 
-ROOT = Path(__file__).resolve().parents[1]
 SEEDS = sorted((ROOT / "scenarios").glob("*.yaml")) + sorted((ROOT / "tests" / "assets").glob("*.yaml"))
 
 

@@ -5,12 +5,10 @@ import math
 
 import numpy as np
 import pytest
+from conftest import SCENARIOS
 
 from wormsim.scenario import load_scenario
 from wormsim.wedge.dynamics import REGIME_CODE, UNLOADED, simulate
-from pathlib import Path
-
-SCENARIOS = Path(__file__).resolve().parents[1] / "scenarios"
 
 
 @pytest.mark.parametrize("overrides", [["wedge.load.force_n=0"], ["wedge.load.start_s=1000"],

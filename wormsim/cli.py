@@ -162,15 +162,15 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt as exc:
         return _interrupted(getattr(exc, "signum", signal.SIGINT), args)
     except OSError as exc:
-        if interrupt.pending():
-            return _interrupted(interrupt.pending(), args)
+        if (sig := interrupt.pending()) is not None:
+            return _interrupted(sig, args)
         if _is_under(exc.filename, _out_path(args)):    # disk full, permissions changed under a running command
             print(f"error: cannot write to {exc.filename}: {exc.strerror or exc}", file=sys.stderr)
             return EXIT_INPUT
         return _internal(exc, args)
     except Exception as exc:  # a bug, not a user error (unless an interrupt was swallowed and resurfaced as one)
-        if interrupt.pending():
-            return _interrupted(interrupt.pending(), args)
+        if (sig := interrupt.pending()) is not None:
+            return _interrupted(sig, args)
         return _internal(exc, args)
     finally:
         interrupt.restore(old_handlers)

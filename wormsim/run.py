@@ -60,16 +60,16 @@ def run_scenario(scenario: Scenario, out_dir: str | Path, progress: bool | None 
         rd.abandon()
         raise
     except (SimulationError, ScenarioError) as exc:     # a diagnosis (exit 3) or input found invalid (exit 2)
-        if interrupt.pending():
+        if (sig := interrupt.pending()) is not None:
             rd.abandon()
-            raise interrupt.Interrupted(interrupt.pending()) from exc
+            raise interrupt.Interrupted(sig) from exc
         rd.fail({"status": "failed", "message": str(exc), **base,
                  "wall_time_s": time.perf_counter() - t0, "sim_time_s": None, "steps": None})
         raise
     except BaseException as exc:  # never leave a result that looks complete
-        if interrupt.pending():     # the interrupt came back as another exception
+        if (sig := interrupt.pending()) is not None:     # the interrupt came back as another exception
             rd.abandon()
-            raise interrupt.Interrupted(interrupt.pending()) from exc
+            raise interrupt.Interrupted(sig) from exc
         rd.fail({"status": "failed", "message": f"internal error: {exc.__class__.__name__}: {exc}", **base,
                  "wall_time_s": time.perf_counter() - t0, "sim_time_s": None, "steps": None})
         raise

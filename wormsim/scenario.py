@@ -330,7 +330,8 @@ def _field_info(loc: tuple):
     import types
     import typing
 
-    model, info = Scenario, None
+    model: type[BaseModel] | None = Scenario
+    info = None
     for part in loc:
         if isinstance(part, str) and part.startswith("function-"):
             continue
