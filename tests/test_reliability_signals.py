@@ -19,8 +19,6 @@ SEAT = ROOT / "scenarios" / "seat_motor.yaml"
 WORMSIM = Path(sys.executable).with_name("wormsim")
 TORSIONAL = ["--set", "model=torsional", "--no-progress"]
 
-pytestmark = pytest.mark.slow
-
 
 def _default_sigint():
     # a child of a background job inherits SIGINT ignored (and Python then keeps ignoring it): as on a terminal
