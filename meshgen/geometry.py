@@ -16,7 +16,8 @@ Relations (m_x axial module, m_n normal module, z1 starts, z2 wheel teeth, gamma
     wheel tip surface: torus about the worm axis, tube radius a - r_a2 = r1 - h_a (the "throat")
     wheel root surface: torus about the worm axis, tube radius a - r_f2 = r1 + h_f
     r_e2 = r_a2 + m_x / 2  (outside radius of the wheel rim; DIN 3975 guide d_e2 <= d_a2 + 2 m for z1 = 1)
-    b2 = 0.75 d_a1 (z1 <= 3), 0.67 d_a1 (z1 >= 4)  (default face width, DIN 3975 guide);
+    b2 = 0.75 d_a1 (z1 <= 3), 0.67 d_a1 (z1 >= 4)  (default face width, DIN 3975 guide), at most 1.2 d_a1;
+    q <= 40 (so also for a given lead angle); p_x <= b1 <= 4 x the default b1 (threaded length, meshgen cost);
     b2 <= 2 sqrt((a - r_f2)^2 - (a - r_e2 + 0.1 (h_a + h_f))^2)  (tooth depth left at the face edges, meshgen;
           the default is clipped to it, a given face width beyond it is an input error)
     wheel tooth thickness on d2: s2 = p_x / 2 - j_t   (backlash j_t taken from the wheel, symmetric)
@@ -160,6 +161,10 @@ class GearGeometry:
         return out
 
 
+Q_MAX = 40.0            # largest diameter quotient (the schema's bound on gear.diameter_quotient)
+WORM_LENGTH_MAX = 4.0   # threaded length at most 4 x the mesh zone (the default length)
+
+
 def derive(gear: GearData) -> GearGeometry:
     """All derived quantities from gear data (a validated `gear:` block or a GearSpec). Raises GeometryError on
     impossible data."""
@@ -168,6 +173,11 @@ def derive(gear: GearData) -> GearGeometry:
     if gear.lead_angle_deg is not None:
         gamma = gear.lead_angle_deg * DEG
         q = z1 / math.tan(gamma)
+        if q > Q_MAX:       # a tiny lead angle is a huge worm: 1e-9 deg gave d1 = 4e10 mm
+            raise GeometryError(
+                f"gear.lead_angle_deg = {gear.lead_angle_deg:.4g}: gives diameter quotient q = z1 / tan(gamma) = "
+                f"{q:.4g}; allowed: q <= {Q_MAX:g}, i.e. lead_angle_deg >= {math.atan(z1 / Q_MAX) / DEG:.4g} "
+                f"for {z1} start(s)")
     else:
         q = gear.diameter_quotient
         gamma = math.atan(z1 / q)
@@ -214,7 +224,12 @@ def derive(gear: GearData) -> GearGeometry:
             f"allowed up to {b2_max / MM:.3f} mm")
     # threaded length: cover every point of the wheel rim that can reach the worm tip cylinder, plus one pitch
     reach = r_e2 ** 2 - (a - r_a1) ** 2
-    b1 = gear.worm_length_mm * MM if gear.worm_length_mm is not None else 2 * math.sqrt(max(reach, 0.0)) + p_x
+    b1_mesh = 2 * math.sqrt(max(reach, 0.0)) + p_x
+    b1 = gear.worm_length_mm * MM if gear.worm_length_mm is not None else b1_mesh
+    if not p_x <= b1 <= WORM_LENGTH_MAX * b1_mesh:   # 1e6 mm ran for > 10 min at 5 GB (pieces along the thread)
+        raise GeometryError(
+            f"gear.worm_length_mm = {b1 / MM:.4g}: allowed {p_x / MM:.4g} (one axial pitch) to "
+            f"{WORM_LENGTH_MAX * b1_mesh / MM:.4g} mm ({WORM_LENGTH_MAX:g} x the mesh zone {b1_mesh / MM:.4g} mm)")
     s2 = p_x / 2 - gear.backlash_mm * MM
     if s2 <= 0.1 * p_x:
         raise GeometryError(

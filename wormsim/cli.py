@@ -1,18 +1,25 @@
 """`wormsim` console script (INTERFACE.md): run, mesh, model, bench, sweep, schema, check.
 
-Exit codes: 0 ok, 2 invalid input (the message names the field), 3 the simulation failed
-(with a diagnosis), 1 an internal error (a bug: rerun with --debug for the traceback).
+Exit codes: 0 ok, 2 invalid input or an output path that cannot be written (the message names the field or
+the path), 3 the simulation failed (with a diagnosis), 130 / 143 interrupted by SIGINT (Ctrl-C) / SIGTERM
+(an earlier result in --out stays as it was), 1 an internal error (a bug: rerun with --debug for the traceback).
+Warnings (numpy, scipy) raised during a command are shown after it only when it succeeds; an error message is
+the only output of a failed command.
 """
 from __future__ import annotations
 
 import argparse
 import json
+import os
+import signal
 import sys
 import traceback
+import warnings
 from pathlib import Path
 
 import yaml
 
+from wormsim import interrupt
 from wormsim.errors import ScenarioError, SimulationError
 from wormsim.run import run_scenario
 from wormsim.scenario import json_schema, load_scenario
@@ -78,26 +85,32 @@ def _cmd_run(args) -> int:
 
 def _cmd_mesh(args) -> int:
     from wormsim.mesh_cmd import write_mesh_outputs
+    from wormsim.output import locked_dir
 
     sc = load_scenario(args.scenario, args.overrides)
-    write_mesh_outputs(sc, args.out)
+    with locked_dir(args.out, names=("worm.stl", "wheel.stl", "assembly.json", "recording.rrd")):
+        write_mesh_outputs(sc, args.out)
     return EXIT_OK
 
 
 def _cmd_model(args) -> int:
     from wormsim.contact3d.mjcf import write_model
+    from wormsim.output import locked_dir
 
     sc = load_scenario(args.scenario, args.overrides)
-    path = write_model(sc, args.out)
+    with locked_dir(args.out, names=("model.xml",)):
+        path = write_model(sc, args.out)
     print(f"wrote {path}  (open with: python -m mujoco.viewer --mjcf {path})")
     return EXIT_OK
 
 
 def _cmd_bench(args) -> int:
     from wormsim.bench.run import run_bench
+    from wormsim.output import locked_dir
 
-    run_bench(quick=args.quick, out_dir=args.out, repeats=args.repeats,
-              scenarios=tuple(args.scenarios) if args.scenarios else None)
+    with locked_dir(args.out, names=("bench.json", "bench_meta.json", "bench.png")):
+        run_bench(quick=args.quick, out_dir=args.out, repeats=args.repeats,
+                  scenarios=tuple(args.scenarios) if args.scenarios else None)
     return EXIT_OK
 
 
@@ -115,16 +128,21 @@ def _cmd_sweep(args) -> int:
 
 
 def _cmd_schema(args) -> int:
+    from wormsim.output import check_writable_file, write_text_atomic
+
     text = json.dumps(json_schema(), indent=2)
     if args.out:
-        Path(args.out).write_text(text + "\n")
+        write_text_atomic(check_writable_file(args.out), text + "\n")
     else:
         print(text)
     return EXIT_OK
 
 
 def _cmd_check(args) -> int:
+    from wormsim.validate import validate_geometry
+
     sc = load_scenario(args.scenario, args.overrides)
+    validate_geometry(sc)           # the same geometric checks as mesh and run
     print(yaml.safe_dump(sc.model_dump(mode="json", exclude_none=True), sort_keys=False), end="")
     return EXIT_OK
 
@@ -133,26 +151,66 @@ COMMANDS = {"run": _cmd_run, "mesh": _cmd_mesh, "model": _cmd_model, "bench": _c
             "schema": _cmd_schema, "check": _cmd_check}
 
 
+def _out_path(args) -> Path | None:
+    out = getattr(args, "out", None)
+    return Path(out).absolute() if out else None
+
+
+def _is_under(filename, root: Path | None) -> bool:
+    if root is None or not filename:
+        return False
+    p = Path(os.fsdecode(filename)).absolute()
+    return p == root or root in p.parents
+
+
 def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
+    old_handlers = interrupt.install()
+    caught: list[warnings.WarningMessage] = []
     try:
-        return COMMANDS[args.command](args)
+        with warnings.catch_warnings(record=True) as caught:
+            code = COMMANDS[args.command](args)
+        interrupt.check()           # an interrupt that a library swallowed
+        for w in caught:            # a successful command: show what numpy/scipy warned about, after the work
+            warnings.showwarning(w.message, w.category, w.filename, w.lineno)
+        return code
     except ScenarioError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return EXIT_INPUT
     except SimulationError as exc:
         print(f"simulation failed: {exc}", file=sys.stderr)
         return EXIT_SIM
-    except KeyboardInterrupt:
-        print("interrupted", file=sys.stderr)
-        return 130
-    except Exception as exc:  # a bug, not a user error
-        if args.debug:
-            traceback.print_exc()
-        else:
-            print(f"internal error: {exc.__class__.__name__}: {exc} (rerun with --debug for the traceback)",
-                  file=sys.stderr)
-        return EXIT_INTERNAL
+    except KeyboardInterrupt as exc:
+        return _interrupted(getattr(exc, "signum", signal.SIGINT), args)
+    except OSError as exc:
+        if (sig := interrupt.pending()) is not None:
+            return _interrupted(sig, args)
+        if _is_under(exc.filename, _out_path(args)):    # disk full, permissions changed under a running command
+            print(f"error: cannot write to {exc.filename}: {exc.strerror or exc}", file=sys.stderr)
+            return EXIT_INPUT
+        return _internal(exc, args)
+    except Exception as exc:  # a bug, not a user error (unless an interrupt was swallowed and resurfaced as one)
+        if (sig := interrupt.pending()) is not None:
+            return _interrupted(sig, args)
+        return _internal(exc, args)
+    finally:
+        interrupt.restore(old_handlers)
+
+
+def _interrupted(signum: int, args) -> int:
+    name = "" if signum == signal.SIGINT else f" ({signal.Signals(signum).name})"
+    print(f"interrupted{name}" + ("; the earlier result in --out is unchanged" if args.command == "run" else ""),
+          file=sys.stderr)
+    return 128 + int(signum)
+
+
+def _internal(exc: BaseException, args) -> int:
+    if args.debug:
+        traceback.print_exception(exc)
+    else:
+        print(f"internal error: {exc.__class__.__name__}: {exc} (rerun with --debug for the traceback)",
+              file=sys.stderr)
+    return EXIT_INTERNAL
 
 
 if __name__ == "__main__":

@@ -61,11 +61,16 @@ def write_mesh_outputs(scenario: Scenario, out_dir: str | Path) -> dict:
     derived = data["derived"]
     width = max(len(k) for k in derived)
     for k, v in derived.items():
+        if k == "hand":
+            v = "right" if v > 0 else "left"
         print(f"  {k:<{width}}  {v:.6g}" if isinstance(v, float) else f"  {k:<{width}}  {v}")
     e = gs.piece_error_um
+    r = gs.resolution
+    level = scenario.simulation.resolution
     print(
-        f"  collision pieces ({gs.resolution}): worm {len(gs.worm_pieces)}, "
-        f"wheel {len(gs.wheel_tooth_pieces)}/tooth; "
+        f"  collision pieces (resolution {level}: {r.worm_segments_per_turn} worm segments per turn, "
+        f"{r.wheel_slabs} wheel slabs across the face, {r.profile_points} profile points per flank): "
+        f"worm {len(gs.worm_pieces)}, wheel {len(gs.wheel_tooth_pieces)}/tooth; "
         f"error worm max {e['worm']['max']:.2f} um rms {e['worm']['rms']:.2f} um, "
         f"wheel max {e['wheel']['max']:.2f} um rms {e['wheel']['rms']:.2f} um"
     )

@@ -8,6 +8,8 @@ import time
 
 from tqdm import tqdm
 
+from wormsim import interrupt
+
 LOG_AFTER_S = 10.0          # no log lines for runs shorter than this (wall time)
 LOG_STEP = 0.1              # fraction of the simulated time between log lines
 
@@ -32,6 +34,7 @@ class Progress:
         self._next_log = LOG_STEP
 
     def update(self, t_s: float) -> None:
+        interrupt.check()           # an interrupt that a library swallowed ends the run here (wormsim.interrupt)
         dt = t_s - self._last
         if dt > 0:
             self._bar.update(dt)

@@ -89,3 +89,32 @@ def recorded_entities(path: str | Path) -> set[str]:
     from rerun.chunk import RrdReader
 
     return set(RrdReader(str(path)).store().schema().entity_paths())
+
+
+ROW_ID_COLUMN = "rerun.controls.RowId"
+
+
+def _plain(col) -> list:
+    """An arrow column as Python values (durations as int64 nanoseconds: to_pylist would need pandas)."""
+    import pyarrow as pa
+
+    if pa.types.is_duration(col.type) or pa.types.is_timestamp(col.type):
+        col = col.cast(pa.int64())
+    return col.to_pylist()
+
+
+def recorded_data(path: str | Path) -> dict[str, list]:
+    """What a recording holds, without rerun's bookkeeping: for each entity path, its chunks' columns (timelines
+    and components) as Python lists. Two recordings of identical runs are equal here; their bytes differ because
+    rerun stamps every row and chunk with a RowId/ChunkId (a TUID: wall-clock nanoseconds plus a random increment)
+    that rerun-sdk 0.41 does not let a logger choose (docs/recording.md)."""
+    from rerun.chunk import RrdReader
+
+    out: dict[str, list] = {}
+    for chunk in RrdReader(str(path)).store().stream().to_chunks():
+        rb = chunk.to_record_batch()
+        cols = {n: _plain(rb.column(n)) for n in rb.schema.names if n != ROW_ID_COLUMN}
+        out.setdefault(chunk.entity_path, []).append(cols)
+    for chunks in out.values():
+        chunks.sort(key=lambda c: repr(sorted(c.items()))[:10000])
+    return out

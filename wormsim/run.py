@@ -9,11 +9,13 @@ from types import ModuleType
 
 import numpy as np
 
+from wormsim import interrupt
 from wormsim.errors import ScenarioError, SimulationError
 from wormsim.output import ResultDir
 from wormsim.progress import Progress
 from wormsim.result import Result
 from wormsim.scenario import Scenario
+from wormsim.validate import validate_geometry
 
 # fidelity level -> its package, which exports simulate(scenario, progress) -> Result, write_report(result, path) and
 # write_recording(result, path). Imported on first use (importlib, not at the top): a wedge run does not load MuJoCo.
@@ -36,8 +38,11 @@ def simulate(scenario: Scenario, progress: Progress | None = None) -> Result:
 def run_scenario(scenario: Scenario, out_dir: str | Path, progress: bool | None = None) -> dict:
     """Simulate and write DIR/{summary.json, timeseries.npz, report.png, recording.rrd}.
 
-    Returns the summary. Raises SimulationError after writing a "failed" summary.
+    Returns the summary. Raises SimulationError / ScenarioError after writing a "failed" summary (which replaces
+    an earlier result); an interrupt (KeyboardInterrupt, SIGTERM via the CLI) leaves DIR as it was
+    (wormsim.output).
     """
+    validate_geometry(scenario)     # the checks `wormsim check` makes, before anything is written
     mod = model_module(scenario.model)
     rd = ResultDir(out_dir)
     base = {"model": scenario.model, "scenario": scenario.name}
@@ -50,11 +55,21 @@ def run_scenario(scenario: Scenario, out_dir: str | Path, progress: bool | None 
         np.savez_compressed(rd.path("timeseries.npz"), **res.series)
         mod.write_report(res, rd.path("report.png"))
         mod.write_recording(res, rd.path("recording.rrd"))
+        interrupt.check()           # an interrupt swallowed on the way (a library's `except BaseException`)
+    except KeyboardInterrupt:       # Ctrl-C / SIGTERM: not a failure of the run; an earlier result stays
+        rd.abandon()
+        raise
     except (SimulationError, ScenarioError) as exc:     # a diagnosis (exit 3) or input found invalid (exit 2)
+        if (sig := interrupt.pending()) is not None:
+            rd.abandon()
+            raise interrupt.Interrupted(sig) from exc
         rd.fail({"status": "failed", "message": str(exc), **base,
                  "wall_time_s": time.perf_counter() - t0, "sim_time_s": None, "steps": None})
         raise
     except BaseException as exc:  # never leave a result that looks complete
+        if (sig := interrupt.pending()) is not None:     # the interrupt came back as another exception
+            rd.abandon()
+            raise interrupt.Interrupted(sig) from exc
         rd.fail({"status": "failed", "message": f"internal error: {exc.__class__.__name__}: {exc}", **base,
                  "wall_time_s": time.perf_counter() - t0, "sim_time_s": None, "steps": None})
         raise

@@ -24,7 +24,8 @@ class ScenarioError(ValueError):
 
 
 class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", validate_default=True)
+    # allow_inf_nan=False: every float field refuses .inf / .nan (YAML reads `.inf` as a float)
+    model_config = ConfigDict(extra="forbid", validate_default=True, allow_inf_nan=False)
 
 
 PositiveFloat = Annotated[float, Field(gt=0)]
@@ -46,9 +47,11 @@ class Gear(_Strict):
     normal_pressure_angle_deg: float = Field(20.0, ge=5, le=30)
     lead_angle_deg: float | None = Field(None, gt=0, lt=45, description="gamma at the worm reference diameter")
     diameter_quotient: float | None = Field(None, gt=0, le=40, description="q = d1 / m_axial")
-    face_width_mm: float | None = Field(None, gt=0, description="wheel face width b2; default 0.75 * worm tip diameter (DIN 3975 guide)")
-    worm_length_mm: float | None = Field(None, gt=0, description="threaded length; default covers the wheel's mesh zone")
-    backlash_mm: NonNegFloat = Field(0.05, description="circumferential, at the wheel reference circle")
+    face_width_mm: float | None = Field(None, gt=0, le=2000, description=(
+        "wheel face width b2; default 0.75 * worm tip diameter (DIN 3975 guide); at most 1.2 worm tip diameters"))
+    worm_length_mm: float | None = Field(None, gt=0, le=10000, description=(
+        "threaded length; default covers the wheel's mesh zone; allowed 1 axial pitch to 4 x that default"))
+    backlash_mm: float = Field(0.05, ge=0, le=50, description="circumferential, at the wheel reference circle; below 0.4 axial pitch")
     addendum_coef: float = Field(1.0, gt=0, le=1.5, description="h_a / m_axial")
     dedendum_coef: float = Field(1.2, gt=0, le=2.0, description="h_f / m_axial")
 
@@ -79,15 +82,15 @@ class Materials(_Strict):
 class Contact(_Strict):
     """Tooth contact. Every key optional; defaults derived from Hertz (README, 'Contact law')."""
 
-    stiffness_n_per_m: float | None = Field(None, gt=0, description="ADAMS IMPACT K")
+    stiffness_n_per_m: float | None = Field(None, gt=0, le=1e13, description="ADAMS IMPACT K")
     exponent: float = Field(1.5, ge=1, le=3, description="ADAMS IMPACT e")
-    damping_n_s_per_m: float | None = Field(None, ge=0, description="ADAMS IMPACT C")
-    penetration_depth_m: float = Field(1e-5, gt=0, description="ADAMS IMPACT d (full damping depth)")
+    damping_n_s_per_m: float | None = Field(None, ge=0, le=1e10, description="ADAMS IMPACT C")
+    penetration_depth_m: float = Field(1e-5, gt=0, le=0.01, description="ADAMS IMPACT d (full damping depth)")
     friction: float | None = Field(None, ge=0, le=1, description="one Coulomb coefficient")
     friction_static: float | None = Field(None, ge=0, le=1)
     friction_dynamic: float | None = Field(None, ge=0, le=1)
     friction_group: FrictionGroup | None = Field(None, description="seed 000 rho(Vs) material group")
-    transition_velocity_m_s: float = Field(1e-3, gt=0, description="static -> dynamic friction blend speed")
+    transition_velocity_m_s: float = Field(1e-3, gt=0, le=10, description="static -> dynamic friction blend speed")
 
     @model_validator(mode="after")
     def _friction(self) -> "Contact":
@@ -107,7 +110,7 @@ class Drive(_Strict):
     on: Literal["worm", "wheel"] = Field("worm", description="driven shaft (wheel = back-driving)")
     speed_rpm: float | None = Field(None, gt=-100000, lt=100000, description="speed-controlled drive, STEP ramp from 0 over ramp_s")
     torque_nm: float | None = Field(None, gt=-1e6, lt=1e6, description="torque drive, same STEP ramp")
-    ramp_s: NonNegFloat = Field(0.0, description="STEP ramp time of the drive")
+    ramp_s: float = Field(0.0, ge=0, le=3600, description="STEP ramp time of the drive")
 
     @model_validator(mode="after")
     def _one_of(self) -> "Drive":
@@ -119,8 +122,8 @@ class Drive(_Strict):
 class Load(_Strict):
     on: Literal["worm", "wheel"] = Field("wheel", description="loaded shaft (the other one)")
     torque_nm: float = Field(0.0, gt=-1e6, lt=1e6, description="resisting torque")
-    start_s: NonNegFloat = Field(0.0, description="STEP ramp of the load starts here")
-    ramp_s: NonNegFloat = Field(0.0, description="STEP ramp time of the load")
+    start_s: float = Field(0.0, ge=0, le=1e6, description="STEP ramp of the load starts here (may lie past the end)")
+    ramp_s: float = Field(0.0, ge=0, le=3600, description="STEP ramp time of the load")
     inertia_kg_m2: float = Field(0.0, ge=0, le=1e6, description=(
         "driven-machine inertia rigidly on the loaded shaft (contact3d: joint armature; 0 = bare gear)"))
 
@@ -143,13 +146,13 @@ class Simulation(_Strict):
 class WedgeMotor(_Strict):
     """Kloss induction-motor force curve of seed 000 (forces reduced to the worm pitch radius)."""
 
-    peak_force_n: float = Field(2178.0, gt=0)
-    synchronous_speed_m_s: float = Field(7.85, gt=0)
-    peak_force_speed_m_s: float = Field(6.5, gt=0)
+    peak_force_n: float = Field(2178.0, gt=0, le=1e8)
+    synchronous_speed_m_s: float = Field(7.85, gt=0, le=1000)
+    peak_force_speed_m_s: float = Field(6.5, gt=0, le=1000)
     nominal_force_n: float = Field(
-        990.0, gt=0, description="rated force Ft1 = M_n / R1 for the dynamic factor Kd1; seed 000: 2178 N / (Mmax/Mn = 2.2)")
+        990.0, gt=0, le=1e8, description="rated force Ft1 = M_n / R1 for the dynamic factor Kd1; seed 000: 2178 N / (Mmax/Mn = 2.2)")
     nominal_speed_m_s: float = Field(
-        7.59, gt=0, description="rated speed n_n R1 (Ft2 uses rho there); seed 000: 2900 rpm at R1 = 25 mm")
+        7.59, gt=0, le=1000, description="rated speed n_n R1 (Ft2 uses rho there); seed 000: 2900 rpm at R1 = 25 mm")
 
     @model_validator(mode="after")
     def _order(self) -> "WedgeMotor":
@@ -163,26 +166,26 @@ class WedgeMotor(_Strict):
 class WedgeLoad(_Strict):
     force_n: float = Field(-5000.0, gt=-1e7, lt=1e7, description="F2 on the driven body (negative resists)")
     initial_force_n: float = Field(0.0, gt=-1e7, lt=1e7, description="F2 before start_s; STEP to force_n over ramp_s")
-    start_s: NonNegFloat = 0.0
-    ramp_s: NonNegFloat = 0.0
+    start_s: float = Field(0.0, ge=0, le=1e6, description="may lie past the end (a load that never starts)")
+    ramp_s: float = Field(0.0, ge=0, le=3600)
 
 
 class Wedge(_Strict):
     lead_angle_deg: float = Field(4.76, gt=0, lt=45)
-    driving_mass_kg: float = Field(11.8, gt=0)
-    driven_mass_kg: float = Field(100.0, gt=0)
+    driving_mass_kg: float = Field(11.8, gt=0, le=1e6)
+    driven_mass_kg: float = Field(100.0, gt=0, le=1e8)
     friction_group: FrictionGroup | None = "III"
     friction: float | None = Field(None, ge=0, le=1, description="constant coefficient; rho = atan(friction)")
     motor: WedgeMotor = WedgeMotor()
     load: WedgeLoad = WedgeLoad()
     monitor: Literal["three_regime", "seed"] = Field(
         "three_regime", description="three_regime: tractive/inverse/locked with events; seed: seed 000's literal two-regime switch")
-    initial_speed_m_s: float = Field(0.0, ge=0)
+    initial_speed_m_s: float = Field(0.0, ge=0, le=1000)
     rtol: float = Field(1e-8, gt=0, le=1e-2)
 
     @model_validator(mode="after")
     def _friction(self) -> "Wedge":
-        if self.friction is not None and "friction_group" in self.model_fields_set:
+        if self.friction is not None and self.friction_group is not None and "friction_group" in self.model_fields_set:
             raise ValueError("give one of friction_group / friction")
         if self.friction is not None:
             self.friction_group = None
@@ -253,8 +256,29 @@ class Scenario(_Strict):
 
 # ----------------------------------------------------------------------------- loading
 
+MAX_FILE_BYTES = 256_000        # a scenario file is a few kB; larger input is refused before parsing (pure-Python YAML)
+MAX_DEPTH = 32                  # nesting of blocks/lists (the schema needs 4)
+MAX_NODES = 100_000             # YAML nodes after alias expansion ("billion laughs": 373 bytes -> 1e9 nodes)
+MAX_PROBLEMS = 10               # validation problems listed; the rest is counted
+MAX_SHOWN = 60                  # characters of a value quoted in a message
+
+
 class _Loader(yaml.SafeLoader):
-    """YAML 1.2 booleans: only true/false. YAML 1.1 would read the key `on:` (drive.on) as True."""
+    """YAML 1.2 booleans: only true/false. YAML 1.1 would read the key `on:` (drive.on) as True.
+
+    Nesting deeper than MAX_DEPTH is refused while composing (PyYAML's composer recurses: 70 000 `[` gave a
+    RecursionError), and the node graph is measured with aliases expanded before any Python object is built."""
+
+    def compose_node(self, parent, index):
+        self._depth = getattr(self, "_depth", 0) + 1
+        try:
+            if self._depth > MAX_DEPTH:
+                mark = self.peek_event().start_mark
+                raise ScenarioError(f"nested deeper than {MAX_DEPTH} levels at line {mark.line + 1}; "
+                                    "a scenario needs at most 4")
+            return super().compose_node(parent, index)
+        finally:
+            self._depth -= 1
 
 
 _Loader.yaml_implicit_resolvers = {
@@ -265,28 +289,134 @@ _Loader.add_implicit_resolver(
     "tag:yaml.org,2002:bool", re.compile(r"^(?:true|True|TRUE|false|False|FALSE)$"), list("tTfF"))
 
 
-def yaml_load(text: str):
-    return yaml.load(text, Loader=_Loader)  # a SafeLoader subclass
+def _expanded_size(root) -> int:
+    """Nodes of the YAML graph with every alias expanded, computed per distinct node (linear in the file)."""
+    size: dict[int, int] = {}
+    stack = [(root, False)]
+    while stack:
+        node, done = stack.pop()
+        if id(node) in size:
+            continue
+        children = [c for pair in node.value for c in pair] if isinstance(node, yaml.MappingNode) else (
+            node.value if isinstance(node, yaml.SequenceNode) else [])
+        if done:
+            size[id(node)] = 1 + sum(size.get(id(c), 0) for c in children)   # a cycle counts 0 (refused below)
+        else:
+            stack.append((node, True))
+            stack.extend((c, False) for c in children if id(c) not in size)
+    return size[id(root)]
+
+
+def yaml_load(text: str, source: str = "scenario"):
+    """Parse one YAML document within the limits above; ScenarioError (exit 2) for anything else."""
+    try:
+        loader = _Loader(text)
+        try:
+            node = loader.get_single_node()
+            if node is None:
+                return None
+            n = _expanded_size(node)
+            if n > MAX_NODES:
+                raise ScenarioError(f"{source}: {n:.3g} YAML values (aliases expanded); allowed at most {MAX_NODES} "
+                                    "(a scenario has about 100)")
+            return loader.construct_document(node)
+        finally:
+            loader.dispose()
+    except ScenarioError as exc:
+        raise ScenarioError(str(exc) if str(exc).startswith(source) else f"{source}: {exc}") from None
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        where = f" at line {mark.line + 1}" if mark else ""
+        problem = getattr(exc, "problem", None) or exc.__class__.__name__
+        raise ScenarioError(f"{source}: not valid YAML{where} ({_abbrev(problem)})") from None
+    except RecursionError:      # a cycle or a depth the composer guard did not see (constructor)
+        raise ScenarioError(f"{source}: nested too deeply (allowed at most {MAX_DEPTH} levels)") from None
+    except (ValueError, TypeError, OverflowError) as exc:       # constructors of odd tags/values
+        raise ScenarioError(f"{source}: a value cannot be read ({exc.__class__.__name__}: {_abbrev(exc)})") from None
 
 
 def _fmt_loc(loc: tuple) -> str:
     return ".".join(str(p) for p in loc if not (isinstance(p, str) and p.startswith("function-")))
 
 
+def _abbrev(value, limit: int = MAX_SHOWN) -> str:
+    """A value as a message shows it: JSON-like, at most `limit` characters (huge ints, lists, strings cut)."""
+    if isinstance(value, dict):
+        return "{...}"
+    if isinstance(value, (list, tuple)):
+        text = "[...]" if len(value) > 20 else None
+    else:
+        text = None
+    if text is None:
+        try:
+            text = json.dumps(value, default=str) if not isinstance(value, str) or len(value) < 10 * limit else None
+        except (ValueError, TypeError, RecursionError):     # ints beyond the str conversion limit, cycles
+            text = None
+        if text is None:
+            text = f"<{type(value).__name__}>"
+    return text if len(text) <= limit else text[:limit - 3] + "..."
+
+
+def _field_info(loc: tuple):
+    """The pydantic FieldInfo of a dotted location in Scenario (None when the location is not a model field)."""
+    import types
+    import typing
+
+    model: type[BaseModel] | None = Scenario
+    info = None
+    for part in loc:
+        if isinstance(part, str) and part.startswith("function-"):
+            continue
+        if model is None or not isinstance(part, str) or part not in model.model_fields:
+            return None
+        info = model.model_fields[part]
+        model = None
+        ann = info.annotation
+        for cand in (typing.get_args(ann) if isinstance(ann, types.UnionType) or typing.get_origin(ann) is typing.Union
+                     else (ann,)):
+            if isinstance(cand, type) and issubclass(cand, BaseModel):
+                model = cand
+    return info
+
+
+def _allowed_range(loc: tuple) -> str | None:
+    """'allowed: 0 < x <= 50' from the field's numeric bounds, for messages about numbers."""
+    info = _field_info(loc)
+    if info is None:
+        return None
+    lo = hi = None
+    for m in info.metadata:
+        for attr, sym in (("gt", "<"), ("ge", "<=")):
+            if getattr(m, attr, None) is not None:
+                lo = f"{getattr(m, attr):g} {sym} "
+        for attr, sym in (("lt", "<"), ("le", "<=")):
+            if getattr(m, attr, None) is not None:
+                hi = f" {sym} {getattr(m, attr):g}"
+    if lo is None and hi is None:
+        return None
+    return f"allowed: {lo or ''}{str(loc[-1])}{hi or ''}"
+
+
+NUMBER_ERRORS = ("finite_number", "greater_than", "greater_than_equal", "less_than", "less_than_equal",
+                 "float_parsing", "float_type", "int_parsing", "int_type", "int_from_float")
+
+
 def format_validation_error(err: ValidationError, source: str = "scenario") -> str:
-    """One line per problem: `source: field = value: what is allowed`."""
+    """One line per problem: `source: field = value: what is allowed`; at most MAX_PROBLEMS lines, then a count."""
     lines = []
-    for e in err.errors(include_url=False):
-        field = _fmt_loc(e["loc"]) or "(top level)"
+    errors = err.errors(include_url=False)
+    for e in errors[:MAX_PROBLEMS]:
+        field = _abbrev(_fmt_loc(e["loc"]) or "(top level)", 2 * MAX_SHOWN).strip('"')
         msg = e["msg"].removeprefix("Value error, ")
         if e["type"] == "extra_forbidden":
             lines.append(f"{source}: unknown key '{field}' (not in the schema; see `wormsim schema`)")
         elif e["type"] == "missing":
             lines.append(f"{source}: missing required field '{field}'")
         else:
-            val = e.get("input")
-            shown = json.dumps(val, default=str) if not isinstance(val, dict) else "{...}"
-            lines.append(f"{source}: {field} = {shown}: {msg}")
+            rng = _allowed_range(e["loc"]) if e["type"] in NUMBER_ERRORS else None
+            lines.append(f"{source}: {field} = {_abbrev(e.get('input'))}: {msg}" + (f"; {rng}" if rng else ""))
+    if len(errors) > MAX_PROBLEMS:
+        lines.append(f"{source}: ... and {len(errors) - MAX_PROBLEMS} more problems")
     return "\n".join(lines)
 
 
@@ -298,10 +428,7 @@ def parse_override(text: str) -> tuple[list[str], Any]:
     path = [p for p in key.strip().split(".") if p]
     if not path:
         raise ScenarioError(f"--set {text}: empty KEY")
-    try:
-        value = yaml_load(raw) if raw.strip() else ""
-    except yaml.YAMLError as exc:
-        raise ScenarioError(f"--set {text}: VALUE is not valid YAML ({exc.__class__.__name__})") from None
+    value = yaml_load(raw, f"--set {key.strip()[:2 * MAX_SHOWN]}") if raw.strip() else ""
     return path, value
 
 
@@ -341,11 +468,17 @@ def load_scenario(path: str | Path, overrides: list[str] | None = None) -> Scena
     if not path.is_file():
         raise ScenarioError(f"{path}: no such scenario file")
     try:
-        data = yaml_load(path.read_text())
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        where = f" at line {mark.line + 1}" if mark else ""
-        raise ScenarioError(f"{path}: not valid YAML{where}") from None
+        size = path.stat().st_size
+        if size > MAX_FILE_BYTES:
+            raise ScenarioError(f"{path}: {size} bytes; a scenario file may have at most {MAX_FILE_BYTES} bytes")
+        raw = path.read_bytes()
+    except OSError as exc:
+        raise ScenarioError(f"{path}: cannot read: {exc.strerror or exc}") from None
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise ScenarioError(f"{path}: not a UTF-8 text file (byte {exc.start}); a scenario is YAML text") from None
+    data = yaml_load(text, path.name)
     return scenario_from_dict(data, str(path.name), overrides)
 
 

@@ -400,13 +400,25 @@ def write_model(scenario: Scenario, out_dir: str | Path) -> Path:
 
     The standalone file gives every wheel tooth its collision pieces (the viewer does not re-pose a window,
     so the wheel can turn any number of turns), and MuJoCo recomputes body_invweight0 on load, so its
-    contact stiffness differs from a wormsim run's.
+    contact stiffness differs from a wormsim run's. Its drive and load act with both controls at zero: the
+    scenario's final drive command (speed or torque) and load torque are the actuators' constant bias terms
+    (without the STEP ramps), so the viewer's play button turns the worm; a control adds to them.
     """
     out = Path(out_dir)
     (out / "meshes").mkdir(parents=True, exist_ok=True)
     geo = derive(scenario.gear) if scenario.gear is not None else None
     bm = build_model(scenario, window_teeth=geo.z2 if geo is not None else None)
     spec = bm.spec
+    cmds = gt.commands(scenario, bm.direction)
+    drive_final, load_final = cmds.drive_target, cmds.load_target_nm
+    for act in spec.actuators:
+        bias = list(act.biasprm)
+        if act.name == "drive" and gt.gear_drive(scenario).speed_rpm is not None:
+            bias[0] = act.gainprm[0] * drive_final       # velocity servo: kv (ctrl + w_final - qdot)
+        else:
+            bias[0] = drive_final if act.name == "drive" else load_final
+        act.biastype = mujoco.mjtBias.mjBIAS_AFFINE
+        act.biasprm = bias
     for me in spec.meshes:
         v = np.asarray(me.uservert, dtype=float).reshape(-1, 3)
         f = np.asarray(me.userface, dtype=int).reshape(-1, 3)

@@ -24,6 +24,19 @@ MAX_FRAMES = 1500
 ARROW_N_PER_MM = None      # chosen per run: the mean tooth force maps to 5 mm
 
 
+SPEED_INTERVALS = 40       # the speeds panel shows the means over this many equal intervals of the run
+
+
+def _interval_means(t: np.ndarray, *ys: np.ndarray, n: int):
+    """Means of each y over n equal time intervals, at the interval centres."""
+    edges = np.linspace(t[0], t[-1], n + 1)
+    idx = np.clip(np.searchsorted(edges, t, side="right") - 1, 0, n - 1)
+    count = np.bincount(idx, minlength=n)
+    keep = count > 0
+    centres = 0.5 * (edges[:-1] + edges[1:])[keep]
+    return (centres, *[(np.bincount(idx, weights=y, minlength=n)[keep] / count[keep]) for y in ys])
+
+
 def write_report(result: Result, path) -> None:
     import matplotlib
 
@@ -44,10 +57,18 @@ def write_report(result: Result, path) -> None:
     a.set(xlabel="time [s]", ylabel="force on the wheel [N]", title="tooth forces (wheel frame)")
     a.legend(fontsize=8)
     a = ax[0, 1]
-    a.plot(t, np.abs(S["worm_speed_rpm"]) / s["ratio_theory"], lw=0.6, label="worm / (z2/z1)")
-    a.plot(t, np.abs(S["wheel_speed_rpm"]), lw=0.6, label="wheel")
+    # raw traces faint (the wheel rattles at the contact frequencies and would hide the worm), interval means bold
+    worm, wheel = np.abs(S["worm_speed_rpm"]) / s["ratio_theory"], np.abs(S["wheel_speed_rpm"])
+    tm, worm_m, wheel_m = _interval_means(t, worm, wheel, n=SPEED_INTERVALS)
+    a.plot(t, wheel, lw=0.4, color="C1", alpha=0.25)
+    a.plot(t, worm, lw=0.4, color="C0", alpha=0.25)
+    a.plot(tm, wheel_m, "-", color="C1", lw=1.6,
+           label=f"wheel (mean of {t[-1] / SPEED_INTERVALS * 1e3:.3g} ms intervals)")
+    a.plot(tm, worm_m, "--", color="C0", lw=1.6, label="worm / (z2/z1) (interval means)")
     a.axvspan(w0, w1, color="0.9", zorder=-1)
-    a.set(xlabel="time [s]", ylabel="speed [rpm]",
+    top = 1.6 * max(float(np.max(worm_m)), float(np.max(wheel_m)), 1e-9)
+    a.set_ylim(min(0.0, 1.2 * float(min(np.min(worm_m), np.min(wheel_m)))), top)   # the raw rattle is clipped
+    a.set(xlabel="time [s]", ylabel="speed [rpm] (raw traces faint, clipped)",
           title=f"speeds: ratio {s['ratio']:.4g} (theory {s['ratio_theory']:.4g}), efficiency {s['efficiency']:.3f} "
                 f"(theory {s['efficiency_theory']:.3f})")
     a.legend(fontsize=8)
@@ -73,10 +94,12 @@ def write_report(result: Result, path) -> None:
         sc = a.scatter(p[ok, 2] * 1e3, r, c=f[ok], s=3, cmap="viridis")
         fig.colorbar(sc, ax=a, label="contact force [N]")
         geo = result.extra["built"].geometry
-        for rr_, lab in ((geo.r2, "r2"), (geo.r_a2, "r_a2"), (geo.r_f2, "r_f2")):
-            a.axhline(rr_ * 1e3, color="0.5", lw=0.6, ls="--")
-            a.text(-geo.face_width / 2 * 1e3, rr_ * 1e3, lab, fontsize=7, va="bottom")
-        a.set_xlim(-0.6 * geo.face_width * 1e3, 0.6 * geo.face_width * 1e3)
+        for rr_, lab in ((geo.r2, "r2 (reference)"), (geo.r_a2, "r_a2 (tip)"), (geo.r_f2, "r_f2 (root)")):
+            a.axhline(rr_ * 1e3, color="0.4", lw=0.7, ls="--", zorder=1)
+            # labels in the margin right of the face (x > b2/2), where no contact point lies
+            a.text(0.52 * geo.face_width * 1e3, rr_ * 1e3, lab, fontsize=9, va="center", ha="left", zorder=3,
+                   bbox=dict(facecolor="white", edgecolor="0.6", alpha=0.9, pad=1.5))
+        a.set_xlim(-0.6 * geo.face_width * 1e3, 0.85 * geo.face_width * 1e3)
     a.set(xlabel="across the face (wheel z) [mm]", ylabel="radius [mm]", title="contact pattern on a wheel tooth")
     fig.suptitle(f"{result.summary.get('scenario', '')} contact3d: dt {s['timestep_s']:.3g} s, resolution "
                  f"{s['resolution']}, steady window {w0:.3g}-{w1:.3g} s")

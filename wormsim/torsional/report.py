@@ -29,10 +29,14 @@ def write_report(result: Result, path) -> None:
     a.set_xlabel("t [s]"); a.set_ylabel("speed [rpm]"); a.legend(); a.set_title("shaft speeds")
     a = ax[0, 1]
     for k in ("tangential_force_n", "radial_force_n", "axial_force_n"):
-        a.plot(t, S[k], label=k.replace("_n", " [N]"))
+        a.plot(t, S[k], label=k.removesuffix("_force_n"))
     w0, w1 = sm["steady_window_s"]
     a.axvspan(w0, w1, color="0.9", zorder=-1, label="steady window")
-    a.set_xlabel("t [s]"); a.legend(fontsize=8); a.set_title("forces on the wheel")
+    # headroom above the curves for the legend, so that it never covers them
+    lo, hi = a.get_ylim()
+    a.set_ylim(lo, hi + 0.35 * (hi - lo))
+    a.set_xlabel("t [s]"); a.set_ylabel("force [N]"); a.set_title("forces on the wheel")
+    a.legend(fontsize=8, loc="upper center", ncol=4)
     a = ax[1, 0]
     a.plot(t, S["transmission_error_rad"] * 1e6)
     a.set_xlabel("t [s]"); a.set_ylabel("transmission error [urad]"); a.set_title("theta2 - hand theta1 z1/z2")

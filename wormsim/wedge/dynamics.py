@@ -32,6 +32,14 @@ Vs = 0 is the static friction angle).
 
 Motor (seed 000, Kloss): F1 = 2 Fmax / (V + 1/V),  V = (V0 - x1') / (V0 - Vmax).
 
+No load (F2 = 0 and constant): the motor runs up to its synchronous speed V0, where F1 = 0 and N = 0 (neither face
+carries a force; regime "unloaded"). Both sliding regimes approach this point (tractive from below, inverse from
+above) and meet on phi = 0, where both give the same acceleration F1/m1 = 0: an equilibrium ON the switching
+surface. The exact solution only tends to it, but the integrator steps across phi = 0 by rounding and would switch
+regimes ever faster (stick-slip-like chatter, found with `--set wedge.load.force_n=0`). A phi event with the load
+constant up to the next breakpoint and |F2| below EQUILIBRIUM_FORCE_TOL x peak force is therefore this equilibrium:
+the speed is held there (x1'' = 0, S1 = S2 = 0) until the load changes.
+
 Integration: scipy solve_ivp (DOP853) per segment of constant regime; terminal events at x1' = 0
 and at phi = 0; a locked segment ends where the stick margin crosses zero (found by bisection, the
 load being the only thing that changes while locked); load breakpoints (start_s, start_s + ramp_s)
@@ -55,8 +63,9 @@ from wormsim.friction import rho_rad
 from wormsim.result import Result
 from wormsim.units import DEG, step
 
-TRACTIVE, INVERSE, LOCKED = "tractive", "inverse", "locked"
-REGIME_CODE = {LOCKED: 0, TRACTIVE: 1, INVERSE: 2}
+TRACTIVE, INVERSE, LOCKED, UNLOADED = "tractive", "inverse", "locked", "unloaded"
+REGIME_CODE = {LOCKED: 0, TRACTIVE: 1, INVERSE: 2, UNLOADED: 3}
+EQUILIBRIUM_FORCE_TOL = 1e-9  # of wedge.motor.peak_force_n: a load this small counts as none (unloaded equilibrium)
 GRID_POINTS = 4001          # uniform output samples over the run (plus solver steps and events)
 MAX_SEGMENTS = 20000        # a guard against endless stick-slip chatter
 STEADY_FRACTION = 0.1       # steady values: time average over the last 10 % of the run
@@ -230,6 +239,16 @@ def _locked_until(t0: float, t1: float, F1_0: float, p: WedgeParams, rho0: float
     return hi
 
 
+def _load_constant(t0: float, t1: float, p: WedgeParams) -> bool:
+    """F2 is constant on [t0, t1] (t1 a breakpoint or the end: outside the open ramp interval)."""
+    return p.load_initial_n == p.load_final_n or t1 <= p.load_start_s or t0 >= p.load_start_s + p.load_ramp_s
+
+
+def _unloaded_equilibrium(t: float, t_end: float, p: WedgeParams) -> bool:
+    """At a phi event: the point is the no-load equilibrium (module docstring) rather than a crossing."""
+    return _load_constant(t, t_end, p) and abs(load_force_n(t, p)) <= EQUILIBRIUM_FORCE_TOL * p.peak_force_n
+
+
 def _segment_times(grid: np.ndarray, t0: float, t1: float, extra=()) -> np.ndarray:
     inner = grid[(grid > t0) & (grid < t1)]
     return np.unique(np.concatenate([[t0], inner, np.asarray(extra, float), [t1]]))
@@ -259,6 +278,12 @@ def simulate_params(p: WedgeParams, progress=None, name: str = "wedge") -> Resul
                                   "lower wedge.rtol or check the friction law")
         t_end = next(b for b in stops if b > t * (1 + 1e-12) + 1e-15)
         F1, F2 = motor_force_n(v, p), load_force_n(t, p)
+        if segs and segs[-1]["regime"] == UNLOADED and _unloaded_equilibrium(t, t_end, p):
+            ts = _segment_times(grid, t, t_end)         # still no load past a breakpoint: stay on the equilibrium
+            segs.append({"regime": UNLOADED, "t": ts, "x": x + v * (ts - t), "v": np.full_like(ts, v),
+                         "a": np.zeros_like(ts), "k": 0})
+            t, x = t_end, float(x + v * (t_end - t))
+            continue
         if v == 0.0 and not seed_monitor:
             if stick_margin(F1, F2, g, rho0) >= 0:
                 t_break = _locked_until(t, t_end, F1, p, rho0)
@@ -316,6 +341,11 @@ def simulate_params(p: WedgeParams, progress=None, name: str = "wedge") -> Resul
         t, x, v = t_stop, float(xs[-1]), float(vs[-1])
         if hit_stop:
             v = 0.0
+        elif hit_phi and _unloaded_equilibrium(t, t_end, p):
+            ts = _segment_times(grid, t, t_end)
+            segs.append({"regime": UNLOADED, "t": ts, "x": x + v * (ts - t), "v": np.full_like(ts, v),
+                         "a": np.zeros_like(ts), "k": 0})
+            t, x = t_end, float(x + v * (t_end - t))
         elif hit_phi:
             sigma_hint = -sigma
         if progress is not None:

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 from wormsim.recording import save_series_recording
 from wormsim.result import Result
-from wormsim.wedge.dynamics import INVERSE, LOCKED, TRACTIVE
+from wormsim.wedge.dynamics import INVERSE, LOCKED, TRACTIVE, UNLOADED
 
 # ----------------------------------------------------------------------------- report, recording
 
@@ -29,8 +29,8 @@ def write_report(result: Result, path) -> None:
     ax[2].plot(t_ms, s["vs_m_s"], ":", lw=1, label="Vs (sliding)")
     ax[2].set_ylabel("speed [m/s]")
     ax[3].step(t_ms, s["regime_code"], where="post")
-    ax[3].set_yticks([0, 1, 2], [LOCKED, TRACTIVE, INVERSE])
-    ax[3].set_ylim(-0.5, 2.5)
+    ax[3].set_yticks([0, 1, 2, 3], [LOCKED, TRACTIVE, INVERSE, UNLOADED])
+    ax[3].set_ylim(-0.5, 3.5)
     ax[3].set_xlabel("time [ms]")
     for a in ax[:3]:
         a.legend(loc="best", fontsize=8)
@@ -39,8 +39,10 @@ def write_report(result: Result, path) -> None:
     name = result.extra.get("name", "wedge")
     fig.suptitle(f"{name}: wedge model (monitor {m['monitor']}), Kd1 {m['Kd1']:.2f}, Kd2 {m['Kd2']:.2f}, "
                  f"stalled {m['stalled']}, self-locking {m['self_locking']}\n"
-                 f"regimes: {' -> '.join(m['regimes'])};  eta {m['efficiency_forward']:.3f}, "
-                 f"mu {m['efficiency_backward']:.3f} at rho {m['rho_steady_deg']:.2f} deg", fontsize=9)
+                 f"regimes: {' -> '.join(m['regimes'])};  efficiency forward {m['efficiency_forward']:.3f}, "
+                 f"backward {m['efficiency_backward']:.3f}"
+                 + (" (self-locking at rest)" if m["self_locking"] else "")
+                 + f", friction angle rho {m['rho_steady_deg']:.2f} deg at the steady speed", fontsize=9)
     fig.tight_layout()
     fig.savefig(path, dpi=100, format="png")
     plt.close(fig)

@@ -1,0 +1,146 @@
+"""Robustness (issue 10): random valid gear data either runs at torsional with the ratio within 0.1 % and the
+torque balance within 2 %, or is refused with exit 2 -- never exit 1, never a hang; and a fuzz test of the scenario
+loader with mutated seed files -- only a Scenario or exit 2, in bounded time and memory.
+
+contact3d is not in the property test: meshing one new random gear set takes about 55 s on the 2-core CI machine
+(measured), beyond this test's budget; the contact3d levels of the seeds and varied gears are covered by
+tests/test_contact3d_*.py."""
+from __future__ import annotations
+
+import json
+import resource
+import signal
+import subprocess
+import sys
+from contextlib import contextmanager
+
+import yaml
+from conftest import ROOT
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from wormsim import cli
+
+SEEDS = sorted((ROOT / "scenarios").glob("*.yaml")) + sorted((ROOT / "tests" / "assets").glob("*.yaml"))
+
+
+@contextmanager
+def time_limit(seconds: int):
+    """A hang becomes a failure (SIGALRM), not a stuck CI job."""
+    def expire(signum, frame):
+        raise TimeoutError(f"no result within {seconds} s")
+    old = signal.signal(signal.SIGALRM, expire)
+    signal.alarm(seconds)
+    try:
+        yield
+    finally:
+        signal.alarm(0)
+        signal.signal(signal.SIGALRM, old)
+
+
+gear_data = st.fixed_dictionaries({
+    "worm_starts": st.integers(1, 4),
+    "wheel_teeth": st.integers(20, 80),
+    "axial_module_mm": st.floats(0.5, 12),
+    "diameter_quotient": st.floats(6, 16),
+    "normal_pressure_angle_deg": st.floats(10, 25),
+    "hand": st.sampled_from(["right", "left"]),
+    "profile": st.sampled_from(["ZI", "ZA"]),
+})
+
+
+OUTCOMES: list[int] = []
+
+
+@settings(max_examples=8, deadline=None, derandomize=True, database=None,
+          suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow])
+@given(gear=gear_data)
+def test_random_gear_runs_or_is_refused(gear, tmp_path_factory, capsys):
+    m = gear["axial_module_mm"]
+    load_nm = 0.04 * m ** 3 * gear["wheel_teeth"]           # a tangential force of about 10 N/mm^2 x m x 8 m
+    scenario = {"name": "prop", "model": "torsional",
+                "gear": {**gear, "backlash_mm": 0.05 * m},
+                "drive": {"speed_rpm": 600, "ramp_s": 0.05}, "load": {"torque_nm": load_nm, "ramp_s": 0.05},
+                "simulation": {"duration_s": 0.3}}
+    d = tmp_path_factory.mktemp("prop")
+    (d / "s.yaml").write_text(yaml.safe_dump(scenario))
+    with time_limit(120):
+        code = cli.main(["run", str(d / "s.yaml"), "--out", str(d / "o"), "--no-progress"])
+    err = capsys.readouterr().err
+    OUTCOMES.append(code)
+    assert code in (0, 2), (gear, code, err)
+    if code == 2:
+        assert err.startswith("error: ") and err.count("\n") == 1 and "gear" in err, (gear, err)
+        return
+    s = json.loads((d / "o" / "summary.json").read_text())
+    assert s["status"] == "ok"
+    assert abs(s["ratio"] / s["ratio_theory"] - 1) < 1e-3, (gear, s["ratio"], s["ratio_theory"])
+    # torque balance: the wheel carries the load, and worm torque x ratio x efficiency is the wheel torque
+    assert abs(abs(s["wheel_torque_mean_nm"]) / load_nm - 1) < 0.02, (gear, s["wheel_torque_mean_nm"], load_nm)
+    balance = abs(s["worm_torque_mean_nm"]) * s["ratio"] * s["efficiency"] / abs(s["wheel_torque_mean_nm"])
+    assert abs(balance - 1) < 0.02, (gear, balance)
+
+
+def test_random_gears_mostly_run():
+    """The property test above is not vacuous: most of its (derandomized) gears run (measured: 7 of 8, one undercut refused)."""
+    if not OUTCOMES:
+        test_random_gear_runs_or_is_refused()
+    assert OUTCOMES.count(0) >= len(OUTCOMES) // 2, OUTCOMES
+
+
+# ----------------------------------------------------------------------------- fuzz of the loader
+
+FUZZ_WORKER = r"""
+import json, random, sys, traceback
+from pathlib import Path
+from wormsim.scenario import ScenarioError, load_scenario
+from wormsim.validate import validate_geometry
+
+seeds, n, tmp = [Path(p) for p in json.loads(sys.argv[1])], int(sys.argv[2]), Path(sys.argv[3])
+rng = random.Random(20251123)
+TOKENS = [b"&a ", b"*a", b"[", b"]", b"{", b"}", b": ", b"- ", b"!!binary ", b"!!python/object:os.system ",
+          b".inf", b"-.nan", b"1e999", b"9" * 5000, b"\x00", b"\xff\xfe", b"'", b'"', b"\t", b"? ", b"|\n",
+          b"<<: *a\n", b"~", b"null", b"-1e-300", b"0x7fffffffffffffff", b"2001-12-14", b"\n" * 3, b"#"]
+bad = []
+for i in range(n):
+    src = rng.choice(seeds).read_bytes()
+    data = bytearray(src)
+    for _ in range(rng.randint(1, 6)):
+        op, pos = rng.random(), rng.randrange(len(data) + 1)
+        if op < 0.3:
+            data[pos:pos] = rng.choice(TOKENS)
+        elif op < 0.5:
+            del data[pos:pos + rng.randint(1, 40)]
+        elif op < 0.7 and len(data):
+            data[pos % len(data)] = rng.randrange(256)
+        elif op < 0.85:
+            lines = data.split(b"\n")
+            k = rng.randrange(len(lines))
+            lines.insert(k, lines[rng.randrange(len(lines))])
+            data = bytearray(b"\n".join(lines))
+        else:
+            data = data.replace(b"0.", rng.choice([b"-0.", b"1e308", b".inf", b"0x"]), 1)
+    f = tmp / f"m{i}.yaml"
+    f.write_bytes(bytes(data))
+    try:
+        validate_geometry(load_scenario(f))
+    except ScenarioError as exc:
+        msg = str(exc)
+        if len(msg) > 4000 or not msg.strip():
+            bad.append([i, "message", msg[:300]])
+    except BaseException as exc:
+        bad.append([i, type(exc).__name__, traceback.format_exc()[-600:]])
+print(json.dumps(bad))
+"""
+
+
+def _limits():
+    resource.setrlimit(resource.RLIMIT_AS, (2 << 30, 2 << 30))
+
+
+def test_fuzz_scenario_loader(tmp_path):
+    r = subprocess.run([sys.executable, "-c", FUZZ_WORKER, json.dumps([str(p) for p in SEEDS]), "400", str(tmp_path)],
+                       capture_output=True, text=True, timeout=300, preexec_fn=_limits)
+    assert r.returncode == 0, r.stderr[-3000:]
+    bad = json.loads(r.stdout.strip().splitlines()[-1])
+    assert bad == [], bad[:5]
