@@ -309,6 +309,12 @@ def open_client(scheduler: str | None, workers: int | None):
     return client, cluster, info
 
 
+def _free_threads(client) -> int:
+    """Worker threads the scheduler knows now (at least 1; workers that join later are used from the next point)."""
+    ws = client.scheduler_info().get("workers", {})
+    return max(1, sum(w.get("nthreads", 0) for w in ws.values()))
+
+
 # ----------------------------------------------------------------------------- the sweep
 
 
@@ -406,8 +412,13 @@ def run_sweep(
             write_json_atomic(out / JSON_NAME, _json_doc(sweep, rows, timing, machine, cluster_info, state))
             from distributed import as_completed
 
+            # Only as many points in flight as the cluster has threads: a point waits on the scheduler, not in
+            # a worker's queue, so a worker that dies (segfault, OOM killer) fails the point it ran and no other.
             futures = {}
-            for p in todo:
+            queue = list(todo)
+
+            def submit_next():
+                p = queue.pop(0)
                 fut = client.submit(
                     run_point,
                     p.scenario.model_dump(mode="json"),
@@ -416,7 +427,12 @@ def run_sweep(
                     key=f"wormsim-point-{p.index}-{p.scenario_hash}",
                 )
                 futures[fut] = (p, time.time())
-            for fut in as_completed(list(futures)):
+                return fut
+
+            pending = as_completed([submit_next() for _ in range(min(len(queue), _free_threads(client)))])
+            for fut in pending:
+                if queue:
+                    pending.add(submit_next())
                 p, t_submit = futures[fut]
                 try:
                     res = fut.result()
