@@ -28,8 +28,6 @@ import numpy as np
 
 from wormsim.contact3d.flanks import MARGIN_PITCH, contact_frames, find_contacts, flank_grid
 
-_ROWS3 = np.arange(3)
-
 
 class FlankContacts:
     """The flank contacts of one model: the grid, the window, the template contact and the step."""
@@ -72,11 +70,12 @@ class FlankContacts:
         t.frame = [0, 0, 1, 1, 0, 0, 0, 1, 0]
         self.template = t
         self.mu = None
-        self.te = 0.0
         self.set_friction(float(m.geom_friction[gw, 0]))
 
     def set_friction(self, mu: float) -> None:
         if mu != self.mu:
+            # frictionless: a 1-dimensional contact (MuJoCo's elliptic cone with mu = 0 gave no normal force at all)
+            self.template.dim = 3 if mu > 0 else 1
             self.template.friction = [mu, mu, 0.0, 0.0, 0.0]
             self.mu = mu
 
@@ -95,7 +94,7 @@ class FlankContacts:
         th1, th2 = d.qpos[self.qa1], d.qpos[self.qa2]
         g = self.grid
         self.n = n = find_contacts(g.xy, g.c, g.c_range, g.zeta, self.window(th2), th1, th2,
-                                   self.margin0 + abs(self.te), g.params, self.pos, self.nrm, self.depth, self.meta)
+                                   self.margin0, g.params, self.pos, self.nrm, self.depth, self.meta)
         contact_frames(self.nrm, n, self.frame)
         return n
 
@@ -168,7 +167,12 @@ def flank_contact_details(fc: FlankContacts, d: mujoco.MjData):
     ok = adr >= 0
     frame = np.asarray(con.frame[k0:])[ok].reshape(-1, 3, 3)
     pos = np.asarray(con.pos[k0:])[ok]
-    f = d.efc_force[adr[ok][:, None] + _ROWS3]
+    adr = adr[ok]
+    f = np.zeros((len(adr), 3))
+    f[:, 0] = d.efc_force[adr]
+    if fc.template.dim == 3:             # elliptic cone rows (normal, two tangents); dim 1: the normal only
+        f[:, 1] = d.efc_force[adr + 1]
+        f[:, 2] = d.efc_force[adr + 2]
     F = np.einsum("ni,nij->nj", f, frame)
     ks = fc.meta[:n, 0][ok]
     th2 = float(d.qpos[fc.qa2])

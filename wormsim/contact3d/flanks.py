@@ -66,7 +66,7 @@ def worm_params(g: GearGeometry) -> np.ndarray:
     zi = 1.0 if g.profile == "ZI" else 0.0
     t1 = math.sqrt(max(g.r1 ** 2 / g.r_b ** 2 - 1.0, 0.0)) if zi else 0.0
     return np.array([g.p, g.p_x, g.r_f1, g.r_a1, g.worm_length / 2, zi, g.r_b, math.tan(g.alpha_x),
-                     t1 - math.atan(t1), g.r1, g.a, 2 * math.pi / g.z2], dtype=float)
+                     t1 - math.atan(t1), g.r1, g.a, 2 * math.pi / g.z2, g.hand * g.z1 / g.z2], dtype=float)
 
 
 @functools.lru_cache(maxsize=16)
@@ -147,9 +147,14 @@ def _eval(x0, y0, zeta, ca, sa, theta1, P, out):
 def find_contacts(xy, c, c_range, zeta, ks, theta1, theta2, margin, P, pos, nrm, depth, meta):
     """Contacts of the window teeth ks at worm angle theta1, wheel angle theta2 (module docstring). Writes per contact
     the assembly position pos (n, 3), unit normal nrm (n, 3) (worm -> wheel), depth (n,) > 0 and meta (n, 4) =
-    (tooth k, flank sigma, slice j, fractional profile index); returns n."""
+    (tooth k, flank sigma, slice j, fractional profile index); returns n. The candidate window is margin plus the
+    transmission error |theta2 - hand z1 / z2 theta1| (wrapped to a pitch), so a wheel pushed far into the
+    worm keeps its contacts."""
     S, N = c.shape[1], c.shape[2]
     pitch = P[11]
+    te = theta2 - P[12] * theta1
+    te = (te + pitch / 2) % pitch - pitch / 2
+    margin = margin + abs(te)
     tmp = np.empty(6)
     gaps = np.empty(N)
     pts = np.empty((N, 3))
