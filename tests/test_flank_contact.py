@@ -124,4 +124,5 @@ def test_flank_static_mesh_stiffness_per_pair_within_5_percent(static_flanks):
     k_theta = (Tb - Ta) / abs(thb - tha)
     arm2 = 0.5 * (np.sum(Ca[Ca[:, 0] > 1e-3, 2] ** 2) + np.sum(Cb[Cb[:, 0] > 1e-3, 2] ** 2))
     k_pair = k_theta * bm.law.contacts_per_pair / arm2
+    print(f"flank tooth-pair stiffness {k_pair:.6g} N/m against K = {bm.law.pair_stiffness_n_per_m:.6g} ({len(Cb)} contacts)")
     assert k_pair == pytest.approx(bm.law.pair_stiffness_n_per_m, rel=0.05)
