@@ -4,15 +4,14 @@ configurations (slices by simulation.resolution: seat_motor and screw_jack 16, i
 contact radius, DIN 3975 radial force 3 %. Measured numbers of the expected failures in docs/contact3d.md."""
 from __future__ import annotations
 
-from pathlib import Path
-
 import pytest
-
+from conftest import SCENARIOS
 from test_contact3d_seeds import CI, assert_mesh_frequency
+
 from wormsim.contact3d.runner import simulate
 from wormsim.scenario import load_scenario
 
-SCEN = Path(__file__).resolve().parent.parent / "scenarios"
+SCEN = SCENARIOS
 SEEDS = list(CI)
 _CACHE: dict[str, dict] = {}
 

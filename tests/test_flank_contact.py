@@ -4,19 +4,20 @@ shows the specified tooth-pair stiffness (issue 13: within 5 %, as tests/test_co
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
 import mujoco
 import numpy as np
 import pytest
+from conftest import SCENARIOS
 
 from meshgen import worm
 from meshgen.geometry import derive
 from wormsim.contact3d import flanks as F
-from wormsim.contact3d.mjcf import build_model, window_size, window_teeth_at
+from wormsim.contact3d.mjcf import build_model
+from wormsim.contact3d.window import window_size, window_teeth_at
 from wormsim.scenario import load_scenario
 
-SCEN = Path(__file__).resolve().parent.parent / "scenarios"
+SCEN = SCENARIOS
 
 
 @pytest.mark.parametrize("name,profile", [("seat_motor", "ZI"), ("screw_jack", "ZA"), ("involute_41", "ZI")])

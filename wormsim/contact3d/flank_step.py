@@ -1,4 +1,5 @@
-"""MuJoCo's step split so that contacts found on the exact flanks (wormsim.contact3d.flanks) enter its constraint solver.
+"""MuJoCo's step split so that contacts found on the exact flanks (wormsim.contact3d.flanks) enter its constraint
+solver.
 
 mj_step (MuJoCo 4.0.0, engine_forward.c) is mj_checkPos, mj_checkVel, mj_forward, mj_checkAcc, integrate, and
 mj_forward's position stage (mj_fwdPosition) is kinematics (mj_fwdKinematics), inertia (mj_makeM, mj_factorM),

@@ -229,7 +229,8 @@ def build_model(scenario: Scenario, gs: GearSet | None = None, check_backlash_vs
     model = spec.compile()
 
     ine = p.inertias
-    meta = {"contact_geometry": scenario.contact.geometry, "worm_mass_kg": ine.worm_mass_kg, "wheel_mass_kg": ine.wheel_mass_kg,
+    meta = {"contact_geometry": scenario.contact.geometry,
+            "worm_mass_kg": ine.worm_mass_kg, "wheel_mass_kg": ine.wheel_mass_kg,
             "worm_inertia_kg_m2": ine.worm_inertia_kg_m2, "wheel_inertia_kg_m2": ine.wheel_inertia_kg_m2,
             "window_teeth": W, "worm_pieces": len(gs.worm_pieces), "tooth_pieces": len(gs.wheel_tooth_pieces),
             **backlash_meta}
@@ -240,7 +241,8 @@ def build_model(scenario: Scenario, gs: GearSet | None = None, check_backlash_vs
     def oid(kind: mujoco.mjtObj, name: str) -> int:
         return mujoco.mj_name2id(model, kind, name)
 
-    slot_geoms = np.array([[oid(mujoco.mjtObj.mjOBJ_GEOM, n) for n in row] for row in slot_names], dtype=int).reshape(W, -1)
+    slot_geoms = np.array([[oid(mujoco.mjtObj.mjOBJ_GEOM, n) for n in row] for row in slot_names],
+                          dtype=int).reshape(W, -1)      # (W, 0) with contact.geometry flanks
     slot_bodies = np.array([oid(mujoco.mjtObj.mjOBJ_BODY, f"slot{i}") for i in range(W)])
     _set_inv_mass_hat(model, law, p.inv_mass_worm, p.inv_mass_wheel, slot_bodies)
     bm = BuiltModel(
