@@ -213,9 +213,6 @@ def build_model(scenario: Scenario, gs: GearSet | None = None, check_backlash_vs
 
     pair = displaced_pair(scenario.errors, geo)      # errors: (issue 12), None for the perfect pair
     dev, kin = pair if pair is not None else (None, None)
-    if flanks and pair is not None:
-        raise ScenarioError("contact.geometry: flanks takes no errors: block (the flank kernel assumes the perfect "
-                            "pair); use contact.geometry: pieces")
     shift = dev.tooth_angle_shift(geo, np.arange(geo.z2)) if dev is not None and any(dev.tooth_shift) else None
 
     spec = mujoco.MjSpec.from_file(str(TEMPLATE))
