@@ -91,6 +91,11 @@ class Contact(_Strict):
     friction_dynamic: float | None = Field(None, ge=0, le=1)
     friction_group: FrictionGroup | None = Field(None, description="seed 000 rho(Vs) material group")
     transition_velocity_m_s: float = Field(1e-3, gt=0, le=10, description="static -> dynamic friction blend speed")
+    geometry: Literal["pieces", "flanks"] = Field("pieces", description=(
+        "contact3d: pieces (MuJoCo collides convex pieces) | flanks (contacts found on the exact flanks, one per "
+        "face slice; docs/contact3d.md)"))
+    slices: int | None = Field(None, ge=2, le=256, description=(
+        "flanks: slices across the face width (default by simulation.resolution: coarse 8, medium 16, fine 32)"))
 
     @model_validator(mode="after")
     def _friction(self) -> "Contact":
@@ -251,6 +256,9 @@ class Scenario(_Strict):
                 raise ValueError(f"model: {self.model} needs a drive: block")
             if self.drive.on == self.load.on:
                 raise ValueError("drive.on and load.on must name different shafts")
+            if self.contact.geometry == "flanks" and not self.errors.is_zero():
+                raise ValueError("errors: contact.geometry flanks finds contacts on the perfect pair's flanks; use "
+                                 "contact.geometry: pieces, or set every errors key to 0")
         return self
 
 

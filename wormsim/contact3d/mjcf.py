@@ -139,6 +139,13 @@ def expected_direction(scenario: Scenario, geo: GearGeometry) -> int:
     return geo.hand
 
 
+def flank_slices(scenario: Scenario) -> int:
+    """contact.geometry flanks: slices across the face (contact.slices, else by simulation.resolution)."""
+    from wormsim.contact3d.flanks import SLICES
+
+    return int(scenario.contact.slices or SLICES[scenario.simulation.resolution])
+
+
 def _slabs_per_flank(gs: GearSet) -> int:
     """n_ref: wheel-tooth pieces across the face width on one flank (meshgen may split a tooth
     into flank pieces; a piece spanning both flanks counts once per flank)."""
@@ -176,7 +183,9 @@ def prepare(scenario: Scenario, gs: GearSet | None = None) -> Prepared:
     # driven-machine inertia J on the loaded shaft (joint armature) belongs to that shaft's effective mass
     a1 = arm1 ** 2 / (ine.worm_inertia_kg_m2 + ine.worm_load_inertia_kg_m2)
     a2 = arm2 ** 2 / (ine.wheel_inertia_kg_m2 + ine.wheel_load_inertia_kg_m2)
-    law = contact_law(scenario.contact, scenario.materials, geo.face_width, max(1, _slabs_per_flank(gs)), a1 + a2)
+    # n_ref: the pieces across the face width, or with contact.geometry flanks the flank contacts' slices
+    slabs = flank_slices(scenario) if scenario.contact.geometry == "flanks" else max(1, _slabs_per_flank(gs))
+    law = contact_law(scenario.contact, scenario.materials, geo.face_width, slabs, a1 + a2)
     mu0 = float(friction_coefficient(scenario.contact, 0.0))
     mu_max = max(mu0, float(friction_coefficient(scenario.contact, 1.0)))
     law = replace(law, impratio=friction_impratio(law, mu_max, nominal_normal_force_n(scenario, geo),
@@ -194,6 +203,9 @@ def build_model(scenario: Scenario, gs: GearSet | None = None, check_backlash_vs
     timestep_s: the timestep to build with (default: choose_timestep's)."""
     p = prepare(scenario, gs)
     geo, gs, law = p.geometry, p.pieces, p.law
+    flanks = scenario.contact.geometry == "flanks"
+    if flanks:
+        check_backlash_vs_pieces = False        # no pieces collide (wormsim.contact3d.flank_step)
     # backlash against the pieces' residual bulge (wormsim.contact3d.backlash (2)): exit 2 before the teeth start jammed
     backlash_meta = check_backlash(geo, gs.piece_error_um, scenario.simulation.resolution) \
         if check_backlash_vs_pieces and gs.piece_error_um else {}
@@ -207,14 +219,15 @@ def build_model(scenario: Scenario, gs: GearSet | None = None, check_backlash_vs
     spec.modelname = scenario.name
     _place_bodies(spec, geo, p.inertias, dev)
     worm_names, slot_names, W = _add_geoms(spec, geo, gs, law, float(friction_coefficient(scenario.contact, 0.0)),
-                                           window_teeth, shift)
+                                           window_teeth, shift, flanks)
     kv, drive_sign = _add_actuators(spec, scenario, geo)
     _set_options(spec, scenario, law, h)
     _add_mesh_sensor(spec)
     model = spec.compile()
 
     ine = p.inertias
-    meta = {"worm_mass_kg": ine.worm_mass_kg, "wheel_mass_kg": ine.wheel_mass_kg,
+    meta = {"contact_geometry": scenario.contact.geometry,
+            "worm_mass_kg": ine.worm_mass_kg, "wheel_mass_kg": ine.wheel_mass_kg,
             "worm_inertia_kg_m2": ine.worm_inertia_kg_m2, "wheel_inertia_kg_m2": ine.wheel_inertia_kg_m2,
             "window_teeth": W, "worm_pieces": len(gs.worm_pieces), "tooth_pieces": len(gs.wheel_tooth_pieces),
             **backlash_meta}
@@ -225,7 +238,8 @@ def build_model(scenario: Scenario, gs: GearSet | None = None, check_backlash_vs
     def oid(kind: mujoco.mjtObj, name: str) -> int:
         return mujoco.mj_name2id(model, kind, name)
 
-    slot_geoms = np.array([[oid(mujoco.mjtObj.mjOBJ_GEOM, n) for n in row] for row in slot_names], dtype=int)
+    slot_geoms = np.array([[oid(mujoco.mjtObj.mjOBJ_GEOM, n) for n in row] for row in slot_names],
+                          dtype=int).reshape(W, -1)      # (W, 0) with contact.geometry flanks
     slot_bodies = np.array([oid(mujoco.mjtObj.mjOBJ_BODY, f"slot{i}") for i in range(W)])
     _set_inv_mass_hat(model, law, p.inv_mass_worm, p.inv_mass_wheel, slot_bodies)
     bm = BuiltModel(
@@ -290,11 +304,12 @@ def _add_mesh(spec: mujoco.MjSpec, name: str, mesh: trimesh.Trimesh) -> None:
 
 
 def _add_geoms(spec: mujoco.MjSpec, geo: GearGeometry, gs: GearSet, law: ContactLaw, mu0: float,
-               window_teeth: int | None, tooth_shift_rad: np.ndarray | None = None
+               window_teeth: int | None, tooth_shift_rad: np.ndarray | None = None, flanks: bool = False
                ) -> tuple[list[str], list[list[str]], int]:
     """Visual meshes, the worm's collision pieces and the wheel's window of W slots (one rigid child body per
     slot, no joint: re-posing a slot moves its body, so MuJoCo's per-body bounding-volume hierarchy, built at
-    compile time in the body frame, stays valid). Returns (worm geom names, slot geom names, W)."""
+    compile time in the body frame, stays valid). Returns (worm geom names, slot geom names, W). flanks
+    (contact.geometry flanks): no collision pieces; the visual geoms carry the flank contacts' law."""
     worm_b, wheel_b = spec.body("worm"), spec.body("wheel")
 
     def set_contact(g: mujoco.MjsGeom) -> None:
@@ -309,8 +324,10 @@ def _add_geoms(spec: mujoco.MjSpec, geo: GearGeometry, gs: GearSet, law: Contact
                           (wheel_b, "wheel_visual", (0.85, 0.65, 0.3, 1))):
         g = b.add_geom(default=spec.find_default("visual"))
         g.name, g.meshname, g.rgba = name, name, rgba
+        if flanks:
+            set_contact(g)          # the flank contacts' geoms (wormsim.contact3d.flank_step): friction, solref
     worm_names = []
-    for i, piece in enumerate(gs.worm_pieces):
+    for i, piece in enumerate([] if flanks else gs.worm_pieces):
         _add_mesh(spec, f"worm_piece_{i}", piece)
         g = worm_b.add_geom(default=spec.find_default("worm_collision"))
         g.name = g.meshname = f"worm_piece_{i}"
@@ -319,7 +336,8 @@ def _add_geoms(spec: mujoco.MjSpec, geo: GearGeometry, gs: GearSet, law: Contact
     for j, piece in enumerate(gs.wheel_tooth_pieces):
         _add_mesh(spec, f"tooth_piece_{j}", piece)
     W = window_size(geo) if window_teeth is None else int(min(max(window_teeth, 1), geo.z2))
-    slot_names = [[""] * len(gs.wheel_tooth_pieces) for _ in range(W)]
+    n_pieces = 0 if flanks else len(gs.wheel_tooth_pieces)
+    slot_names = [[""] * n_pieces for _ in range(W)]
     for k in window_teeth_at(0.0, geo.z2, W, _tooth0_angle(gs)):
         s = int(k % W)
         sb = wheel_b.add_body()
@@ -328,7 +346,7 @@ def _add_geoms(spec: mujoco.MjSpec, geo: GearGeometry, gs: GearSet, law: Contact
         sb.explicitinertial = True
         sb.mass = 1e-9
         sb.inertia = [1e-15, 1e-15, 1e-15]
-        for j in range(len(gs.wheel_tooth_pieces)):
+        for j in range(n_pieces):
             g = sb.add_geom(default=spec.find_default("wheel_collision"))
             g.name = f"slot{s}_piece{j}"
             g.meshname = f"tooth_piece_{j}"

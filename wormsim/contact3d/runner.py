@@ -279,8 +279,19 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
     pts_world = np.full((n_rec, MAX_POINTS, 3), np.nan, dtype=np.float32)
     forces = np.full((n_rec, MAX_POINTS, 3), np.nan, dtype=np.float32)
 
-    window = repose_window(bm, 0.0)
-    mujoco.mj_forward(m, d)
+    fc = None
+    if bm.meta.get("contact_geometry") == "flanks":
+        # contacts found on the exact flanks and added between collision and constraints (wormsim.contact3d.flank_step)
+        from wormsim.contact3d.flank_step import FlankContacts, flank_contact_details, split_forward
+
+        fc = FlankContacts(bm, bm.law.contacts_per_pair)
+        split_forward(m, d, fc.add)
+        window = None
+        step_fn = fc.step
+    else:
+        window = repose_window(bm, 0.0)
+        mujoco.mj_forward(m, d)
+        step_fn = mujoco.mj_step
     t_wall = time.perf_counter()
     worm_is_drive = scenario.drive.on == "worm"
     sd, act, qv, ctrl = d.sensordata, d.actuator_force, d.qvel, d.ctrl
@@ -303,7 +314,7 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
             ctrl[ia_drv] = cmd_blk[j]
             ctrl[ia_load] = load_blk[j]
             w1j, w2j = qv[dof1], qv[dof2]
-            mujoco.mj_step(m, d)
+            step_fn(m, d)
             # actuator forces of this step (computed at its start, with the speeds above) and the sensor's
             # resultant (found, F (3), torque about the point (3), point (3); global frame, on the wheel)
             q1, q2 = act[a1], act[a2]
@@ -324,12 +335,16 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
         w1, w2 = float(qv[dof1]), float(qv[dof2])
         t = float(d.time)
         te = guards.state(d, t, th1, th2, w1, w2)
-        window = repose_window(bm, th2, window)
         vs = abs(w1) * geo.r1 / math.cos(geo.gamma)
         mu = mu_of(vs)
-        if mu != mu_set:
-            m.geom_friction[coll, 0] = mu_set = mu
-        nteeth, pen, p0, F, pw = contact_details(bm, d, window)
+        if fc is None:
+            window = repose_window(bm, th2, window)
+            if mu != mu_set:
+                m.geom_friction[coll, 0] = mu_set = mu
+            nteeth, pen, p0, F, pw = contact_details(bm, d, window)
+        else:
+            fc.set_friction(mu)
+            nteeth, pen, p0, F, pw = flank_contact_details(fc, d)
         # each contact's force turned about the worm axis onto the line of centres (phi = its angle about the
         # worm axis from the line of centres): the radial force DIN 3975's single pitch-point contact means
         phi = np.arctan2(pw[:, 2], pw[:, 1] + geo.a)
@@ -361,7 +376,8 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
         if progress is not None:
             progress.update(t)
     wall = time.perf_counter() - t_wall
-    summary = _run_summary(S, scenario, bm, rec, guards.turn_max, len(coll), 1e6 * wall / max(n_rec * rec, 1))
+    summary = _run_summary(S, scenario, bm, rec, guards.turn_max, len(coll), 1e6 * wall / max(n_rec * rec, 1),
+                           flanks=fc is not None)
     if bm.kinematic_tca is not None:       # errors: the displaced exact flanks' kinematic TE and play (issue 12)
         kin = bm.kinematic_tca.summary(bm.geometry, gt.working_flank(scenario, bm.geometry.hand))
         summary.update({k: v for k, v in kin.items() if not k.startswith("contact_pattern")})
@@ -370,8 +386,9 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
 
 
 def _run_summary(S: dict, scenario: Scenario, bm: BuiltModel, rec: int, turn_max: float, collision_geoms: int,
-                 step_wall_us: float) -> dict:
-    """contact3d_summary plus what the run used: timestep, contact law, friction, window, cost."""
+                 step_wall_us: float, flanks: bool = False) -> dict:
+    """contact3d_summary plus what the run used: timestep, contact law, friction, window, contact geometry
+    (contact.geometry; flank_slices: the flank contacts per tooth flank, None for pieces), cost."""
     law = bm.law
     return {
         **contact3d_summary(S, scenario, bm),
@@ -390,6 +407,8 @@ def _run_summary(S: dict, scenario: Scenario, bm: BuiltModel, rec: int, turn_max
         "friction": friction_mode(scenario.contact),
         "friction_impratio": law.impratio,
         "window_teeth": bm.window_teeth, "collision_geoms": collision_geoms,
+        "contact_geometry": bm.meta.get("contact_geometry", "pieces"),
+        "flank_slices": law.contacts_per_pair if flanks else None,
         "step_wall_us": step_wall_us,
         "piece_error_um": bm.pieces.piece_error_um,
     }

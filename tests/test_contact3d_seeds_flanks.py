@@ -1,0 +1,82 @@
+"""The seed validation of tests/test_contact3d_seeds.py with `contact.geometry: flanks` (issue 13): same CI
+configurations (slices by simulation.resolution: seat_motor and screw_jack 16, involute_41 32), same criteria: ratio
+0.1 %, meshing frequency, torque balance 2 %, efficiency within 3 % of the wedge model at the pitch radius and at the
+contact radius, DIN 3975 radial force 3 %. Measured numbers of the expected failures in docs/contact3d.md."""
+from __future__ import annotations
+
+import pytest
+from conftest import SCENARIOS
+from test_contact3d_seeds import CI, assert_mesh_frequency
+
+from wormsim.contact3d.runner import simulate
+from wormsim.scenario import load_scenario
+
+SCEN = SCENARIOS
+SEEDS = list(CI)
+_CACHE: dict[str, dict] = {}
+
+
+def run(name: str) -> dict:
+    if name not in _CACHE:
+        sc = load_scenario(SCEN / f"{name}.yaml", CI[name] + ["contact.geometry=flanks"])
+        _CACHE[name] = {"summary": simulate(sc).summary, "scenario": sc}
+    return _CACHE[name]
+
+
+MESH_XFAIL = {
+    "screw_jack": "F_t's largest peak is the 3rd meshing harmonic: 66.4 Hz against z1 n1/60 = 22.14 Hz (p2p 66 N on "
+                  "400 N); the radial force peaks at 22.15 Hz (test below). The exact flanks' mesh stiffness has a 3rd "
+                  "harmonic of 0.35 of the 1st (wormsim.torsional.mesh_stiffness TCA); pieces showed 22 Hz under "
+                  "their facet noise",
+    "involute_41": "F_t peak 1087 Hz against 24.14 Hz: the 41-tooth wheel's mesh mode rings (p2p 55 kN on 13.8 kN), "
+                   "as with pieces (tests/test_contact3d_seeds.py); the radial force shows 24.19 Hz",
+}
+
+
+def _xf(table, n):
+    return pytest.param(n, marks=pytest.mark.xfail(reason=table[n], strict=True)) if n in table else n
+
+
+@pytest.mark.parametrize("name", SEEDS)
+def test_flanks_ratio_within_0p1_percent(name):
+    s = run(name)["summary"]
+    assert s["contact_geometry"] == "flanks"
+    assert abs(s["ratio"] / s["ratio_theory"] - 1) < 1e-3, s["ratio"]
+
+
+@pytest.mark.parametrize("name", [_xf(MESH_XFAIL, n) for n in SEEDS])
+def test_flanks_mesh_frequency(name):
+    assert_mesh_frequency(run(name)["summary"], "mesh_frequency_hz")
+
+
+@pytest.mark.parametrize("name", SEEDS)
+def test_flanks_mesh_frequency_in_the_radial_force(name):
+    assert_mesh_frequency(run(name)["summary"], "mesh_frequency_radial_hz")
+
+
+@pytest.mark.parametrize("name", SEEDS)
+def test_flanks_torque_balance_within_2_percent(name):
+    from meshgen.geometry import derive
+
+    r = run(name)
+    s, sc = r["summary"], r["scenario"]
+    assert abs(s["tangential_force_mean_n"] * derive(sc.gear).r2 / sc.load.torque_nm - 1) < 0.02
+
+
+@pytest.mark.parametrize("name", SEEDS)
+def test_flanks_efficiency_within_3_percent_of_wedge(name):
+    """Passes for the seat motor too (pieces: -3.2 %, an xfail): exact flanks give 0.613 against 0.620."""
+    s = run(name)["summary"]
+    assert abs(s["efficiency"] / s["efficiency_theory"] - 1) < 0.03, (s["efficiency"], s["efficiency_theory"])
+
+
+@pytest.mark.parametrize("name", SEEDS)
+def test_flanks_efficiency_within_3_percent_at_the_contact_radius(name):
+    s = run(name)["summary"]
+    assert abs(s["efficiency"] / s["efficiency_theory_at_contact_radius"] - 1) < 0.03
+
+
+@pytest.mark.parametrize("name", SEEDS)
+def test_flanks_radial_force_on_the_line_of_centres_is_din_3975(name):
+    s = run(name)["summary"]
+    assert abs(s["radial_force_line_of_centres_mean_n"] / s["radial_force_theory_n"] - 1) < 0.03

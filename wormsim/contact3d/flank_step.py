@@ -1,0 +1,185 @@
+"""MuJoCo's step split so that contacts found on the exact flanks (wormsim.contact3d.flanks) enter its constraint
+solver.
+
+mj_step (MuJoCo 4.0.0, engine_forward.c) is mj_checkPos, mj_checkVel, mj_forward, mj_checkAcc, integrate, and
+mj_forward's position stage (mj_fwdPosition) is kinematics (mj_fwdKinematics), inertia (mj_makeM, mj_factorM),
+mj_collision, mj_makeConstraint, mj_island, mj_transmission, mj_projectConstraint. `split_step` runs the same stages
+one by one and adds the flank contacts with mj_addContact between mj_collision (which empties the contact list and
+its arena) and mj_makeConstraint (which turns the contacts into constraint rows), then mj_sensorPos, mj_fwdVelocity,
+mj_sensorVel and mj_step2 (actuation, acceleration, constraint solve, mj_sensorAcc, mj_checkAcc, and the implicit or
+Euler integrator: RK4 is not available this way, MuJoCo's mj_step2 falls back to Euler). Energy is not computed (the
+template disables it). Validated on a 1 kg box with collision off and the contact added by hand
+(tests/test_flank_contact_path.py): static normal force = weight, penetration = the solref mapping, sliding
+deceleration = mu g.
+
+A contact is added by copying a template mjContact (mj_addContact allocates it in the arena), then its per-contact
+fields (dist, pos, frame) are written for all contacts at once through d.contact's numpy views: setting them on the
+template one contact at a time costs about 4x more from Python (docs/contact3d.md, "Exact flanks: cost").
+
+Every flank contact is between the worm's visual geom and the wheel's visual geom (contype/conaffinity 0, so MuJoCo
+never collides them itself): their bodies give the contact Jacobian, body_invweight0 the contact law's A_hat, and the
+model's contact sensor (worm against the wheel's subtree) sees the contacts like collision contacts.
+"""
+from __future__ import annotations
+
+import math
+
+import mujoco
+import numpy as np
+
+from wormsim.contact3d.flanks import MARGIN_PITCH, contact_frames, find_contacts, flank_grid
+
+
+class FlankContacts:
+    """The flank contacts of one model: the grid, the window, the template contact and the step."""
+
+    def __init__(self, bm, slices: int):
+        g = bm.geometry
+        m = bm.model
+        self.bm = bm
+        self.grid = flank_grid(g, slices)
+        self.pitch = 2 * math.pi / g.z2
+        self.margin0 = MARGIN_PITCH * self.pitch + g.backlash / (2 * g.r2)
+        W = bm.window_teeth
+        cap = 2 * W * slices
+        self.pos = np.zeros((cap, 3))
+        self.nrm = np.zeros((cap, 3))
+        self.depth = np.zeros(cap)
+        self.meta = np.zeros((cap, 4))
+        self.frame = np.zeros((cap, 9))
+        self.n = 0
+        self.qa1 = int(m.jnt_qposadr[m.dof_jntid[bm.worm_dof]])
+        self.qa2 = int(m.jnt_qposadr[m.dof_jntid[bm.wheel_dof]])
+        self._c = None
+        self.ks = np.zeros(W, dtype=np.int64)
+        gw = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, "worm_visual")
+        gg = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, "wheel_visual")
+        self.geoms = (gw, gg)
+        law = bm.law
+        t = mujoco.MjContact()
+        t.dim = 3
+        t.geom = [gw, gg]
+        t.geom1, t.geom2 = gw, gg
+        t.flex = [-1, -1]
+        t.elem = [-1, -1]
+        t.vert = [-1, -1]
+        t.solref = law.solref
+        t.solreffriction = [0.0, 0.0]
+        t.solimp = law.solimp
+        t.includemargin = 0.0
+        t.exclude = 0
+        t.frame = [0, 0, 1, 1, 0, 0, 0, 1, 0]
+        self.template = t
+        self.mu = None
+        self.set_friction(float(m.geom_friction[gw, 0]))
+
+    def set_friction(self, mu: float) -> None:
+        if mu != self.mu:
+            # frictionless: a 1-dimensional contact (MuJoCo's elliptic cone with mu = 0 gave no normal force at all)
+            self.template.dim = 3 if mu > 0 else 1
+            self.template.friction = [mu, mu, 0.0, 0.0, 0.0]
+            self.mu = mu
+
+    def window(self, theta2: float) -> np.ndarray:
+        """Tooth indices of the mesh window (wormsim.contact3d.mjcf.window_teeth_at), updated by whole pitches."""
+        bm = self.bm
+        c = math.floor((-math.pi / 2 - bm.tooth0_angle_rad - theta2) / self.pitch)
+        if c != self._c:
+            h = bm.window_teeth // 2
+            self.ks[:] = np.arange(c - h + 1, c - h + 1 + bm.window_teeth)
+            self._c = c
+        return self.ks
+
+    def find(self, d: mujoco.MjData) -> int:
+        """Run the kernel at the current positions; returns the number of contacts."""
+        th1, th2 = d.qpos[self.qa1], d.qpos[self.qa2]
+        g = self.grid
+        self.n = n = find_contacts(g.xy, g.c, g.c_range, g.zeta, self.window(th2), th1, th2,
+                                   self.margin0, g.params, self.pos, self.nrm, self.depth, self.meta)
+        contact_frames(self.nrm, n, self.frame)
+        return n
+
+    def add(self, m: mujoco.MjModel, d: mujoco.MjData) -> None:
+        """Find the flank contacts and append them to d.contact (after mj_collision)."""
+        n = self.find(d)
+        if n == 0:
+            return
+        k0 = d.ncon
+        t = self.template
+        for _ in range(n):
+            if mujoco.mj_addContact(m, d, t):
+                break                               # arena full: MuJoCo warns (mjWARN_CONTACTFULL)
+        k1 = d.ncon
+        c = d.contact
+        c.dist[k0:k1] = -self.depth[:k1 - k0]
+        c.pos[k0:k1] = self.pos[:k1 - k0]
+        c.frame[k0:k1] = self.frame[:k1 - k0]
+
+    def step(self, m: mujoco.MjModel, d: mujoco.MjData) -> None:
+        split_step(m, d, self.add)
+
+
+def split_step(m: mujoco.MjModel, d: mujoco.MjData, add_contacts) -> None:
+    """mj_step with add_contacts(m, d) called between mj_collision and mj_makeConstraint (module docstring)."""
+    mujoco.mj_checkPos(m, d)
+    mujoco.mj_checkVel(m, d)
+    mujoco.mj_fwdKinematics(m, d)
+    mujoco.mj_makeM(m, d)
+    mujoco.mj_factorM(m, d)
+    mujoco.mj_collision(m, d)
+    add_contacts(m, d)
+    mujoco.mj_makeConstraint(m, d)
+    mujoco.mj_island(m, d)
+    mujoco.mj_transmission(m, d)
+    mujoco.mj_projectConstraint(m, d)
+    mujoco.mj_sensorPos(m, d)
+    mujoco.mj_fwdVelocity(m, d)
+    mujoco.mj_sensorVel(m, d)
+    mujoco.mj_step2(m, d)
+
+
+def split_forward(m: mujoco.MjModel, d: mujoco.MjData, add_contacts) -> None:
+    """mj_forward with the added contacts (for the initial state and for checks)."""
+    mujoco.mj_fwdKinematics(m, d)
+    mujoco.mj_makeM(m, d)
+    mujoco.mj_factorM(m, d)
+    mujoco.mj_collision(m, d)
+    add_contacts(m, d)
+    mujoco.mj_makeConstraint(m, d)
+    mujoco.mj_island(m, d)
+    mujoco.mj_transmission(m, d)
+    mujoco.mj_projectConstraint(m, d)
+    mujoco.mj_sensorPos(m, d)
+    mujoco.mj_forwardSkip(m, d, mujoco.mjtStage.mjSTAGE_POS, 0)
+
+
+def flank_contact_details(fc: FlankContacts, d: mujoco.MjData):
+    """As wormsim.contact3d.runner.contact_details for flank contacts: (n teeth touching, max penetration, points in
+    the frame of wheel tooth 0, forces on the wheel (world), points (world)). The kernel's contacts are d.contact's
+    last fc.n entries; the force on the wheel (geom 2) is the elliptic-cone rows turned into the world frame."""
+    bm = fc.bm
+    n = min(fc.n, d.ncon)
+    if n == 0:
+        z = np.zeros((0, 3))
+        return 0, 0.0, z, z, z
+    k0 = d.ncon - n
+    con = d.contact
+    adr = np.asarray(con.efc_address[k0:])
+    ok = adr >= 0
+    frame = np.asarray(con.frame[k0:])[ok].reshape(-1, 3, 3)
+    pos = np.asarray(con.pos[k0:])[ok]
+    adr = adr[ok]
+    f = np.zeros((len(adr), 3))
+    f[:, 0] = d.efc_force[adr]
+    if fc.template.dim == 3:             # elliptic cone rows (normal, two tangents); dim 1: the normal only
+        f[:, 1] = d.efc_force[adr + 1]
+        f[:, 2] = d.efc_force[adr + 2]
+    F = np.einsum("ni,nij->nj", f, frame)
+    ks = fc.meta[:n, 0][ok]
+    th2 = float(d.qpos[fc.qa2])
+    ang = -(th2 + 2 * math.pi * ks / bm.geometry.z2)
+    c, s = np.cos(ang), np.sin(ang)
+    p0 = np.stack([c * pos[:, 0] - s * pos[:, 1], s * pos[:, 0] + c * pos[:, 1], pos[:, 2]], axis=1)
+    touching = ks[np.linalg.norm(F, axis=1) > 0] if len(ks) else ks
+    pen = float(fc.depth[:n].max())
+    return int(np.unique(touching).size), pen, p0, F, pos

@@ -1,0 +1,260 @@
+"""Exact-flank tooth contact of contact3d (`contact.geometry: flanks`): the geometry kernel.
+
+Per gear, once (`flank_grid`, cached in process): the wheel's generated flanks of tooth 0 on a grid of S SLICES
+across the face (zeta_j = slice centres, zeta across the face, 0 at the mid-plane) by N_PROFILE points along the
+profile (rho from the worm tip's reach, or the wheel root, to the wheel tip: the active zone of
+wormsim.torsional.mesh_stiffness), from meshgen.wheel.tooth_flanks / space_flank (the envelope; no equation repeated
+here). Flank A of tooth 0 is psi_+ of tooth space 0 (it faces -psi), flank B is psi_- of space 1; backlash applied.
+With each point goes its conjugate wheel angle c = beta - psi (mesh_stiffness (1)): tooth k's flank point touches
+the conjugate worm at wheel angle theta2 = c - 2 pi (k + sigma) / z2 (sigma = 0 flank A, 1 flank B). Points cut by
+the hob tip edge (root fillet, not conjugate) are left out: exact flanks carry the working flanks only.
+
+Each step (`find_contacts`, numba): for every wheel tooth k of the mesh window and both flanks, and for every slice,
+only the profile points whose conjugate angle is within `margin` of the current wheel angle (plus one point either
+side) are evaluated, so a step costs a few points per slice instead of the whole grid. A point of tooth k at wheel
+angle theta2 sits in the assembly at (rho cos b, rho sin b, zeta), b = psi + theta2 + 2 pi k / z2, and in the
+static worm frame (meshgen.assembly: x_s = y + a, y_s = -z, z_s = -x) at radius r and angle phi. Its signed
+normal distance from the worm thread is the closed form of meshgen.worm.thread_gap (equations (1), (2) there):
+
+    u = wrap(z_s - p (phi - theta1), p_x),   G = (|u| - H(r)) / |grad G|,
+    grad G = sign(u) (e_z - (p / r) e_phi) - H'(r) e_r,                                              (1)
+
+negative inside the thread, valid for r_f1 <= r <= r_a1 and |z_s| <= b1 / 2 (outside: no thread, no contact). In
+each slice the deepest point along the profile is refined by the parabola through it and its two neighbours (the gap
+across a contact line is quadratic), giving ONE contact per (tooth, flank, slice): depth delta = -G_min, normal
+n = grad G / |grad G| in the assembly frame (from the worm into the wheel: the force on the wheel is along +n),
+position = the wheel point moved delta / 2 along n (MuJoCo's midpoint). A tooth pair whose contact line spans the face
+thus gives S contacts of stiffness K / S each (wormsim.contact3d.law, n_ref = S): the slice method of gear dynamics.
+
+The kernel repeats the worm's H(r) (meshgen.worm.half_thickness, ZI/ZA) in compiled form; tests/test_flank_contact.py
+pins the kernel's distance to meshgen.worm.thread_gap.
+"""
+from __future__ import annotations
+
+import functools
+import math
+from dataclasses import dataclass
+
+import numba
+import numpy as np
+
+from meshgen import wheel, worm
+from meshgen.geometry import GearGeometry
+
+N_PROFILE = 64              # points along the profile per slice (the parabola refines between them)
+SLICES = {"coarse": 8, "medium": 16, "fine": 32}   # default slices across the face per simulation.resolution
+MARGIN_PITCH = 0.03         # candidate points: conjugate angle within this fraction of a pitch (plus the backlash
+                            # angle and the transmission error, find_contacts' margin) of the wheel angle
+
+
+@dataclass(frozen=True)
+class FlankGrid:
+    """Tooth 0's two active flanks on (slice, profile) grids; wheel frame, SI."""
+
+    slices: int
+    zeta: np.ndarray        # (S,) slice centres
+    rho: np.ndarray         # (S, N) radius of the profile points
+    psi: np.ndarray         # (2, S, N) polar angle (flank A, flank B), nan where not an active flank point
+    xy: np.ndarray          # (2, S, N, 2) the points' (x, y) in the wheel frame (rho cos psi, rho sin psi)
+    c: np.ndarray           # (2, S, N) conjugate wheel angle, nan where not active
+    c_range: np.ndarray     # (2, S, 2) min and max of c per flank and slice (whole slices are skipped by it)
+    params: np.ndarray      # worm scalars for the kernel (worm_params)
+
+
+def worm_params(g: GearGeometry) -> np.ndarray:
+    """Scalars of meshgen.worm's closed form, in the order the kernel reads them."""
+    zi = 1.0 if g.profile == "ZI" else 0.0
+    t1 = math.sqrt(max(g.r1 ** 2 / g.r_b ** 2 - 1.0, 0.0)) if zi else 0.0
+    return np.array([g.p, g.p_x, g.r_f1, g.r_a1, g.worm_length / 2, zi, g.r_b, math.tan(g.alpha_x),
+                     t1 - math.atan(t1), g.r1, g.a, 2 * math.pi / g.z2, g.hand * g.z1 / g.z2], dtype=float)
+
+
+@functools.lru_cache(maxsize=16)
+def flank_grid(g: GearGeometry, slices: int, n_profile: int = N_PROFILE) -> FlankGrid:
+    """The grids of the module docstring (meshgen.wheel's envelope, both flanks of tooth 0)."""
+    bw = g.face_width
+    zeta = -bw / 2 + (np.arange(slices) + 0.5) * bw / slices
+    lo = np.maximum(g.a - np.sqrt(np.maximum(g.r_a1 ** 2 - zeta ** 2, 0.0)), wheel.root_rho(g, zeta))
+    hi = wheel.tip_rho(g, zeta)
+    s = np.linspace(0.0, 1.0, n_profile)
+    R = lo[:, None] + (hi - lo)[:, None] * s[None, :]
+    Z = np.broadcast_to(zeta[:, None], R.shape)
+    dj = g.backlash / (2 * g.r2)
+    pitch = 2 * math.pi / g.z2
+    psi = np.full((2,) + R.shape, np.nan)
+    c = np.full((2,) + R.shape, np.nan)
+    for i, side in enumerate((+1, -1)):
+        sol = wheel.space_flank(g, R, Z, side)
+        ok = sol.interior & (hi > lo)[:, None]
+        # flank A: psi_+ of space 0 + dj; flank B: psi_- of space 0 + pitch - dj (meshgen.wheel.tooth_flanks);
+        # c is the conjugate angle of the unshifted space-0 flank (flank B's tooth space is 1: sigma in find_contacts)
+        shift = dj if side > 0 else pitch - dj
+        psi[i] = np.where(ok, sol.psi + shift, np.nan)
+        c[i] = np.where(ok, sol.beta - sol.psi, np.nan)
+    with np.errstate(all="ignore"):
+        rng = np.stack([np.nanmin(c, axis=2), np.nanmax(c, axis=2)], axis=-1)
+    rng = np.where(np.isfinite(rng), rng, np.array([np.inf, -np.inf]))
+    xy = np.stack([R * np.cos(psi), R * np.sin(psi)], axis=-1)
+    return FlankGrid(slices=slices, zeta=zeta, rho=R, psi=psi, xy=xy, c=c, c_range=rng, params=worm_params(g))
+
+
+@numba.njit(cache=True, inline="always")
+def _half_thickness(r, P):
+    """meshgen.worm.half_thickness and its derivative dH/dr (ZI equation (2), ZA straight)."""
+    p, p_x, r1 = P[0], P[1], P[9]
+    if P[5] > 0.5:
+        r_b = P[6]
+        x = r * r / (r_b * r_b) - 1.0
+        t = math.sqrt(x) if x > 0.0 else 0.0
+        ap = abs(p)
+        return p_x / 4 - ap * ((t - math.atan(t)) - P[8]), -ap * t / r
+    return p_x / 4 - (r - r1) * P[7], -P[7]
+
+
+@numba.njit(cache=True)
+def worm_gap(xs, ys, zs, theta1, P, out):
+    """Signed normal distance (1) of a static-worm-frame point and the unit gradient (static worm frame) in out[0:3].
+    Returns +inf where there is no thread (r outside [r_f1, r_a1] or |z_s| > b1/2)."""
+    r = math.sqrt(xs * xs + ys * ys)
+    if r > P[3] or r < P[2] or abs(zs) > P[4]:
+        return np.inf
+    p, p_x = P[0], P[1]
+    phi = math.atan2(ys, xs)
+    u = zs - p * (phi - theta1)
+    u = (u + p_x / 2) % p_x - p_x / 2
+    H, dH = _half_thickness(r, P)
+    sg = 1.0 if u >= 0.0 else -1.0
+    cp, sp = xs / r, ys / r
+    # grad G = sg (e_z - p/r e_phi) - H' e_r, e_r = (c, s, 0), e_phi = (-s, c, 0)
+    gx = sg * (p / r) * sp - dH * cp
+    gy = -sg * (p / r) * cp - dH * sp
+    gz = sg
+    nrm = math.sqrt(gx * gx + gy * gy + gz * gz)
+    out[0], out[1], out[2] = gx / nrm, gy / nrm, gz / nrm
+    return (abs(u) - H) / nrm
+
+
+@numba.njit(cache=True)
+def _eval(x0, y0, zeta, ca, sa, theta1, P, out):
+    """Gap of the wheel point (x0, y0, zeta) turned by the angle (cos ca, sin sa) about z (assembly frame), and
+    the turned point in out[3:6]."""
+    x, y = ca * x0 - sa * y0, sa * x0 + ca * y0
+    out[3], out[4], out[5] = x, y, zeta
+    return worm_gap(y + P[10], -zeta, -x, theta1, P, out)
+
+
+@numba.njit(cache=True)
+def find_contacts(xy, c, c_range, zeta, ks, theta1, theta2, margin, P, pos, nrm, depth, meta):
+    """Contacts of the window teeth ks at worm angle theta1, wheel angle theta2 (module docstring). Writes per contact
+    the assembly position pos (n, 3), unit normal nrm (n, 3) (worm -> wheel), depth (n,) > 0 and meta (n, 4) =
+    (tooth k, flank sigma, slice j, fractional profile index); returns n. The candidate window is margin plus the
+    transmission error |theta2 - hand z1 / z2 theta1| (wrapped to a pitch), so a wheel pushed far into the
+    worm keeps its contacts."""
+    S, N = c.shape[1], c.shape[2]
+    pitch = P[11]
+    te = theta2 - P[12] * theta1
+    te = (te + pitch / 2) % pitch - pitch / 2
+    margin = margin + abs(te)
+    tmp = np.empty(6)
+    gaps = np.empty(N)
+    pts = np.empty((N, 3))
+    nrs = np.empty((N, 3))
+    n = 0
+    for kk in range(ks.shape[0]):
+        k = ks[kk]
+        ang = theta2 + pitch * k
+        ca, sa = math.cos(ang), math.sin(ang)
+        for sg in range(2):
+            target = theta2 + pitch * (k + sg)
+            target = (target + math.pi) % (2 * math.pi) - math.pi
+            lo, hi = target - margin, target + margin
+            for j in range(S):
+                if hi < c_range[sg, j, 0] or lo > c_range[sg, j, 1]:
+                    continue
+                i0, i1 = N, -1
+                for i in range(N):
+                    ci = c[sg, j, i]
+                    if ci > lo and ci < hi:
+                        if i < i0:
+                            i0 = i
+                        i1 = i
+                if i1 < 0:
+                    continue
+                i0 = max(i0 - 1, 0)
+                i1 = min(i1 + 1, N - 1)
+                best, ib = 0.0, -1
+                for i in range(i0, i1 + 1):
+                    x0 = xy[sg, j, i, 0]
+                    if x0 != x0:
+                        gaps[i] = np.inf
+                        continue
+                    gv = _eval(x0, xy[sg, j, i, 1], zeta[j], ca, sa, theta1, P, tmp)
+                    gaps[i] = gv
+                    pts[i, 0], pts[i, 1], pts[i, 2] = tmp[3], tmp[4], tmp[5]
+                    nrs[i, 0], nrs[i, 1], nrs[i, 2] = tmp[0], tmp[1], tmp[2]
+                    if gv < best:
+                        best, ib = gv, i
+                if ib < 0:
+                    continue
+                # parabola through the deepest point and its neighbours (when both are on the thread)
+                t = 0.0
+                gmin = best
+                if ib > i0 and ib < i1 and gaps[ib - 1] < np.inf and gaps[ib + 1] < np.inf:
+                    gm, gp = gaps[ib - 1], gaps[ib + 1]
+                    curv = gm - 2.0 * best + gp
+                    if curv > 0.0:
+                        t = 0.5 * (gm - gp) / curv
+                        gmin = best - 0.25 * (gm - gp) * t
+                if t != 0.0:
+                    jn = ib + 1 if t > 0 else ib - 1
+                    w = abs(t)
+                    px = (1 - w) * pts[ib, 0] + w * pts[jn, 0]
+                    py = (1 - w) * pts[ib, 1] + w * pts[jn, 1]
+                    pz = (1 - w) * pts[ib, 2] + w * pts[jn, 2]
+                    nx = (1 - w) * nrs[ib, 0] + w * nrs[jn, 0]
+                    ny = (1 - w) * nrs[ib, 1] + w * nrs[jn, 1]
+                    nz = (1 - w) * nrs[ib, 2] + w * nrs[jn, 2]
+                    nn = math.sqrt(nx * nx + ny * ny + nz * nz)
+                    nx, ny, nz = nx / nn, ny / nn, nz / nn
+                else:
+                    px, py, pz = pts[ib, 0], pts[ib, 1], pts[ib, 2]
+                    nx, ny, nz = nrs[ib, 0], nrs[ib, 1], nrs[ib, 2]
+                # static worm frame -> assembly: (x, y, z)_asm = (-z_s, x_s - a, -y_s), i.e. R0 applied
+                ax, ay, az = -nz, nx, -ny
+                dlt = -gmin
+                if n >= depth.shape[0]:
+                    return n
+                pos[n, 0] = px + 0.5 * dlt * ax
+                pos[n, 1] = py + 0.5 * dlt * ay
+                pos[n, 2] = pz + 0.5 * dlt * az
+                nrm[n, 0], nrm[n, 1], nrm[n, 2] = ax, ay, az
+                depth[n] = dlt
+                meta[n, 0], meta[n, 1], meta[n, 2], meta[n, 3] = k, sg, j, ib + t
+                n += 1
+    return n
+
+
+@numba.njit(cache=True)
+def contact_frames(nrm, n, frame):
+    """MuJoCo contact frames (n, 9): the normal, then two unit tangents (mju_makeFrame's construction)."""
+    for i in range(n):
+        a0, a1, a2 = nrm[i, 0], nrm[i, 1], nrm[i, 2]
+        # tangent 1: normal x (the axis least aligned with it)
+        if abs(a0) < 0.5:
+            t0, t1, t2 = 0.0, a2, -a1          # n x e_x
+        else:
+            t0, t1, t2 = -a2, 0.0, a0          # e_y x n
+        tn = math.sqrt(t0 * t0 + t1 * t1 + t2 * t2)
+        t0, t1, t2 = t0 / tn, t1 / tn, t2 / tn
+        b0 = a1 * t2 - a2 * t1
+        b1 = a2 * t0 - a0 * t2
+        b2 = a0 * t1 - a1 * t0
+        f = frame[i]
+        f[0], f[1], f[2] = a0, a1, a2
+        f[3], f[4], f[5] = t0, t1, t2
+        f[6], f[7], f[8] = b0, b1, b2
+
+
+def gap_reference(g: GearGeometry, pts_static: np.ndarray, theta1: float) -> np.ndarray:
+    """meshgen.worm.thread_gap on static-worm-frame points (the reference the kernel is tested against)."""
+    return worm.thread_gap(g, pts_static, theta1)
