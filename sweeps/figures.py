@@ -13,12 +13,10 @@ import math
 import shutil
 from pathlib import Path
 
-import matplotlib
+import matplotlib.pyplot as plt  # Agg where there is no display
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-
-from wormsim.sweep.runner import parse_value, read_csv  # noqa: E402
+from wormsim.sweep.plot import parse_value
+from wormsim.sweep.runner import read_csv
 
 ROOT = Path(__file__).resolve().parents[1]
 IMG, CSV_DIR = ROOT / "docs" / "img", ROOT / "docs" / "sweeps"
@@ -123,8 +121,11 @@ def friction(runs: Path) -> None:
         if mu in {r["contact.friction"] for r in c3d} or abs(mu * 100 - round(mu * 100)) < 1e-9:
             t, c = by[mu].get("torsional"), by[mu].get("contact3d")
             th = math.tan(gamma) / math.tan(gamma + math.atan(mu / math.cos(alpha_n)))
-            fmt = lambda r: "-" if r is None else (f"{r['efficiency']:.3f}" if r["status"] == "ok" else "failed")  # noqa: E731
-            print(f"| {mu:.3f} | {fmt(t)} | {fmt(c)} | {th:.3f} |")
+            print(f"| {mu:.3f} | {_cell(t)} | {_cell(c)} | {th:.3f} |")
+
+
+def _cell(r) -> str:
+    return "-" if r is None else (f"{r['efficiency']:.3f}" if r["status"] == "ok" else "failed")
 
 
 def resonance(runs: Path) -> None:

@@ -75,7 +75,9 @@ def test_zero_errors_take_the_perfect_pairs_path_bit_identically():
     a = simulate(load_scenario(SCEN / "screw_jack.yaml", base))
     b = simulate(load_scenario(SCEN / "screw_jack.yaml", base + zeros + ["errors.wheel_runout_phase_deg=40",
                                                                            "errors.wheel_pitch_deviation_um=[0, 0]"]))
-    drop = lambda s: {k: v for k, v in s.items() if "wall" not in k}  # noqa: E731
+    def drop(s):
+        return {k: v for k, v in s.items() if "wall" not in k}
+
     assert drop(a.summary) == drop(b.summary)
     assert "transmission_error_kinematic_p2p_urad" not in a.summary
     for k in a.series:
@@ -157,7 +159,9 @@ def test_wedge_rejects_errors():
 def test_center_distance_changes_the_play_as_the_line_theory_predicts(da_mm):
     g, res = _tca("seat_motor", [f"errors.center_distance_mm={da_mm}"])
     da = da_mm * 1e-3
-    up = lambda th1, P: np.tile([0.0, da, 0.0], (len(P), 1))   # noqa: E731  (the wheel seen from the worm: +y)
+    def up(th1, P):  # the wheel seen from the worm: +y
+        return np.tile([0.0, da, 0.0], (len(P), 1))
+
     theory = g.r2 * (line_theory(g, res.theta1_rad, 1, up) + line_theory(g, res.theta1_rad, -1, up))
     dj, dj_theory = np.mean(res.play_m(g)) - g.backlash, np.mean(theory)
     # measured: +10 um: TCA +2.20 um, line theory +2.155 um (the opening contact moves to the line ends, which the
@@ -182,7 +186,10 @@ def test_wheel_runout_gives_te_2e_over_r2_and_the_line_theory_shape(runout):
     assert np.ptp(te) == pytest.approx(2 * e / g.r2, rel=0.06)
     th2 = g.hand * res.theta1_rad * g.z1 / g.z2
     # the pitch circle's centre, turning with the wheel: a translation of the wheel (phase 0)
-    disp = lambda th1, P: np.tile([e * math.cos(g.hand * th1 * g.z1 / g.z2), e * math.sin(g.hand * th1 * g.z1 / g.z2), 0.0], (len(P), 1))  # noqa: E731
+    def disp(th1, P):
+        a = g.hand * th1 * g.z1 / g.z2
+        return np.tile([e * math.cos(a), e * math.sin(a), 0.0], (len(P), 1))
+
     theory = -(g.backlash / (2 * g.r2) + line_theory(g, res.theta1_rad, 1, disp))
     assert np.max(np.abs(te - theory)) < 0.02 * np.ptp(theory), np.max(np.abs(te - theory)) * 1e6
     assert len(th2) == 24 * 8
@@ -255,7 +262,9 @@ def test_torsional_reports_te_with_runout_and_its_sidebands():
     t = S["t_s"]
     sl = t > t[-1] - 6 / fw                     # the last 6 wheel revolutions: bins of fw / 6
     _, df, f, amp = dominant_frequency(t[sl], S["transmission_error_rad"][sl])
-    near = lambda x: amp[int(np.argmin(np.abs(f - x)))]  # noqa: E731
+    def near(x):
+        return amp[int(np.argmin(np.abs(f - x)))]
+
     # measured (urad): fm 5.33, fm - fw 2.61, fm + fw 2.57, fm +- fw / 2 (between the lines) 0.002
     between = max(near(fm - fw / 2), near(fm + fw / 2))
     assert near(fm - fw) > 100 * between and near(fm + fw) > 100 * between

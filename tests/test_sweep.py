@@ -299,9 +299,11 @@ def test_a_lost_worker_is_a_failed_row(tmp_path, monkeypatch):
 
     from wormsim.sweep import runner
 
-    # a lambda is pickled by value (cloudpickle), so the worker runs this one; it calls the real run_point
-    dying = lambda sc, keep: os._exit(1) if sc["load"]["torque_nm"] > 1000 else real(sc, keep)  # noqa: E731
     real = runner.run_point
+
+    def dying(sc, keep):  # a local function is pickled by value (cloudpickle): the worker runs this one
+        return os._exit(1) if sc["load"]["torque_nm"] > 1000 else real(sc, keep)
+
     monkeypatch.setattr(runner, "run_point", dying)
     with dask.config.set({"distributed.scheduler.allowed-failures": 0}):
         sw = load_sweep(SWEEP)

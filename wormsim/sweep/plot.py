@@ -37,9 +37,23 @@ MAX_PANELS = 6
 MAX_LINES = 8
 
 
-def _num(v):
-    from wormsim.sweep.runner import parse_value
+def parse_value(text):
+    """A csv cell back to a number / bool / None where it is one."""
+    if not isinstance(text, str):
+        return text
+    if text == "":
+        return None
+    if text in ("True", "False"):
+        return text == "True"
+    for cast in (int, float):
+        try:
+            return cast(text)
+        except ValueError:
+            pass
+    return text
 
+
+def _num(v):
     v = parse_value(v)
     if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
         return None
@@ -55,8 +69,6 @@ def write_sweep_png(rows: list[dict], swept: list[str], plot: Plot | None, path:
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-
-    from wormsim.sweep.runner import parse_value
 
     plot = plot or Plot()
     ok = [r for r in rows if r.get("status") == "ok"]

@@ -87,7 +87,7 @@ def run_point(scenario: dict, keep_files: bool) -> dict:
             **base,
             "wall_time_s": time.perf_counter() - t0,
         }
-    except Exception as exc:  # noqa: BLE001  (a bug in one point must not stop the sweep)
+    except Exception as exc:  # (a bug in one point must not stop the sweep)
         summary = {
             "status": "failed",
             "message": f"internal error: {exc.__class__.__name__}: {exc}",
@@ -167,22 +167,6 @@ def read_csv(path: Path) -> list[dict]:
         return []
     with path.open(newline="") as fh:
         return list(csv.DictReader(fh))
-
-
-def parse_value(text):
-    """A csv cell back to a number / bool / None where it is one."""
-    if not isinstance(text, str):
-        return text
-    if text == "":
-        return None
-    if text in ("True", "False"):
-        return text == "True"
-    for cast in (int, float):
-        try:
-            return cast(text)
-        except ValueError:
-            pass
-    return text
 
 
 # ----------------------------------------------------------------------------- progress
@@ -436,7 +420,7 @@ def run_sweep(
                 p, t_submit = futures[fut]
                 try:
                     res = fut.result()
-                except Exception as exc:  # noqa: BLE001  (the worker died or the task could not run)
+                except Exception as exc:  # (the worker died or the task could not run)
                     res = {
                         "summary": {
                             "status": "failed",
@@ -471,7 +455,7 @@ def run_sweep(
                 client.close()
             if cluster is not None:
                 cluster.close()
-        except Exception:  # noqa: BLE001  (closing a cluster after Ctrl-C may fail; the tables are written)
+        except Exception:  # (closing a cluster after Ctrl-C may fail; the tables are written)
             pass
         write_json_atomic(out / JSON_NAME, _json_doc(sweep, rows, timing, machine, cluster_info, state))
         ordered = [rows[i] for i in sorted(rows)]
