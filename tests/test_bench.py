@@ -21,9 +21,10 @@ def test_pareto_front_keeps_only_undominated_points():
 
 
 def test_chart_is_written(tmp_path):
-    recs = [{"scenario": "s", "model": m, "status": "ok", "wall_s_per_sim_s": w, "reference": False,
+    recs = [{"scenario": "s", "model": m, "resolution": res, "status": "ok", "wall_s_per_sim_s": w, "reference": False,
              "finer": False, "error": {k: e for k in ERROR_KEYS}}
-            for m, w, e in [("contact3d", 1.0, 0.01), ("contact3d", 0.3, 0.05), ("torsional", 1e-3, 0.02)]]
+            for m, res, w, e in [("contact3d", {"geometry": "pieces"}, 1.0, 0.01),
+                                 ("contact3d", {"geometry": "flanks"}, 0.3, 0.05), ("torsional", {}, 1e-3, 0.02)]]
     plot_bench(recs, tmp_path / "bench.png")
     assert (tmp_path / "bench.png").read_bytes()[:4] == b"\x89PNG"
 
@@ -69,12 +70,34 @@ def test_full_grid_runs_each_contact3d_case_once_and_marks_the_finer_check():
     from wormsim.bench.cases import bench_cases
 
     cases = [c for c in bench_cases(quick=False, scenarios=("screw_jack",)) if c.model == "contact3d"]
-    keys = [(c.resolution["level"], c.timestep_s) for c in cases]
-    assert len(keys) == len(set(keys)) == 9
+    keys = [(c.resolution["geometry"], c.resolution["level"], c.timestep_s) for c in cases]
+    assert len(keys) == len(set(keys)) == 18
+    assert {c.resolution["geometry"] for c in cases} == {"flanks", "pieces"}
     assert sum(c.reference for c in cases) == 1 and sum(c.finer for c in cases) == 1
     ref = next(c for c in cases if c.reference)
     fin = next(c for c in cases if c.finer)
     assert fin.resolution == ref.resolution and abs(fin.timestep_s - ref.timestep_s / 2) < 1e-12
+    # the reference is the finest level of the scenario's default contact.geometry
+    from wormsim.bench.cases import SCENARIOS
+    from wormsim.scenario import load_scenario
+
+    assert ref.resolution == {"level": "fine", "geometry": load_scenario(SCENARIOS / "screw_jack.yaml").contact.geometry}
+    only = bench_cases(quick=True, models=("contact3d",), geometries=("flanks",))
+    assert only and {c.resolution["geometry"] for c in only} == {"flanks"} and sum(c.reference for c in only) == 1
+
+
+def test_speedup_of_flanks_over_pieces_pairs_equal_level_and_step_factor():
+    from wormsim.bench.run import speedups
+
+    def rec(geo, lvl, f, w):
+        return {"scenario": "s", "model": "contact3d", "status": "ok", "resolution": {"level": lvl, "geometry": geo},
+                "timestep_factor": f, "wall_s_per_sim_s": w}
+
+    recs = [rec("pieces", "medium", 1.0, 120.0), rec("flanks", "medium", 1.0, 10.0), rec("pieces", "medium", 2.0, 60.0),
+            rec("flanks", "medium", 2.0, 6.0), rec("flanks", "fine", 1.0, 20.0)]
+    assert speedups(recs) == {"s": {"medium": 12.0}}
+    assert recs[1]["speedup_vs_pieces"] == 12.0 and recs[3]["speedup_vs_pieces"] == 10.0
+    assert "speedup_vs_pieces" not in recs[4]           # no pieces run of that level: no speed-up claimed
 
 
 def test_json_results_are_readable_by_others(tmp_path):

@@ -25,6 +25,7 @@ class BenchCase:
     overrides: tuple[str, ...] = field(default_factory=tuple)
     reference: bool = False       # the converged reference of its scenario
     finer: bool = False           # the finer run that checks the reference
+    timestep_factor: float | None = None   # contact3d: timestep_s / the default timestep of its geometry
 
 
 def _level_available(model: str) -> bool:
@@ -41,6 +42,7 @@ VARIANTS = {
 }
 DURATION_S = {"seat_motor": 0.25, "screw_jack": 0.3, "involute_41": 0.3}
 QUICK_DURATION_S = 0.15
+GEOMETRIES = ("flanks", "pieces")   # contact3d's contact.geometry, both benched so one run gives the speed-up
 
 
 def contact3d_default_timestep(name: str, overrides: tuple[str, ...] = ()) -> float:
@@ -51,12 +53,14 @@ def contact3d_default_timestep(name: str, overrides: tuple[str, ...] = ()) -> fl
 
 
 def bench_cases(quick: bool, models: tuple[str, ...] | None = None,
-                scenarios: tuple[str, ...] | None = None) -> list[BenchCase]:
-    """The grid. contact3d: resolution levels x timesteps of 2, 1 and 1/2 times its default (the default
-    is 0.4 x the explicit stability limit, so 2x probes the edge); the reference is the finest level at
-    the default step, checked against half that step. torsional: k(theta) samples per mesh cycle.
-    quick: the seat motor only, 0.15 s, coarse/medium (a few minutes; CI runs the torsional part only).
-    models: only these levels. scenarios: only these seeds (names of VARIANTS)."""
+                scenarios: tuple[str, ...] | None = None,
+                geometries: tuple[str, ...] | None = None) -> list[BenchCase]:
+    """The grid. contact3d, for each contact.geometry (flanks, pieces): resolution levels x timesteps of 2, 1 and 1/2
+    times its default (the default is 0.4 x the explicit stability limit, so 2x probes the edge); the reference is
+    the finest level of the scenario's default geometry at the default step, checked against half that step.
+    torsional: k(theta) samples per mesh cycle.
+    quick: the seat motor only, 0.15 s, coarse/medium. models: only these levels. scenarios: only these seeds (names
+    of VARIANTS). geometries: only these contact.geometry values for contact3d."""
     names = ("seat_motor",) if quick else tuple(VARIANTS)
     if scenarios is not None:
         unknown = sorted(set(scenarios) - set(VARIANTS))
@@ -64,37 +68,49 @@ def bench_cases(quick: bool, models: tuple[str, ...] | None = None,
             raise ScenarioError(f"bench --scenario: {', '.join(unknown)} is not a seed scenario; "
                                 f"allowed: {', '.join(VARIANTS)}")
         names = tuple(n for n in VARIANTS if n in scenarios)
+    geos = tuple(g for g in GEOMETRIES if geometries is None or g in geometries)
     levels = ("coarse", "medium") if quick else ("coarse", "medium", "fine")
     out: list[BenchCase] = []
     for name in names:
         dur = QUICK_DURATION_S if quick else DURATION_S[name]
         common = VARIANTS[name] + (f"simulation.duration_s={dur}",)
-        if _level_available("contact3d") and (models is None or "contact3d" in models):
-            h = contact3d_default_timestep(name, common)
-            factors = (2.0, 1.0) if quick else (2.0, 1.0, 0.5)
-            for lvl in levels:
-                for f in factors:
-                    dt = float(f"{h * f:.4g}")
-                    out.append(BenchCase(name, "contact3d", {"level": lvl}, dt,
-                                         common + (f"simulation.resolution={lvl}", f"simulation.timestep_s={dt}"),
-                                         reference=(lvl == levels[-1] and f == 1.0)))
-            dt = float(f"{h / 2:.4g}")
-            same = next((i for i, c in enumerate(out) if c.scenario == name and c.model == "contact3d"
-                         and c.resolution == {"level": levels[-1]} and c.timestep_s == dt), None)
-            if same is not None:     # the grid already runs the finest level at h/2: that run is the check
-                out[same] = BenchCase(**{**out[same].__dict__, "finer": True})
-            else:
-                out.append(BenchCase(name, "contact3d", {"level": levels[-1]}, dt,
-                                     common + (f"simulation.resolution={levels[-1]}", f"simulation.timestep_s={dt}"),
-                                     finer=True))
-        if _level_available("torsional"):
+        if _level_available("contact3d") and (models is None or "contact3d" in models) and geos:
+            default_geo = load_scenario(SCENARIOS / f"{name}.yaml", list(common)).contact.geometry
+            ref_geo = default_geo if default_geo in geos else geos[0]
+            for geo in geos:
+                out += _contact3d_cases(name, common + (f"contact.geometry={geo}",), geo, levels,
+                                        (2.0, 1.0) if quick else (2.0, 1.0, 0.5), reference=geo == ref_geo)
+        if _level_available("torsional") and (models is None or "torsional" in models):
             # resolution = k(theta) samples per mesh cycle; the default timestep is one sample's worth of worm
             # rotation at full speed (wormsim.torsional.dynamics.default_timestep), so this sweeps both
             for n in ((16, 64) if quick else (16, 32, 64, 128, 256)):
                 out.append(BenchCase(name, "torsional", {"level": "mesh-stiffness table", "mesh_stiffness_samples": n},
                                      None, common + ("model=torsional", f"simulation.mesh_stiffness_samples={n}")))
-    if models is not None:
-        out = [c for c in out if c.model in models]
+    return out
+
+
+def _contact3d_cases(name: str, common: tuple[str, ...], geo: str, levels: tuple[str, ...],
+                     factors: tuple[float, ...], reference: bool) -> list[BenchCase]:
+    """One geometry's resolution x timestep grid; with `reference`, the finest level at the default step is the
+    reference and the same at half the step its check (`finer`)."""
+    h = contact3d_default_timestep(name, common)
+    out = []
+    for lvl in levels:
+        for f in factors:
+            dt = float(f"{h * f:.4g}")
+            out.append(BenchCase(name, "contact3d", {"level": lvl, "geometry": geo}, dt,
+                                 common + (f"simulation.resolution={lvl}", f"simulation.timestep_s={dt}"),
+                                 reference=reference and lvl == levels[-1] and f == 1.0, timestep_factor=f))
+    if not reference:
+        return out
+    dt = float(f"{h / 2:.4g}")
+    same = next((i for i, c in enumerate(out) if c.resolution["level"] == levels[-1] and c.timestep_s == dt), None)
+    if same is not None:     # the grid already runs the finest level at h/2: that run is the check
+        out[same] = BenchCase(**{**out[same].__dict__, "finer": True})
+    else:
+        out.append(BenchCase(name, "contact3d", {"level": levels[-1], "geometry": geo}, dt,
+                             common + (f"simulation.resolution={levels[-1]}", f"simulation.timestep_s={dt}"),
+                             finer=True, timestep_factor=0.5))
     return out
 
 

@@ -119,12 +119,16 @@ def stability_edge(scenario_name: str, factors: tuple[float, ...] = STABILITY_FA
             "runs": runs}
 
 
-def stability_map(quick: bool, scenarios: tuple[str, ...] | None = None) -> dict:
-    """stability_edge for each seed's bench variant (VARIANTS) at STABILITY_RESOLUTION; quick: the seat motor only
-    (about half a minute). Keyed by scenario, written to bench_meta.json under "stability"."""
+def stability_map(quick: bool, scenarios: tuple[str, ...] | None = None,
+                  geometries: tuple[str, ...] = ("pieces",)) -> dict:
+    """stability_edge for each seed's bench variant (VARIANTS) at STABILITY_RESOLUTION and each contact.geometry;
+    quick: the seat motor only (about half a minute). Keyed by scenario (and "/flanks" for the flank contacts),
+    written to bench_meta.json under "stability"."""
     names = ("seat_motor",) if quick else tuple(VARIANTS)
     if scenarios is not None:
         names = tuple(n for n in names if n in scenarios)
     dur = STABILITY_DURATION_S     # 1.5 mesh periods of the seat motor at 1800 rpm; shorter runs: no steady window
-    return {n: stability_edge(n, duration_s=dur, overrides=VARIANTS[n], resolution=STABILITY_RESOLUTION[n])
-            for n in names}
+    return {n + ("" if geo == "pieces" else f"/{geo}"):
+            stability_edge(n, duration_s=dur, overrides=VARIANTS[n] + (f"contact.geometry={geo}",),
+                           resolution=STABILITY_RESOLUTION[n])
+            for n in names for geo in geometries}
