@@ -57,8 +57,9 @@ def rho_rel_by_surface_fit(g, zeta, rho, c, side):
     Pq = np.column_stack([c1 * qs[:, 0] - s1 * qs[:, 1], s1 * qs[:, 0] + c1 * qs[:, 1], qs[:, 2]]) - P0
     assert np.max(np.abs(Pq @ n)) < 0.2 * hh          # the thread patch lies on the tangent plane (same point)
     Hq = _quad_hessian(np.column_stack([Pq @ e1, Pq @ e2]), Pq @ n)
-    lam = np.linalg.eigvalsh(Hw - Hq)
-    return 1.0 / lam[1], lam
+    lam, V = np.linalg.eigh(Hw - Hq)
+    t = V[0, 0] * e1 + V[1, 0] * e2              # the contact line (static worm frame; wheel axis z = -y_s)
+    return 1.0 / lam[1], lam, abs(t[1])
 
 
 @pytest.mark.parametrize("name", ["seat_motor", "screw_jack", "involute_41"])
@@ -69,7 +70,51 @@ def test_relative_curvature_matches_a_fit_of_the_two_surfaces(name):
     for j in (3, 8, 12):
         act = np.where(np.isfinite(fg.c[0, j]))[0]
         for i in (act[len(act) // 4], act[len(act) // 2], act[3 * len(act) // 4]):
-            ref, lam = rho_rel_by_surface_fit(g, fg.zeta[j], fg.rho[j, i], fg.c[0, j, i], +1)
+            ref, lam, tz = rho_rel_by_surface_fit(g, fg.zeta[j], fg.rho[j, i], fg.c[0, j, i], +1)
             got = 1.0 / cv.inv_rho[0, j, i]
             assert abs(lam[0]) < 0.02 * lam[1], lam             # a line contact: one ~zero eigenvalue
             assert abs(got / ref - 1) < 2e-3, (j, i, got, ref)    # measured: within 3e-4
+            assert abs(cv.line_tz[0, j, i] - tz) < 0.01, (j, i, cv.line_tz[0, j, i], tz)
+
+
+def test_hertz_line_pressure_is_johnsons_p0():
+    """(3) against Johnson's line contact written through the half-width: a = sqrt(4 w R / (pi E*)),
+    p0 = 2 w / (pi a) (Contact Mechanics, eqs. 4.43, 4.45); steel cylinders R1 = R2 = 20 mm, w = 100 N/mm."""
+    E = 1.0 / (2 * (1 - 0.3**2) / 210e9)
+    R, w = 0.01, 1e5
+    a = math.sqrt(4 * w * R / (math.pi * E))
+    assert FO.hertz_line_pressure_pa(w, E, 1 / R) == pytest.approx(2 * w / (math.pi * a), rel=1e-12)
+    assert FO.hertz_line_pressure_pa(w, E, 1 / R) == pytest.approx(606.2e6, rel=1e-3)   # by hand
+
+
+KEYS = ("contact_pattern_centroid_face_mm", "contact_pattern_centroid_radius_mm", "contact_pattern_extent_face_mm",
+        "contact_pressure_max_mpa", "contact_pressure_mean_mpa", "contact_pressure_max_face_mm",
+        "contact_pressure_max_radius_mm")
+
+
+@pytest.mark.parametrize("name", ["seat_motor", "screw_jack", "involute_41"])
+def test_flank_runs_report_pattern_and_pressure(name):
+    """The CI runs of tests/test_contact3d_seeds_flanks.py (cached there): every key finite; the pattern lies on the
+    face and between the wheel's root and tip; the mean pressure below the max; the extent within the face."""
+    from test_contact3d_seeds_flanks import run
+
+    r = run(name)
+    s, g = r["summary"], derive(r["scenario"].gear)
+    for k in KEYS:
+        assert np.isfinite(s[k]), (k, s[k])
+    b = g.face_width * 1e3
+    assert abs(s["contact_pattern_centroid_face_mm"]) < b / 2
+    assert 0 < s["contact_pattern_extent_face_mm"] <= b * (1 + 1e-9)
+    assert g.r_f2 * 1e3 < s["contact_pattern_centroid_radius_mm"] < g.r_a2 * 1e3 + 1e-6
+    assert 0 < s["contact_pressure_mean_mpa"] < s["contact_pressure_max_mpa"]
+    assert s["contact_pattern_source"].startswith("loaded")
+
+
+def test_screw_jack_pattern_is_centred_on_the_mid_plane():
+    """The perfect screw jack pair, worm driving: the load centroid within 2 % of the face width of the mid-plane
+    (measured: -0.17 mm on a 20 mm face, CI run)."""
+    from test_contact3d_seeds_flanks import run
+
+    r = run("screw_jack")
+    b = derive(r["scenario"].gear).face_width * 1e3
+    assert abs(r["summary"]["contact_pattern_centroid_face_mm"]) < 0.02 * b

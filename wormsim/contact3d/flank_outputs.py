@@ -38,6 +38,7 @@ import math
 from dataclasses import dataclass
 
 import mujoco
+import numba
 import numpy as np
 
 from meshgen import wheel, worm
@@ -144,16 +145,38 @@ def hertz_line_pressure_pa(line_load_n_per_m, e_star_pa: float, inv_rho_per_m):
     return np.sqrt(np.maximum(line_load_n_per_m, 0.0) * e_star_pa * np.maximum(inv_rho_per_m, 0.0) / math.pi)
 
 
-def _interp(a: np.ndarray, sg: np.ndarray, j: np.ndarray, f: np.ndarray) -> np.ndarray:
-    """a[sg, j, f] linear in the fractional profile index f; a nan neighbour falls back to the other one."""
-    N = a.shape[-1]
-    i0 = np.clip(np.floor(f).astype(int), 0, N - 1)
-    i1 = np.minimum(i0 + 1, N - 1)
-    w = np.clip(f - i0, 0.0, 1.0)
+@numba.njit(cache=True, inline="always")
+def _lerp(a, sg, j, f):
+    """a[sg, j, f] linear in the fractional profile index f; a nan neighbour gives the other one."""
+    N = a.shape[2]
+    i0 = min(max(int(math.floor(f)), 0), N - 1)
+    i1 = min(i0 + 1, N - 1)
+    w = min(max(f - i0, 0.0), 1.0)
     a0, a1 = a[sg, j, i0], a[sg, j, i1]
-    a0 = np.where(np.isfinite(a0), a0, a1)
-    a1 = np.where(np.isfinite(a1), a1, a0)
+    if a0 != a0:
+        return a1
+    if a1 != a1:
+        return a0
     return (1 - w) * a0 + w * a1
+
+
+@numba.njit(cache=True)
+def _rows(i, adr, efc_force, meta, inv_rho, line_len, rho, zeta, e_star, out, m):
+    """Appends (i, sigma, j, f, F_n, p_H (3), zeta, rho) per contact with a constraint row to out from row m."""
+    for c in range(adr.shape[0]):
+        if adr[c] < 0:
+            continue
+        sg, j, f = int(meta[c, 1]), int(meta[c, 2]), meta[c, 3]
+        fn = efc_force[adr[c]]                  # the normal row: the force on the wheel along +n
+        k = _lerp(inv_rho, sg, j, f)
+        L = _lerp(line_len, sg, j, f)
+        o = out[m]
+        o[0], o[1], o[2], o[3], o[4] = i, sg, j, f, fn
+        o[5] = math.sqrt(max(fn, 0.0) / L * e_star * max(k, 0.0) / math.pi)
+        o[6] = zeta[j]
+        o[7] = _lerp(rho, sg, j, f)
+        m += 1
+    return m
 
 
 class PatternLog:
@@ -164,32 +187,27 @@ class PatternLog:
         self.fc = fc
         self.geo = g
         self.cv = flank_curvature(g, fc.grid.slices, fc.grid.rho.shape[1])
+        self.rho3 = np.ascontiguousarray(np.broadcast_to(self.cv.rho, self.cv.inv_rho.shape))
         self.e_star = e_star_pa
-        self.rows: list[np.ndarray] = []
+        self.buf = np.zeros((4096, 8))
+        self.m = 0
 
     def record(self, i: int, d: mujoco.MjData) -> None:
-        """The kernel's contacts (d.contact's last fc.n entries) at sample i: (i, sigma, j, f, F_n, p_H, zeta, rho)."""
+        """The kernel's contacts (d.contact's last fc.n entries) at sample i: (i, sigma, j, f, F_n, p_H, zeta, rho);
+        p_H by (3) (in `_rows`, compiled: the same formula as hertz_line_pressure_pa)."""
         fc = self.fc
         n = min(fc.n, d.ncon)
         if n == 0:
             return
-        k0 = d.ncon - n
-        adr = np.asarray(d.contact.efc_address[k0:d.ncon])
-        ok = adr >= 0
-        if not ok.any():
-            return
-        meta = fc.meta[:n][ok]
-        fn = d.efc_force[adr[ok]]                      # normal row of each contact (on the wheel, along +n)
-        sg, j, f = meta[:, 1].astype(int), meta[:, 2].astype(int), meta[:, 3]
+        if self.m + n > len(self.buf):
+            self.buf = np.concatenate([self.buf, np.zeros_like(self.buf)])
+        adr = d.contact.efc_address[d.ncon - n:d.ncon]
         cv = self.cv
-        k = _interp(cv.inv_rho, sg, j, f)
-        L = _interp(cv.line_len, sg, j, f)
-        p = hertz_line_pressure_pa(fn / L, self.e_star, k)
-        rho = _interp(np.broadcast_to(cv.rho, cv.inv_rho.shape), sg, j, f)
-        self.rows.append(np.column_stack([np.full(len(fn), i), sg, j, f, fn, p, cv.zeta[j], rho]))
+        self.m = _rows(i, adr, d.efc_force, fc.meta, cv.inv_rho, cv.line_len, self.rho3, cv.zeta, self.e_star,
+                       self.buf, self.m)
 
     def table(self) -> np.ndarray:
-        return np.concatenate(self.rows) if self.rows else np.zeros((0, 8))
+        return self.buf[:self.m]
 
     def summary(self, t_s: np.ndarray, window_s) -> dict:
         """The summary keys of the module docstring over the samples with t in window_s."""
@@ -247,4 +265,76 @@ class PatternLog:
             np.add.at(load, (sg, j, i), T[:, 4])
             np.maximum.at(pmax, (sg, j, i), T[:, 5])
         return {"load": load, "pressure_max_pa": pmax, "rho_m": self.cv.rho, "zeta_m": self.cv.zeta,
-                "slice_width_m": self.cv.slice_width}
+                "slice_width_m": self.cv.slice_width, "xy_m": self.fc.grid.xy}
+
+
+def draw_pattern(ax, fig, grid: dict, geo: GearGeometry, summary: dict) -> None:
+    """report.png's pattern panel with flanks: the loaded cells of the working flank (the one carrying more load) as
+    a band, face position against flank radius, coloured by the largest Hertz pressure (3) over the steady window;
+    the load centroid, the 95 % load span across the face and where the largest pressure sits."""
+    from matplotlib.collections import PolyCollection
+
+    load, pmax = grid["load"], grid["pressure_max_pa"]
+    sg = int(np.argmax(load.sum(axis=(1, 2))))
+    L, P, R, Z, w = load[sg], pmax[sg] * 1e-6, grid["rho_m"] * 1e3, grid["zeta_m"] * 1e3, grid["slice_width_m"] * 1e3
+    keep = L > 1e-3 * max(float(L.max()), 1e-300)
+    dr = np.gradient(R, axis=1)
+    polys, vals = [], []
+    for j, i in zip(*np.nonzero(keep)):
+        x0, x1 = Z[j] - w / 2, Z[j] + w / 2
+        y0, y1 = R[j, i] - dr[j, i] / 2, R[j, i] + dr[j, i] / 2
+        polys.append([(x0, y0), (x1, y0), (x1, y1), (x0, y1)])
+        vals.append(P[j, i])
+    if polys:
+        pc = PolyCollection(polys, array=np.asarray(vals), cmap="inferno", edgecolors="none")
+        ax.add_collection(pc)
+        fig.colorbar(pc, ax=ax, label="largest Hertz pressure p_H [MPa]")
+    cz, cr = summary.get("contact_pattern_centroid_face_mm"), summary.get("contact_pattern_centroid_radius_mm")
+    ext = summary.get("contact_pattern_extent_face_mm", float("nan"))
+    if cz is not None and np.isfinite(cz):
+        ax.plot([cz], [cr], "c+", ms=14, mew=2, label=f"load centroid ({cz:.2f} mm, {cr:.2f} mm)")
+        ax.axvline(cz, color="c", lw=0.6, ls=":")
+    if np.isfinite(ext):
+        ax.plot([], [], " ", label=f"95 % of the load within {ext:.2f} mm of face")
+    pz, prr = summary.get("contact_pressure_max_face_mm"), summary.get("contact_pressure_max_radius_mm")
+    if pz is not None and np.isfinite(pz):
+        ax.plot([pz], [prr], "*", color="lime", mec="k", ms=12,
+                label=f"p_H max {summary['contact_pressure_max_mpa']:.0f} MPa "
+                      f"(mean {summary['contact_pressure_mean_mpa']:.0f} MPa)")
+    zf = np.linspace(-geo.face_width / 2, geo.face_width / 2, 101)
+    edge = 0.5 * geo.face_width * 1e3
+    for r_, lab in ((wheel.tip_rho(geo, zf), "wheel tip"), (np.full_like(zf, geo.r2), "r2 (reference)"),
+                    (wheel.root_rho(geo, zf), "wheel root")):
+        ax.plot(zf * 1e3, r_ * 1e3, color="0.4", lw=0.7, ls="--", zorder=1)
+        ax.text(1.04 * edge, r_[-1] * 1e3, lab, fontsize=9, va="center", ha="left", zorder=3,
+                bbox=dict(facecolor="white", edgecolor="0.6", alpha=0.9, pad=1.5))
+    ax.set_xlim(-0.6 * geo.face_width * 1e3, 0.85 * geo.face_width * 1e3)
+    lo = min(geo.r_f2, float(np.nanmin(R)) * 1e-3) * 1e3
+    hi = max(geo.r_a2, float(np.nanmax(R)) * 1e-3) * 1e3
+    ax.set_ylim(lo - 0.1 * (hi - lo), hi + 0.25 * (hi - lo))
+    ax.legend(fontsize=7, loc="upper left")
+    ax.set(xlabel="across the face: wheel axis position, 0 at the mid-plane [mm]", ylabel="wheel radius [mm]",
+           title=f"contact pattern on the wheel flank ({'AB'[sg]}, exact flanks, steady window)")
+
+
+def log_pattern(rec, path: str, grid: dict, geo: GearGeometry) -> None:
+    """The recording's pattern: every loaded grid cell of both flanks, on every wheel tooth (the steady-window
+    pattern repeats tooth to tooth), as points in the wheel frame (`path` under the moving wheel), coloured by the
+    largest Hertz pressure (inferno, 0 .. the run's largest) and sized by the slice width. Logged once (static)."""
+    import matplotlib
+    import rerun as rr
+
+    load, pmax, xy = grid["load"], grid["pressure_max_pa"], grid["xy_m"]
+    keep = load > 1e-3 * max(float(load.max()), 1e-300)
+    if not keep.any():
+        return
+    sg, j, i = np.nonzero(keep)
+    p = pmax[sg, j, i]
+    base = np.column_stack([xy[sg, j, i, 0], xy[sg, j, i, 1], grid["zeta_m"][j]])
+    ang = 2 * np.pi * np.arange(geo.z2) / geo.z2
+    c, s = np.cos(ang)[:, None], np.sin(ang)[:, None]
+    pts = np.stack([c * base[None, :, 0] - s * base[None, :, 1], s * base[None, :, 0] + c * base[None, :, 1],
+                    np.broadcast_to(base[None, :, 2], c.shape[:1] + base.shape[:1])], axis=-1).reshape(-1, 3)
+    rgb = (matplotlib.colormaps["inferno"](p / max(float(p.max()), 1e-300))[:, :3] * 255).astype(np.uint8)
+    rr.log(path, rr.Points3D(pts, colors=np.tile(rgb, (geo.z2, 1)), radii=0.3 * grid["slice_width_m"]),
+           static=True, recording=rec)

@@ -8,7 +8,9 @@ mapped into the frame of tooth 0: axial position across the face against radius,
 recording.rrd (wormsim.recording layout): /series/* time series on the sim_time timeline; the worm and
 wheel meshes under /assembly/worm and /assembly/wheel moved by their 4x4 transforms; contact points
 (/assembly/contacts/points) and force arrows on the wheel (/assembly/contacts/forces, 1 mm per
-`ARROW_N_PER_MM` newtons) at up to MAX_FRAMES instants.
+`ARROW_N_PER_MM` newtons) at up to MAX_FRAMES instants. With exact flanks: the steady-window contact
+pattern on every wheel tooth, coloured by pressure (/assembly/wheel/contact_pattern, flank_outputs.log_pattern),
+and in report.png the pattern as a band on the wheel flank coloured by pressure (flank_outputs.draw_pattern).
 """
 from __future__ import annotations
 
@@ -86,7 +88,11 @@ def write_report(result: Result, path) -> None:
     a = ax[1, 1]
     P = result.extra.get("points_tooth0")
     F = result.extra.get("forces_world")
-    if P is not None and sl.any():
+    if "flank_pattern" in result.extra:      # exact flanks: the loaded band coloured by pressure (flank_outputs)
+        from wormsim.contact3d.flank_outputs import draw_pattern
+
+        draw_pattern(a, fig, result.extra["flank_pattern"], result.extra["built"].geometry, s)
+    elif P is not None and sl.any():
         p = P[sl].reshape(-1, 3)
         f = np.linalg.norm(F[sl].reshape(-1, 3), axis=1)
         ok = np.isfinite(p[:, 0])
@@ -100,7 +106,7 @@ def write_report(result: Result, path) -> None:
             a.text(0.52 * geo.face_width * 1e3, rr_ * 1e3, lab, fontsize=9, va="center", ha="left", zorder=3,
                    bbox=dict(facecolor="white", edgecolor="0.6", alpha=0.9, pad=1.5))
         a.set_xlim(-0.6 * geo.face_width * 1e3, 0.85 * geo.face_width * 1e3)
-    a.set(xlabel="across the face (wheel z) [mm]", ylabel="radius [mm]", title="contact pattern on a wheel tooth")
+        a.set(xlabel="across the face (wheel z) [mm]", ylabel="radius [mm]", title="contact pattern on a wheel tooth")
     fig.suptitle(f"{result.summary.get('scenario', '')} contact3d: dt {s['timestep_s']:.3g} s, resolution "
                  f"{s['resolution']}, steady window {w0:.3g}-{w1:.3g} s")
     fig.tight_layout()
@@ -123,6 +129,10 @@ def write_recording(result: Result, path) -> None:
         Tg = np.stack([assembly.wheel_to_assembly(float(a)) for a in S["wheel_angle_rad"][idx]])
         log_transforms(rec, "assembly/worm", t[idx], Tw)
         log_transforms(rec, "assembly/wheel", t[idx], Tg)
+        if "flank_pattern" in result.extra:     # exact flanks: the loaded pattern on the wheel, coloured by pressure
+            from wormsim.contact3d.flank_outputs import log_pattern
+
+            log_pattern(rec, "assembly/wheel/contact_pattern", result.extra["flank_pattern"], geo)
         P, F = result.extra["points_world"], result.extra["forces_world"]
         fmean = np.nanmean(np.linalg.norm(F.reshape(-1, 3), axis=1)) if np.isfinite(F).any() else 1.0
         scale = 5e-3 / max(fmean, 1e-9)           # mean contact force -> 5 mm arrow

@@ -279,12 +279,14 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
     pts_world = np.full((n_rec, MAX_POINTS, 3), np.nan, dtype=np.float32)
     forces = np.full((n_rec, MAX_POINTS, 3), np.nan, dtype=np.float32)
 
-    fc = None
+    fc = pattern = None
     if bm.meta.get("contact_geometry") == "flanks":
         # contacts found on the exact flanks and added between collision and constraints (wormsim.contact3d.flank_step)
+        from wormsim.contact3d.flank_outputs import PatternLog
         from wormsim.contact3d.flank_step import FlankContacts, flank_contact_details, split_forward
 
         fc = FlankContacts(bm, bm.law.contacts_per_pair)
+        pattern = PatternLog(fc, gt.effective_modulus_pa(scenario.materials))   # contact pattern and stress
         split_forward(m, d, fc.add)
         window = None
         step_fn = fc.step
@@ -345,6 +347,7 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
         else:
             fc.set_friction(mu)
             nteeth, pen, p0, F, pw = flank_contact_details(fc, d)
+            pattern.record(i, d)
         # each contact's force turned about the worm axis onto the line of centres (phi = its angle about the
         # worm axis from the line of centres): the radial force DIN 3975's single pitch-point contact means
         phi = np.arctan2(pw[:, 2], pw[:, 1] + geo.a)
@@ -378,11 +381,15 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
     wall = time.perf_counter() - t_wall
     summary = _run_summary(S, scenario, bm, rec, guards.turn_max, len(coll), 1e6 * wall / max(n_rec * rec, 1),
                            flanks=fc is not None)
+    extra = {"points_tooth0": pts, "points_world": pts_world, "forces_world": forces, "built": bm}
+    if pattern is not None:                 # the loaded contact pattern and Hertz stress (flank_outputs)
+        summary.update(pattern.summary(S["t_s"], summary["steady_window_s"]))
+        extra["flank_pattern"] = pattern.grid(S["t_s"], summary["steady_window_s"])
     if bm.kinematic_tca is not None:       # errors: the displaced exact flanks' kinematic TE and play (issue 12)
         kin = bm.kinematic_tca.summary(bm.geometry, gt.working_flank(scenario, bm.geometry.hand))
         summary.update({k: v for k, v in kin.items() if not k.startswith("contact_pattern")})
     return Result(model="contact3d", summary=summary, series=S, steps=n_rec * rec, sim_time_s=float(d.time),
-                  extra={"points_tooth0": pts, "points_world": pts_world, "forces_world": forces, "built": bm})
+                  extra=extra)
 
 
 def _run_summary(S: dict, scenario: Scenario, bm: BuiltModel, rec: int, turn_max: float, collision_geoms: int,
