@@ -167,3 +167,23 @@ def test_report_and_recording_show_the_pattern(tmp_path):
     chunks = recorded_data(tmp_path / "recording.rrd")["/assembly/wheel/contact_pattern"]
     n_pts = sum(len(v[0]) for c in chunks for k, v in c.items() if k.endswith("positions") and v and v[0])
     assert n_pts == int((grid["load"] > 1e-3 * grid["load"].max()).sum()) * derive(sc.gear).z2
+
+
+def test_extent_is_the_face_span_holding_95_percent_of_the_load():
+    """contact_pattern_extent_face_mm's quantile rule on synthetic loads: an even load over the whole face gives
+    0.95 b2; a load in one slice 0.95 of that slice's width; two equal end slices the span between their inner
+    quantile points."""
+    g = derive(load_scenario(SCENARIOS / "screw_jack.yaml").gear)
+    log = FO.PatternLog.__new__(FO.PatternLog)
+    log.cv = FO.flank_curvature(g, 16)
+    w = log.cv.slice_width
+
+    def rows(slices, loads):
+        T = np.zeros((len(slices), 8))
+        T[:, 2], T[:, 4] = slices, loads
+        return T
+
+    assert log.extent_face_m(rows(np.arange(16), np.ones(16))) == pytest.approx(0.95 * g.face_width, rel=1e-12)
+    assert log.extent_face_m(rows([5], [3.0])) == pytest.approx(0.95 * w, rel=1e-12)
+    # half the load in slice 0, half in slice 15: 2.5 % lies 0.05 w into slice 0, 97.5 % 0.95 w into slice 15
+    assert log.extent_face_m(rows([0, 15], [1.0, 1.0])) == pytest.approx(g.face_width - 0.1 * w, rel=1e-12)
