@@ -161,8 +161,17 @@ def _lerp(a, sg, j, f):
 
 
 @numba.njit(cache=True)
-def _rows(i, adr, efc_force, meta, inv_rho, line_len, rho, zeta, e_star, out, m):
-    """Appends (i, sigma, j, f, F_n, p_H (3), zeta, rho) per contact with a constraint row to out from row m."""
+def _lerp_rows(a, sg, j, f):
+    """_lerp for arrays of (sigma, j, f)."""
+    out = np.empty(f.shape[0])
+    for k in range(f.shape[0]):
+        out[k] = _lerp(a, int(sg[k]), int(j[k]), f[k])
+    return out
+
+
+@numba.njit(cache=True)
+def _rows(i, adr, efc_force, meta, inv_rho, line_len, e_star, out, m):
+    """Appends (i, sigma, j, f, F_n, p_H (3)) per contact with a constraint row to out (float32) from row m."""
     for c in range(adr.shape[0]):
         if adr[c] < 0:
             continue
@@ -173,8 +182,6 @@ def _rows(i, adr, efc_force, meta, inv_rho, line_len, rho, zeta, e_star, out, m)
         o = out[m]
         o[0], o[1], o[2], o[3], o[4] = i, sg, j, f, fn
         o[5] = math.sqrt(max(fn, 0.0) / L * e_star * max(k, 0.0) / math.pi)
-        o[6] = zeta[j]
-        o[7] = _lerp(rho, sg, j, f)
         m += 1
     return m
 
@@ -189,11 +196,11 @@ class PatternLog:
         self.cv = flank_curvature(g, fc.grid.slices, fc.grid.rho.shape[1])
         self.rho3 = np.ascontiguousarray(np.broadcast_to(self.cv.rho, self.cv.inv_rho.shape))
         self.e_star = e_star_pa
-        self.buf = np.zeros((4096, 8))
+        self.buf = np.zeros((4096, 6), dtype=np.float32)      # 24 bytes per contact and sample
         self.m = 0
 
     def record(self, i: int, d: mujoco.MjData) -> None:
-        """The kernel's contacts (d.contact's last fc.n entries) at sample i: (i, sigma, j, f, F_n, p_H, zeta, rho);
+        """The kernel's contacts (d.contact's last fc.n entries) at sample i: (i, sigma, j, f, F_n, p_H);
         p_H by (3) (in `_rows`, compiled: the same formula as hertz_line_pressure_pa)."""
         fc = self.fc
         n = min(fc.n, d.ncon)
@@ -203,11 +210,17 @@ class PatternLog:
             self.buf = np.concatenate([self.buf, np.zeros_like(self.buf)])
         adr = d.contact.efc_address[d.ncon - n:d.ncon]
         cv = self.cv
-        self.m = _rows(i, adr, d.efc_force, fc.meta, cv.inv_rho, cv.line_len, self.rho3, cv.zeta, self.e_star,
-                       self.buf, self.m)
+        self.m = _rows(i, adr, d.efc_force, fc.meta, cv.inv_rho, cv.line_len, self.e_star, self.buf, self.m)
 
     def table(self) -> np.ndarray:
-        return self.buf[:self.m]
+        """The log as float64 rows (i, sigma, j, f, F_n, p_H, zeta, rho): zeta the slice centre, rho the flank radius
+        at the contact's profile position."""
+        T = self.buf[:self.m].astype(float)
+        if not len(T):
+            return np.zeros((0, 8))
+        j = T[:, 2].astype(np.int64)
+        rho = _lerp_rows(self.rho3, T[:, 1].astype(np.int64), j, T[:, 3])
+        return np.column_stack([T, self.cv.zeta[j], rho])
 
     def summary(self, t_s: np.ndarray, window_s) -> dict:
         """The summary keys of the module docstring over the samples with t in window_s."""
