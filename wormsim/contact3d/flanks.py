@@ -86,6 +86,7 @@ def flank_grid(g: GearGeometry, slices: int, n_profile: int = N_PROFILE) -> Flan
     for i, side in enumerate((+1, -1)):
         sol = wheel.space_flank(g, R, Z, side)
         ok = sol.interior & (hi > lo)[:, None]
+        ok &= ~_cut_by_worm(g, R, sol.psi, zeta)
         # flank A: psi_+ of space 0 + dj; flank B: psi_- of space 0 + pitch - dj (meshgen.wheel.tooth_flanks);
         # c is the conjugate angle of the unshifted space-0 flank (flank B's tooth space is 1: sigma in find_contacts)
         shift = dj if side > 0 else pitch - dj
@@ -96,6 +97,15 @@ def flank_grid(g: GearGeometry, slices: int, n_profile: int = N_PROFILE) -> Flan
     rng = np.where(np.isfinite(rng), rng, np.array([np.inf, -np.inf]))
     xy = np.stack([R * np.cos(psi), R * np.sin(psi)], axis=-1)
     return FlankGrid(slices=slices, zeta=zeta, rho=R, psi=psi, xy=xy, c=c, c_range=rng, params=worm_params(g))
+
+
+def _cut_by_worm(g: GearGeometry, R: np.ndarray, psi0: np.ndarray, zeta: np.ndarray) -> np.ndarray:
+    """Envelope points of tooth space 0 that the conjugate worm cuts into (wormsim.contact3d.flank_trim)."""
+    from wormsim.contact3d.flank_trim import cut_points
+    from wormsim.contact3d.window import window_size
+
+    xy = np.stack([R * np.cos(psi0), R * np.sin(psi0)], axis=-1)[None]
+    return cut_points(xy, zeta, worm_params(g), float(window_size(g)))[0]
 
 
 @numba.njit(cache=True, inline="always")
