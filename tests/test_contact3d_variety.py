@@ -45,3 +45,120 @@ def test_interfering_coarse_pieces_are_refused_before_simulating_with_the_cure(t
     assert "simulation.resolution medium" in capsys.readouterr().err
     bm = build_model(load_scenario(GEAR, WIDE + ["simulation.resolution=medium"]))
     assert bm.meta["conjugate_interference_m"] == 0.0
+
+
+# ----------------------------------------------------------------------------- exact flanks (issue 13)
+# contact.geometry flanks (8 slices at coarse) on the variants: ZI/ZA, both hands, 1-4 starts, z2 30-80, q 6-16,
+# alpha_n 20-25, a narrow face. Short runs at 3000 rpm (1500 rpm where gamma 33.7 deg needs a 5 us step), at least
+# 5 mesh periods in the steady window. Criteria of tests/test_contact3d_seeds_flanks.py: ratio 0.1 %, torque
+# balance 2 %, efficiency within 3 % of the wedge formula at the contacts' radius, meshing frequency (F_t).
+# Measured numbers per gear: docs/contact3d.md, "Variety with exact flanks".
+
+FAST = ["drive.speed_rpm=3000", "contact.geometry=flanks"]
+FLANK_GEARS = {
+    "4-start-z41": ["gear.worm_starts=4", "gear.wheel_teeth=41", "simulation.duration_s=0.05"],          # gamma 21.8
+    "left-ZA": ["gear.hand=left", "gear.profile=ZA", "simulation.duration_s=0.07"],                      # 11.3
+    "left-q6-4start": ["gear.hand=left", "gear.worm_starts=4", "gear.diameter_quotient=6", "gear.wheel_teeth=37",
+                       "drive.speed_rpm=1500", "simulation.duration_s=0.07"],                            # 33.7
+    "wide-z80-q16": WIDE + ["simulation.duration_s=0.12"],                                               # 3.58
+    "ZA-a25-z60-3start": ["gear.profile=ZA", "gear.normal_pressure_angle_deg=25", "gear.wheel_teeth=60",
+                          "gear.worm_starts=3", "simulation.duration_s=0.05"],                           # 16.7
+    "narrow-b8": ["gear.face_width_mm=8", "simulation.duration_s=0.08"],                                 # 11.3
+}
+RATTLE = ("friction-driven rattle: MuJoCo's elliptic soft cone adds about mu c_c Vs to a sliding contact's normal "
+          "force (c_c the contact damping, Vs ~6 m/s), above the static load per contact, so the wheel bounces on its "
+          "driving flank (restitution > 1 measured) and F_t's largest peak is an impact harmonic: ")
+FLANK_MESH_XFAIL = {
+    "4-start-z41": RATTLE + "601.5 Hz against 199.8 Hz, 1.4 contacts on average (13-18 at the conjugate pose)",
+    "left-ZA": RATTLE + "593 Hz against 99.9 Hz, 1.7 contacts (frictionless: 12.3 and no rattle, test below)",
+    "wide-z80-q16": RATTLE + "404.7 Hz against 49.9 Hz, 0.1 contacts",
+    "ZA-a25-z60-3start": RATTLE + "599.7 Hz against 149.8 Hz, 0.6 contacts",
+}
+_FLANK_RUNS: dict[str, tuple] = {}
+
+
+def flank_run(name: str):
+    if name not in _FLANK_RUNS:
+        sc = load_scenario(GEAR, FAST + FLANK_GEARS[name])
+        _FLANK_RUNS[name] = (sc, derive(sc.gear), simulate(sc).summary)
+    return _FLANK_RUNS[name]
+
+
+@pytest.mark.parametrize("name", list(FLANK_GEARS))
+def test_flanks_other_gears_ratio_torque_balance_and_efficiency(name):
+    sc, g, s = flank_run(name)
+    assert s["contact_geometry"] == "flanks"
+    assert abs(s["ratio"] / (g.z2 / g.z1) - 1) < 1e-3, s["ratio"]
+    assert abs(s["tangential_force_mean_n"] * g.r2 / sc.load.torque_nm - 1) < 0.02, s["tangential_force_mean_n"]
+    assert abs(s["efficiency"] / s["efficiency_theory_at_contact_radius"] - 1) < 0.03, (
+        s["efficiency"], s["efficiency_theory_at_contact_radius"])
+
+
+@pytest.mark.parametrize("name", [pytest.param(n, marks=pytest.mark.xfail(reason=FLANK_MESH_XFAIL[n], strict=True))
+                                  if n in FLANK_MESH_XFAIL else n for n in FLANK_GEARS])
+def test_flanks_other_gears_mesh_frequency(name):
+    from test_contact3d_seeds import assert_mesh_frequency
+
+    assert_mesh_frequency(flank_run(name)[2], "mesh_frequency_hz")
+
+
+def test_flanks_rattle_is_friction_driven():
+    """The xfails' diagnosis, kept checked: the same left-hand ZA gear without friction keeps its contact lines
+    (12.3 contacts on average, measured), with mu 0.05 it bounces (1.7)."""
+    s_mu = flank_run("left-ZA")[2]
+    s_0 = simulate(load_scenario(GEAR, FAST + ["gear.hand=left", "gear.profile=ZA", "simulation.duration_s=0.04",
+                                               "contact.friction=0"])).summary
+    assert s_0["contacts_mean"] > 8 and s_mu["contacts_mean"] < 4, (s_0["contacts_mean"], s_mu["contacts_mean"])
+    assert abs(s_0["ratio"] / 15 - 1) < 1e-3
+
+
+def test_flanks_no_grid_point_is_cut_by_the_worm():
+    """wormsim.contact3d.flank_trim: at gamma 33.7 deg (z1 4, q 6) meshgen's envelope folds near the wheel tip and 7
+    points per flank lay 1-29 um inside the thread at other worm positions; the kernel took them as flank (76 um
+    contacts against the conjugate 47 um, 14 um penetration under load). Trimmed, the wheel turned two backlash
+    angles behind the conjugate angle meets the worm at the conjugate depth within 2 % over a whole mesh cycle."""
+    import math
+
+    import numpy as np
+
+    from wormsim.contact3d import flanks as F
+    from wormsim.contact3d.window import window_size, window_teeth_at
+
+    g = derive(load_scenario(GEAR, FLANK_GEARS["left-q6-4start"]).gear)
+    fg = F.flank_grid(g, 8)
+    W = window_size(g)
+    cap = 4 * W * 8
+    pos, nrm, dep, meta = np.zeros((cap, 3)), np.zeros((cap, 3)), np.zeros(cap), np.zeros((cap, 4))
+    bl, pitch = g.backlash / (2 * g.r2), 2 * math.pi / g.z2
+    expected = bl * g.r2 * math.cos(g.alpha_n) * math.cos(g.gamma)
+    deepest = []
+    for th1 in np.linspace(0, 2 * math.pi / g.z1, 60, endpoint=False):
+        th2 = g.hand * th1 * g.z1 / g.z2
+        ks = window_teeth_at(th2, g.z2, W, -math.pi / 2 + math.pi / g.z2).astype(np.int64)
+        n = F.find_contacts(fg.xy, fg.c, fg.c_range, fg.zeta, ks, th1, th2 - g.hand * 2 * bl,
+                            F.MARGIN_PITCH * pitch + 3 * bl, fg.params, pos, nrm, dep, meta)
+        deepest.append(dep[:n].max())
+    assert max(deepest) < 1.02 * expected and min(deepest) > 0.98 * expected, (min(deepest), max(deepest), expected)
+
+
+def test_flanks_self_locking_worm_creeps():
+    """z1 1, q 16: gamma 3.58 deg. With mu 0.1 (rho' = atan(0.1 / cos 20 deg) = 6.07 deg > gamma) a torque on the
+    wheel must not turn the free worm (under 1 % of the frictionless speed); without friction it spins it up.
+    Measured after 6 ms: 0.022 rpm at mu 0.1, 167 rpm frictionless."""
+    base = FAST + WIDE + ["drive.on=wheel", "drive.torque_nm=500", "drive.speed_rpm=null", "drive.ramp_s=0.002",
+                          "load.on=worm", "load.torque_nm=0", "load.ramp_s=0", "simulation.duration_s=0.006"]
+    speeds = {mu: abs(simulate(load_scenario(GEAR, base + [f"contact.friction={mu}"])).series["worm_speed_rpm"][-1])
+              for mu in (0.1, 0.0)}
+    assert speeds[0.0] > 10.0
+    assert speeds[0.1] < 0.01 * speeds[0.0], speeds
+
+
+def test_flanks_undercut_wheel_is_refused(tmp_path, capsys):
+    """z2 20 at alpha_n 10 deg: undercut beyond the limit, refused with exit 2 and one line (not simulated)."""
+    args = ["run", str(GEAR), "--out", str(tmp_path / "r"), "--no-progress"]
+    for o in ["contact.geometry=flanks", "gear.wheel_teeth=20", "gear.normal_pressure_angle_deg=10",
+              "gear.worm_starts=1"]:
+        args += ["--set", o]
+    assert main(args) == 2
+    err = capsys.readouterr().err
+    assert "undercut" in err and err.count("\n") == 1, err
