@@ -43,7 +43,7 @@ from meshgen.geometry import GearGeometry
 
 N_PROFILE = 64              # points along the profile per slice (the parabola refines between them)
 SLICES = {"coarse": 8, "medium": 16, "fine": 32}   # default slices across the face per simulation.resolution
-MARGIN_PITCH = 0.03         # candidate points: conjugate angle within this fraction of a pitch (plus the backlash
+MARGIN_PITCH = 0.10         # candidate points: conjugate angle within this fraction of a pitch (plus the backlash
                             # angle and the transmission error, find_contacts' margin) of the wheel angle
 
 
@@ -122,12 +122,12 @@ def _half_thickness(r, P):
 
 
 @numba.njit(cache=True)
-def worm_gap(xs, ys, zs, theta1, P, out):
-    """Signed normal distance (1) of a static-worm-frame point and the unit gradient (static worm frame) in out[0:3].
-    Returns +inf where there is no thread (r outside [r_f1, r_a1] or |z_s| > b1/2)."""
+def worm_gap_ext(xs, ys, zs, theta1, P, out):
+    """Signed normal distance (1) of a static-worm-frame point from the thread flank extended past the worm's tip,
+    root and end faces, the unit gradient (static worm frame) in out[0:3], and the excess (m) by which the point is
+    outside the threaded region: max(r - r_a1, r_f1 - r, |z_s| - b1/2) (<= 0 inside). Returns (gap, excess)."""
     r = math.sqrt(xs * xs + ys * ys)
-    if r > P[3] or r < P[2] or abs(zs) > P[4]:
-        return np.inf
+    ex = max(r - P[3], P[2] - r, abs(zs) - P[4])
     p, p_x = P[0], P[1]
     phi = math.atan2(ys, xs)
     u = zs - p * (phi - theta1)
@@ -141,16 +141,44 @@ def worm_gap(xs, ys, zs, theta1, P, out):
     gz = sg
     nrm = math.sqrt(gx * gx + gy * gy + gz * gz)
     out[0], out[1], out[2] = gx / nrm, gy / nrm, gz / nrm
-    return (abs(u) - H) / nrm
+    return (abs(u) - H) / nrm, ex
+
+
+@numba.njit(cache=True)
+def worm_gap(xs, ys, zs, theta1, P, out):
+    """Signed normal distance (1) of a static-worm-frame point and the unit gradient (static worm frame) in out[0:3].
+    Returns +inf where there is no thread (r outside [r_f1, r_a1] or |z_s| > b1/2)."""
+    gv, ex = worm_gap_ext(xs, ys, zs, theta1, P, out)
+    return np.inf if ex > 0.0 else gv
 
 
 @numba.njit(cache=True)
 def _eval(x0, y0, zeta, ca, sa, theta1, P, out):
-    """Gap of the wheel point (x0, y0, zeta) turned by the angle (cos ca, sin sa) about z (assembly frame), and
-    the turned point in out[3:6]."""
+    """Extended gap and excess (worm_gap_ext) of the wheel point (x0, y0, zeta) turned by the angle (cos ca, sin sa)
+    about z (assembly frame), and the turned point in out[3:6]."""
     x, y = ca * x0 - sa * y0, sa * x0 + ca * y0
     out[3], out[4], out[5] = x, y, zeta
-    return worm_gap(y + P[10], -zeta, -x, theta1, P, out)
+    return worm_gap_ext(y + P[10], -zeta, -x, theta1, P, out)
+
+
+@numba.njit(cache=True)
+def _gap_at(xy, sg, j, i, zeta, ca, sa, theta1, P, tmp, gaps, exc, pts, nrs, stamp, sid):
+    """Extended gap of profile point i of (flank sg, slice j), evaluated once per slice (stamp[i] == sid) and kept in
+    gaps, exc (excess), pts, nrs; +inf off the grid and at points that are not active flank points."""
+    if i < 0 or i >= gaps.shape[0]:
+        return np.inf
+    if stamp[i] == sid:
+        return gaps[i]
+    stamp[i] = sid
+    x0 = xy[sg, j, i, 0]
+    if x0 != x0:
+        gaps[i], exc[i] = np.inf, np.inf
+        return np.inf
+    gv, ex = _eval(x0, xy[sg, j, i, 1], zeta, ca, sa, theta1, P, tmp)
+    gaps[i], exc[i] = gv, ex
+    pts[i, 0], pts[i, 1], pts[i, 2] = tmp[3], tmp[4], tmp[5]
+    nrs[i, 0], nrs[i, 1], nrs[i, 2] = tmp[0], tmp[1], tmp[2]
+    return gv
 
 
 @numba.njit(cache=True)
@@ -167,8 +195,11 @@ def find_contacts(xy, c, c_range, zeta, ks, theta1, theta2, margin, P, pos, nrm,
     margin = margin + abs(te)
     tmp = np.empty(6)
     gaps = np.empty(N)
+    exc = np.empty(N)
     pts = np.empty((N, 3))
     nrs = np.empty((N, 3))
+    stamp = np.full(N, -1, dtype=np.int64)
+    sid = 0
     n = 0
     for kk in range(ks.shape[0]):
         k = ks[kk]
@@ -181,54 +212,93 @@ def find_contacts(xy, c, c_range, zeta, ks, theta1, theta2, margin, P, pos, nrm,
             for j in range(S):
                 if hi < c_range[sg, j, 0] or lo > c_range[sg, j, 1]:
                     continue
-                i0, i1 = N, -1
+                # start at the active point whose conjugate angle is nearest the target (the contact line's point)
+                i_s, dc = -1, np.inf
                 for i in range(N):
                     ci = c[sg, j, i]
-                    if ci > lo and ci < hi:
-                        if i < i0:
-                            i0 = i
-                        i1 = i
-                if i1 < 0:
+                    if ci == ci and abs(ci - target) < dc:
+                        dc, i_s = abs(ci - target), i
+                if i_s < 0:
                     continue
-                i0 = max(i0 - 1, 0)
-                i1 = min(i1 + 1, N - 1)
-                best, ib = 0.0, -1
-                for i in range(i0, i1 + 1):
-                    x0 = xy[sg, j, i, 0]
-                    if x0 != x0:
-                        gaps[i] = np.inf
-                        continue
-                    gv = _eval(x0, xy[sg, j, i, 1], zeta[j], ca, sa, theta1, P, tmp)
-                    gaps[i] = gv
-                    pts[i, 0], pts[i, 1], pts[i, 2] = tmp[3], tmp[4], tmp[5]
-                    nrs[i, 0], nrs[i, 1], nrs[i, 2] = tmp[0], tmp[1], tmp[2]
-                    if gv < best:
-                        best, ib = gv, i
-                if ib < 0:
+                sid += 1
+                zj = zeta[j]
+                ib = i_s
+                best = _gap_at(xy, sg, j, ib, zj, ca, sa, theta1, P, tmp, gaps, exc, pts, nrs, stamp, sid)
+                # descend along the profile to the minimum of the extended gap (one minimum per slice: the gap across
+                # a contact line is quadratic)
+                step = 0
+                gl = _gap_at(xy, sg, j, ib - 1, zj, ca, sa, theta1, P, tmp, gaps, exc, pts, nrs, stamp, sid)
+                gr = _gap_at(xy, sg, j, ib + 1, zj, ca, sa, theta1, P, tmp, gaps, exc, pts, nrs, stamp, sid)
+                if gl < best and gl <= gr:
+                    step, ib, best = -1, ib - 1, gl
+                elif gr < best:
+                    step, ib, best = 1, ib + 1, gr
+                while step != 0:
+                    gn = _gap_at(xy, sg, j, ib + step, zj, ca, sa, theta1, P, tmp, gaps, exc, pts, nrs, stamp, sid)
+                    if gn < best:
+                        ib, best = ib + step, gn
+                    else:
+                        break
+                if best == np.inf:
                     continue
-                # parabola through the deepest point and its neighbours (when both are on the thread)
-                t = 0.0
-                gmin = best
-                if ib > i0 and ib < i1 and gaps[ib - 1] < np.inf and gaps[ib + 1] < np.inf:
-                    gm, gp = gaps[ib - 1], gaps[ib + 1]
-                    curv = gm - 2.0 * best + gp
-                    if curv > 0.0:
-                        t = 0.5 * (gm - gp) / curv
-                        gmin = best - 0.25 * (gm - gp) * t
-                if t != 0.0:
-                    jn = ib + 1 if t > 0 else ib - 1
-                    w = abs(t)
-                    px = (1 - w) * pts[ib, 0] + w * pts[jn, 0]
-                    py = (1 - w) * pts[ib, 1] + w * pts[jn, 1]
-                    pz = (1 - w) * pts[ib, 2] + w * pts[jn, 2]
-                    nx = (1 - w) * nrs[ib, 0] + w * nrs[jn, 0]
-                    ny = (1 - w) * nrs[ib, 1] + w * nrs[jn, 1]
-                    nz = (1 - w) * nrs[ib, 2] + w * nrs[jn, 2]
+                gm = _gap_at(xy, sg, j, ib - 1, zj, ca, sa, theta1, P, tmp, gaps, exc, pts, nrs, stamp, sid)
+                gp = _gap_at(xy, sg, j, ib + 1, zj, ca, sa, theta1, P, tmp, gaps, exc, pts, nrs, stamp, sid)
+                # parabola q(x) = best + qa x + qb x^2 through the deepest point and its neighbours (the gap across a
+                # contact line is quadratic; the extended gap is one smooth surface across the worm's edges)
+                qa, qb, x = 0.0, 0.0, 0.0
+                par = gm < np.inf and gp < np.inf and gm - 2.0 * best + gp > 0.0
+                if par:
+                    qa, qb = 0.5 * (gp - gm), 0.5 * (gm - 2.0 * best + gp)
+                    x = -qa / (2.0 * qb)
+                nb = ib + 1 if x > 0.0 else ib - 1
+                e_x = exc[ib] if x == 0.0 else exc[ib] + abs(x) * (exc[nb] - exc[ib])
+                if e_x <= 0.0:
+                    gmin = best + qa * x + qb * x * x
+                elif exc[ib] <= 0.0:
+                    # the minimum lies just past the worm's tip, root or end face: the contact is the worm's edge on
+                    # the wheel flank, where the excess crosses zero between ib and nb
+                    x = (x / abs(x)) * exc[ib] / (exc[ib] - exc[nb])
+                    gmin = best + qa * x + qb * x * x
+                else:
+                    # the minimum lies outside: walk towards the inside to the first point there; the edge contact
+                    # sits where the excess crosses zero, its depth falls to zero continuously as the line moves on
+                    step = -1 if (gm < np.inf and (gp == np.inf or exc[ib - 1] < exc[ib + 1])) else 1
+                    ia = ib
+                    gmin = np.inf
+                    while True:
+                        ibn = ia + step
+                        gn = _gap_at(xy, sg, j, ibn, zj, ca, sa, theta1, P, tmp, gaps, exc, pts, nrs, stamp, sid)
+                        if gn == np.inf:
+                            break
+                        if exc[ibn] <= 0.0:
+                            w = exc[ia] / (exc[ia] - exc[ibn])
+                            x = (ia - ib) + w * step
+                            if par and abs(x) <= 1.0:
+                                gmin = best + qa * x + qb * x * x
+                            else:
+                                gmin = gaps[ia] + w * (gn - gaps[ia])
+                            break
+                        ia = ibn
+                        if gaps[ia] >= 0.0:
+                            break       # past the parabola's reach: the linear crossings from here on are >= 0
+                if gmin >= 0.0:
+                    continue
+                # the contact point and normal at fractional index f, linear between the grid points around it
+                f = ib + x
+                i0 = min(int(math.floor(f)), N - 2)
+                t = f - i0
+                if t <= 0.0:
+                    px, py, pz = pts[i0, 0], pts[i0, 1], pts[i0, 2]
+                    nx, ny, nz = nrs[i0, 0], nrs[i0, 1], nrs[i0, 2]
+                else:
+                    px = (1 - t) * pts[i0, 0] + t * pts[i0 + 1, 0]
+                    py = (1 - t) * pts[i0, 1] + t * pts[i0 + 1, 1]
+                    pz = (1 - t) * pts[i0, 2] + t * pts[i0 + 1, 2]
+                    nx = (1 - t) * nrs[i0, 0] + t * nrs[i0 + 1, 0]
+                    ny = (1 - t) * nrs[i0, 1] + t * nrs[i0 + 1, 1]
+                    nz = (1 - t) * nrs[i0, 2] + t * nrs[i0 + 1, 2]
                     nn = math.sqrt(nx * nx + ny * ny + nz * nz)
                     nx, ny, nz = nx / nn, ny / nn, nz / nn
-                else:
-                    px, py, pz = pts[ib, 0], pts[ib, 1], pts[ib, 2]
-                    nx, ny, nz = nrs[ib, 0], nrs[ib, 1], nrs[ib, 2]
                 # static worm frame -> assembly: (x, y, z)_asm = (-z_s, x_s - a, -y_s), i.e. R0 applied
                 ax, ay, az = -nz, nx, -ny
                 dlt = -gmin
@@ -239,7 +309,7 @@ def find_contacts(xy, c, c_range, zeta, ks, theta1, theta2, margin, P, pos, nrm,
                 pos[n, 2] = pz + 0.5 * dlt * az
                 nrm[n, 0], nrm[n, 1], nrm[n, 2] = ax, ay, az
                 depth[n] = dlt
-                meta[n, 0], meta[n, 1], meta[n, 2], meta[n, 3] = k, sg, j, ib + t
+                meta[n, 0], meta[n, 1], meta[n, 2], meta[n, 3] = k, sg, j, f
                 n += 1
     return n
 
