@@ -67,11 +67,11 @@ def test_conjugate_pose_touches_across_the_backlash(name):
         ks = window_teeth_at(th2c, g.z2, W, tooth0).astype(np.int64)
         for s in (-0.95, 0.95):
             n = F.find_contacts(fg.xy, fg.c, fg.c_range, fg.zeta, ks, th1, th2c + s * bl,
-                                F.MARGIN_PITCH * pitch + 3 * bl, fg.params, pos, nrm, dep, meta)
+                                F.MARGIN_PITCH * pitch + 3 * bl, fg.params, pos, nrm, dep, meta, np.zeros((len(dep), 2)))
             assert n == 0, (th1, s, dep[:n].max())
         for s, flank in ((-2.0, 0), (2.0, 1)):
             n = F.find_contacts(fg.xy, fg.c, fg.c_range, fg.zeta, ks, th1, th2c + g.hand * s * bl,
-                                F.MARGIN_PITCH * pitch + 3 * bl, fg.params, pos, nrm, dep, meta)
+                                F.MARGIN_PITCH * pitch + 3 * bl, fg.params, pos, nrm, dep, meta, np.zeros((len(dep), 2)))
             assert n >= 8 and np.all(meta[:n, 1] == flank)
             assert dep[:n].max() == pytest.approx(bl * arm0, rel=0.05)
 
@@ -104,7 +104,8 @@ def static_flanks():
         for i in range(d.ncon):
             c = d.contact[i]
             n = np.array(c.frame[:3])
-            C.append((float(d.efc_force[c.efc_address]), -float(c.dist), c.pos[0] * n[1] - c.pos[1] * n[0]))
+            w = float(c.solref[0] / bm.law.solref[0])       # the contact's share of its slice (slice_weights)
+            C.append((float(d.efc_force[c.efc_address]), -float(c.dist), c.pos[0] * n[1] - c.pos[1] * n[0], w))
         out.append((T, float(rel), np.array(C), float(np.abs(d.qvel).max())))
     return bm, out
 
@@ -114,7 +115,8 @@ def test_flank_contact_stiffness_is_k_over_slices(static_flanks):
     C = out[-1][2]
     assert bm.law.contacts_per_pair == 16
     assert len(C) >= 8
-    ratio = C[:, 0] / C[:, 1] / bm.law.contact_stiffness_n_per_m
+    assert np.all((C[:, 3] > 0) & (C[:, 3] <= 1)) and np.sum(C[:, 3] == 1) >= 8
+    ratio = C[:, 0] / C[:, 1] / (C[:, 3] * bm.law.contact_stiffness_n_per_m)
     assert np.all(np.abs(ratio - 1) < 0.05), ratio
 
 
@@ -123,7 +125,7 @@ def test_flank_static_mesh_stiffness_per_pair_within_5_percent(static_flanks):
     (Ta, tha, Ca, _), (Tb, thb, Cb, vmax) = out
     assert vmax < 1e-3
     k_theta = (Tb - Ta) / abs(thb - tha)
-    arm2 = 0.5 * (np.sum(Ca[Ca[:, 0] > 1e-3, 2] ** 2) + np.sum(Cb[Cb[:, 0] > 1e-3, 2] ** 2))
+    arm2 = 0.5 * sum(np.sum(C[C[:, 0] > 1e-3, 3] * C[C[:, 0] > 1e-3, 2] ** 2) for C in (Ca, Cb))
     k_pair = k_theta * bm.law.contacts_per_pair / arm2
     print(f"flank tooth-pair stiffness {k_pair:.6g} N/m against K = {bm.law.pair_stiffness_n_per_m:.6g} ({len(Cb)} contacts)")
     assert k_pair == pytest.approx(bm.law.pair_stiffness_n_per_m, rel=0.05)

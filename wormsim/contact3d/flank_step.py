@@ -27,7 +27,7 @@ import math
 import mujoco
 import numpy as np
 
-from wormsim.contact3d.flanks import MARGIN_PITCH, contact_frames, find_contacts, flank_grid
+from wormsim.contact3d.flanks import MARGIN_PITCH, contact_frames, find_contacts, flank_grid, slice_weights
 
 
 class FlankContacts:
@@ -46,6 +46,9 @@ class FlankContacts:
         self.nrm = np.zeros((cap, 3))
         self.depth = np.zeros(cap)
         self.meta = np.zeros((cap, 4))
+        self.line = np.zeros((cap, 2))
+        self.weight = np.zeros(cap)          # each contact's share of its slice (flanks.slice_weights)
+        self.slices = slices
         self.frame = np.zeros((cap, 9))
         self.n = 0
         self.qa1 = int(m.jnt_qposadr[m.dof_jntid[bm.worm_dof]])
@@ -64,6 +67,7 @@ class FlankContacts:
         t.elem = [-1, -1]
         t.vert = [-1, -1]
         t.solref = law.solref
+        self.solref = np.asarray(law.solref, dtype=float)
         t.solreffriction = [0.0, 0.0]
         t.solimp = law.solimp
         t.includemargin = 0.0
@@ -94,8 +98,9 @@ class FlankContacts:
         """Run the kernel at the current positions; returns the number of contacts."""
         th1, th2 = d.qpos[self.qa1], d.qpos[self.qa2]
         g = self.grid
-        self.n = n = find_contacts(g.xy, g.c, g.c_range, g.zeta, self.window(th2), th1, th2,
-                                   self.margin0, g.params, self.pos, self.nrm, self.depth, self.meta)
+        n = find_contacts(g.xy, g.c, g.c_range, g.zeta, self.window(th2), th1, th2,
+                          self.margin0, g.params, self.pos, self.nrm, self.depth, self.meta, self.line)
+        self.n = n = slice_weights(self.meta, self.line, n, self.slices, self.pos, self.nrm, self.depth, self.weight)
         contact_frames(self.nrm, n, self.frame)
         return n
 
@@ -114,6 +119,8 @@ class FlankContacts:
         c.dist[k0:k1] = -self.depth[:k1 - k0]
         c.pos[k0:k1] = self.pos[:k1 - k0]
         c.frame[k0:k1] = self.frame[:k1 - k0]
+        # each contact's stiffness and damping scaled by its share of its slice (direct solref: -k, -b)
+        c.solref[k0:k1] = np.multiply.outer(self.weight[:k1 - k0], self.solref)
 
     def step(self, m: mujoco.MjModel, d: mujoco.MjData) -> None:
         split_step(m, d, self.add)

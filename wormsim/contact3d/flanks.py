@@ -182,10 +182,12 @@ def _gap_at(xy, sg, j, i, zeta, ca, sa, theta1, P, tmp, gaps, exc, pts, nrs, sta
 
 
 @numba.njit(cache=True)
-def find_contacts(xy, c, c_range, zeta, ks, theta1, theta2, margin, P, pos, nrm, depth, meta):
+def find_contacts(xy, c, c_range, zeta, ks, theta1, theta2, margin, P, pos, nrm, depth, meta, line):
     """Contacts of the window teeth ks at worm angle theta1, wheel angle theta2 (module docstring). Writes per contact
     the assembly position pos (n, 3), unit normal nrm (n, 3) (worm -> wheel), depth (n,) > 0 and meta (n, 4) =
-    (tooth k, flank sigma, slice j, fractional profile index); returns n. The candidate window is margin plus the
+    (tooth k, flank sigma, slice j, fractional profile index), and line (n, 2) = (excess of the contact line's point,
+    its depth: the extended gap's minimum, m) for slice_weights; returns n. A contact is written where the depth at
+    the worm's edge or the line's depth is positive (depth may then be 0). The candidate window is margin plus the
     transmission error |theta2 - hand z1 / z2 theta1| (wrapped to a pitch), so a wheel pushed far into the
     worm keeps its contacts."""
     S, N = c.shape[1], c.shape[2]
@@ -252,6 +254,7 @@ def find_contacts(xy, c, c_range, zeta, ks, theta1, theta2, margin, P, pos, nrm,
                     x = -qa / (2.0 * qb)
                 nb = ib + 1 if x > 0.0 else ib - 1
                 e_x = exc[ib] if x == 0.0 else exc[ib] + abs(x) * (exc[nb] - exc[ib])
+                x_l = x
                 if e_x <= 0.0:
                     gmin = best + qa * x + qb * x * x
                 elif exc[ib] <= 0.0:
@@ -281,8 +284,11 @@ def find_contacts(xy, c, c_range, zeta, ks, theta1, theta2, margin, P, pos, nrm,
                         ia = ibn
                         if gaps[ia] >= 0.0:
                             break       # past the parabola's reach: the linear crossings from here on are >= 0
-                if gmin >= 0.0:
+                gline = best + qa * x_l + qb * x_l * x_l
+                if gmin >= 0.0 and gline >= 0.0:
                     continue
+                if gmin == np.inf:
+                    x = x_l      # no edge inside reach: the line's point (only its weight can make it carry)
                 # the contact point and normal at fractional index f, linear between the grid points around it
                 f = ib + x
                 i0 = min(int(math.floor(f)), N - 2)
@@ -301,17 +307,59 @@ def find_contacts(xy, c, c_range, zeta, ks, theta1, theta2, margin, P, pos, nrm,
                     nx, ny, nz = nx / nn, ny / nn, nz / nn
                 # static worm frame -> assembly: (x, y, z)_asm = (-z_s, x_s - a, -y_s), i.e. R0 applied
                 ax, ay, az = -nz, nx, -ny
-                dlt = -gmin
+                dlt = -gmin if gmin < np.inf else -gline
                 if n >= depth.shape[0]:
                     return n
                 pos[n, 0] = px + 0.5 * dlt * ax
                 pos[n, 1] = py + 0.5 * dlt * ay
                 pos[n, 2] = pz + 0.5 * dlt * az
                 nrm[n, 0], nrm[n, 1], nrm[n, 2] = ax, ay, az
-                depth[n] = dlt
+                depth[n] = max(dlt, 0.0)
+                line[n, 0], line[n, 1] = e_x, -gline
                 meta[n, 0], meta[n, 1], meta[n, 2], meta[n, 3] = k, sg, j, f
                 n += 1
     return n
+
+
+@numba.njit(cache=True)
+def slice_weights(meta, line, n, slices, pos, nrm, depth, weight):
+    """Line-end interpolation of the slice method: each contact's share w in [0, 1] of its slice's strip (width b2 / S)
+    that the contact line covers, so that the mesh stiffness changes continuously as the line's end (where it runs
+    past the worm's tip, root or end face: the line point's excess e crosses 0) sweeps across the face, instead of by
+    K / S when the end crosses a slice centre. The end lies between slices j and j + 1 where e changes sign, linear
+    in e; each half-strip counts as covered up to it (the trapezoidal rule for the line load with its end
+    interpolated). A half-strip towards the face edge or towards a slice without contact counts as covered when the
+    line point is inside. Keeps the contacts with w > 0 (in place: pos, nrm, depth, meta, line), sets depth to the
+    line's depth and weight to w; returns their number."""
+    m = 0
+    for i in range(n):
+        k, sg, j = meta[i, 0], meta[i, 1], meta[i, 2]
+        e = line[i, 0]
+        w = 0.0
+        for side in (-1, 1):
+            nb = i + side
+            if nb >= 0 and nb < n and meta[nb, 0] == k and meta[nb, 1] == sg and meta[nb, 2] == j + side:
+                en = line[nb, 0]
+                if e <= 0.0 and en <= 0.0:
+                    w += 0.5
+                elif e <= 0.0:
+                    w += min(e / (e - en), 0.5)
+                elif en <= 0.0:
+                    w += max(en / (en - e) - 0.5, 0.0)
+            elif e <= 0.0:
+                w += 0.5
+        if w <= 0.0 or line[i, 1] <= 0.0:
+            continue
+        if m != i:
+            for a in range(3):
+                pos[m, a], nrm[m, a] = pos[i, a], nrm[i, a]
+            for a in range(4):
+                meta[m, a] = meta[i, a]
+            line[m, 0], line[m, 1] = line[i, 0], line[i, 1]
+        depth[m] = line[i, 1]
+        weight[m] = w
+        m += 1
+    return m
 
 
 @numba.njit(cache=True)
