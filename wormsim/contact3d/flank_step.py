@@ -98,7 +98,7 @@ class FlankContacts:
         """Run the kernel at the current positions; returns the number of contacts."""
         th1, th2 = d.qpos[self.qa1], d.qpos[self.qa2]
         g = self.grid
-        n = find_contacts(g.xy, g.c, g.c_range, g.zeta, self.window(th2), th1, th2,
+        n = find_contacts(g.xy, g.c, g.c_range, g.span, g.zeta, self.window(th2), th1, th2,
                           self.margin0, g.params, self.pos, self.nrm, self.depth, self.meta, self.line)
         self.n = n = slice_weights(self.meta, self.line, n, self.slices, self.pos, self.nrm, self.depth, self.weight)
         contact_frames(self.nrm, n, self.frame)

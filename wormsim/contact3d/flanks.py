@@ -58,6 +58,8 @@ class FlankGrid:
     xy: np.ndarray          # (2, S, N, 2) the points' (x, y) in the wheel frame (rho cos psi, rho sin psi)
     c: np.ndarray           # (2, S, N) conjugate wheel angle, nan where not active
     c_range: np.ndarray     # (2, S, 2) min and max of c per flank and slice (whole slices are skipped by it)
+    span: np.ndarray        # (2, S, 2) first and last active profile index per flank and slice (c is monotone
+                            # between them; -1, -1 where a slice has none)
     params: np.ndarray      # worm scalars for the kernel (worm_params)
 
 
@@ -96,7 +98,12 @@ def flank_grid(g: GearGeometry, slices: int, n_profile: int = N_PROFILE) -> Flan
         rng = np.stack([np.nanmin(c, axis=2), np.nanmax(c, axis=2)], axis=-1)
     rng = np.where(np.isfinite(rng), rng, np.array([np.inf, -np.inf]))
     xy = np.stack([R * np.cos(psi), R * np.sin(psi)], axis=-1)
-    return FlankGrid(slices=slices, zeta=zeta, rho=R, psi=psi, xy=xy, c=c, c_range=rng, params=worm_params(g))
+    act = np.isfinite(c)
+    first = np.where(act.any(axis=2), np.argmax(act, axis=2), -1)
+    last = np.where(act.any(axis=2), n_profile - 1 - np.argmax(act[:, :, ::-1], axis=2), -1)
+    span = np.stack([first, last], axis=-1).astype(np.int64)
+    return FlankGrid(slices=slices, zeta=zeta, rho=R, psi=psi, xy=xy, c=c, c_range=rng, span=span,
+                     params=worm_params(g))
 
 
 def _cut_by_worm(g: GearGeometry, R: np.ndarray, psi0: np.ndarray, zeta: np.ndarray) -> np.ndarray:
@@ -121,7 +128,7 @@ def _half_thickness(r, P):
     return p_x / 4 - (r - r1) * P[7], -P[7]
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def worm_gap_ext(xs, ys, zs, theta1, P, out):
     """Signed normal distance (1) of a static-worm-frame point from the thread flank extended past the worm's tip,
     root and end faces, the unit gradient (static worm frame) in out[0:3], and the excess (m) by which the point is
@@ -152,7 +159,7 @@ def worm_gap(xs, ys, zs, theta1, P, out):
     return np.inf if ex > 0.0 else gv
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _eval(x0, y0, zeta, ca, sa, theta1, P, out):
     """Extended gap and excess (worm_gap_ext) of the wheel point (x0, y0, zeta) turned by the angle (cos ca, sin sa)
     about z (assembly frame), and the turned point in out[3:6]."""
@@ -161,7 +168,7 @@ def _eval(x0, y0, zeta, ca, sa, theta1, P, out):
     return worm_gap_ext(y + P[10], -zeta, -x, theta1, P, out)
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _gap_at(xy, sg, j, i, zeta, ca, sa, theta1, P, tmp, gaps, exc, pts, nrs, stamp, sid):
     """Extended gap of profile point i of (flank sg, slice j), evaluated once per slice (stamp[i] == sid) and kept in
     gaps, exc (excess), pts, nrs; +inf off the grid and at points that are not active flank points."""
@@ -182,7 +189,7 @@ def _gap_at(xy, sg, j, i, zeta, ca, sa, theta1, P, tmp, gaps, exc, pts, nrs, sta
 
 
 @numba.njit(cache=True)
-def find_contacts(xy, c, c_range, zeta, ks, theta1, theta2, margin, P, pos, nrm, depth, meta, line):
+def find_contacts(xy, c, c_range, span, zeta, ks, theta1, theta2, margin, P, pos, nrm, depth, meta, line):
     """Contacts of the window teeth ks at worm angle theta1, wheel angle theta2 (module docstring). Writes per contact
     the assembly position pos (n, 3), unit normal nrm (n, 3) (worm -> wheel), depth (n,) > 0 and meta (n, 4) =
     (tooth k, flank sigma, slice j, fractional profile index), and line (n, 2) = (excess of the contact line's point,
@@ -214,14 +221,19 @@ def find_contacts(xy, c, c_range, zeta, ks, theta1, theta2, margin, P, pos, nrm,
             for j in range(S):
                 if hi < c_range[sg, j, 0] or lo > c_range[sg, j, 1]:
                     continue
-                # start at the active point whose conjugate angle is nearest the target (the contact line's point)
-                i_s, dc = -1, np.inf
-                for i in range(N):
-                    ci = c[sg, j, i]
-                    if ci == ci and abs(ci - target) < dc:
-                        dc, i_s = abs(ci - target), i
-                if i_s < 0:
+                # start at the active point whose conjugate angle is nearest the target (the contact line's point;
+                # bisection, c is monotone along the active profile)
+                a, b = span[sg, j, 0], span[sg, j, 1]
+                if a < 0:
                     continue
+                inc = c[sg, j, b] > c[sg, j, a]
+                while b - a > 1:
+                    mid = (a + b) // 2
+                    if (c[sg, j, mid] < target) == inc:
+                        a = mid
+                    else:
+                        b = mid
+                i_s = a if abs(c[sg, j, a] - target) <= abs(c[sg, j, b] - target) else b
                 sid += 1
                 zj = zeta[j]
                 ib = i_s
