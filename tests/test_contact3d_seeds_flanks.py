@@ -24,7 +24,10 @@ def run(name: str) -> dict:
 
 
 MESH_XFAIL = {
-    "screw_jack": "F_t's largest peak is the 3rd meshing harmonic: 66.4 Hz against z1 n1/60 = 22.14 Hz (p2p 66 N on "
+    "seat_motor": "F_t's largest peak is the 3rd meshing harmonic: 89.9 Hz against z1 n1/60 = 29.97 Hz (p2p 51.5 N on "
+                  "1289 N, since the line-end interpolation of flanks.slice_weights; before it the bursts put the peak "
+                  "at 29.97 Hz); the radial force peaks at the meshing frequency (test below)",
+    "screw_jack": "F_t's largest peak is the 3rd meshing harmonic: 66.4 Hz against z1 n1/60 = 22.14 Hz (p2p 28.4 N on "
                   "400 N); the radial force peaks at 22.15 Hz (test below). The exact flanks' mesh stiffness has a 3rd "
                   "harmonic of 0.35 of the 1st (wormsim.torsional.mesh_stiffness TCA); pieces showed 22 Hz under "
                   "their facet noise",
