@@ -229,11 +229,22 @@ def find_contacts(xy, c, c_range, span, zeta, ks, theta1, theta2, margin, P, pos
                 inc = c[sg, j, b] > c[sg, j, a]
                 while b - a > 1:
                     mid = (a + b) // 2
-                    if (c[sg, j, mid] < target) == inc:
+                    cm = c[sg, j, mid]
+                    if cm != cm:            # a point trimmed inside the row (flank_trim): scan the row instead
+                        a = -1
+                        break
+                    if (cm < target) == inc:
                         a = mid
                     else:
                         b = mid
-                i_s = a if abs(c[sg, j, a] - target) <= abs(c[sg, j, b] - target) else b
+                if a >= 0:
+                    i_s = a if abs(c[sg, j, a] - target) <= abs(c[sg, j, b] - target) else b
+                else:
+                    i_s, dc = -1, np.inf
+                    for i in range(span[sg, j, 0], span[sg, j, 1] + 1):
+                        ci = c[sg, j, i]
+                        if ci == ci and abs(ci - target) < dc:
+                            dc, i_s = abs(ci - target), i
                 sid += 1
                 zj = zeta[j]
                 ib = i_s
