@@ -9,9 +9,10 @@ With each point goes its conjugate wheel angle c = beta - psi (mesh_stiffness (1
 the conjugate worm at wheel angle theta2 = c - 2 pi (k + sigma) / z2 (sigma = 0 flank A, 1 flank B). Points cut by
 the hob tip edge (root fillet, not conjugate) are left out: exact flanks carry the working flanks only.
 
-Each step (`find_contacts`, numba): for every wheel tooth k of the mesh window and both flanks, and for every slice,
-only the profile points whose conjugate angle is within `margin` of the current wheel angle (plus one point either
-side) are evaluated, so a step costs a few points per slice instead of the whole grid. A point of tooth k at wheel
+Each step (`find_contacts`, numba): for every wheel tooth k of the mesh window and both flanks, and for every slice
+whose conjugate angles come within `margin` of the current wheel angle, the kernel starts at the profile point whose
+conjugate angle is nearest (bisection) and descends along the profile to the gap's minimum, so a step costs about three
+points per slice. A point of tooth k at wheel
 angle theta2 sits in the assembly at (rho cos b, rho sin b, zeta), b = psi + theta2 + 2 pi k / z2, and in the
 static worm frame (meshgen.assembly: x_s = y + a, y_s = -z, z_s = -x) at radius r and angle phi. Its signed
 normal distance from the worm thread is the closed form of meshgen.worm.thread_gap (equations (1), (2) there):
@@ -19,12 +20,15 @@ normal distance from the worm thread is the closed form of meshgen.worm.thread_g
     u = wrap(z_s - p (phi - theta1), p_x),   G = (|u| - H(r)) / |grad G|,
     grad G = sign(u) (e_z - (p / r) e_phi) - H'(r) e_r,                                              (1)
 
-negative inside the thread, valid for r_f1 <= r <= r_a1 and |z_s| <= b1 / 2 (outside: no thread, no contact). In
-each slice the deepest point along the profile is refined by the parabola through it and its two neighbours (the gap
-across a contact line is quadratic), giving ONE contact per (tooth, flank, slice): depth delta = -G_min, normal
+negative inside the thread, valid for r_f1 <= r <= r_a1 and |z_s| <= b1 / 2; the kernel evaluates it past these
+bounds too (the flank extended, worm_gap_ext) and, where the minimum lies outside, takes the worm's edge on the wheel
+flank (where the excess crosses zero), so contacts enter and leave at zero depth (docs/contact3d.md). In each slice
+the deepest point along the profile is refined by the parabola through it and its two neighbours (the gap across a
+contact line is quadratic), giving ONE contact per (tooth, flank, slice): depth delta = -G_min, normal
 n = grad G / |grad G| in the assembly frame (from the worm into the wheel: the force on the wheel is along +n),
 position = the wheel point moved delta / 2 along n (MuJoCo's midpoint). A tooth pair whose contact line spans the face
-thus gives S contacts of stiffness K / S each (wormsim.contact3d.law, n_ref = S): the slice method of gear dynamics.
+thus gives S contacts of stiffness K / S each (wormsim.contact3d.law, n_ref = S): the slice method of gear dynamics;
+slice_weights scales each by the share of its slice the contact line covers (the line's end interpolated).
 
 The kernel repeats the worm's H(r) (meshgen.worm.half_thickness, ZI/ZA) in compiled form; tests/test_flank_contact.py
 pins the kernel's distance to meshgen.worm.thread_gap.
