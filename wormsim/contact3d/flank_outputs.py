@@ -15,7 +15,9 @@ length across the line and rho' the relative radius of curvature of the two flan
 wheel frame, zeta = its z), has lambda_min ~ 0 with the contact line's direction t = J v_min / |J v_min|, and
 lambda_max = 1 / rho'. The slice's contact-line length inside the slice (width b2 / S across the face) is
 
-    L = (b2 / S) / |t . e_z|,   capped at the active profile length of the slice                              (2)
+    L = s (b2 / S) / |t . e_z|,   capped at the active profile length of the slice                            (2)
+
+(s the contact's share of its slice, wormsim.contact3d.flanks.slice_weights: 1 inside the line, less at its ends).
 
 Hertz line contact (Johnson eq. 4.45; DIN 3996 and ISO/TS 14521 use the same p_H for line contact):
 
@@ -170,15 +172,16 @@ def _lerp_rows(a, sg, j, f):
 
 
 @numba.njit(cache=True)
-def _rows(i, adr, efc_force, meta, inv_rho, line_len, e_star, out, m):
-    """Appends (i, sigma, j, f, F_n, p_H (3)) per contact with a constraint row to out (float32) from row m."""
+def _rows(i, adr, efc_force, meta, weight, inv_rho, line_len, e_star, out, m):
+    """Appends (i, sigma, j, f, F_n, p_H (3)) per contact with a constraint row to out (float32) from row m. The
+    contact carries the share weight[c] of its slice (flanks.slice_weights), so its line is weight[c] x L long."""
     for c in range(adr.shape[0]):
-        if adr[c] < 0:
+        if adr[c] < 0 or weight[c] <= 0.0:
             continue
         sg, j, f = int(meta[c, 1]), int(meta[c, 2]), meta[c, 3]
         fn = efc_force[adr[c]]                  # the normal row: the force on the wheel along +n
         k = _lerp(inv_rho, sg, j, f)
-        L = _lerp(line_len, sg, j, f)
+        L = weight[c] * _lerp(line_len, sg, j, f)
         o = out[m]
         o[0], o[1], o[2], o[3], o[4] = i, sg, j, f, fn
         o[5] = math.sqrt(max(fn, 0.0) / L * e_star * max(k, 0.0) / math.pi)
@@ -210,7 +213,8 @@ class PatternLog:
             self.buf = np.concatenate([self.buf, np.zeros_like(self.buf)])
         adr = d.contact.efc_address[d.ncon - n:d.ncon]
         cv = self.cv
-        self.m = _rows(i, adr, d.efc_force, fc.meta, cv.inv_rho, cv.line_len, self.e_star, self.buf, self.m)
+        self.m = _rows(i, adr, d.efc_force, fc.meta, fc.weight, cv.inv_rho, cv.line_len, self.e_star, self.buf,
+                       self.m)
 
     def table(self) -> np.ndarray:
         """The log as float64 rows (i, sigma, j, f, F_n, p_H, zeta, rho): zeta the slice centre, rho the flank radius
