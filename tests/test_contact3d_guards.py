@@ -186,8 +186,8 @@ def test_bench_writes_the_stability_record_into_bench_meta(tmp_path, monkeypatch
     the first step and no stable timestep."""
     from wormsim.bench import run as bench
 
-    monkeypatch.setattr(bench, "bench_cases", lambda quick, models=None, scenarios=None: [])
-    monkeypatch.setattr(bench, "stability_map", lambda quick, scenarios=None: {"seat_motor_demo": stability_edge(
+    monkeypatch.setattr(bench, "bench_cases", lambda *args: [])
+    monkeypatch.setattr(bench, "stability_map", lambda *args: {"seat_motor_demo": stability_edge(
         "seat_motor_demo", factors=(4,), duration_s=0.002, overrides=("drive.ramp_s=0.002", "load.ramp_s=0.002"))})
     bench.run_bench(quick=True, out_dir=tmp_path, models=("contact3d",))
     rec = json.loads((tmp_path / "bench_meta.json").read_text())["stability"]["seat_motor_demo"]
