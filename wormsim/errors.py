@@ -14,6 +14,7 @@ __all__ = [
     "PenetrationError",
     "LockedError",
     "OverspeedError",
+    "RingingError",
 ]
 
 
@@ -42,3 +43,7 @@ class LockedError(SimulationError):
 
 class OverspeedError(SimulationError):
     """The worm turns more per step than contact3d resolves: its pieces would pass through the wheel's."""
+
+
+class RingingError(SimulationError):
+    """A mass-scaled run rang: efficiency above 1 or kinetic energy far above its target share of the work."""

@@ -49,6 +49,12 @@ class Progress:
             while self._next_log <= frac:
                 self._next_log += LOG_STEP
 
+    def note(self, text: str) -> None:
+        """A line the user must see before the run (e.g. mass scaling), unless progress is off (WORMSIM_NO_PROGRESS,
+        --no-progress: the summary still says it)."""
+        if self._log or not self._bar.disable:
+            print(text, file=self._stream, flush=True)
+
     def close(self) -> None:
         self._bar.close()
 

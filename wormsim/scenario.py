@@ -144,6 +144,10 @@ class Simulation(_Strict):
         "contact3d: MuJoCo's speculative contacts (sweep fast geoms over the step against tunnelling)"))
     mesh_stiffness_samples: int = Field(
         64, ge=8, le=4096, description="torsional: k(theta) samples per mesh cycle (tooth contact analysis)")
+    mass_scaling: Annotated[float, Field(ge=1, le=1e8)] | Literal["auto"] = Field(1.0, description=(
+        "contact3d, quasi-static runs only: both shafts' inertias (and load.inertia_kg_m2) times this factor, so the "
+        "stable timestep grows by its square root; auto: the largest factor that keeps the kinetic energy below 1 % "
+        "of the drive's work; 1 = off. Refused for dynamic runs (docs/contact3d.md, 'Mass scaling')"))
 
 
 # ----------------------------------------------------------------------------- wedge (seed 000)
@@ -243,6 +247,10 @@ class Scenario(_Strict):
 
     @model_validator(mode="after")
     def _blocks(self) -> "Scenario":
+        if self.model != "contact3d" and self.simulation.mass_scaling != 1:
+            raise ValueError(f"simulation.mass_scaling = {self.simulation.mass_scaling}: only model contact3d scales "
+                             f"masses (torsional runs the 20 s seat motor in seconds without it); allowed: "
+                             f"simulation.mass_scaling = 1 with model {self.model}")
         if self.model == "wedge":
             if self.wedge is None:
                 raise ValueError("model: wedge needs a wedge: block")

@@ -24,7 +24,7 @@ Built with mujoco.MjSpec from the template `models/worm_pair.xml` (see models/RE
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import astuple, dataclass, field, replace
 from importlib.resources import files
 from pathlib import Path
 
@@ -39,7 +39,9 @@ from meshgen.kinematic_tca import KinematicTCA
 from meshgen.pieces import GearSet
 from wormsim import gear_theory as gt
 from wormsim.contact3d.backlash import check_backlash, check_conjugate_interference
+from wormsim.contact3d import mass_scaling
 from wormsim.contact3d.law import ContactLaw, contact_law, friction_impratio
+from wormsim.contact3d.mass_scaling import ScalingCheck
 from wormsim.contact3d.timestep import choose_timestep
 from wormsim.contact3d.window import slot_quat, window_size, window_teeth_at
 from wormsim.friction import friction_coefficient
@@ -105,6 +107,7 @@ class Prepared:
     law: ContactLaw
     inv_mass_worm: float     # arm1^2 / (I1 + J1): the worm's share of A_hat
     inv_mass_wheel: float    # arm2^2 / (I2 + J2)
+    scaling: ScalingCheck | None = None   # simulation.mass_scaling: the factor used and its checks (inertias x it)
 
 
 # ----------------------------------------------------------------------------- geometry helpers
@@ -181,16 +184,25 @@ def prepare(scenario: Scenario, gs: GearSet | None = None) -> Prepared:
     ine = shaft_inertias(scenario, geo, gs)
     arm1, arm2 = gt.mesh_arms_m(geo.r1, geo.r2, geo.alpha_n, geo.gamma)
     # driven-machine inertia J on the loaded shaft (joint armature) belongs to that shaft's effective mass
-    a1 = arm1 ** 2 / (ine.worm_inertia_kg_m2 + ine.worm_load_inertia_kg_m2)
-    a2 = arm2 ** 2 / (ine.wheel_inertia_kg_m2 + ine.wheel_load_inertia_kg_m2)
+    I1, I2 = ine.worm_inertia_kg_m2 + ine.worm_load_inertia_kg_m2, ine.wheel_inertia_kg_m2 + ine.wheel_load_inertia_kg_m2
     # n_ref: the pieces across the face width, or with contact.geometry flanks the flank contacts' slices
     slabs = flank_slices(scenario) if scenario.contact.geometry == "flanks" else max(1, _slabs_per_flank(gs))
+    # simulation.mass_scaling (wormsim.contact3d.mass_scaling): every inertia x S before the law takes them
+    law1 = contact_law(scenario.contact, scenario.materials, geo.face_width, slabs, arm1 ** 2 / I1 + arm2 ** 2 / I2)
+    scaling = mass_scaling.resolve(
+        scenario, ratio=geo.ratio, z1=geo.z1, gamma=geo.gamma, alpha_n=geo.alpha_n,
+        mu=float(friction_coefficient(scenario.contact, 1.0)), pair_stiffness_n_per_m=law1.pair_stiffness_n_per_m,
+        inv_mass_hat=law1.inv_mass_hat, inertias_kg_m2=(I1, I2))
+    S = scaling.factor
+    if S != 1:
+        ine = Inertias(*(S * v for v in astuple(ine)))
+    a1, a2 = arm1 ** 2 / (S * I1), arm2 ** 2 / (S * I2)
     law = contact_law(scenario.contact, scenario.materials, geo.face_width, slabs, a1 + a2)
     mu0 = float(friction_coefficient(scenario.contact, 0.0))
     mu_max = max(mu0, float(friction_coefficient(scenario.contact, 1.0)))
     law = replace(law, impratio=friction_impratio(law, mu_max, nominal_normal_force_n(scenario, geo),
                                                   scenario.contact.transition_velocity_m_s))
-    return Prepared(geo, gs, ine, law, a1, a2)
+    return Prepared(geo, gs, ine, law, a1, a2, scaling)
 
 
 # ----------------------------------------------------------------------------- build
@@ -209,7 +221,8 @@ def build_model(scenario: Scenario, gs: GearSet | None = None, check_backlash_vs
     # backlash against the pieces' residual bulge (wormsim.contact3d.backlash (2)): exit 2 before the teeth start jammed
     backlash_meta = check_backlash(geo, gs.piece_error_um, scenario.simulation.resolution) \
         if check_backlash_vs_pieces and gs.piece_error_um else {}
-    h, h_source = choose_timestep(scenario, geo, law) if timestep_s is None else (timestep_s, "given to build_model")
+    h, h_source = choose_timestep(scenario, geo, law, p.scaling.factor) if timestep_s is None else (
+        timestep_s, "given to build_model")
 
     pair = displaced_pair(scenario.errors, geo)      # errors: (issue 12), None for the perfect pair
     dev, kin = pair if pair is not None else (None, None)
@@ -221,6 +234,8 @@ def build_model(scenario: Scenario, gs: GearSet | None = None, check_backlash_vs
     worm_names, slot_names, W = _add_geoms(spec, geo, gs, law, float(friction_coefficient(scenario.contact, 0.0)),
                                            window_teeth, shift, flanks)
     kv, drive_sign = _add_actuators(spec, scenario, geo)
+    spec.joint(f"{scenario.load.on}_hinge").armature = max(p.inertias.worm_load_inertia_kg_m2,
+                                                           p.inertias.wheel_load_inertia_kg_m2)   # x mass_scaling
     _set_options(spec, scenario, law, h)
     _add_mesh_sensor(spec)
     model = spec.compile()
@@ -234,6 +249,10 @@ def build_model(scenario: Scenario, gs: GearSet | None = None, check_backlash_vs
     if kv is not None:
         meta["drive_kv_nm_s"] = kv
     meta["load_inertia_kg_m2"] = scenario.load.inertia_kg_m2
+    meta["mass_scaling"] = p.scaling.factor
+    meta["mass_scaling_check"] = p.scaling
+    meta["shaft_inertias_kg_m2"] = (ine.worm_inertia_kg_m2 + ine.worm_load_inertia_kg_m2,
+                                    ine.wheel_inertia_kg_m2 + ine.wheel_load_inertia_kg_m2)
 
     def oid(kind: mujoco.mjtObj, name: str) -> int:
         return mujoco.mj_name2id(model, kind, name)

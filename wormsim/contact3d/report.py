@@ -107,8 +107,12 @@ def write_report(result: Result, path) -> None:
                    bbox=dict(facecolor="white", edgecolor="0.6", alpha=0.9, pad=1.5))
         a.set_xlim(-0.6 * geo.face_width * 1e3, 0.85 * geo.face_width * 1e3)
         a.set(xlabel="across the face (wheel z) [mm]", ylabel="radius [mm]", title="contact pattern on a wheel tooth")
+    scaled = s.get("mass_scaling", 1) > 1       # wormsim.contact3d.mass_scaling: say so where the plots are
     fig.suptitle(f"{result.summary.get('scenario', '')} contact3d: dt {s['timestep_s']:.3g} s, resolution "
-                 f"{s['resolution']}, steady window {w0:.3g}-{w1:.3g} s")
+                 f"{s['resolution']}, steady window {w0:.3g}-{w1:.3g} s" + (
+                     f"\nMASS SCALING x {s['mass_scaling']:g} (kinetic energy {100 * s['kinetic_energy_share']:.2g} % "
+                     f"of the work): means only; force fluctuation, speeds' rattle and start-up peaks are not physical"
+                     if scaled else ""), color="C3" if scaled else "k")
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)

@@ -34,6 +34,7 @@ import mujoco
 import numpy as np
 
 from wormsim import gear_theory as gt
+from wormsim.contact3d import mass_scaling
 from wormsim.contact3d.metrics import contact3d_summary
 from wormsim.contact3d.mjcf import BuiltModel, build_model
 from wormsim.contact3d.timestep import (
@@ -63,11 +64,11 @@ _ROWS3 = np.arange(3)       # the normal and two tangent rows of an elliptic-con
 JUMP_PITCH = 0.5            # transmission error (in pitches) that counts as teeth jumping
 
 
-def _record_every(scenario: Scenario, dt: float, n_steps: int) -> int:
+def _record_every(scenario: Scenario, dt: float, n_steps: int, scaled: bool = False) -> int:
     sim = scenario.simulation
     if "record_every" in sim.model_fields_set:
         return sim.record_every
-    return max(1, n_steps // TARGET_SAMPLES)
+    return max(1, n_steps // (mass_scaling.SCALED_SAMPLES if scaled else TARGET_SAMPLES))
 
 
 def contact_details(bm: BuiltModel, d: mujoco.MjData, window_ks: np.ndarray):
@@ -267,7 +268,7 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
     geo = bm.geometry
     dt = bm.timestep_s
     n_steps = int(round(scenario.simulation.duration_s / dt))
-    rec = _record_every(scenario, dt, n_steps)
+    rec = _record_every(scenario, dt, n_steps, bm.meta.get("mass_scaling", 1) > 1)
     n_rec = n_steps // rec
     qa_worm = int(m.jnt_qposadr[m.dof_jntid[bm.worm_dof]])
     qa_wheel = int(m.jnt_qposadr[m.dof_jntid[bm.wheel_dof]])
@@ -385,6 +386,7 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
     if pattern is not None:                 # the loaded contact pattern and Hertz stress (flank_outputs)
         summary.update(pattern.summary(S["t_s"], summary["steady_window_s"]))
         extra["flank_pattern"] = pattern.grid(S["t_s"], summary["steady_window_s"])
+    summary.update(mass_scaling.run_summary(S, scenario, bm.meta, summary))   # and the ringing guard (exit 3)
     if bm.kinematic_tca is not None:       # errors: the displaced exact flanks' kinematic TE and play (issue 12)
         kin = bm.kinematic_tca.summary(bm.geometry, gt.working_flank(scenario, bm.geometry.hand))
         summary.update({k: v for k, v in kin.items() if not k.startswith("contact_pattern")})
@@ -423,4 +425,8 @@ def _run_summary(S: dict, scenario: Scenario, bm: BuiltModel, rec: int, turn_max
 
 def simulate(scenario: Scenario, progress=None) -> Result:
     """Build the model (its timestep chosen before the build) and run it."""
-    return run_model(build_model(scenario), scenario, progress)
+    bm = build_model(scenario)
+    if progress is not None and scenario.simulation.mass_scaling != 1:
+        progress.note(mass_scaling.note(bm.meta["mass_scaling_check"], scenario.simulation.mass_scaling,
+                                        bm.timestep_s))
+    return run_model(bm, scenario, progress)
