@@ -16,7 +16,7 @@ from pathlib import Path
 from typing import Annotated, Any, Literal
 
 import yaml
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
 
 class ScenarioError(ValueError):
@@ -148,6 +148,14 @@ class Simulation(_Strict):
         "contact3d, quasi-static runs only: both shafts' inertias (and load.inertia_kg_m2) times this factor, so the "
         "stable timestep grows by its square root; auto: the largest factor that keeps the kinetic energy below 1 % "
         "of the drive's work; 1 = off. Refused for dynamic runs (docs/contact3d.md, 'Mass scaling')"))
+
+    @field_validator("mass_scaling", mode="before")
+    @classmethod
+    def _scaling(cls, v):
+        """One message for both forms (the union would give one per member)."""
+        if v == "auto" or (isinstance(v, int | float) and not isinstance(v, bool) and 1 <= v <= 1e8):
+            return v
+        raise ValueError("allowed: 1 <= simulation.mass_scaling <= 1e8 (1 = off), or auto")
 
 
 # ----------------------------------------------------------------------------- wedge (seed 000)
