@@ -145,7 +145,7 @@ class Simulation(_Strict):
     mesh_stiffness_samples: int = Field(
         64, ge=8, le=4096, description="torsional: k(theta) samples per mesh cycle (tooth contact analysis)")
     mass_scaling: Annotated[float, Field(ge=1, le=1e8)] | Literal["auto"] = Field(1.0, description=(
-        "contact3d, quasi-static runs only: both shafts' inertias (and load.inertia_kg_m2) times this factor, so the "
+        "1 <= S <= 1e8 or auto; contact3d, quasi-static runs only: both shafts' inertias (and load.inertia_kg_m2) times this factor, so the "
         "stable timestep grows by its square root; auto: the largest factor that keeps the kinetic energy below 1 % "
         "of the drive's work; 1 = off. Refused for dynamic runs (docs/contact3d.md, 'Mass scaling')"))
 

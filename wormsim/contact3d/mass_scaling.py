@@ -190,10 +190,10 @@ def run_summary(S: dict, scenario: Scenario, meta: dict, summary: dict) -> dict:
             why.append(f"kinetic energy {100 * share:.3g} % of the drive's work (target {100 * KE_SHARE_TARGET:g} %, "
                        f"limit {100 * RINGING_KE_SHARE:g} %)")
         if why:
+            h, lim = summary["timestep_s"], summary["timestep_stable_limit_s"]
             raise RingingError(
-                f"the mass-scaled run rang (simulation.mass_scaling = {c.factor:g}, timestep {summary['timestep_s']:.3g} "
-                f"s, {summary['timestep_s'] / summary['timestep_stable_limit_s']:.2f} of the scaled stable limit "
-                f"{summary['timestep_stable_limit_s']:.3g} s): {'; '.join(why)}; its means are not quasi-static. Leave "
+                f"the mass-scaled run rang (simulation.mass_scaling = {c.factor:g}, timestep {h:.3g} s, {h / lim:.2f} "
+                f"of the scaled stable limit {lim:.3g} s): {'; '.join(why)}; its means are not quasi-static. Leave "
                 f"simulation.timestep_s unset (default {SCALED_STEP_FRACTION} x the limit) or lower "
                 f"simulation.mass_scaling")
     return out

@@ -38,8 +38,8 @@ from meshgen.geometry import GearGeometry
 from meshgen.kinematic_tca import KinematicTCA
 from meshgen.pieces import GearSet
 from wormsim import gear_theory as gt
-from wormsim.contact3d.backlash import check_backlash, check_conjugate_interference
 from wormsim.contact3d import mass_scaling
+from wormsim.contact3d.backlash import check_backlash, check_conjugate_interference
 from wormsim.contact3d.law import ContactLaw, contact_law, friction_impratio
 from wormsim.contact3d.mass_scaling import ScalingCheck
 from wormsim.contact3d.timestep import choose_timestep
@@ -184,7 +184,8 @@ def prepare(scenario: Scenario, gs: GearSet | None = None) -> Prepared:
     ine = shaft_inertias(scenario, geo, gs)
     arm1, arm2 = gt.mesh_arms_m(geo.r1, geo.r2, geo.alpha_n, geo.gamma)
     # driven-machine inertia J on the loaded shaft (joint armature) belongs to that shaft's effective mass
-    I1, I2 = ine.worm_inertia_kg_m2 + ine.worm_load_inertia_kg_m2, ine.wheel_inertia_kg_m2 + ine.wheel_load_inertia_kg_m2
+    I1 = ine.worm_inertia_kg_m2 + ine.worm_load_inertia_kg_m2
+    I2 = ine.wheel_inertia_kg_m2 + ine.wheel_load_inertia_kg_m2
     # n_ref: the pieces across the face width, or with contact.geometry flanks the flank contacts' slices
     slabs = flank_slices(scenario) if scenario.contact.geometry == "flanks" else max(1, _slabs_per_flank(gs))
     # simulation.mass_scaling (wormsim.contact3d.mass_scaling): every inertia x S before the law takes them

@@ -46,8 +46,9 @@ def speed_timestep_limit_s(w1_rad_s: float) -> float:
     return MAX_WORM_TURN_PER_STEP_RAD / w1_rad_s
 
 
-def choose_timestep(scenario: Scenario, geo: GearGeometry, law: ContactLaw, mass_scaling: float = 1.0
-                    ) -> tuple[float, str]:
+def choose_timestep(
+    scenario: Scenario, geo: GearGeometry, law: ContactLaw, mass_scaling: float = 1.0
+) -> tuple[float, str]:
     """(timestep, timestep_source): the scenario's (checked against the speed limit), else the contact's default
     unless the commanded worm speed needs a smaller one: then the speed limit rounded down to 1-2-5. A mass-scaled run
     (mass_scaling > 1; `law` is then the scaled one) defaults to SCALED_STEP_FRACTION of the scaled stable limit,
@@ -69,8 +70,10 @@ def choose_timestep(scenario: Scenario, geo: GearGeometry, law: ContactLaw, mass
     h, source = default_timestep(law), DEFAULT_SOURCE
     if mass_scaling > 1:
         h = floor_2_digits(SCALED_STEP_FRACTION * law.stable_limit_s)
-        source = (f"mass scaling x {mass_scaling:g}: {SCALED_STEP_FRACTION} x the scaled stable limit, rounded down to "
-                  f"two digits (docs/contact3d.md, 'Mass scaling')")
+        source = (
+            f"mass scaling x {mass_scaling:g}: {SCALED_STEP_FRACTION} x the scaled stable limit, rounded down to "
+            f"two digits (docs/contact3d.md, 'Mass scaling')"
+        )
     if w1 is not None and w1 * h > MAX_WORM_TURN_PER_STEP_RAD:
         return round_down_125(speed_timestep_limit_s(w1)), (
             f"worm speed: {rad_s_to_rpm(w1):.0f} rpm needs <= {MAX_WORM_TURN_PER_STEP_RAD} rad of worm rotation "
