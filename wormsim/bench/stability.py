@@ -14,6 +14,7 @@ from wormsim.errors import (
     LockedError,
     OverspeedError,
     PenetrationError,
+    RingingError,
     SimulationError,
     TeethJumpedError,
 )
@@ -32,11 +33,12 @@ STABILITY_DURATION_S = 0.05
 # each guard's exception (wormsim.errors) -> the class name bench_meta.json holds
 FAILURE_CLASSES: tuple[tuple[type[SimulationError], str], ...] = (
     (DivergedError, "diverged"), (TeethJumpedError, "teeth_jumped"), (PenetrationError, "penetration"),
-    (LockedError, "locked"), (OverspeedError, "overspeed"))
+    (LockedError, "locked"), (OverspeedError, "overspeed"), (RingingError, "ringing"))
 
 
 def classify_failure(exc: BaseException) -> str:
-    """Class of a guard's exception: diverged | teeth_jumped | penetration | locked | overspeed, else "other"."""
+    """Class of a guard's exception: diverged | teeth_jumped | penetration | locked | overspeed | ringing, else
+    "other"."""
     for klass, name in FAILURE_CLASSES:
         if isinstance(exc, klass):
             return name
