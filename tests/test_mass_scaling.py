@@ -92,6 +92,7 @@ REFUSED = {
     "short ramp": (["drive.ramp_s=0.05", "load.ramp_s=0.05", "simulation.mass_scaling=10000"], "ramp of 0.05 s"),
     "kinetic energy": (["drive.speed_rpm=1800", "drive.ramp_s=0.02", "load.ramp_s=0.02",
                         "simulation.mass_scaling=8"], "kinetic energy"),
+    "pieces facets": (["contact.geometry=pieces", "simulation.mass_scaling=1000"], "convex pieces pass"),
     "torque drive": (["drive.speed_rpm=null", "drive.torque_nm=1", "simulation.mass_scaling=300"], "speed-driven"),
     "torsional": (["model=torsional", "simulation.mass_scaling=300"], "only model contact3d"),
     "below 1": (["simulation.mass_scaling=0.5"], "simulation.mass_scaling"),

@@ -19,6 +19,9 @@ simulation.mass_scaling, exit 2) where a run is dynamic:
   (a harmonic k f_z amplifies by 1 / (1 - (k f_z / f_S)^2): under 1 % up to k = 10 at f_S = MODE_TO_MESH_MIN f_z;
   measured on the seat motor at 36 rpm: at 50 x the tangential force's spectrum peaked at the scaled mode, not at
   f_z, while ratio and efficiency still held; at 113 x it peaked at f_z);
+- with contact.geometry pieces, f_S below FACET_TO_MODE_MIN x the piece-passing frequency (worm pieces per turn x
+  n1 / 60), whose facets excite the mesh (seat motor, 36 rpm, pieces medium, 28.8 Hz: at S = 5000, f_S = 4.7 x it,
+  the efficiency fell 1.9 % against the unscaled pieces run, with flanks it held to 4e-7);
 - drive.ramp_s (and load.ramp_s when there is a load) shorter than RAMP_PERIODS_MIN scaled mode periods 1 / f_S;
 - the estimated kinetic-energy share above KE_SHARE_TARGET (below).
 
@@ -45,6 +48,7 @@ from wormsim.units import rpm_to_rad_s
 KE_SHARE_TARGET = 0.01          # kinetic energy at most 1 % of the drive's work
 MODE_TO_MESH_MIN = 100.0        # scaled mesh mode at least 100 x the meshing frequency (seat motor, 36 rpm: at 50 x
                                 # the F_t spectrum peaked at the scaled mode, at 113 x at z1 n1 / 60)
+FACET_TO_MODE_MIN = 20.0        # contact.geometry pieces: scaled mode at least 20 x the piece-passing frequency
 RAMP_PERIODS_MIN = 10.0         # ramps at least 10 scaled mesh-mode periods (S = 1e4 failed 0.05 s ramps: 5.7)
 SCALED_STEP_FRACTION = 0.35     # default step of a scaled run: this fraction of the scaled stable limit
 SCALED_SAMPLES = 2000           # automatic record_every of a scaled run aims at this many samples (the per-sample
@@ -63,6 +67,7 @@ class ScalingCheck:
     ramp_s: float               # the shortest ramp that counts
     ke_share_estimate: float
     factor_limits: dict         # the largest S each check allows
+    facet_hz: float = float("nan")  # contact.geometry pieces: worm pieces per turn x n1 / 60
 
 
 def _work_j(scenario: Scenario, ratio: float, gamma: float, alpha_n: float, mu: float, t_s: float) -> float:
@@ -86,12 +91,14 @@ def kinetic_energy_j(inertias_kg_m2: tuple[float, float], w1_rad_s, w2_rad_s):
 
 def check(scenario: Scenario, ratio: float, z1: int, gamma: float, alpha_n: float, mu: float,
           pair_stiffness_n_per_m: float, inv_mass_hat: float, inertias_kg_m2: tuple[float, float],
-          factor: float) -> ScalingCheck:
-    """The quasi-static checks for factor S with the UNSCALED A_hat and shaft inertias (I1 + J1, I2 + J2)."""
+          factor: float, segments_per_turn: int = 0) -> ScalingCheck:
+    """The quasi-static checks for factor S with the UNSCALED A_hat and shaft inertias (I1 + J1, I2 + J2);
+    segments_per_turn: the worm's convex pieces per turn (contact.geometry pieces; 0 for flanks)."""
     drv = gt.gear_drive(scenario)
     w1 = abs(rpm_to_rad_s(drv.speed_rpm)) * (1.0 if drv.on == "worm" else ratio)
     mesh_hz = z1 * w1 / (2 * math.pi)
     mode1_hz = math.sqrt(pair_stiffness_n_per_m * inv_mass_hat) / (2 * math.pi)
+    facet_hz = segments_per_turn * w1 / (2 * math.pi)
     ramps = [drv.ramp_s] + ([scenario.load.ramp_s] if scenario.load.torque_nm != 0 else [])
     ramp = min(ramps)
     t_end = gt.ramps_end_s(scenario)
@@ -101,23 +108,30 @@ def check(scenario: Scenario, ratio: float, z1: int, gamma: float, alpha_n: floa
     limits = {
         "mode": (mode1_hz / (MODE_TO_MESH_MIN * mesh_hz)) ** 2 if mesh_hz > 0 else float("inf"),
         "ramp": (ramp * mode1_hz / RAMP_PERIODS_MIN) ** 2,
+        "facets": (mode1_hz / (FACET_TO_MODE_MIN * facet_hz)) ** 2 if segments_per_turn else float("inf"),
         # KE share at S: S ke1 / (work + S ke1) <= target
         "kinetic_energy": KE_SHARE_TARGET * work / ((1 - KE_SHARE_TARGET) * ke1) if ke1 > 0 else float("inf"),
     }
     ke_s = factor * ke1 / (work + factor * ke1) if work + factor * ke1 > 0 else ke_share1
-    return ScalingCheck(factor, mode1_hz / math.sqrt(factor), mesh_hz, ramp, ke_s, limits)
+    return ScalingCheck(factor, mode1_hz / math.sqrt(factor), mesh_hz, ramp, ke_s, limits,
+                        facet_hz if segments_per_turn else float("nan"))
 
 
 def refuse_if_dynamic(c: ScalingCheck, requested) -> None:
     """ScenarioError (exit 2) naming simulation.mass_scaling when factor S > 1 fails a check."""
     if c.factor <= 1:
         return
-    head = f"simulation.mass_scaling = {requested}: the run is dynamic"
+    head = f"simulation.mass_scaling = {requested:g}: the run is dynamic"
     lim = min(c.factor_limits.values())
     allowed = f"allowed here: 1 <= simulation.mass_scaling <= {max(1.0, lim):.3g} (or auto)"
     if c.mode_hz < MODE_TO_MESH_MIN * c.mesh_hz:
         raise ScenarioError(f"{head}: the scaled mesh mode {c.mode_hz:.3g} Hz comes within {MODE_TO_MESH_MIN:g} x the "
                             f"meshing frequency {c.mesh_hz:.3g} Hz (z1 n1 / 60) and its harmonics; {allowed}")
+    if c.factor > c.factor_limits.get("facets", float("inf")):
+        facet_hz = c.facet_hz
+        raise ScenarioError(f"{head}: the scaled mesh mode {c.mode_hz:.3g} Hz comes within {FACET_TO_MODE_MIN:g} x the "
+                            f"frequency at which the worm's convex pieces pass ({facet_hz:.3g} Hz, contact.geometry "
+                            f"pieces); use contact.geometry flanks, or {allowed}")
     if c.ramp_s < RAMP_PERIODS_MIN / c.mode_hz:
         raise ScenarioError(f"{head}: the ramp of {c.ramp_s:.3g} s is shorter than {RAMP_PERIODS_MIN:g} periods of the "
                             f"scaled mesh mode ({RAMP_PERIODS_MIN / c.mode_hz:.3g} s at {c.mode_hz:.3g} Hz); lengthen "

@@ -193,7 +193,8 @@ def prepare(scenario: Scenario, gs: GearSet | None = None) -> Prepared:
     scaling = mass_scaling.resolve(
         scenario, ratio=geo.ratio, z1=geo.z1, gamma=geo.gamma, alpha_n=geo.alpha_n,
         mu=float(friction_coefficient(scenario.contact, 1.0)), pair_stiffness_n_per_m=law1.pair_stiffness_n_per_m,
-        inv_mass_hat=law1.inv_mass_hat, inertias_kg_m2=(I1, I2))
+        inv_mass_hat=law1.inv_mass_hat, inertias_kg_m2=(I1, I2),
+        segments_per_turn=0 if scenario.contact.geometry == "flanks" else gs.resolution.worm_segments_per_turn or 0)
     S = scaling.factor
     if S != 1:
         ine = Inertias(*(S * v for v in astuple(ine)))
