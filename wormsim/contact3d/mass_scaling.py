@@ -104,15 +104,14 @@ def check(scenario: Scenario, ratio: float, z1: int, gamma: float, alpha_n: floa
     t_end = gt.ramps_end_s(scenario)
     work = _work_j(scenario, ratio, gamma, alpha_n, mu, t_end)
     ke1 = float(kinetic_energy_j(inertias_kg_m2, w1, w1 / ratio))
-    ke_share1 = ke1 / (work + ke1) if work + ke1 > 0 else float("inf")
     limits = {
         "mode": (mode1_hz / (MODE_TO_MESH_MIN * mesh_hz)) ** 2 if mesh_hz > 0 else float("inf"),
         "ramp": (ramp * mode1_hz / RAMP_PERIODS_MIN) ** 2,
-        "facets": (mode1_hz / (FACET_TO_MODE_MIN * facet_hz)) ** 2 if segments_per_turn else float("inf"),
+        "facets": (mode1_hz / (FACET_TO_MODE_MIN * facet_hz)) ** 2 if facet_hz > 0 else float("inf"),
         # KE share at S: S ke1 / (work + S ke1) <= target
         "kinetic_energy": KE_SHARE_TARGET * work / ((1 - KE_SHARE_TARGET) * ke1) if ke1 > 0 else float("inf"),
     }
-    ke_s = factor * ke1 / (work + factor * ke1) if work + factor * ke1 > 0 else ke_share1
+    ke_s = factor * ke1 / (work + factor * ke1) if ke1 > 0 else 0.0       # at standstill: no kinetic energy
     return ScalingCheck(factor, mode1_hz / math.sqrt(factor), mesh_hz, ramp, ke_s, limits,
                         facet_hz if segments_per_turn else float("nan"))
 
