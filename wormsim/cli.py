@@ -52,6 +52,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="only this seed scenario (repeatable): seat_motor, screw_jack, involute_41")
     p.add_argument("--geometry", action="append", default=None, dest="geometries", choices=("flanks", "pieces"),
                    help="contact3d: only this contact.geometry (repeatable; default both, for the speed-up)")
+    p.add_argument("--resolution", action="append", default=None, dest="resolutions",
+                   help="contact3d: only this resolution level (repeatable): coarse, medium, fine")
     p.add_argument("--out", required=True)
     p = sub.add_parser("sweep", help="parameter study on dask.distributed: sweep.csv, sweep.json, sweep.png; resumes")
     p.add_argument("sweep", help="sweep YAML file")
@@ -113,7 +115,8 @@ def _cmd_bench(args) -> int:
     with locked_dir(args.out, names=("bench.json", "bench_meta.json", "bench.png")):
         run_bench(quick=args.quick, out_dir=args.out, repeats=args.repeats,
                   scenarios=tuple(args.scenarios) if args.scenarios else None,
-                  geometries=tuple(args.geometries) if args.geometries else None)
+                  geometries=tuple(args.geometries) if args.geometries else None,
+                  resolutions=tuple(args.resolutions) if args.resolutions else None)
     return EXIT_OK
 
 

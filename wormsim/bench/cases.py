@@ -54,13 +54,15 @@ def contact3d_default_timestep(name: str, overrides: tuple[str, ...] = ()) -> fl
 
 def bench_cases(quick: bool, models: tuple[str, ...] | None = None,
                 scenarios: tuple[str, ...] | None = None,
-                geometries: tuple[str, ...] | None = None) -> list[BenchCase]:
+                geometries: tuple[str, ...] | None = None,
+                resolutions: tuple[str, ...] | None = None) -> list[BenchCase]:
     """The grid. contact3d, for each contact.geometry (flanks, pieces): resolution levels x timesteps of 2, 1 and 1/2
     times its default (the default is 0.4 x the explicit stability limit, so 2x probes the edge); the reference is
     the finest level of the scenario's default geometry at the default step, checked against half that step.
     torsional: k(theta) samples per mesh cycle.
     quick: the seat motor only, 0.15 s, coarse/medium. models: only these levels. scenarios: only these seeds (names
-    of VARIANTS). geometries: only these contact.geometry values for contact3d."""
+    of VARIANTS). geometries: only these contact.geometry values for contact3d. resolutions: only these contact3d
+    resolution levels (the reference is then the finest of them)."""
     names = ("seat_motor",) if quick else tuple(VARIANTS)
     if scenarios is not None:
         unknown = sorted(set(scenarios) - set(VARIANTS))
@@ -70,6 +72,12 @@ def bench_cases(quick: bool, models: tuple[str, ...] | None = None,
         names = tuple(n for n in VARIANTS if n in scenarios)
     geos = tuple(g for g in GEOMETRIES if geometries is None or g in geometries)
     levels = ("coarse", "medium") if quick else ("coarse", "medium", "fine")
+    if resolutions is not None:
+        unknown = sorted(set(resolutions) - {"coarse", "medium", "fine"})
+        if unknown:
+            raise ScenarioError(f"bench --resolution: {', '.join(unknown)} is not a level; "
+                                "allowed: coarse, medium, fine")
+        levels = tuple(lv for lv in ("coarse", "medium", "fine") if lv in resolutions)
     out: list[BenchCase] = []
     for name in names:
         dur = QUICK_DURATION_S if quick else DURATION_S[name]

@@ -96,7 +96,7 @@ def speedups(records: list[dict]) -> dict:
 
 def run_bench(quick: bool, out_dir: str | Path, repeats: int | None = None,
               models: tuple[str, ...] | None = None, scenarios: tuple[str, ...] | None = None,
-              geometries: tuple[str, ...] | None = None) -> list[dict]:
+              geometries: tuple[str, ...] | None = None, resolutions: tuple[str, ...] | None = None) -> list[dict]:
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     if repeats is not None and repeats < 1:
@@ -104,7 +104,7 @@ def run_bench(quick: bool, out_dir: str | Path, repeats: int | None = None,
     repeats = repeats or (1 if quick else 3)
     records, summaries, notes = [], {}, []
     machine_start = machine_info()
-    for case in bench_cases(quick, models, scenarios, geometries):
+    for case in bench_cases(quick, models, scenarios, geometries, resolutions):
         try:
             summary, wall, sim_s = _run_case(case, repeats)
         except SimulationError as exc:
