@@ -68,7 +68,8 @@ class FlankContacts:
         t.vert = [-1, -1]
         t.solref = law.solref
         self.solref = np.asarray(law.solref, dtype=float)
-        t.solreffriction = [0.0, 0.0]
+        t.solreffriction = law.solreffriction   # friction rows' own damping, wormsim.contact3d.law (4)
+        self.solreffriction = np.asarray(law.solreffriction, dtype=float)
         t.solimp = law.solimp
         t.includemargin = 0.0
         t.exclude = 0
@@ -121,6 +122,8 @@ class FlankContacts:
         c.frame[k0:k1] = self.frame[:k1 - k0]
         # each contact's stiffness and damping scaled by its share of its slice (direct solref: -k, -b)
         c.solref[k0:k1] = np.multiply.outer(self.weight[:k1 - k0], self.solref)
+        if self.solreffriction[1] != 0.0:
+            c.solreffriction[k0:k1] = np.multiply.outer(self.weight[:k1 - k0], self.solreffriction)
 
     def step(self, m: mujoco.MjModel, d: mujoco.MjData) -> None:
         split_step(m, d, self.add)

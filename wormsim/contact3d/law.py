@@ -68,6 +68,21 @@ cos(gamma))), mu_max = max(mu(0), mu(1 m/s)) and v_t = contact.transition_veloci
 carrying the whole load saturates once it slips faster than the static -> dynamic transition velocity (the
 stiction range of ADAMS's friction), so friction is Coulomb's wherever mu(Vs) is dynamic. Only the friction rows
 change: the normal rows and the stiffness mapping (1) are untouched.
+
+Friction-row damping of the flank contacts (friction-driven rattle; MuJoCo 4.0.0 engine_core_constraint.c,
+mj_makeImpedance and the elliptic cone's middle zone). On the cone (sliding) the solver's forces are
+f_n = D_n / (1 + mu_r^2) (-jar_n + mu |jar_t|) and |f_t| = mu f_n, with jar = J qacc - a_ref, D_n = 1 / R,
+mu_r = mu / sqrt(impratio). The friction rows' a_ref = -b_f v_t enters the normal force: at an imposed slip
+(J qacc_t ~ 0) a sliding contact gains f_n,slip = mu c_f |v_t| / (1 + mu_r^2), c_f = B_f / ((1 - d) A_hat),
+whatever its depth: a damper-like push that lifts a fast-sliding contact off its flank (docs/contact3d.md,
+"Friction-driven rattle"). With solreffriction = solref (MuJoCo's default) c_f = c_c. The flank contacts set
+their own solreffriction (-S, -B_f) with
+
+    c_f = min(c_c, EPS_SLIP mu_max^-1 F_n / (n_ref Vs))                                                   (4)
+
+so that f_n,slip stays below EPS_SLIP of a contact's share F_n / n_ref of the nominal normal force at the nominal
+sliding speed Vs = omega1 r1 / cos(gamma); impratio (3) is then taken with c_f, so friction still saturates above
+the transition velocity.
 """
 from __future__ import annotations
 
@@ -80,6 +95,7 @@ from wormsim.gear_theory import DEFAULT_DAMPING_RATIO, MAX_DAMPING_RATIO, effect
 from wormsim.scenario import Contact, Materials
 
 STABLE_LIMIT_PAIRS = 3      # tooth pairs in contact at once that the stable limit allows for
+EPS_SLIP = 0.01             # (4): the sliding contact's spurious normal force, share of its static load
 IMPEDANCE = 0.01            # d: added mass in the contact normal is d/(1-d) = 1 % of the mesh's effective mass
 
 
@@ -100,6 +116,20 @@ class ContactLaw:
     solref: tuple[float, float]         # (-S, -B)
     solimp: tuple[float, float, float, float, float]
     impratio: float = 1.0               # MuJoCo opt.impratio: R_normal / R_friction, (3)
+    friction_damping_n_s_per_m: float | None = None   # c_f of the friction rows, (4); None: c_c (solref)
+
+    @property
+    def friction_damping(self) -> float:
+        """c_f: the friction rows' damping per contact (c_c where the contacts use solref for them)."""
+        c = self.friction_damping_n_s_per_m
+        return self.contact_damping_n_s_per_m if c is None else c
+
+    @property
+    def solreffriction(self) -> tuple[float, float]:
+        """MuJoCo's per-contact solreffriction, direct (-S, -B_f) with B_f = c_f (1 - d) A_hat; (0, 0) = solref."""
+        if self.friction_damping_n_s_per_m is None:
+            return (0.0, 0.0)
+        return (self.solref[0], -self.friction_damping_n_s_per_m * (1 - self.impedance) * self.inv_mass_hat)
 
     def natural_frequency_rad_s(self, contacts: int) -> float:
         """omega = sqrt(n k_c A_hat): mesh mode with `contacts` contacts in parallel."""
@@ -161,17 +191,28 @@ def contact_law(contact: Contact, materials: Materials, face_width_m: float, con
         solref=(-s, -b), solimp=(d, d, 0.001, 0.5, 2.0))
 
 
+def friction_damping_n_s_per_m(law: ContactLaw, mu_max: float, normal_force_n: float, sliding_speed_m_s: float,
+                               eps: float | None = None) -> float:
+    """(4): c_f = min(c_c, eps F_n / (n_ref mu_max Vs)), eps = EPS_SLIP; c_c where there is no friction, load or
+    sliding speed."""
+    eps = EPS_SLIP if eps is None else eps
+    c_c = law.contact_damping_n_s_per_m
+    if mu_max <= 0 or normal_force_n <= 0 or sliding_speed_m_s <= 0:
+        return c_c
+    return min(c_c, eps * normal_force_n / (law.contacts_per_pair * mu_max * sliding_speed_m_s))
+
+
 def friction_impratio(law: ContactLaw, mu_max: float, normal_force_n: float, transition_velocity_m_s: float) -> float:
-    """(3): impratio = max(1, mu_max F_n / (c_c v_t)), so that by (2) a contact carrying F_n is on the
-    friction cone for slip above v_t."""
-    if mu_max <= 0 or normal_force_n <= 0 or law.contact_damping_n_s_per_m <= 0:
+    """(3): impratio = max(1, mu_max F_n / (c_f v_t)), so that by (2) a contact carrying F_n is on the
+    friction cone for slip above v_t (c_f = c_c unless the law sets the friction rows' damping, (4))."""
+    if mu_max <= 0 or normal_force_n <= 0 or law.friction_damping <= 0:
         return 1.0
-    return max(1.0, mu_max * normal_force_n / (law.contact_damping_n_s_per_m * transition_velocity_m_s))
+    return max(1.0, mu_max * normal_force_n / (law.friction_damping * transition_velocity_m_s))
 
 
 def friction_regularisation_velocity_m_s(law: ContactLaw, mu: float, normal_force_n: float) -> float:
-    """v_reg = mu f_n / (impratio c_c): slip speed above which a contact carrying f_n is on the cone, by (2)."""
-    return mu * normal_force_n / (law.impratio * law.contact_damping_n_s_per_m)
+    """v_reg = mu f_n / (impratio c_f): slip speed above which a contact carrying f_n is on the cone, by (2)."""
+    return mu * normal_force_n / (law.impratio * law.friction_damping)
 
 
 def friction_utilisation(model, data) -> np.ndarray:

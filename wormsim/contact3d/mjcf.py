@@ -40,13 +40,14 @@ from meshgen.pieces import GearSet
 from wormsim import gear_theory as gt
 from wormsim.contact3d import mass_scaling
 from wormsim.contact3d.backlash import check_backlash, check_conjugate_interference
-from wormsim.contact3d.law import ContactLaw, contact_law, friction_impratio
+from wormsim.contact3d.law import ContactLaw, contact_law, friction_damping_n_s_per_m, friction_impratio
 from wormsim.contact3d.mass_scaling import ScalingCheck
 from wormsim.contact3d.timestep import choose_timestep
 from wormsim.contact3d.window import slot_quat, window_size, window_teeth_at
 from wormsim.friction import friction_coefficient
 from wormsim.geometry import derive, displaced_pair, gear_set
 from wormsim.scenario import Scenario, ScenarioError
+from wormsim.units import rpm_to_rad_s
 
 TEMPLATE = files("wormsim.models") / "worm_pair.xml"   # models/, shipped as package data
 MESH_SENSOR_DATA = 1 | 2 | 4 | 16    # contact sensor fields found, force, torque, pos (mjtConDataField bits)
@@ -136,6 +137,16 @@ def nominal_normal_force_n(scenario: Scenario, geo: GearGeometry) -> float:
     return gt.normal_force_n(gt.working_wheel_torque_nm(scenario, geo.ratio), geo.r2, geo.alpha_n, geo.gamma)
 
 
+def nominal_sliding_speed_m_s(scenario: Scenario, geo: GearGeometry) -> float:
+    """Vs = omega1 r1 / cos(gamma) at a speed-controlled drive's full speed (the worm's speed from the wheel's by
+    the ratio); 0 for a torque drive (speed not known before the run)."""
+    drv = scenario.drive
+    if drv is None or drv.speed_rpm is None:
+        return 0.0
+    w1 = abs(rpm_to_rad_s(drv.speed_rpm)) * (geo.ratio if drv.on == "wheel" else 1.0)
+    return w1 * geo.r1 / math.cos(geo.gamma)
+
+
 def expected_direction(scenario: Scenario, geo: GearGeometry) -> int:
     """+1/-1: sign of the driven shaft's speed per sign of the drive command. INTERFACE.md: a positive
     worm rotation drives the wheel positive for a right-hand worm (and back-driving the same way)."""
@@ -202,8 +213,11 @@ def prepare(scenario: Scenario, gs: GearSet | None = None) -> Prepared:
     law = contact_law(scenario.contact, scenario.materials, geo.face_width, slabs, a1 + a2)
     mu0 = float(friction_coefficient(scenario.contact, 0.0))
     mu_max = max(mu0, float(friction_coefficient(scenario.contact, 1.0)))
-    law = replace(law, impratio=friction_impratio(law, mu_max, nominal_normal_force_n(scenario, geo),
-                                                  scenario.contact.transition_velocity_m_s))
+    f_n = nominal_normal_force_n(scenario, geo)
+    if scenario.contact.geometry == "flanks":       # the flank contacts' own friction-row damping, law (4)
+        law = replace(law, friction_damping_n_s_per_m=friction_damping_n_s_per_m(
+            law, mu_max, f_n, nominal_sliding_speed_m_s(scenario, geo)))
+    law = replace(law, impratio=friction_impratio(law, mu_max, f_n, scenario.contact.transition_velocity_m_s))
     return Prepared(geo, gs, ine, law, a1, a2, scaling)
 
 
