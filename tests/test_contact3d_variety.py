@@ -139,14 +139,15 @@ def test_flanks_no_grid_point_is_cut_by_the_worm():
     W = window_size(g)
     cap = 4 * W * 8
     pos, nrm, dep, meta = np.zeros((cap, 3)), np.zeros((cap, 3)), np.zeros(cap), np.zeros((cap, 4))
+    line = np.zeros((cap, 2))
     bl, pitch = g.backlash / (2 * g.r2), 2 * math.pi / g.z2
     expected = bl * g.r2 * math.cos(g.alpha_n) * math.cos(g.gamma)
     deepest = []
     for th1 in np.linspace(0, 2 * math.pi / g.z1, 60, endpoint=False):
         th2 = g.hand * th1 * g.z1 / g.z2
         ks = window_teeth_at(th2, g.z2, W, -math.pi / 2 + math.pi / g.z2).astype(np.int64)
-        n = F.find_contacts(fg.xy, fg.c, fg.c_range, fg.zeta, ks, th1, th2 - g.hand * 2 * bl,
-                            F.MARGIN_PITCH * pitch + 3 * bl, fg.params, pos, nrm, dep, meta)
+        n = F.find_contacts(fg.xy, fg.c, fg.c_range, fg.span, fg.zeta, ks, th1, th2 - g.hand * 2 * bl,
+                            F.MARGIN_PITCH * pitch + 3 * bl, fg.params, pos, nrm, dep, meta, line)
         deepest.append(dep[:n].max())
     assert max(deepest) < 1.02 * expected and min(deepest) > 0.98 * expected, (min(deepest), max(deepest), expected)
 
