@@ -129,13 +129,3 @@ def test_flank_static_mesh_stiffness_per_pair_within_5_percent(static_flanks):
     k_pair = k_theta * bm.law.contacts_per_pair / arm2
     print(f"flank tooth-pair stiffness {k_pair:.6g} N/m against K = {bm.law.pair_stiffness_n_per_m:.6g} ({len(Cb)} contacts)")
     assert k_pair == pytest.approx(bm.law.pair_stiffness_n_per_m, rel=0.05)
-
-
-def test_flanks_refuse_errors():
-    """The flank kernel finds contacts on the perfect pair: errors: with contact.geometry flanks is exit 2 (one line)."""
-    from wormsim.scenario import ScenarioError
-
-    with pytest.raises(ScenarioError, match="errors: contact.geometry flanks"):
-        load_scenario(SCEN / "seat_motor.yaml", ["contact.geometry=flanks", "errors.center_distance_mm=0.01"])
-    sc = load_scenario(SCEN / "seat_motor.yaml", ["contact.geometry=flanks", "errors.center_distance_mm=0"])
-    assert sc.contact.geometry == "flanks" and sc.errors.is_zero()

@@ -272,9 +272,6 @@ class Scenario(_Strict):
                 raise ValueError(f"model: {self.model} needs a drive: block")
             if self.drive.on == self.load.on:
                 raise ValueError("drive.on and load.on must name different shafts")
-            if self.contact.geometry == "flanks" and not self.errors.is_zero():
-                raise ValueError("errors: contact.geometry flanks finds contacts on the perfect pair's flanks; use "
-                                 "contact.geometry: pieces, or set every errors key to 0")
         return self
 
 

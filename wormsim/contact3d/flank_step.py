@@ -77,6 +77,17 @@ class FlankContacts:
         self.template = t
         self.mu = None
         self.set_friction(float(m.geom_friction[gw, 0]))
+        # errors: (issue 12): the kernel gets the displaced bodies' poses each step (wormsim.contact3d.flank_pose)
+        self.params = self.grid.params
+        dev = getattr(bm, "deviations", None)
+        self.displaced = dev is not None and not dev.is_zero()
+        if self.displaced:
+            from wormsim.contact3d import flank_pose
+
+            shift = bm.tooth_shift_rad if bm.tooth_shift_rad is not None else np.zeros(g.z2)
+            self.params = flank_pose.displaced_params(self.grid.params, np.asarray(shift, dtype=float))
+            self.margin0 += flank_pose.error_margin_rad(g, self.grid, dev)
+            self._set_pose = flank_pose.set_pose
 
     def set_friction(self, mu: float) -> None:
         if mu != self.mu:
@@ -99,8 +110,10 @@ class FlankContacts:
         """Run the kernel at the current positions; returns the number of contacts."""
         th1, th2 = d.qpos[self.qa1], d.qpos[self.qa2]
         g = self.grid
+        if self.displaced:
+            self._set_pose(self.params, d.xpos, d.xmat, self.bm.worm_body, self.bm.wheel_body, th1)
         n = find_contacts(g.xy, g.c, g.c_range, g.span, g.zeta, self.window(th2), th1, th2,
-                          self.margin0, g.params, self.pos, self.nrm, self.depth, self.meta, self.line)
+                          self.margin0, self.params, self.pos, self.nrm, self.depth, self.meta, self.line)
         self.n = n = slice_weights(self.meta, self.line, n, self.slices, self.pos, self.nrm, self.depth, self.weight)
         contact_frames(self.nrm, n, self.frame)
         return n
@@ -188,8 +201,14 @@ def flank_contact_details(fc: FlankContacts, d: mujoco.MjData):
     ks = fc.meta[:n, 0][ok]
     th2 = float(d.qpos[fc.qa2])
     ang = -(th2 + 2 * math.pi * ks / bm.geometry.z2)
+    pw = pos
+    if fc.displaced:            # via the displaced wheel body's frame (wormsim.contact3d.flank_pose)
+        from wormsim.contact3d.flank_pose import tooth_shift_of, wheel_body_points
+
+        pos = wheel_body_points(fc.params, pos)
+        ang = -(2 * math.pi * ks / bm.geometry.z2 + tooth_shift_of(fc.params, ks))
     c, s = np.cos(ang), np.sin(ang)
     p0 = np.stack([c * pos[:, 0] - s * pos[:, 1], s * pos[:, 0] + c * pos[:, 1], pos[:, 2]], axis=1)
     touching = ks[np.linalg.norm(F, axis=1) > 0] if len(ks) else ks
     pen = float(fc.depth[:n].max())
-    return int(np.unique(touching).size), pen, p0, F, pos
+    return int(np.unique(touching).size), pen, p0, F, pw

@@ -44,6 +44,7 @@ import numpy as np
 
 from meshgen import wheel, worm
 from meshgen.geometry import GearGeometry
+from wormsim.contact3d.flank_pose import N_WORM_PARAMS, static_dir_to_world, to_static, tooth_angle
 
 N_PROFILE = 64              # points along the profile per slice (the parabola refines between them)
 SLICES = {"coarse": 8, "medium": 16, "fine": 32}   # default slices across the face per simulation.resolution
@@ -166,8 +167,13 @@ def worm_gap(xs, ys, zs, theta1, P, out):
 @numba.njit(cache=True, inline="always")
 def _eval(x0, y0, zeta, ca, sa, theta1, P, out):
     """Extended gap and excess (worm_gap_ext) of the wheel point (x0, y0, zeta) turned by the angle (cos ca, sin sa)
-    about z (assembly frame), and the turned point in out[3:6]."""
+    about z (assembly frame), and the turned point in out[3:6]. With a displaced pose in P
+    (wormsim.contact3d.flank_pose) the turned point is in the wheel body's frame and goes through the poses instead
+    (flank_pose.to_static)."""
     x, y = ca * x0 - sa * y0, sa * x0 + ca * y0
+    if P.shape[0] > N_WORM_PARAMS:
+        xs, ys, zs = to_static(x, y, zeta, P, out)
+        return worm_gap_ext(xs, ys, zs, theta1, P, out)
     out[3], out[4], out[5] = x, y, zeta
     return worm_gap_ext(y + P[10], -zeta, -x, theta1, P, out)
 
@@ -217,9 +223,12 @@ def find_contacts(xy, c, c_range, span, zeta, ks, theta1, theta2, margin, P, pos
     for kk in range(ks.shape[0]):
         k = ks[kk]
         ang = theta2 + pitch * k
+        dk = 0.0
+        if P.shape[0] > N_WORM_PARAMS:
+            ang, dk = tooth_angle(k, P)      # wheel body frame, pitch deviation dk (flank_pose)
         ca, sa = math.cos(ang), math.sin(ang)
         for sg in range(2):
-            target = theta2 + pitch * (k + sg)
+            target = theta2 + pitch * (k + sg) + dk
             target = (target + math.pi) % (2 * math.pi) - math.pi
             lo, hi = target - margin, target + margin
             for j in range(S):
@@ -334,6 +343,8 @@ def find_contacts(xy, c, c_range, span, zeta, ks, theta1, theta2, margin, P, pos
                     nx, ny, nz = nx / nn, ny / nn, nz / nn
                 # static worm frame -> assembly: (x, y, z)_asm = (-z_s, x_s - a, -y_s), i.e. R0 applied
                 ax, ay, az = -nz, nx, -ny
+                if P.shape[0] > N_WORM_PARAMS:
+                    ax, ay, az = static_dir_to_world(nx, ny, nz, P)
                 dlt = -gmin if gmin < np.inf else -gline
                 if n >= depth.shape[0]:
                     return n

@@ -83,6 +83,7 @@ class BuiltModel:
     meta: dict = field(default_factory=dict)
     tooth_shift_rad: np.ndarray | None = None   # (z2,) pitch deviations f_k / r2 (errors:, meshgen.displaced)
     kinematic_tca: KinematicTCA | None = None   # of the displaced pair (errors: only)
+    deviations: Deviations | None = None        # the errors: block in SI (None for the perfect pair)
 
 
 @dataclass(frozen=True)
@@ -287,7 +288,8 @@ def build_model(scenario: Scenario, gs: GearSet | None = None, check_backlash_vs
         worm_geoms=np.array([oid(mujoco.mjtObj.mjOBJ_GEOM, n) for n in worm_names], dtype=int),
         wheel_slot_geoms=slot_geoms, slot_bodies=slot_bodies, window_teeth=W, tooth0_angle_rad=_tooth0_angle(gs),
         direction=expected_direction(scenario, geo), drive_sign=drive_sign, pieces=gs,
-        timestep_s=h, timestep_source=h_source, meta=meta, tooth_shift_rad=shift, kinematic_tca=kin)
+        timestep_s=h, timestep_source=h_source, meta=meta, tooth_shift_rad=shift, kinematic_tca=kin,
+        deviations=dev)
     if check_backlash_vs_pieces:
         # the model itself at the rigid-conjugate pose (wormsim.contact3d.backlash.check_conjugate_interference): exit 2
         meta["conjugate_interference_m"] = check_conjugate_interference(
