@@ -1,0 +1,132 @@
+"""Exact-flank contact with assembly errors (issue 12 on issue 13's flanks; wormsim.contact3d.flank_pose): the kernel
+maps the wheel flanks through the displaced bodies as MuJoCo places them. Checks: with the nominal poses the pose
+path gives the nominal kernel's contacts (1e-12), and with each error the kernel's first touch is where the kinematic
+TCA (meshgen.kinematic_tca: meshgen.displaced's transforms and meshgen.worm.thread_gap, no MuJoCo) puts it. Loaded
+runs: docs/errors.md, "Loaded, exact flanks"."""
+from __future__ import annotations
+
+import math
+
+import mujoco
+import numpy as np
+import pytest
+from conftest import SCENARIOS
+
+from wormsim.contact3d import flank_pose
+from wormsim.contact3d.flank_step import FlankContacts
+from wormsim.contact3d.mjcf import build_model
+from wormsim.scenario import load_scenario
+
+SEAT = ["contact.geometry=flanks", "simulation.resolution=medium"]
+
+
+def _built(name: str, sets=()):
+    return build_model(load_scenario(SCENARIOS / f"{name}.yaml", SEAT + list(sets)))
+
+
+def _pose(bm, d, fc, th1, th2):
+    d.qpos[fc.qa1], d.qpos[fc.qa2] = th1, th2
+    mujoco.mj_kinematics(bm.model, d)
+
+
+@pytest.mark.parametrize("name", ["seat_motor", "screw_jack"])
+def test_pose_path_with_the_nominal_poses_gives_the_nominal_contacts(name):
+    """Zero errors take the nominal kernel (P without poses); the pose path fed the perfect pair's poses from MuJoCo
+    finds the same contacts: positions to 1e-12 m, normals to 1e-12, depths to 1e-12 m, same (tooth, flank, slice)."""
+    bm = _built(name, ["errors.center_distance_mm=0"])
+    assert bm.deviations is None
+    d = mujoco.MjData(bm.model)
+    fc0 = FlankContacts(bm, bm.law.contacts_per_pair)
+    assert not fc0.displaced
+    fc1 = FlankContacts(bm, bm.law.contacts_per_pair)
+    fc1.displaced, fc1._set_pose = True, flank_pose.set_pose
+    fc1.params = flank_pose.displaced_params(fc1.grid.params, np.zeros(bm.geometry.z2))
+    g = bm.geometry
+    total = 0
+    for th1 in np.linspace(0.0, 2 * math.pi, 7):
+        for s in (-2.0, 0.5, 2.0):          # wheel turned from the conjugate angle by s backlash angles
+            _pose(bm, d, fc0, th1, g.hand * th1 * g.z1 / g.z2 + s * g.backlash / (2 * g.r2))
+            n = fc0.find(d)
+            assert fc1.find(d) == n
+            total += n
+            for a, b in ((fc0.pos, fc1.pos), (fc0.nrm, fc1.nrm), (fc0.depth, fc1.depth)):
+                assert np.abs(a[:n] - b[:n]).max(initial=0.0) < 1e-12
+            assert np.array_equal(fc0.meta[:n, :3], fc1.meta[:n, :3])
+    assert total > 50
+
+
+ERRORS = {
+    "wheel_axial_offset": ["errors.wheel_axial_offset_mm=0.1"],
+    "shaft_angle": ["errors.shaft_angle_deg=0.1"],
+    "center_distance": ["errors.center_distance_mm=-0.03"],
+    "worm_runout": ["errors.worm_runout_mm=0.01"],
+}
+
+
+@pytest.mark.parametrize("case", list(ERRORS))
+def test_kernel_first_touch_is_the_kinematic_tca(case):
+    """Seat motor, each error: at sampled worm angles the wheel is turned past the TCA's first touch g_side by E and
+    2 E (E = 100 urad); the kernel's deepest contact on that flank grows at the moment arm and extrapolates to zero
+    depth at g_side within 1 um of play (r2 x angle). The kernel sees the slice centres only, so it touches a little
+    later than the TCA's grid, which reaches the face edges (measured: 0.2 um on side +1, 0.8 um on side -1 with the
+    wheel axial offset, whose first touch is on the face edge)."""
+    bm = _built("seat_motor", ERRORS[case])
+    g, kin = bm.geometry, bm.kinematic_tca
+    d = mujoco.MjData(bm.model)
+    fc = FlankContacts(bm, bm.law.contacts_per_pair)
+    assert fc.displaced
+    E = 1e-4
+    idx = np.linspace(0, len(kin.theta1_rad) - 1, 9).astype(int)
+    worst = 0.0
+    for side, gaps, sg in ((+1, kin.gap_fwd_rad, 0), (-1, kin.gap_rev_rad, 1)):
+        for i in idx:
+            th1, gk = float(kin.theta1_rad[i]), float(gaps[i])
+            th2c = g.hand * th1 * g.z1 / g.z2
+            dep = []
+            for e in (E, 2 * E):
+                _pose(bm, d, fc, th1, th2c - g.hand * side * (gk + e))
+                n = fc.find(d)
+                on = fc.meta[:n, 1] == sg
+                assert on.any(), (case, side, th1)
+                dep.append(float(fc.depth[:n][on].max()))
+            arm = (dep[1] - dep[0]) / E
+            assert arm == pytest.approx(g.r2 * math.cos(g.alpha_n) * math.cos(g.gamma), rel=0.1)
+            g0 = gk + E - dep[0] / arm
+            worst = max(worst, abs(g0 - gk) * g.r2)
+    assert worst < 1e-6, worst
+
+
+def test_a_shifted_tooth_meshes_as_the_tooth_turned_by_its_pitch_deviation():
+    """Pitch deviation f_k (the per-tooth angle in P): tooth k's contacts at wheel angle theta2 are the unshifted
+    tooth's at theta2 + f_k / r2 (to 1e-12), and the other teeth's are unchanged. (The wheel runout is the worm
+    runout's mechanism on the other hinge, checked with the TCA above.)"""
+    bm = _built("seat_motor")
+    g = bm.geometry
+    d = mujoco.MjData(bm.model)
+    fc0 = FlankContacts(bm, bm.law.contacts_per_pair)
+    fc1 = FlankContacts(bm, bm.law.contacts_per_pair)
+    fc1.displaced, fc1._set_pose = True, flank_pose.set_pose
+    bl = g.backlash / (2 * g.r2)
+    th1 = 0.7
+    th2 = g.hand * th1 * g.z1 / g.z2 - 2.0 * bl
+    _pose(bm, d, fc0, th1, th2)
+    fc0.find(d)
+    ks = fc0.window(th2).copy()
+    f = 8e-6
+    checked = 0
+    for k in ks:
+        shift = np.zeros(g.z2)
+        shift[int(k) % g.z2] = f / g.r2
+        fc1.params = flank_pose.displaced_params(fc1.grid.params, shift)
+        _pose(bm, d, fc0, th1, th2)
+        n1 = fc1.find(d)
+        got = {tuple(fc1.meta[i, :3].astype(int)): fc1.depth[i] for i in range(n1)}
+        base = {tuple(fc0.meta[i, :3].astype(int)): fc0.depth[i] for i in range(fc0.find(d))}
+        _pose(bm, d, fc0, th1, th2 + f / g.r2)
+        turned = {tuple(fc0.meta[i, :3].astype(int)): fc0.depth[i] for i in range(fc0.find(d))}
+        for key in set(got) | set(base) | set(turned):
+            want = turned if key[0] == k else base
+            assert key in got and key in want, key
+            assert got[key] == pytest.approx(want[key], abs=1e-12)
+        checked += sum(key[0] == k for key in got)
+    assert checked >= 8
