@@ -20,8 +20,10 @@ X_g = Rz(theta2) and A = Trans(0, -a, 0) R0: the nominal mapping (tests/test_fla
 
 The kernel's candidate window (find_contacts' margin) is widened by `error_margin_rad`: the wheel points move
 relative to the worm by at most delta = |da| + |dz| + e1 + e2 + (b2 / 2) |sin dS| (the worm's axial offset is a phase,
-meshgen.displaced), which changes the conjugate angle of the touching point by at most delta max|grad c| (c the
-conjugate angle over the flank grid, per metre along the flank).
+meshgen.displaced), which changes the conjugate angle of the touching point by about delta |grad c| (c the
+conjugate angle over the flank grid, per metre along the flank; its 99th percentile, the largest values sit at the
+grid's ragged edges). Measured on the seat motor with a 0.1 mm axial offset: 0.60 pitch; 0.37 pitch missed contacts
+27 um deep (docs/errors.md, section 6).
 """
 from __future__ import annotations
 
