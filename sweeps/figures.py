@@ -73,7 +73,8 @@ def screw_jack(runs: Path) -> None:
             ):
                 y = [r.get(k) for r in rs]
                 if all(isinstance(v, float) for v in y):
-                    ax.plot(x, y, style, label=f"{level}: {lab}")
+                    geo = rs[0].get("contact_geometry") if level == "contact3d" else None
+                    ax.plot(x, y, style, label=f"{level}{' ' + geo if geo else ''}: {lab}")
         ax.set_yscale("log")
         ax.set_xlabel(xlabel)
         ax.set_ylabel("tangential force on the wheel [N]")
@@ -99,7 +100,9 @@ def friction(runs: Path) -> None:
     theory = [math.tan(gamma) / math.tan(gamma + math.atan(m / math.cos(alpha_n))) for m in mus]
     ax.plot(mus, theory, "k--", lw=1, label="tan(gamma) / tan(gamma + rho')")
     ax.plot([r["contact.friction"] for r in tor], [r["efficiency"] for r in tor], "o-", ms=3, label="torsional")
-    ax.plot([r["contact.friction"] for r in c3d], [r["efficiency"] for r in c3d], "s", ms=7, label="contact3d")
+    geo = c3d[0].get("contact_geometry") if c3d else None
+    c3d_label = f"contact3d ({geo})" if geo else "contact3d"
+    ax.plot([r["contact.friction"] for r in c3d], [r["efficiency"] for r in c3d], "s", ms=7, label=c3d_label)
     if failed:
         ax.plot([r["contact.friction"] for r in failed], [0.05] * len(failed), "rx", label="failed")
     ax.axvline(mu_lock, color="red", lw=1)
