@@ -25,6 +25,7 @@ space centred at polar angle -pi/2 of the wheel frame, on the line of centres. T
 
 Kinematics (exact for the conjugate pair): theta2 = hand * theta1 * z1 / z2, hand = +1 right, -1 left.
 """
+
 from __future__ import annotations
 
 import math

@@ -48,6 +48,7 @@ removes 2 dr tan(alpha_x) of the circumferential play, and a radial approach bey
 Together they are a first-order budget; the kinematic tooth contact analysis (meshgen.kinematic_tca) measures the
 play of the displaced flanks, and a play <= 0 anywhere over the analysed period is rejected as interference.
 """
+
 from __future__ import annotations
 
 import math
@@ -60,7 +61,7 @@ import numpy as np
 from meshgen import assembly, wheel
 from meshgen.geometry import DEG, MM, GearGeometry, GeometryError
 
-UM = 1e-6                      # m per um
+UM = 1e-6  # m per um
 
 
 class ErrorsData(Protocol):
@@ -89,26 +90,38 @@ class ErrorsData(Protocol):
 class Deviations:
     """The errors of a scenario in SI (module docstring, symbols of (1), (2))."""
 
-    center_distance: float = 0.0        # da, m
-    shaft_angle: float = 0.0            # dS, rad
-    wheel_axial_offset: float = 0.0     # dz, m
-    worm_axial_offset: float = 0.0      # dw, m
-    wheel_runout: float = 0.0           # e2, m
-    wheel_runout_phase: float = 0.0     # ph2, rad
-    worm_runout: float = 0.0            # e1, m
-    tooth_shift: tuple = ()             # f_k, m, tooth 0, 1, ... (missing teeth 0)
+    center_distance: float = 0.0  # da, m
+    shaft_angle: float = 0.0  # dS, rad
+    wheel_axial_offset: float = 0.0  # dz, m
+    worm_axial_offset: float = 0.0  # dw, m
+    wheel_runout: float = 0.0  # e2, m
+    wheel_runout_phase: float = 0.0  # ph2, rad
+    worm_runout: float = 0.0  # e1, m
+    tooth_shift: tuple = ()  # f_k, m, tooth 0, 1, ... (missing teeth 0)
 
     @classmethod
     def from_data(cls, errors: ErrorsData) -> Deviations:
-        return cls(center_distance=errors.center_distance_mm * MM, shaft_angle=errors.shaft_angle_deg * DEG,
-                   wheel_axial_offset=errors.wheel_axial_offset_mm * MM,
-                   worm_axial_offset=errors.worm_axial_offset_mm * MM, wheel_runout=errors.wheel_runout_mm * MM,
-                   wheel_runout_phase=errors.wheel_runout_phase_deg * DEG, worm_runout=errors.worm_runout_mm * MM,
-                   tooth_shift=tuple(float(f) * UM for f in errors.wheel_pitch_deviation_um))
+        return cls(
+            center_distance=errors.center_distance_mm * MM,
+            shaft_angle=errors.shaft_angle_deg * DEG,
+            wheel_axial_offset=errors.wheel_axial_offset_mm * MM,
+            worm_axial_offset=errors.worm_axial_offset_mm * MM,
+            wheel_runout=errors.wheel_runout_mm * MM,
+            wheel_runout_phase=errors.wheel_runout_phase_deg * DEG,
+            worm_runout=errors.worm_runout_mm * MM,
+            tooth_shift=tuple(float(f) * UM for f in errors.wheel_pitch_deviation_um),
+        )
 
     def is_zero(self) -> bool:
-        return not (self.center_distance or self.shaft_angle or self.wheel_axial_offset or self.worm_axial_offset
-                    or self.wheel_runout or self.worm_runout or any(self.tooth_shift))
+        return not (
+            self.center_distance
+            or self.shaft_angle
+            or self.wheel_axial_offset
+            or self.worm_axial_offset
+            or self.wheel_runout
+            or self.worm_runout
+            or any(self.tooth_shift)
+        )
 
     def per_wheel_revolution(self) -> bool:
         """True when an error repeats once per wheel revolution (runout, pitch deviations)."""
@@ -117,7 +130,7 @@ class Deviations:
     def tooth_angle_shift(self, g: GearGeometry, k) -> np.ndarray:
         """f_k / r2 (rad) for wheel tooth indices k (any integers, taken mod z2)."""
         f = np.zeros(g.z2)
-        f[:len(self.tooth_shift)] = self.tooth_shift
+        f[: len(self.tooth_shift)] = self.tooth_shift
         return f[np.mod(np.asarray(k, dtype=int), g.z2)] / g.r2
 
 
@@ -138,8 +151,9 @@ def worm_mount(g: GearGeometry, dev: Deviations) -> tuple[np.ndarray, np.ndarray
     """(M, E): worm body -> assembly = M Rz(theta1) E, (1). M places the axis of rotation, E the thread's axis on it."""
     M = _trans(0.0, -(g.a + dev.center_distance), 0.0)
     M[:3, :3] = assembly.R0
-    return M @ _trans(0.0, 0.0, dev.worm_axial_offset) @ assembly._rz(dev.worm_axial_offset / g.p), \
-        _trans(dev.worm_runout, 0.0, 0.0)
+    return M @ _trans(0.0, 0.0, dev.worm_axial_offset) @ assembly._rz(dev.worm_axial_offset / g.p), _trans(
+        dev.worm_runout, 0.0, 0.0
+    )
 
 
 def wheel_mount(g: GearGeometry, dev: Deviations) -> tuple[np.ndarray, np.ndarray]:
@@ -161,6 +175,7 @@ def wheel_to_assembly(g: GearGeometry, dev: Deviations, theta2: float) -> np.nda
 
 # ----------------------------------------------------------------------------- limits (module docstring (3)-(8))
 
+
 def limits(g: GearGeometry) -> dict:
     """The limits (3)-(8) of this gear, SI."""
     c = g.h_f - g.h_a
@@ -178,16 +193,16 @@ def limits(g: GearGeometry) -> dict:
         for _ in range(60):
             mid = 0.5 * (lo + hi)
             lo, hi = (mid, hi) if min(clear(mid), clear(-mid)) > 0 else (lo, mid)
-    reach = math.sqrt(max(g.r_e2 ** 2 - (g.a - g.r_a1) ** 2, 0.0))
+    reach = math.sqrt(max(g.r_e2**2 - (g.a - g.r_a1) ** 2, 0.0))
     return {
-        "radial_closing_m": min(g.backlash / (2 * math.tan(g.alpha_x)), c),       # (3)
+        "radial_closing_m": min(g.backlash / (2 * math.tan(g.alpha_x)), c),  # (3)
         "radial_closing_backlash_m": g.backlash / (2 * math.tan(g.alpha_x)),
         "tip_clearance_m": c,
-        "center_distance_opening_m": g.h_a,                                          # (4)
-        "shaft_angle_rad": math.asin(min(1.0, g.backlash / g.face_width)),          # (5)
-        "wheel_axial_offset_m": lo,                                                  # (6)
-        "worm_axial_offset_m": max(0.0, g.worm_length / 2 - reach),                  # (7)
-        "tooth_shift_m": g.backlash / 2,                                             # (8)
+        "center_distance_opening_m": g.h_a,  # (4)
+        "shaft_angle_rad": math.asin(min(1.0, g.backlash / g.face_width)),  # (5)
+        "wheel_axial_offset_m": lo,  # (6)
+        "worm_axial_offset_m": max(0.0, g.worm_length / 2 - reach),  # (7)
+        "tooth_shift_m": g.backlash / 2,  # (8)
     }
 
 
@@ -206,12 +221,15 @@ def check_limits(g: GearGeometry, errors: ErrorsData) -> Deviations:
         return f"{x / MM:.4g} mm"
 
     if len(dev.tooth_shift) > g.z2:
-        raise GeometryError(f"errors.wheel_pitch_deviation_um: {len(dev.tooth_shift)} entries for a wheel of "
-                            f"{g.z2} teeth; allowed at most {g.z2}")
+        raise GeometryError(
+            f"errors.wheel_pitch_deviation_um: {len(dev.tooth_shift)} entries for a wheel of "
+            f"{g.z2} teeth; allowed at most {g.z2}"
+        )
     if dev.center_distance >= lim["center_distance_opening_m"]:
         raise GeometryError(
             f"errors.center_distance_mm = {errors.center_distance_mm}: opens the mesh beyond the addendum h_a = "
-            f"{mm(g.h_a)} (the worm tip would no longer reach the wheel's reference circle); allowed below {mm(g.h_a)}")
+            f"{mm(g.h_a)} (the worm tip would no longer reach the wheel's reference circle); allowed below {mm(g.h_a)}"
+        )
     r_close = max(0.0, -dev.center_distance) + dev.worm_runout + dev.wheel_runout
     if r_close >= lim["radial_closing_m"]:
         which = "the backlash" if lim["radial_closing_backlash_m"] <= lim["tip_clearance_m"] else "the tip clearance"
@@ -219,25 +237,30 @@ def check_limits(g: GearGeometry, errors: ErrorsData) -> Deviations:
             f"errors: the radial approach max(0, -center_distance_mm) + worm_runout_mm + wheel_runout_mm = "
             f"{mm(r_close)} closes the mesh into interference with {which}: allowed below "
             f"min(j / (2 tan(alpha_x)), h_f - h_a) = min({mm(lim['radial_closing_backlash_m'])}, "
-            f"{mm(lim['tip_clearance_m'])}) for gear.backlash_mm = {g.backlash / MM:.4g}")
+            f"{mm(lim['tip_clearance_m'])}) for gear.backlash_mm = {g.backlash / MM:.4g}"
+        )
     if abs(dev.shaft_angle) >= lim["shaft_angle_rad"]:
         raise GeometryError(
             f"errors.shaft_angle_deg = {errors.shaft_angle_deg}: twists the face edges by (b2 / 2) sin(dS) beyond "
             f"the flank clearance j / 2; allowed |dS| < asin(j / b2) = {lim['shaft_angle_rad'] / DEG:.4g} deg "
-            f"(gear.backlash_mm = {g.backlash / MM:.4g}, face width {mm(g.face_width)})")
+            f"(gear.backlash_mm = {g.backlash / MM:.4g}, face width {mm(g.face_width)})"
+        )
     if abs(dev.wheel_axial_offset) >= lim["wheel_axial_offset_m"]:
         raise GeometryError(
             f"errors.wheel_axial_offset_mm = {errors.wheel_axial_offset_mm}: the wheel throat would hit the worm root "
-            f"cylinder at a face edge; allowed |offset| < {mm(lim['wheel_axial_offset_m'])}")
+            f"cylinder at a face edge; allowed |offset| < {mm(lim['wheel_axial_offset_m'])}"
+        )
     if abs(dev.worm_axial_offset) >= lim["worm_axial_offset_m"] and dev.worm_axial_offset:
         raise GeometryError(
             f"errors.worm_axial_offset_mm = {errors.worm_axial_offset_mm}: the threaded length ({mm(g.worm_length)}) "
             f"would no longer cover the wheel's reach on the worm axis; allowed |offset| < "
-            f"{mm(lim['worm_axial_offset_m'])} (or raise gear.worm_length_mm)")
+            f"{mm(lim['worm_axial_offset_m'])} (or raise gear.worm_length_mm)"
+        )
     if dev.tooth_shift and max(abs(f) for f in dev.tooth_shift) >= lim["tooth_shift_m"]:
         k = int(np.argmax(np.abs(dev.tooth_shift)))
         raise GeometryError(
             f"errors.wheel_pitch_deviation_um[{k}] = {errors.wheel_pitch_deviation_um[k]}: shifts the tooth beyond "
             f"its flank clearance j / 2; allowed |deviation| < {um(lim['tooth_shift_m'])} "
-            f"(gear.backlash_mm = {g.backlash / MM:.4g})")
+            f"(gear.backlash_mm = {g.backlash / MM:.4g})"
+        )
     return dev

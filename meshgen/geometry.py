@@ -25,6 +25,7 @@ Relations (m_x axial module, m_n normal module, z1 starts, z2 wheel teeth, gamma
 
 Hand: right-hand worms have p > 0; a left-hand worm is the mirror image (p -> -p, seed 003).
 """
+
 from __future__ import annotations
 
 import math
@@ -33,8 +34,8 @@ from typing import Literal, Protocol
 
 # meshgen reads gear data in the units of its field names (mm, deg) and works in SI: these are its conversions
 # (the simulator's are in wormsim.units; meshgen imports nothing from wormsim)
-MM = 1e-3                      # m per mm
-DEG = math.pi / 180.0          # rad per deg
+MM = 1e-3  # m per mm
+DEG = math.pi / 180.0  # rad per deg
 
 
 class GeometryError(ValueError):
@@ -99,38 +100,38 @@ class GearSpec:
 
 @dataclass(frozen=True)
 class GearGeometry:
-    profile: str            # "ZI" | "ZA"
-    hand: int               # +1 right, -1 left
+    profile: str  # "ZI" | "ZA"
+    hand: int  # +1 right, -1 left
     z1: int
     z2: int
-    m_x: float              # axial module, m
-    m_n: float              # normal module, m
-    gamma: float            # lead angle at d1, rad
-    alpha_n: float          # normal pressure angle, rad
-    alpha_x: float          # axial pressure angle, rad
-    q: float                # diameter quotient
+    m_x: float  # axial module, m
+    m_n: float  # normal module, m
+    gamma: float  # lead angle at d1, rad
+    alpha_n: float  # normal pressure angle, rad
+    alpha_x: float  # axial pressure angle, rad
+    q: float  # diameter quotient
     d1: float
     d2: float
-    a: float                # centre distance, m
-    p_x: float              # axial pitch, m
-    lead: float             # p_z, m
-    p: float                # helix parameter lead / 2 pi (signed by hand), m/rad
-    gamma_b: float          # base lead angle (ZI), rad
-    r_b: float              # base radius (ZI), m
+    a: float  # centre distance, m
+    p_x: float  # axial pitch, m
+    lead: float  # p_z, m
+    p: float  # helix parameter lead / 2 pi (signed by hand), m/rad
+    gamma_b: float  # base lead angle (ZI), rad
+    r_b: float  # base radius (ZI), m
     h_a: float
     h_f: float
     r_a1: float
     r_f1: float
     r_a2: float
     r_f2: float
-    r_e2: float             # wheel outside (rim) radius
-    throat_radius: float    # tube radius of the wheel tip torus, a - r_a2
+    r_e2: float  # wheel outside (rim) radius
+    throat_radius: float  # tube radius of the wheel tip torus, a - r_a2
     root_torus_radius: float  # tube radius of the wheel root torus, a - r_f2
-    face_width: float       # b2, m
-    worm_length: float      # b1, m
-    backlash: float         # circumferential at d2, m
+    face_width: float  # b2, m
+    worm_length: float  # b1, m
+    backlash: float  # circumferential at d2, m
     wheel_tooth_thickness: float  # s2 on d2 (arc), m
-    ratio: float            # z2 / z1
+    ratio: float  # z2 / z1
 
     @property
     def r1(self) -> float:
@@ -161,8 +162,8 @@ class GearGeometry:
         return out
 
 
-Q_MAX = 40.0            # largest diameter quotient (the schema's bound on gear.diameter_quotient)
-WORM_LENGTH_MAX = 4.0   # threaded length at most 4 x the mesh zone (the default length)
+Q_MAX = 40.0  # largest diameter quotient (the schema's bound on gear.diameter_quotient)
+WORM_LENGTH_MAX = 4.0  # threaded length at most 4 x the mesh zone (the default length)
 
 
 def derive(gear: GearData) -> GearGeometry:
@@ -173,17 +174,19 @@ def derive(gear: GearData) -> GearGeometry:
     if gear.lead_angle_deg is not None:
         gamma = gear.lead_angle_deg * DEG
         q = z1 / math.tan(gamma)
-        if q > Q_MAX:       # a tiny lead angle is a huge worm: 1e-9 deg gave d1 = 4e10 mm
+        if q > Q_MAX:  # a tiny lead angle is a huge worm: 1e-9 deg gave d1 = 4e10 mm
             raise GeometryError(
                 f"gear.lead_angle_deg = {gear.lead_angle_deg:.4g}: gives diameter quotient q = z1 / tan(gamma) = "
                 f"{q:.4g}; allowed: q <= {Q_MAX:g}, i.e. lead_angle_deg >= {math.atan(z1 / Q_MAX) / DEG:.4g} "
-                f"for {z1} start(s)")
+                f"for {z1} start(s)"
+            )
     else:
         q = gear.diameter_quotient
         gamma = math.atan(z1 / q)
         if not (0 < gamma < 45 * DEG):
             raise GeometryError(
-                f"gear.diameter_quotient = {q}: gives lead angle {gamma / DEG:.2f} deg; allowed (0, 45) deg")
+                f"gear.diameter_quotient = {q}: gives lead angle {gamma / DEG:.2f} deg; allowed (0, 45) deg"
+            )
     if gear.axial_module_mm is not None:
         m_x = gear.axial_module_mm * MM
     else:
@@ -205,39 +208,72 @@ def derive(gear: GearData) -> GearGeometry:
     if r_f1 <= 0.2 * r1:
         raise GeometryError(
             f"gear: worm root radius {r_f1 / MM:.3f} mm is too small for reference radius {r1 / MM:.3f} mm "
-            f"(diameter quotient q = {q:.2f}); use a lead angle giving q >= {2.5 * gear.dedendum_coef:.1f}")
+            f"(diameter quotient q = {q:.2f}); use a lead angle giving q >= {2.5 * gear.dedendum_coef:.1f}"
+        )
     r_e2 = r_a2 + 0.5 * m_x
     b2 = gear.face_width_mm * MM if gear.face_width_mm is not None else (0.75 if z1 <= 3 else 0.67) * 2 * r_a1
     if b2 >= 2 * (a - r_f1) * 0.999 or b2 > 2 * r_a1 * 1.2:
         raise GeometryError(
             f"gear.face_width_mm = {b2 / MM:.3f}: too wide for this worm; allowed up to {1.2 * 2 * r_a1 / MM:.3f} mm "
-            f"(1.2 x worm tip diameter)")
+            f"(1.2 x worm tip diameter)"
+        )
     # the wheel root torus (tube radius a - r_f2) rises towards the face edges; the tooth must keep at least
     # 0.1 of its full depth h_a + h_f under the rim radius r_e2 at zeta = +-b2/2
     R_root, edge = a - r_f2, a - r_e2 + 0.1 * (h_a + h_f)
-    b2_max = 2 * math.sqrt(max(R_root ** 2 - edge ** 2, 0.0))
+    b2_max = 2 * math.sqrt(max(R_root**2 - edge**2, 0.0))
     if gear.face_width_mm is None:
-        b2 = min(b2, b2_max)        # the DIN guide default, clipped where the root torus would eat the edges
+        b2 = min(b2, b2_max)  # the DIN guide default, clipped where the root torus would eat the edges
     if b2 > b2_max:
         raise GeometryError(
             f"gear.face_width_mm = {b2 / MM:.3f}: the wheel root torus leaves no tooth at the face edges; "
-            f"allowed up to {b2_max / MM:.3f} mm")
+            f"allowed up to {b2_max / MM:.3f} mm"
+        )
     # threaded length: cover every point of the wheel rim that can reach the worm tip cylinder, plus one pitch
-    reach = r_e2 ** 2 - (a - r_a1) ** 2
+    reach = r_e2**2 - (a - r_a1) ** 2
     b1_mesh = 2 * math.sqrt(max(reach, 0.0)) + p_x
     b1 = gear.worm_length_mm * MM if gear.worm_length_mm is not None else b1_mesh
-    if not p_x <= b1 <= WORM_LENGTH_MAX * b1_mesh:   # 1e6 mm ran for > 10 min at 5 GB (pieces along the thread)
+    if not p_x <= b1 <= WORM_LENGTH_MAX * b1_mesh:  # 1e6 mm ran for > 10 min at 5 GB (pieces along the thread)
         raise GeometryError(
             f"gear.worm_length_mm = {b1 / MM:.4g}: allowed {p_x / MM:.4g} (one axial pitch) to "
-            f"{WORM_LENGTH_MAX * b1_mesh / MM:.4g} mm ({WORM_LENGTH_MAX:g} x the mesh zone {b1_mesh / MM:.4g} mm)")
+            f"{WORM_LENGTH_MAX * b1_mesh / MM:.4g} mm ({WORM_LENGTH_MAX:g} x the mesh zone {b1_mesh / MM:.4g} mm)"
+        )
     s2 = p_x / 2 - gear.backlash_mm * MM
     if s2 <= 0.1 * p_x:
         raise GeometryError(
             f"gear.backlash_mm = {gear.backlash_mm}: leaves a wheel tooth of {s2 / MM:.3f} mm on d2; "
-            f"allowed below {0.4 * p_x / MM:.3f} mm (0.4 axial pitch)")
+            f"allowed below {0.4 * p_x / MM:.3f} mm (0.4 axial pitch)"
+        )
     return GearGeometry(
-        profile=gear.profile, hand=hand, z1=z1, z2=z2, m_x=m_x, m_n=m_n, gamma=gamma, alpha_n=alpha_n,
-        alpha_x=alpha_x, q=q, d1=d1, d2=d2, a=a, p_x=p_x, lead=lead, p=p, gamma_b=gamma_b, r_b=r_b,
-        h_a=h_a, h_f=h_f, r_a1=r_a1, r_f1=r_f1, r_a2=r_a2, r_f2=r_f2, r_e2=r_e2,
-        throat_radius=a - r_a2, root_torus_radius=a - r_f2, face_width=b2, worm_length=b1,
-        backlash=gear.backlash_mm * MM, wheel_tooth_thickness=s2, ratio=z2 / z1)
+        profile=gear.profile,
+        hand=hand,
+        z1=z1,
+        z2=z2,
+        m_x=m_x,
+        m_n=m_n,
+        gamma=gamma,
+        alpha_n=alpha_n,
+        alpha_x=alpha_x,
+        q=q,
+        d1=d1,
+        d2=d2,
+        a=a,
+        p_x=p_x,
+        lead=lead,
+        p=p,
+        gamma_b=gamma_b,
+        r_b=r_b,
+        h_a=h_a,
+        h_f=h_f,
+        r_a1=r_a1,
+        r_f1=r_f1,
+        r_a2=r_a2,
+        r_f2=r_f2,
+        r_e2=r_e2,
+        throat_radius=a - r_a2,
+        root_torus_radius=a - r_f2,
+        face_width=b2,
+        worm_length=b1,
+        backlash=gear.backlash_mm * MM,
+        wheel_tooth_thickness=s2,
+        ratio=z2 / z1,
+    )

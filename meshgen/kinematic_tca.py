@@ -28,6 +28,7 @@ wheel revolution; the common period when both):
     centroid (face coordinate zeta, 0 at the wheel's own mid-plane, and radius rho in the wheel's body frame) and
     extent across the face over all analysed angles, weighted by the grid cells' areas.
 """
+
 from __future__ import annotations
 
 import functools
@@ -39,21 +40,21 @@ import numpy as np
 from meshgen import assembly, displaced, wheel, worm
 from meshgen.geometry import GearGeometry, GeometryError
 
-GRID_ZETA = 33              # flank grid across the face
-GRID_RHO = 33               # flank grid root .. tip
-SAMPLES_PER_MESH = 16       # worm angles per mesh cycle (2 pi / z1)
-MARKING_FILM_M = 6e-6       # our choice: a marking compound's film is a few micrometres thick
+GRID_ZETA = 33  # flank grid across the face
+GRID_RHO = 33  # flank grid root .. tip
+SAMPLES_PER_MESH = 16  # worm angles per mesh cycle (2 pi / z1)
+MARKING_FILM_M = 6e-6  # our choice: a marking compound's film is a few micrometres thick
 
 
 @dataclass(frozen=True)
 class KinematicTCA:
-    theta1_rad: np.ndarray          # (N,) analysed worm angles over `period_rad` (periodic)
+    theta1_rad: np.ndarray  # (N,) analysed worm angles over `period_rad` (periodic)
     period_rad: float
-    gap_fwd_rad: np.ndarray         # (N,) g_+1 (1): wheel rotation from the conjugate angle to touch side +1
-    gap_rev_rad: np.ndarray         # (N,) g_-1
-    contact_fwd: np.ndarray         # (N, 2) (zeta, rho) of the first touch, side +1, wheel body frame, m
+    gap_fwd_rad: np.ndarray  # (N,) g_+1 (1): wheel rotation from the conjugate angle to touch side +1
+    gap_rev_rad: np.ndarray  # (N,) g_-1
+    contact_fwd: np.ndarray  # (N, 2) (zeta, rho) of the first touch, side +1, wheel body frame, m
     contact_rev: np.ndarray
-    pattern_fwd: dict               # film pattern (module docstring), side +1, m
+    pattern_fwd: dict  # film pattern (module docstring), side +1, m
     pattern_rev: dict
 
     def te_rad(self, side: int) -> np.ndarray:
@@ -124,7 +125,7 @@ def _refine_min(F: np.ndarray) -> tuple[float, tuple]:
     f0 = float(F[idx])
     if not (1 <= i < F.shape[1] - 1 and 1 <= j < F.shape[2] - 1):
         return f0, idx
-    N = F[k, i - 1:i + 2, j - 1:j + 2]
+    N = F[k, i - 1 : i + 2, j - 1 : j + 2]
     if not np.all(np.isfinite(N)):
         return f0, idx
     gx, gy = (N[2, 1] - N[0, 1]) / 2, (N[1, 2] - N[1, 0]) / 2
@@ -141,8 +142,13 @@ def _refine_min(F: np.ndarray) -> tuple[float, tuple]:
     return float(min(val, f0)), idx
 
 
-def analyse(g: GearGeometry, dev: displaced.Deviations, samples_per_mesh: int = SAMPLES_PER_MESH,
-            period_rad: float | None = None, grid: tuple[int, int] = (GRID_ZETA, GRID_RHO)) -> KinematicTCA:
+def analyse(
+    g: GearGeometry,
+    dev: displaced.Deviations,
+    samples_per_mesh: int = SAMPLES_PER_MESH,
+    period_rad: float | None = None,
+    grid: tuple[int, int] = (GRID_ZETA, GRID_RHO),
+) -> KinematicTCA:
     """The kinematic TCA (module docstring) over `period_rad` of worm angle (default analysis_period)."""
     period = analysis_period(g, dev) if period_rad is None else period_rad
     n = max(4, int(round(period / (2 * math.pi / g.z1) * samples_per_mesh)))
@@ -158,9 +164,17 @@ def analyse(g: GearGeometry, dev: displaced.Deviations, samples_per_mesh: int = 
     # every tooth's flank points in the wheel's body frame: tooth k = tooth 0 turned by k pitch + f_k / r2
     rot = np.arange(g.z2) * pitch + dev.tooth_angle_shift(g, np.arange(g.z2))
     cr, sr = np.cos(rot)[:, None, None], np.sin(rot)[:, None, None]
-    teeth = {side: np.stack([cr * P[None, ..., 0] - sr * P[None, ..., 1], sr * P[None, ..., 0] + cr * P[None, ..., 1],
-                             np.broadcast_to(P[..., 2], (g.z2,) + P.shape[:2])], axis=-1)
-             for side, P in fl.pts.items()}
+    teeth = {
+        side: np.stack(
+            [
+                cr * P[None, ..., 0] - sr * P[None, ..., 1],
+                sr * P[None, ..., 0] + cr * P[None, ..., 1],
+                np.broadcast_to(P[..., 2], (g.z2,) + P.shape[:2]),
+            ],
+            axis=-1,
+        )
+        for side, P in fl.pts.items()
+    }
     gaps = {1: np.zeros(n), -1: np.zeros(n)}
     where = {1: np.zeros((n, 2)), -1: np.zeros((n, 2))}
     pats = {1: [], -1: []}
@@ -173,7 +187,7 @@ def analyse(g: GearGeometry, dev: displaced.Deviations, samples_per_mesh: int = 
         c = (-math.pi / 2 - tooth0 - th2c) / pitch
         ks = np.arange(int(math.floor(c)) - half, int(math.ceil(c)) + half + 1)
         for side in (1, -1):
-            B = teeth[side][np.mod(ks, g.z2)]           # (K, nz, nr, 3) body points of the teeth in the window
+            B = teeth[side][np.mod(ks, g.z2)]  # (K, nz, nr, 3) body points of the teeth in the window
             flat = B.reshape(-1, 3)
 
             def to_worm(th2: float, pts: np.ndarray) -> np.ndarray:
@@ -217,12 +231,22 @@ def analyse(g: GearGeometry, dev: displaced.Deviations, samples_per_mesh: int = 
         w = np.concatenate([c for _, _, c in items])
         if not len(z):
             return {"centroid_face_m": float("nan"), "centroid_radius_m": float("nan"), "extent_face_m": 0.0}
-        return {"centroid_face_m": float(np.sum(w * z) / np.sum(w)),
-                "centroid_radius_m": float(np.sum(w * r) / np.sum(w)), "extent_face_m": float(np.ptp(z))}
+        return {
+            "centroid_face_m": float(np.sum(w * z) / np.sum(w)),
+            "centroid_radius_m": float(np.sum(w * r) / np.sum(w)),
+            "extent_face_m": float(np.ptp(z)),
+        }
 
-    return KinematicTCA(theta1_rad=th1s, period_rad=period, gap_fwd_rad=gaps[1], gap_rev_rad=gaps[-1],
-                        contact_fwd=where[1], contact_rev=where[-1], pattern_fwd=pattern(pats[1]),
-                        pattern_rev=pattern(pats[-1]))
+    return KinematicTCA(
+        theta1_rad=th1s,
+        period_rad=period,
+        gap_fwd_rad=gaps[1],
+        gap_rev_rad=gaps[-1],
+        contact_fwd=where[1],
+        contact_rev=where[-1],
+        pattern_fwd=pattern(pats[1]),
+        pattern_rev=pattern(pats[-1]),
+    )
 
 
 @functools.lru_cache(maxsize=16)
@@ -241,6 +265,6 @@ def check_play(g: GearGeometry, kin: KinematicTCA) -> KinematicTCA:
         raise GeometryError(
             f"errors: together the errors close the play between the flanks to {play[i] * 1e6:.3g} um at worm angle "
             f"{math.degrees(kin.theta1_rad[i]):.1f} deg (gear.backlash_mm = {g.backlash * 1e3:.4g}): the flanks "
-            f"interfere; reduce the errors (the play must stay above 0; docs/errors.md) or raise gear.backlash_mm")
+            f"interfere; reduce the errors (the play must stay above 0; docs/errors.md) or raise gear.backlash_mm"
+        )
     return kin
-

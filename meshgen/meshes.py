@@ -10,6 +10,7 @@ Construction (no approximation beyond the sampling of the exact surfaces):
   thread ridge's axial profile (meshgen.worm), trimmed to the worm length by the planes z = +-b1/2.
 Booleans run in millimetres (manifold3d's tolerance), the result is scaled back to metres.
 """
+
 from __future__ import annotations
 
 import math
@@ -25,8 +26,10 @@ MM_PER_M = 1000.0
 
 
 def _to_manifold(m: trimesh.Trimesh) -> mf.Manifold:
-    mesh = mf.Mesh64(vert_properties=np.ascontiguousarray(m.vertices * MM_PER_M, dtype=np.float64),
-                     tri_verts=np.ascontiguousarray(m.faces, dtype=np.uint32))
+    mesh = mf.Mesh64(
+        vert_properties=np.ascontiguousarray(m.vertices * MM_PER_M, dtype=np.float64),
+        tri_verts=np.ascontiguousarray(m.faces, dtype=np.uint32),
+    )
     out = mf.Manifold(mesh)
     if out.status() != mf.Error.NoError:
         raise RuntimeError(f"manifold3d rejected a mesh: {out.status()}")
@@ -46,8 +49,9 @@ def _from_manifold(man: mf.Manifold) -> trimesh.Trimesh:
     return out
 
 
-def wheel_mesh(g: GearGeometry, n_zeta: int | None = None, n_rho: int = 14, n_w: int = 4, n_root: int = 4,
-               n_bore: int = 360) -> trimesh.Trimesh:
+def wheel_mesh(
+    g: GearGeometry, n_zeta: int | None = None, n_rho: int = 14, n_w: int = 4, n_root: int = 4, n_bore: int = 360
+) -> trimesh.Trimesh:
     """Whole wheel as ONE structured surface, no booleans (see module docstring).
 
     Every zeta section's outline runs around all z2 teeth: flank A root -> tip (n_rho exact points), the tip arc,
@@ -63,7 +67,7 @@ def wheel_mesh(g: GearGeometry, n_zeta: int | None = None, n_rho: int = 14, n_w:
     zeta = np.linspace(-g.face_width / 2, g.face_width / 2, n_zeta)
     lo, hi = wheel.root_rho(g, zeta), wheel.tip_rho(g, zeta)
     s = np.linspace(0.0, 1.0, n_rho)
-    R = lo[:, None] + s[None, :] * (hi - lo)[:, None]                  # (n_zeta, n_rho)
+    R = lo[:, None] + s[None, :] * (hi - lo)[:, None]  # (n_zeta, n_rho)
     Z = np.broadcast_to(zeta[:, None], R.shape)
     pa, pb = wheel.tooth_flanks(g, R, Z)
     w = np.linspace(0.0, 1.0, n_w + 2)[1:-1]
@@ -71,17 +75,20 @@ def wheel_mesh(g: GearGeometry, n_zeta: int | None = None, n_rho: int = 14, n_w:
     pitch = 2 * math.pi / g.z2
     v = np.linspace(0.0, 1.0, n_root + 2)[1:-1]
     root_psi = pb[:, :1] + v[None, :] * (pa[:, :1] + pitch - pb[:, :1])
-    psi1 = np.concatenate([pa, tip_psi, pb[:, ::-1], root_psi], axis=1)             # one tooth + one space
-    rho1 = np.concatenate([R, np.broadcast_to(hi[:, None], tip_psi.shape), R[:, ::-1],
-                           np.broadcast_to(lo[:, None], root_psi.shape)], axis=1)
-    psi = np.concatenate([psi1 + k * pitch for k in range(g.z2)], axis=1)            # (n_zeta, N), CCW
+    psi1 = np.concatenate([pa, tip_psi, pb[:, ::-1], root_psi], axis=1)  # one tooth + one space
+    rho1 = np.concatenate(
+        [R, np.broadcast_to(hi[:, None], tip_psi.shape), R[:, ::-1], np.broadcast_to(lo[:, None], root_psi.shape)],
+        axis=1,
+    )
+    psi = np.concatenate([psi1 + k * pitch for k in range(g.z2)], axis=1)  # (n_zeta, N), CCW
     rho = np.tile(rho1, (1, g.z2))
     N = psi.shape[1]
     outer = np.stack([rho * np.cos(psi), rho * np.sin(psi), np.broadcast_to(zeta[:, None], rho.shape)], -1)
     r_bore = 0.35 * g.r_f2
     ang = np.linspace(0.0, 2 * math.pi, n_bore, endpoint=False)
-    bore = np.stack([np.stack([r_bore * np.cos(ang), r_bore * np.sin(ang), np.full(n_bore, z)], -1)
-                     for z in (zeta[0], zeta[-1])])                                   # (2, n_bore, 3)
+    bore = np.stack(
+        [np.stack([r_bore * np.cos(ang), r_bore * np.sin(ang), np.full(n_bore, z)], -1) for z in (zeta[0], zeta[-1])]
+    )  # (2, n_bore, 3)
     V = np.concatenate([outer.reshape(-1, 3), bore.reshape(-1, 3)])
     o_idx = np.arange(n_zeta * N).reshape(n_zeta, N)
     b_idx = n_zeta * N + np.arange(2 * n_bore).reshape(2, n_bore)
@@ -94,7 +101,7 @@ def wheel_mesh(g: GearGeometry, n_zeta: int | None = None, n_rho: int = 14, n_w:
     faces = [strip(o_idx), strip(b_idx)[:, ::-1]]
     for row, brow, up in ((0, 0, False), (n_zeta - 1, 1, True)):
         xy_out = outer[row, :, :2]
-        xy_in = bore[brow, ::-1, :2]                                                  # hole: clockwise
+        xy_in = bore[brow, ::-1, :2]  # hole: clockwise
         tri = np.asarray(mf.triangulate([xy_out, xy_in]), dtype=np.int64)
         ids = np.concatenate([o_idx[row], b_idx[brow, ::-1]])
         t = ids[tri]
@@ -129,9 +136,12 @@ def worm_mesh(g: GearGeometry, segments_per_turn: int = 96, n_flank: int = 12) -
 def _worm_mesh(g: GearGeometry, segments_per_turn: int, n_flank: int, phase: float) -> trimesh.Trimesh:
     half = g.worm_length / 2
     r_in = g.r_f1 - 0.3 * g.m_x
-    prof = worm.ridge_profile(g, n_flank, r_in)              # (m, 2) closed, CCW in (r, u)
-    parts = [mf.Manifold.cylinder(g.worm_length * MM_PER_M + 2, g.r_f1 * MM_PER_M,
-                                  circular_segments=4 * segments_per_turn, center=True)]
+    prof = worm.ridge_profile(g, n_flank, r_in)  # (m, 2) closed, CCW in (r, u)
+    parts = [
+        mf.Manifold.cylinder(
+            g.worm_length * MM_PER_M + 2, g.r_f1 * MM_PER_M, circular_segments=4 * segments_per_turn, center=True
+        )
+    ]
     for n in range(g.z1):
         # thread centre z = p phi + n p_x must cover [-half - p_x, half + p_x]
         z0, z1 = -half - g.p_x, half + g.p_x
@@ -140,12 +150,14 @@ def _worm_mesh(g: GearGeometry, segments_per_turn: int, n_flank: int, phase: flo
         nseg = max(2, int(math.ceil((ph[1] - ph[0]) / dphi)) + 1)
         phi = ph[0] - phase * dphi + dphi * np.arange(nseg + 1)
         r, u = prof[:, 0], prof[:, 1]
-        X = np.stack([r[None] * np.cos(phi[:, None]), r[None] * np.sin(phi[:, None]),
-                      g.p * phi[:, None] + n * g.p_x + u[None]], axis=-1)   # (nphi, m, 3)
+        X = np.stack(
+            [r[None] * np.cos(phi[:, None]), r[None] * np.sin(phi[:, None]), g.p * phi[:, None] + n * g.p_x + u[None]],
+            axis=-1,
+        )  # (nphi, m, 3)
         m = X.shape[1]
         verts = X.reshape(-1, 3)
         idx = np.arange(len(phi) * m).reshape(len(phi), m)
-        idx_c = np.concatenate([idx, idx[:, :1]], axis=1)           # close the profile loop
+        idx_c = np.concatenate([idx, idx[:, :1]], axis=1)  # close the profile loop
         a, b, c, d = idx_c[:-1, :-1], idx_c[1:, :-1], idx_c[1:, 1:], idx_c[:-1, 1:]
         faces = np.concatenate([np.stack([a, b, c], -1).reshape(-1, 3), np.stack([a, c, d], -1).reshape(-1, 3)])
         c0 = len(verts)

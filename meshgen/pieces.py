@@ -16,6 +16,7 @@ negative: the piece bulges beyond the flank, positive: a gap.
 piece_error_um = {"worm"|"wheel"[|"wheel_undercut_zone"]: {"max": max |d|, "rms", "min_signed", "max_signed",
 "n_points"}}.
 """
+
 from __future__ import annotations
 
 import functools
@@ -36,8 +37,8 @@ CODE_VERSION = "meshgen-14"
 @dataclass(frozen=True)
 class Resolution:
     worm_segments_per_turn: int
-    wheel_slabs: int          # slabs across the face width per wheel tooth
-    profile_points: int       # samples along the tooth profile (each flank)
+    wheel_slabs: int  # slabs across the face width per wheel tooth
+    profile_points: int  # samples along the tooth profile (each flank)
 
 
 RESOLUTIONS: dict[str, Resolution] = {
@@ -63,6 +64,7 @@ class GearSet:
 
 
 # ----------------------------------------------------------------------------- pieces
+
 
 def _hull(points: np.ndarray) -> trimesh.Trimesh:
     """Convex hull as a watertight, outward-oriented mesh (scipy/qhull; trimesh's hull may drop sliver faces)."""
@@ -102,17 +104,18 @@ def _clip_convex(points: np.ndarray, zmin: float, zmax: float) -> np.ndarray | N
     return pts
 
 
-WORM_SUBSECTIONS = 4   # the hull of a helical segment spans SUB + 1 exact ridge sections (helix chords: gap only)
+WORM_SUBSECTIONS = 4  # the hull of a helical segment spans SUB + 1 exact ridge sections (helix chords: gap only)
 
 
-def worm_piece_points(g: GearGeometry, res: Resolution, start: int, phi0: float, phi1: float,
-                      shrink: tuple[float, float] = (0.0, 0.0)):
+def worm_piece_points(
+    g: GearGeometry, res: Resolution, start: int, phi0: float, phi1: float, shrink: tuple[float, float] = (0.0, 0.0)
+):
     """Exact ridge sections across one helical segment; shrink = (axial offset of the -H flank, of the +H flank)
     toward the thread centre (conservative pieces)."""
     r_in = g.r_f1 - 0.1 * g.m_x
     prof = worm.ridge_profile(g, res.profile_points, r_in)
     r, u = prof[:, 0], prof[:, 1].copy()
-    half_n = len(u) // 2                      # first half: the -H flank (root -> tip), second: the +H flank
+    half_n = len(u) // 2  # first half: the -H flank (root -> tip), second: the +H flank
     u[:half_n] += shrink[0]
     u[half_n:] -= shrink[1]
     pts = []
@@ -135,8 +138,7 @@ def worm_shrink(g: GearGeometry, res: Resolution) -> tuple[float, float]:
     symmetry), so the bulge of one segment's hull beyond dense exact flank points (ZA: saddle flank) is measured
     once per flank and the flank moved into the thread by it (CONSERVATIVE_PASSES passes); 0 for ZI."""
     d = 2 * math.pi / res.worm_segments_per_turn
-    R, PHI = np.meshgrid(np.linspace(g.r_f1, g.r_a1, 49), np.linspace(0.0, d, 8 * WORM_SUBSECTIONS + 1),
-                         indexing="ij")
+    R, PHI = np.meshgrid(np.linspace(g.r_f1, g.r_a1, 49), np.linspace(0.0, d, 8 * WORM_SUBSECTIONS + 1), indexing="ij")
     checks = [worm.flank_points(g, R, PHI, side).reshape(-1, 3) for side in (-1, 1)]
     r = R[:, 0]
     n_z = float(np.min(1.0 / np.sqrt(1.0 + (g.p / r) ** 2 + worm.half_thickness_dr(g, r) ** 2)))
@@ -167,11 +169,12 @@ def build_worm_pieces(g: GearGeometry, res: Resolution) -> list[trimesh.Trimesh]
                     continue
             out.append(_hull(pts))
     vmax = max(h.volume for h in out)
-    return [h for h in out if h.volume > 1e-3 * vmax]   # drop end slivers of the clipping
+    return [h for h in out if h.volume > 1e-3 * vmax]  # drop end slivers of the clipping
 
 
-def conjugate_junction_rho(g: GearGeometry, zeta: np.ndarray, side: int, n_grid: int = 48,
-                           n_bisect: int = 30) -> np.ndarray:
+def conjugate_junction_rho(
+    g: GearGeometry, zeta: np.ndarray, side: int, n_grid: int = 48, n_bisect: int = 30
+) -> np.ndarray:
     """Per zeta: the lowest radius above which the flank of tooth space 0 on `side` (+1: psi_+, the tooth-0
     flank A; -1: psi_-, flank B of tooth 0 by periodicity) is conjugate (envelope points), i.e. the top of the
     root fillet / undercut cut by the hob tip edge; the root radius where there is none."""
@@ -195,8 +198,19 @@ def conjugate_junction_rho(g: GearGeometry, zeta: np.ndarray, side: int, n_grid:
     return np.where(none, lo, b)
 
 
-def wheel_slab_sections(g: GearGeometry, n_profile: int, zeta: np.ndarray, lo_a, hi_a, lo_b, hi_b,
-                        n_tip: int = 3, tip: bool = True, dpsi_a: float = 0.0, dpsi_b: float = 0.0):
+def wheel_slab_sections(
+    g: GearGeometry,
+    n_profile: int,
+    zeta: np.ndarray,
+    lo_a,
+    hi_a,
+    lo_b,
+    hi_b,
+    n_tip: int = 3,
+    tip: bool = True,
+    dpsi_a: float = 0.0,
+    dpsi_b: float = 0.0,
+):
     """Points of tooth-0 sections at the given zeta values: flank A (psi_a) from lo_a to hi_a, flank B from lo_b
     to hi_b (radius arrays over zeta), plus n_tip points across the tip arc when tip: (len(zeta), m, 3).
     dpsi_a, dpsi_b >= 0 move flank A / flank B into the tooth by that angle (conservative pieces)."""
@@ -246,25 +260,39 @@ def build_wheel_tooth_pieces(g: GearGeometry, res: Resolution) -> list[trimesh.T
     root, tip = wheel.root_rho(g, zeta), wheel.tip_rho(g, zeta)
     ja, jb = conjugate_junction_rho(g, zeta, +1), conjugate_junction_rho(g, zeta, -1)
     has_fillet = (ja > root + 1e-6 * g.m_x) | (jb > root + 1e-6 * g.m_x)
-    c = math.cos(g.alpha_n) * math.cos(g.gamma)      # |n . e_psi| of the flank at the pitch point
+    c = math.cos(g.alpha_n) * math.cos(g.gamma)  # |n . e_psi| of the flank at the pitch point
     out = []
     for j in range(res.wheel_slabs):
         sl = slice(sub * j, sub * (j + 1) + 1)
         zf = np.linspace(zeta[sl][0], zeta[sl][-1], 8 * sub + 1)
         checks = [_flank_check_points(g, zf, side) for side in (+1, -1)]
-        out.append(_conservative_hull(
-            lambda da, db: wheel_slab_sections(g, res.profile_points, zeta[sl], ja[sl], tip[sl], jb[sl], tip[sl],
-                                               dpsi_a=da, dpsi_b=db), checks, g.m_x, c))
+        out.append(
+            _conservative_hull(
+                lambda da, db: wheel_slab_sections(
+                    g, res.profile_points, zeta[sl], ja[sl], tip[sl], jb[sl], tip[sl], dpsi_a=da, dpsi_b=db
+                ),
+                checks,
+                g.m_x,
+                c,
+            )
+        )
         if has_fillet[sl].any():
             # the core stays inside the whole flank (fillet included): checked on root-to-tip points
             full = [_flank_check_points(g, zf, side, from_root=True) for side in (+1, -1)]
-            out.append(_conservative_hull(
-                lambda da, db: _fillet_core_sections(g, zeta[sl], root[sl], np.minimum(ja, jb)[sl],
-                                                     dpsi_a=da, dpsi_b=db), full, g.m_x, c))
+            out.append(
+                _conservative_hull(
+                    lambda da, db: _fillet_core_sections(
+                        g, zeta[sl], root[sl], np.minimum(ja, jb)[sl], dpsi_a=da, dpsi_b=db
+                    ),
+                    full,
+                    g.m_x,
+                    c,
+                )
+            )
     return out
 
 
-CONSERVATIVE_PASSES = 2   # 0: pieces exact at the sections and bulging between them
+CONSERVATIVE_PASSES = 2  # 0: pieces exact at the sections and bulging between them
 
 
 def _conservative_hull(sections, checks, m_x: float, c: float) -> trimesh.Trimesh:
@@ -297,10 +325,11 @@ def _flank_check_points(g: GearGeometry, zeta: np.ndarray, side: int, n_rho: int
     return pts, float(R.mean())
 
 
-SLAB_SUBSECTIONS = 4   # exact sections per slab that its hull spans (2 ends + 3 inside)
+SLAB_SUBSECTIONS = 4  # exact sections per slab that its hull spans (2 ends + 3 inside)
 
 
 # ----------------------------------------------------------------------------- error of the pieces
+
 
 def _plane_sets(pieces):
     out = []
@@ -333,8 +362,13 @@ def union_signed_distance(pieces, pts: np.ndarray) -> np.ndarray:
 
 def _stats(d: np.ndarray) -> dict:
     d_um = d * 1e6
-    return {"max": float(np.max(np.abs(d_um))), "rms": float(np.sqrt(np.mean(d_um ** 2))),
-            "min_signed": float(d_um.min()), "max_signed": float(d_um.max()), "n_points": int(len(d_um))}
+    return {
+        "max": float(np.max(np.abs(d_um))),
+        "rms": float(np.sqrt(np.mean(d_um**2))),
+        "min_signed": float(d_um.min()),
+        "max_signed": float(d_um.max()),
+        "n_points": int(len(d_um)),
+    }
 
 
 def worm_active_flank_points(g: GearGeometry, phi0: float, phi1: float, n_r: int = 25, n_phi: int = 41):
@@ -346,7 +380,7 @@ def worm_active_flank_points(g: GearGeometry, phi0: float, phi1: float, n_r: int
 
 def wheel_active_flank_points(g: GearGeometry, n_rho: int = 25, n_zeta: int = 61):
     zeta = np.linspace(-g.face_width / 2, g.face_width / 2, n_zeta)
-    lo = g.a - np.sqrt(np.maximum(g.r_a1 ** 2 - zeta ** 2, 0.0))
+    lo = g.a - np.sqrt(np.maximum(g.r_a1**2 - zeta**2, 0.0))
     hi = wheel.tip_rho(g, zeta)
     lo = np.minimum(lo, hi)
     s = np.linspace(0.0, 1.0, n_rho)
@@ -363,7 +397,7 @@ def wheel_random_flank_points(g: GearGeometry, n: int, seed: int):
     """n random (rho, zeta) of the active flank region, both flanks of tooth 0, and their conjugate flags."""
     rng = np.random.default_rng(seed)
     zeta = rng.uniform(-g.face_width / 2, g.face_width / 2, n)
-    lo = g.a - np.sqrt(np.maximum(g.r_a1 ** 2 - zeta ** 2, 0.0))
+    lo = g.a - np.sqrt(np.maximum(g.r_a1**2 - zeta**2, 0.0))
     hi = wheel.tip_rho(g, zeta)
     lo = np.minimum(lo, hi)
     rho = lo + rng.uniform(0, 1, n) * (hi - lo)
@@ -392,6 +426,7 @@ def measure_piece_error(g: GearGeometry, res: Resolution, worm_pieces, wheel_pie
 
 
 # ----------------------------------------------------------------------------- gear set + cache
+
 
 def gear_set_key(g: GearGeometry, res: Resolution) -> dict:
     return {"g": asdict(g), "r": asdict(res), "v": CODE_VERSION}
@@ -427,11 +462,15 @@ def build_gear_set(geometry: GearGeometry, resolution: Resolution | str = "mediu
     g = geometry
     data = cached("gearset", gear_set_key(g, res), lambda: _generate(g, res), use_cache)
     return GearSet(
-        geometry=g, resolution=res,
+        geometry=g,
+        resolution=res,
         worm_pieces=[_unpack(t) for t in data["worm_pieces"]],
         wheel_tooth_pieces=[_unpack(t) for t in data["wheel_tooth_pieces"]],
         tooth_angle_rad=functools.partial(wheel.tooth_angle, g),
-        worm_visual=_unpack(data["worm_visual"]), wheel_visual=_unpack(data["wheel_visual"]),
-        worm_core_radius_m=g.r_f1, piece_error_um=data["piece_error_um"],
+        worm_visual=_unpack(data["worm_visual"]),
+        wheel_visual=_unpack(data["wheel_visual"]),
+        worm_core_radius_m=g.r_f1,
+        piece_error_um=data["piece_error_um"],
         undercut_fraction=data["undercut_fraction"],
-        info={"cache_key": cache_key(gear_set_key(g, res)), "code_version": CODE_VERSION})
+        info={"cache_key": cache_key(gear_set_key(g, res)), "code_version": CODE_VERSION},
+    )

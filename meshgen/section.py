@@ -38,8 +38,16 @@ def plot_section(
     ax.set_ylim(-(g.a + g.r_a1 + 0.8 * g.m_x) * 1e3, -(g.r2 - 6 * g.m_x) * 1e3)
     ax.set_aspect("equal")
     ax.axhline(-g.r2 * 1e3, color="0.6", ls="--", lw=0.7)
-    ax.text(-w * 0.97, -g.r2 * 1e3, "wheel reference circle d2", ha="left", va="center", fontsize=8, color="0.3",
-            bbox=dict(facecolor="white", edgecolor="none", alpha=0.85))
+    ax.text(
+        -w * 0.97,
+        -g.r2 * 1e3,
+        "wheel reference circle d2",
+        ha="left",
+        va="center",
+        fontsize=8,
+        color="0.3",
+        bbox=dict(facecolor="white", edgecolor="none", alpha=0.85),
+    )
     ax.set_xlabel("x along the worm axis [mm]")
     ax.set_ylabel("y towards the wheel centre [mm] (wheel centre at 0)")
     ax.set_title(

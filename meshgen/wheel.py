@@ -29,6 +29,7 @@ Backlash j: each wheel flank is moved into the tooth by j / (2 r2) in angle (cir
 Blank: wheel tip (throat) rho <= a - sqrt((a - r_a2)^2 - zeta^2) capped at the rim radius r_e2,
 root rho >= a - sqrt(R_r^2 - zeta^2), |zeta| <= b2 / 2.
 """
+
 from __future__ import annotations
 
 import math
@@ -77,9 +78,9 @@ def _beta_range(g: GearGeometry, rho, zeta):
 
 @dataclass
 class FlankSolution:
-    psi: np.ndarray        # flank polar angle (space 0), rad
-    beta: np.ndarray       # assembly polar angle of the contact (worm angle via beta - psi), rad
-    interior: np.ndarray   # True where an interior extremum (conjugate contact), False: cut by the hob tip edge
+    psi: np.ndarray  # flank polar angle (space 0), rad
+    beta: np.ndarray  # assembly polar angle of the contact (worm angle via beta - psi), rad
+    interior: np.ndarray  # True where an interior extremum (conjugate contact), False: cut by the hob tip edge
 
 
 def space_flank(g: GearGeometry, rho, zeta, side: int, n_grid: int = 48, n_newton: int = 8) -> FlankSolution:
@@ -151,13 +152,15 @@ def check_wheel(g: GearGeometry, n: int = 25) -> None:
     if s_tip < 0.05 * g.m_x:
         raise GeometryError(
             f"gear: the wheel tooth is pointed (tip thickness {s_tip * 1e3:.4f} mm, minimum 0.05 m_x); "
-            f"lower gear.normal_pressure_angle_deg or gear.backlash_mm, or raise gear.wheel_teeth")
+            f"lower gear.normal_pressure_angle_deg or gear.backlash_mm, or raise gear.wheel_teeth"
+        )
     frac = undercut_fraction(g, n)
     if frac > UNDERCUT_LIMIT:
         raise GeometryError(
             f"gear: the wheel teeth are undercut: on the mid-plane the hob tip edge removes {100 * frac:.0f} % of "
             f"the working flank below the reference circle (limit {100 * UNDERCUT_LIMIT:.0f} %); raise "
-            f"gear.normal_pressure_angle_deg (now {math.degrees(g.alpha_n):.2f}) or gear.wheel_teeth (now {g.z2})")
+            f"gear.normal_pressure_angle_deg (now {math.degrees(g.alpha_n):.2f}) or gear.wheel_teeth (now {g.z2})"
+        )
 
 
 UNDERCUT_LIMIT = 0.6

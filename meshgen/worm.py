@@ -30,6 +30,7 @@ radial-line helicoid H(r) = H(r_b) (dH/dr = 0 at r_b, so the continuation is C1)
 Normal of a flank z - p phi - s H(r) = const (s = +-1): grad = (-s H'(r)) e_r + (-p / r) e_phi + e_z, so the
 normal pressure angle at radius r is sin(alpha_n) = |n . e_r| = |H'| / sqrt(H'^2 + (p/r)^2 + 1).
 """
+
 from __future__ import annotations
 
 import math
@@ -40,7 +41,7 @@ from meshgen.geometry import GearGeometry, GeometryError
 
 
 def _t_of_r(g: GearGeometry, r):
-    return np.sqrt(np.maximum(np.asarray(r, dtype=float) ** 2 / g.r_b ** 2 - 1.0, 0.0))
+    return np.sqrt(np.maximum(np.asarray(r, dtype=float) ** 2 / g.r_b**2 - 1.0, 0.0))
 
 
 def half_thickness(g: GearGeometry, r):
@@ -96,7 +97,8 @@ def check_worm(g: GearGeometry, hob_tip_radius: float) -> None:
             raise GeometryError(
                 f"gear: the worm thread is pointed at the {name} (thickness {s * 1e3:.4f} mm); lower "
                 f"gear.normal_pressure_angle_deg (now {math.degrees(g.alpha_n):.2f}) or gear.dedendum_coef / "
-                f"gear.addendum_coef")
+                f"gear.addendum_coef"
+            )
     if g.profile == "ZI" and g.r_b > g.r_f1:
         # allowed: flank continued radially below r_b (module docstring); nothing to do
         pass

@@ -1,4 +1,5 @@
 """Shared helpers of the meshgen tests: seed gears, exact clearance between worm and wheel surfaces."""
+
 from __future__ import annotations
 
 import math

@@ -1,5 +1,6 @@
 """Benchmark bookkeeping: relative errors, Pareto front, the chart (the speed numbers themselves are
 never asserted)."""
+
 import numpy as np
 
 from wormsim.bench.cases import ERROR_KEYS, relative_errors
@@ -7,8 +8,10 @@ from wormsim.bench.run import pareto_front, plot_bench
 
 
 def test_relative_errors_only_where_defined():
-    e = relative_errors({"ratio": 53.053, "efficiency": 0.6, "mesh_frequency_hz": None},
-                        {"ratio": 53.0, "efficiency": 0.0, "mesh_frequency_hz": 0.6})
+    e = relative_errors(
+        {"ratio": 53.053, "efficiency": 0.6, "mesh_frequency_hz": None},
+        {"ratio": 53.0, "efficiency": 0.0, "mesh_frequency_hz": 0.6},
+    )
     assert abs(e["ratio"] - 0.001) < 1e-12
     assert e["efficiency"] is None and e["mesh_frequency_hz"] is None
     assert set(e) == set(ERROR_KEYS)
@@ -21,10 +24,23 @@ def test_pareto_front_keeps_only_undominated_points():
 
 
 def test_chart_is_written(tmp_path):
-    recs = [{"scenario": "s", "model": m, "resolution": res, "status": "ok", "wall_s_per_sim_s": w, "reference": False,
-             "finer": False, "error": {k: e for k in ERROR_KEYS}}
-            for m, res, w, e in [("contact3d", {"geometry": "pieces"}, 1.0, 0.01),
-                                 ("contact3d", {"geometry": "flanks"}, 0.3, 0.05), ("torsional", {}, 1e-3, 0.02)]]
+    recs = [
+        {
+            "scenario": "s",
+            "model": m,
+            "resolution": res,
+            "status": "ok",
+            "wall_s_per_sim_s": w,
+            "reference": False,
+            "finer": False,
+            "error": {k: e for k in ERROR_KEYS},
+        }
+        for m, res, w, e in [
+            ("contact3d", {"geometry": "pieces"}, 1.0, 0.01),
+            ("contact3d", {"geometry": "flanks"}, 0.3, 0.05),
+            ("torsional", {}, 1e-3, 0.02),
+        ]
+    ]
     plot_bench(recs, tmp_path / "bench.png")
     assert (tmp_path / "bench.png").read_bytes()[:4] == b"\x89PNG"
 
@@ -81,7 +97,10 @@ def test_full_grid_runs_each_contact3d_case_once_and_marks_the_finer_check():
     from wormsim.bench.cases import SCENARIOS
     from wormsim.scenario import load_scenario
 
-    assert ref.resolution == {"level": "fine", "geometry": load_scenario(SCENARIOS / "screw_jack.yaml").contact.geometry}
+    assert ref.resolution == {
+        "level": "fine",
+        "geometry": load_scenario(SCENARIOS / "screw_jack.yaml").contact.geometry,
+    }
     only = bench_cases(quick=True, models=("contact3d",), geometries=("flanks",))
     assert only and {c.resolution["geometry"] for c in only} == {"flanks"} and sum(c.reference for c in only) == 1
 
@@ -90,14 +109,25 @@ def test_speedup_of_flanks_over_pieces_pairs_equal_level_and_step_factor():
     from wormsim.bench.run import speedups
 
     def rec(geo, lvl, f, w):
-        return {"scenario": "s", "model": "contact3d", "status": "ok", "resolution": {"level": lvl, "geometry": geo},
-                "timestep_factor": f, "wall_s_per_sim_s": w}
+        return {
+            "scenario": "s",
+            "model": "contact3d",
+            "status": "ok",
+            "resolution": {"level": lvl, "geometry": geo},
+            "timestep_factor": f,
+            "wall_s_per_sim_s": w,
+        }
 
-    recs = [rec("pieces", "medium", 1.0, 120.0), rec("flanks", "medium", 1.0, 10.0), rec("pieces", "medium", 2.0, 60.0),
-            rec("flanks", "medium", 2.0, 6.0), rec("flanks", "fine", 1.0, 20.0)]
+    recs = [
+        rec("pieces", "medium", 1.0, 120.0),
+        rec("flanks", "medium", 1.0, 10.0),
+        rec("pieces", "medium", 2.0, 60.0),
+        rec("flanks", "medium", 2.0, 6.0),
+        rec("flanks", "fine", 1.0, 20.0),
+    ]
     assert speedups(recs) == {"s": {"medium": 12.0}}
     assert recs[1]["speedup_vs_pieces"] == 12.0 and recs[3]["speedup_vs_pieces"] == 10.0
-    assert "speedup_vs_pieces" not in recs[4]           # no pieces run of that level: no speed-up claimed
+    assert "speedup_vs_pieces" not in recs[4]  # no pieces run of that level: no speed-up claimed
 
 
 def test_json_results_are_readable_by_others(tmp_path):

@@ -1,4 +1,5 @@
 """CLI exit codes and atomic result writing (INTERFACE.md: 0 ok, 2 invalid input, 3 simulation failed)."""
+
 import json
 import subprocess
 import sys
@@ -27,7 +28,7 @@ def test_invalid_input_exits_2_with_one_line_per_problem(capsys):
     err = capsys.readouterr().err
     assert code == 2
     assert "gear.wheel_teeth = 5: Input should be greater than or equal to 10" in err
-    assert "gear.hand = \"up\"" in err and "'right' or 'left'" in err
+    assert 'gear.hand = "up"' in err and "'right' or 'left'" in err
     assert "Traceback" not in err
 
 
@@ -51,6 +52,7 @@ def test_console_script_is_installed():
 
 
 # --- atomic writes, with a stand-in fidelity level so the runner is tested on its own --------------
+
 
 def _fake_level(fail: bool):
     def simulate(scenario, progress=None):
@@ -81,13 +83,15 @@ def test_failed_run_leaves_only_a_failed_summary(tmp_path, monkeypatch, capsys):
     assert "simulation failed: timestep 1e-3 s exceeds" in err
     summary = json.loads((out / "summary.json").read_text())
     assert summary["status"] == "failed" and "stable limit" in summary["message"]
-    assert [p.name for p in out.iterdir()] == ["summary.json"]     # stale results removed, no staging left
+    assert [p.name for p in out.iterdir()] == ["summary.json"]  # stale results removed, no staging left
 
 
 def test_internal_error_is_not_a_traceback_and_leaves_failed_summary(tmp_path, monkeypatch, capsys):
     def boom(scenario, progress=None):
         raise ZeroDivisionError("x")
-    lvl = _fake_level(False); lvl.simulate = boom
+
+    lvl = _fake_level(False)
+    lvl.simulate = boom
     monkeypatch.setattr(run, "model_module", lambda name: lvl)
     out = tmp_path / "o"
     assert cli.main(["run", str(MINIMAL), "--out", str(out), "--no-progress"]) == 1

@@ -6,6 +6,7 @@ seat-motor contact) and at seed 001's real 36 rpm (sliding speed Vs = omega1 r1 
 friction reached 12-19 % of mu f_n. The model now sets impratio by (3); these tests read every contact's
 friction force |f_t| against mu f_n (the utilisation) over a short run of the seat motor.
 """
+
 from __future__ import annotations
 
 import math
@@ -23,15 +24,23 @@ from wormsim.friction import friction_coefficient
 from wormsim.gear_theory import commands, mesh_arms_m
 from wormsim.scenario import ScenarioError, load_scenario
 
-DURATION_S = 0.05           # 10 000 steps of 5 us; contacts read over the last 40 % (after the 0.01 s ramps)
+DURATION_S = 0.05  # 10 000 steps of 5 us; contacts read over the last 40 % (after the 0.01 s ramps)
 
 
 def sliding_contacts(rpm: float, impratio: float | None = None) -> tuple[np.ndarray, float, object]:
     """Seat motor (seed 001 gear, load and contact law; coarse pieces) with the worm at `rpm`: rows
     (f_n, |f_t|, mu, |v_t|) of every loaded contact sampled every 20 steps over the last 40 % of the run,
     the sliding speed Vs, and the model. mu(Vs) is set as wormsim.contact3d.runner sets it."""
-    sc = load_scenario(SCEN / "seat_motor.yaml", [f"drive.speed_rpm={rpm}", "drive.ramp_s=0.01", "load.ramp_s=0.01",
-                                                  f"simulation.duration_s={DURATION_S}", "simulation.resolution=coarse"])
+    sc = load_scenario(
+        SCEN / "seat_motor.yaml",
+        [
+            f"drive.speed_rpm={rpm}",
+            "drive.ramp_s=0.01",
+            "load.ramp_s=0.01",
+            f"simulation.duration_s={DURATION_S}",
+            "simulation.resolution=coarse",
+        ],
+    )
     bm = build_model(sc)
     m, geo = bm.model, bm.geometry
     if impratio is not None:
@@ -65,7 +74,7 @@ def test_friction_saturates_on_sliding_contacts(rpm):
     sliding = C[:, 3] > 0.5 * vs
     assert sliding.sum() >= 100, sliding.sum()
     util = C[sliding, 1] / (C[sliding, 2] * C[sliding, 0])
-    assert np.all(util <= 1 + 1e-6)                           # never outside the cone
+    assert np.all(util <= 1 + 1e-6)  # never outside the cone
     assert util.mean() >= 0.95, (util.mean(), np.percentile(util, [5, 50, 95]))
 
 
@@ -80,7 +89,7 @@ def test_soft_friction_rows_are_viscous_below_the_cone():
     assert inside.sum() >= 100
     law = replace(bm.law, impratio=1.0)
     v_reg = np.array([friction_regularisation_velocity_m_s(law, mu, fn) for mu, fn in zip(C[inside, 2], C[inside, 0])])
-    slope = C[inside, 2] * C[inside, 0] / v_reg              # = impratio c_c = c_c
+    slope = C[inside, 2] * C[inside, 0] / v_reg  # = impratio c_c = c_c
     ratio = C[inside, 1] / C[inside, 3] / slope
     assert np.all(np.abs(ratio - 1) < 0.02), np.percentile(ratio, [0, 50, 100])
 
@@ -110,7 +119,7 @@ def test_load_inertia_is_the_loaded_hinge_armature_and_in_the_contact_mass():
     g = heavy.geometry
     a1, a2 = mesh_arms_m(g.r1, g.r2, g.alpha_n, g.gamma)
     i1, i2 = heavy.meta["worm_inertia_kg_m2"], heavy.meta["wheel_inertia_kg_m2"]
-    assert bare.law.inv_mass_hat == pytest.approx(a1 ** 2 / i1 + a2 ** 2 / i2, rel=1e-12)
-    assert heavy.law.inv_mass_hat == pytest.approx(a1 ** 2 / i1 + a2 ** 2 / (i2 + 1e-4), rel=1e-12)
+    assert bare.law.inv_mass_hat == pytest.approx(a1**2 / i1 + a2**2 / i2, rel=1e-12)
+    assert heavy.law.inv_mass_hat == pytest.approx(a1**2 / i1 + a2**2 / (i2 + 1e-4), rel=1e-12)
     with pytest.raises(ScenarioError, match="inertia_kg_m2"):
         load_scenario(SCEN / "seat_motor.yaml", ["load.inertia_kg_m2=-1"])

@@ -11,6 +11,7 @@ measured first (seat motor demo gear, default timestep 5e-6 s, explicit stable l
     (1.6 to 4700 pitch); the state stays finite, MuJoCo's bad-qacc warning does not fire. This is divergence, and is
     reported so (a stiffer contact, the jump guard's other cure, would make it worse).
 """
+
 from __future__ import annotations
 
 import json
@@ -35,9 +36,17 @@ JACK = SCEN / "screw_jack.yaml"
 
 # screw jack (gamma 5.71 deg, alpha_n 20 deg) with the WHEEL speed-driven at its nominal 55 rpm and a light load on
 # the worm; one constant friction coefficient
-WHEEL_DRIVEN = ["drive.on=wheel", "drive.speed_rpm=55", "drive.ramp_s=0.01", "load.on=worm", "load.torque_nm=0.1",
-                "load.ramp_s=0.01", "contact.friction_static=null", "contact.friction_dynamic=null",
-                "simulation.resolution=coarse"]
+WHEEL_DRIVEN = [
+    "drive.on=wheel",
+    "drive.speed_rpm=55",
+    "drive.ramp_s=0.01",
+    "load.on=worm",
+    "load.torque_nm=0.1",
+    "load.ramp_s=0.01",
+    "contact.friction_static=null",
+    "contact.friction_dynamic=null",
+    "simulation.resolution=coarse",
+]
 # the lock guard arms 0.02 s after the ramps and fires after 0.05 s below half the command: 0.085 s covers it
 LOCK_DURATION = "simulation.duration_s=0.085"
 
@@ -61,7 +70,7 @@ def test_self_locking_pair_with_speed_driven_wheel_stops_locked_through_the_cli(
     summary = json.loads((out / "summary.json").read_text())
     assert summary["status"] == "failed" and summary["model"] == "contact3d"
     msg = summary["message"]
-    with pytest.raises(LockedError):       # the same run through the API: the guard's own exception type
+    with pytest.raises(LockedError):  # the same run through the API: the guard's own exception type
         run_scenario(load_scenario(JACK, WHEEL_DRIVEN + ["contact.friction=0.2", LOCK_DURATION]), tmp_path / "api")
     assert "self-locking" in msg and "drive.on=worm" in msg, msg
     # the numbers it states: rho' at the friction given and the lead angle of the screw jack (q = 10)
@@ -96,16 +105,27 @@ def test_valid_back_driven_run_trips_no_guard():
     assert abs(res.series["worm_speed_rpm"][-1]) > 0.5 * 55 * 24
 
 
-@pytest.mark.parametrize("torque_nm, klass, cure", [
-    (700, "penetration", "lower load.torque_nm"),
-    (2000, "teeth_jumped", "lower load.torque_nm"),
-])
+@pytest.mark.parametrize(
+    "torque_nm, klass, cure",
+    [
+        (700, "penetration", "lower load.torque_nm"),
+        (2000, "teeth_jumped", "lower load.torque_nm"),
+    ],
+)
 def test_overload_on_held_worm_penetrates_or_jumps_with_a_diagnosis(torque_nm, klass, cure):
     """A wheel load stepped onto the worm held at 0 rpm, at the default (stable) timestep: 700 N m is stopped by the
     penetration guard (0.4 m_x); 2000 N m throws the wheel past a tooth within two steps: the jump guard's
     message, not the divergence guard's."""
-    sc = load_scenario(DEMO, ["drive.speed_rpm=0", "drive.ramp_s=0", "load.ramp_s=0", f"load.torque_nm={torque_nm}",
-                              "simulation.duration_s=0.001"])
+    sc = load_scenario(
+        DEMO,
+        [
+            "drive.speed_rpm=0",
+            "drive.ramp_s=0",
+            "load.ramp_s=0",
+            f"load.torque_nm={torque_nm}",
+            "simulation.duration_s=0.001",
+        ],
+    )
     bm = build_model(sc)
     assert bm.model.opt.timestep == bm.timestep_s <= bm.law.stable_limit_s
     with pytest.raises(SimulationError) as exc:
@@ -135,7 +155,6 @@ def test_timestep_above_the_stable_limit_diverges_and_names_the_stable_timestep(
     assert advice < limit < 1e-4
 
 
-
 def test_bad_qacc_at_a_stable_timestep_names_the_command_step_and_its_cure():
     """MuJoCo's bad-qacc warning at the default (stable) timestep: a 100 N m load and the full speed command applied
     as steps at t = 0 (ramp_s = 0) on the 7 g seat wheel. The divergence guard names that cause and its cure; the
@@ -154,17 +173,28 @@ def test_classify_failure_names_each_guard_by_its_exception_type():
     for exc_type, klass in FAILURE_CLASSES:
         assert issubclass(exc_type, SimulationError)
         assert classify_failure(exc_type("any wording at all")) == klass
-    assert classify_failure(SimulationError("diverged at t = 0.1 s")) == "other"     # the wording does not count
+    assert classify_failure(SimulationError("diverged at t = 0.1 s")) == "other"  # the wording does not count
     assert classify_failure(ZeroDivisionError()) == "other"
 
 
 def test_stability_edge_records_the_last_stable_timestep_and_the_failure():
     """A tiny sweep on the seat motor demo (x1, x4 its default timestep, 15 ms): x1 is the reference and passes,
     x4 (1.24 x the explicit limit) runs away and is classified as divergence; the record says so."""
-    rec = stability_edge("seat_motor_demo", factors=(1, 4), duration_s=0.015,
-                         overrides=("drive.ramp_s=0.002", "load.ramp_s=0.002"))
-    for k in ("scenario", "default_timestep_s", "stable_limit_s", "last_stable_timestep_s", "last_stable_factor",
-              "failure", "failed_timestep_s", "failure_message", "runs", "tolerances"):
+    rec = stability_edge(
+        "seat_motor_demo", factors=(1, 4), duration_s=0.015, overrides=("drive.ramp_s=0.002", "load.ramp_s=0.002")
+    )
+    for k in (
+        "scenario",
+        "default_timestep_s",
+        "stable_limit_s",
+        "last_stable_timestep_s",
+        "last_stable_factor",
+        "failure",
+        "failed_timestep_s",
+        "failure_message",
+        "runs",
+        "tolerances",
+    ):
         assert k in rec, k
     h0 = rec["default_timestep_s"]
     assert h0 == pytest.approx(5e-6) and h0 < rec["stable_limit_s"] < 4 * h0
@@ -177,7 +207,7 @@ def test_stability_edge_records_the_last_stable_timestep_and_the_failure():
     assert second["timestep_s"] == pytest.approx(4 * h0) and second["timestep_over_limit"] > 1
     assert rec["last_stable_timestep_s"] == pytest.approx(h0) and rec["last_stable_factor"] == 1
     assert rec["failure"] == "diverged" and rec["failed_timestep_s"] == pytest.approx(4 * h0)
-    json.dumps(rec)                                          # bench_meta.json-ready
+    json.dumps(rec)  # bench_meta.json-ready
 
 
 def test_bench_writes_the_stability_record_into_bench_meta(tmp_path, monkeypatch):
@@ -187,8 +217,15 @@ def test_bench_writes_the_stability_record_into_bench_meta(tmp_path, monkeypatch
     from wormsim.bench import run as bench
 
     monkeypatch.setattr(bench, "bench_cases", lambda *args: [])
-    monkeypatch.setattr(bench, "stability_map", lambda *args: {"seat_motor_demo": stability_edge(
-        "seat_motor_demo", factors=(4,), duration_s=0.002, overrides=("drive.ramp_s=0.002", "load.ramp_s=0.002"))})
+    monkeypatch.setattr(
+        bench,
+        "stability_map",
+        lambda *args: {
+            "seat_motor_demo": stability_edge(
+                "seat_motor_demo", factors=(4,), duration_s=0.002, overrides=("drive.ramp_s=0.002", "load.ramp_s=0.002")
+            )
+        },
+    )
     bench.run_bench(quick=True, out_dir=tmp_path, models=("contact3d",))
     rec = json.loads((tmp_path / "bench_meta.json").read_text())["stability"]["seat_motor_demo"]
     assert rec["last_stable_timestep_s"] is None and rec["failure"] == "diverged"

@@ -1,5 +1,6 @@
 """Contact law of contact3d (wormsim.contact3d.law): the mapping's numbers, friction, and the static mesh
 stiffness the MuJoCo model actually shows under a known torque (within 5 % of the specified)."""
+
 from __future__ import annotations
 
 import math
@@ -26,7 +27,7 @@ def test_hertz_default_follows_seed_001_formula():
 def test_friction_static_to_dynamic_step():
     c = Contact(friction_static=0.08, friction_dynamic=0.05, transition_velocity_m_s=1e-3)
     assert friction_coefficient(c, 0.0) == pytest.approx(0.08)
-    assert friction_coefficient(c, 5e-4) == pytest.approx(0.065)       # STEP midpoint
+    assert friction_coefficient(c, 5e-4) == pytest.approx(0.065)  # STEP midpoint
     assert friction_coefficient(c, 0.5) == pytest.approx(0.05)
     g = Contact(friction_group="III")
     assert math.degrees(math.atan(friction_coefficient(g, 0.0))) == pytest.approx(1 / 0.088, rel=1e-6)
@@ -47,8 +48,8 @@ def _contacts(bm, d):
             continue
         n = np.array(c.frame[:3])
         if m.geom_bodyid[c.geom[1]] == bm.worm_body:
-            n = -n                                            # normal pushing the wheel
-        arm = c.pos[0] * n[1] - c.pos[1] * n[0]               # moment arm about the wheel axis z
+            n = -n  # normal pushing the wheel
+        arm = c.pos[0] * n[1] - c.pos[1] * n[0]  # moment arm about the wheel axis z
         out.append((float(d.efc_force[c.efc_address]), -float(c.dist), arm))
     return np.array(out)
 
@@ -57,9 +58,18 @@ def _contacts(bm, d):
 def static_mesh():
     """Worm held by its speed servo at 0 rpm, frictionless, two wheel torques; returns measurements.
     The torques are close (21, 24 N m) so that the set of contacts barely changes between them."""
-    sc = load_scenario(SCEN / "seat_motor.yaml", ["drive.speed_rpm=0", "drive.ramp_s=0", "load.ramp_s=0",
-                                                  "simulation.resolution=coarse", "contact.friction=0",
-                                                  "contact.friction_static=null", "contact.friction_dynamic=null"])
+    sc = load_scenario(
+        SCEN / "seat_motor.yaml",
+        [
+            "drive.speed_rpm=0",
+            "drive.ramp_s=0",
+            "load.ramp_s=0",
+            "simulation.resolution=coarse",
+            "contact.friction=0",
+            "contact.friction_static=null",
+            "contact.friction_dynamic=null",
+        ],
+    )
     bm = build_model(sc)
     m = bm.model
     d = mujoco.MjData(m)
@@ -89,7 +99,7 @@ def test_static_mesh_stiffness_per_pair_within_5_percent(static_mesh):
     stiffness the model shows."""
     bm, out = static_mesh
     (Ta, tha, Ca, _), (Tb, thb, Cb, vmax) = out
-    assert vmax < 1e-3                                        # at rest
+    assert vmax < 1e-3  # at rest
     k_theta = (Tb - Ta) / abs(thb - tha)
     arm2 = 0.5 * (np.sum(Ca[Ca[:, 0] > 1e-3, 2] ** 2) + np.sum(Cb[Cb[:, 0] > 1e-3, 2] ** 2))
     k_pair = k_theta * bm.law.contacts_per_pair / arm2

@@ -1,4 +1,5 @@
 """The contact3d MuJoCo model: standalone MJCF, contact filtering, collision window, guards."""
+
 from __future__ import annotations
 
 import math
@@ -38,8 +39,9 @@ def test_only_tooth_contact_couples_the_shafts(seat):
 def test_window_cost_does_not_grow_with_tooth_count():
     n = []
     for z2 in (40, 120):
-        bm = build_model(load_scenario(SCEN / "involute_41.yaml",
-                                       COARSE + [f"gear.wheel_teeth={z2}", "gear.worm_length_mm=120"]))
+        bm = build_model(
+            load_scenario(SCEN / "involute_41.yaml", COARSE + [f"gear.wheel_teeth={z2}", "gear.worm_length_mm=120"])
+        )
         n.append((bm.window_teeth, bm.wheel_slot_geoms.size))
     assert n[0] == n[1]
 
@@ -59,9 +61,17 @@ def test_window_repose_places_the_tooth_k_pieces(seat):
     want = np.array([[c, -sn, 0], [sn, c, 0], [0, 0, 1]]) @ piece.vertices.T
     # the compiled mesh is recentred: compare the hull's centre of mass
     got_centre = d.geom_xpos[gid]
-    assert np.linalg.norm(got_centre - piece.copy().apply_transform(
-        np.block([[np.array([[c, -sn, 0], [sn, c, 0], [0, 0, 1]]), np.zeros((3, 1))], [np.zeros((1, 3)), 1]])
-    ).center_mass) < 1e-6
+    assert (
+        np.linalg.norm(
+            got_centre
+            - piece.copy()
+            .apply_transform(
+                np.block([[np.array([[c, -sn, 0], [sn, c, 0], [0, 0, 1]]), np.zeros((3, 1))], [np.zeros((1, 3)), 1]])
+            )
+            .center_mass
+        )
+        < 1e-6
+    )
     assert want.shape[0] == 3
     repose_window(seat, 0.0)
 
@@ -81,8 +91,17 @@ def test_write_model_is_standalone(tmp_path, name):
 
 
 def test_too_large_timestep_stops_with_a_diagnosis():
-    sc = load_scenario(SCEN / "seat_motor.yaml", COARSE + ["simulation.timestep_s=2e-4", "simulation.duration_s=0.05",
-                                                           "drive.speed_rpm=1800", "drive.ramp_s=0.01", "load.ramp_s=0.01"])
+    sc = load_scenario(
+        SCEN / "seat_motor.yaml",
+        COARSE
+        + [
+            "simulation.timestep_s=2e-4",
+            "simulation.duration_s=0.05",
+            "drive.speed_rpm=1800",
+            "drive.ramp_s=0.01",
+            "load.ramp_s=0.01",
+        ],
+    )
     with pytest.raises(SimulationError, match=r"timestep"):
         simulate(sc)
 
@@ -90,9 +109,19 @@ def test_too_large_timestep_stops_with_a_diagnosis():
 def test_self_locking_worm_creeps_under_1_percent_of_frictionless():
     """rho' = atan(0.1 / cos 10 deg) = 5.8 deg > gamma = 4.79 deg: a torque on the wheel must not turn the
     free worm; without friction the same torque spins it up."""
-    base = ["drive.on=wheel", "drive.torque_nm=12", "drive.speed_rpm=null", "drive.ramp_s=0.002", "load.on=worm",
-            "load.torque_nm=0", "load.ramp_s=0", "simulation.duration_s=0.003", "simulation.resolution=coarse",
-            "contact.friction_static=null", "contact.friction_dynamic=null"]
+    base = [
+        "drive.on=wheel",
+        "drive.torque_nm=12",
+        "drive.speed_rpm=null",
+        "drive.ramp_s=0.002",
+        "load.on=worm",
+        "load.torque_nm=0",
+        "load.ramp_s=0",
+        "simulation.duration_s=0.003",
+        "simulation.resolution=coarse",
+        "contact.friction_static=null",
+        "contact.friction_dynamic=null",
+    ]
     # 3 ms: the frictionless worm reaches 54000 rpm (0.028 rad per 5e-6 s step); by 4.1 ms it turns faster than
     # contact3d resolves and the overspeed guard stops the run (docs/stability_speed.md). Measured: 0.064 rpm at mu 0.1
     speeds = {}
@@ -111,16 +140,38 @@ def test_run_writes_summary_series_report_and_3d_recording(tmp_path):
 
     sc = load_scenario(SCEN / "seat_motor_demo.yaml", ["simulation.duration_s=0.03"])
     summary = run_scenario(sc, tmp_path / "out", progress=False)
-    keys = ["ratio", "ratio_theory", "mesh_frequency_hz", "mesh_frequency_theory_hz", "tangential_force_mean_n",
-            "tangential_force_p2p_n", "radial_force_mean_n", "axial_force_mean_n", "worm_torque_mean_nm",
-            "wheel_torque_mean_nm", "worm_speed_mean_rpm", "wheel_speed_mean_rpm", "efficiency", "steady_window_s",
-            "efficiency_theory", "timestep_s", "resolution", "contacts_mean"]
+    keys = [
+        "ratio",
+        "ratio_theory",
+        "mesh_frequency_hz",
+        "mesh_frequency_theory_hz",
+        "tangential_force_mean_n",
+        "tangential_force_p2p_n",
+        "radial_force_mean_n",
+        "axial_force_mean_n",
+        "worm_torque_mean_nm",
+        "wheel_torque_mean_nm",
+        "worm_speed_mean_rpm",
+        "wheel_speed_mean_rpm",
+        "efficiency",
+        "steady_window_s",
+        "efficiency_theory",
+        "timestep_s",
+        "resolution",
+        "contacts_mean",
+    ]
     assert summary["status"] == "ok" and all(k in summary for k in keys)
     for f in ("summary.json", "timeseries.npz", "report.png", "recording.rrd"):
         assert (tmp_path / "out" / f).stat().st_size > 0
     ents = recorded_entities(tmp_path / "out" / "recording.rrd")
-    for e in ("/assembly/worm", "/assembly/wheel", "/assembly/worm/mesh", "/assembly/contacts/points",
-              "/assembly/contacts/forces", "/series/tangential_force_n"):
+    for e in (
+        "/assembly/worm",
+        "/assembly/wheel",
+        "/assembly/worm/mesh",
+        "/assembly/contacts/points",
+        "/assembly/contacts/forces",
+        "/series/tangential_force_n",
+    ):
         assert e in ents, sorted(ents)[:20]
 
 

@@ -8,6 +8,7 @@ z1 n1 / 60; torque balance: mean tangential force x r2 within 2 % of the load to
 3 % of the wedge model's tan(g) / tan(g + rho'). Failing physics stays strict and is marked xfail with
 the measured numbers (see docs/contact3d.md).
 """
+
 from __future__ import annotations
 
 import pytest
@@ -17,11 +18,20 @@ from wormsim.contact3d.runner import simulate
 from wormsim.scenario import load_scenario
 
 CI = {
-    "seat_motor": ["drive.speed_rpm=1800", "drive.ramp_s=0.02", "load.ramp_s=0.02", "simulation.duration_s=0.25",
-                   "simulation.resolution=medium"],
-    "screw_jack": ["drive.ramp_s=0.02", "load.ramp_s=0.02", "simulation.duration_s=0.35", "simulation.resolution=medium"],
-    "involute_41": ["drive.ramp_s=0.02", "load.ramp_s=0.02", "simulation.duration_s=0.3",
-                    "simulation.resolution=fine"],
+    "seat_motor": [
+        "drive.speed_rpm=1800",
+        "drive.ramp_s=0.02",
+        "load.ramp_s=0.02",
+        "simulation.duration_s=0.25",
+        "simulation.resolution=medium",
+    ],
+    "screw_jack": [
+        "drive.ramp_s=0.02",
+        "load.ramp_s=0.02",
+        "simulation.duration_s=0.35",
+        "simulation.resolution=medium",
+    ],
+    "involute_41": ["drive.ramp_s=0.02", "load.ramp_s=0.02", "simulation.duration_s=0.3", "simulation.resolution=fine"],
 }
 _CACHE: dict[str, dict] = {}
 
@@ -46,17 +56,17 @@ def test_ratio_within_0p1_percent(name):
 # measured on this CI configuration (docs/contact3d.md): kept strict, marked as expected failures
 MESH_XFAIL = {
     "involute_41": "F_t peak 771 Hz against z1 n1/60 = 24.14 Hz, bin 4.0 Hz (1137.5 Hz with the runner of "
-                   "stop 6): the 41-tooth bronze wheel's mesh mode (5.4e9 N/m Hertz contact, 10 % critical damping) rings "
-                   "at ~0.8-1.1 kHz with p2p 55 kN on a 13.8 kN mean, above the meshing component; the radial force "
-                   "does show 24.4 Hz (test below)",
+    "stop 6): the 41-tooth bronze wheel's mesh mode (5.4e9 N/m Hertz contact, 10 % critical damping) rings "
+    "at ~0.8-1.1 kHz with p2p 55 kN on a 13.8 kN mean, above the meshing component; the radial force "
+    "does show 24.4 Hz (test below)",
 }
 EFF_XFAIL = {
     "seat_motor": "efficiency 0.600 against tan(g)/tan(g+rho') = 0.620 at the pitch radius (-3.2 %): the contacts sit "
-                  "on the worm above its pitch radius (force-weighted 4.40 mm against r1 4.19 mm; the wheel is 58 % "
-                  "undercut), where the local lead angle is smaller; the same formula at each contact's own radius "
-                  "gives 0.609 (test below). Finer pieces resolve it further: coarse / medium / fine 0.605 / 0.600 / "
-                  "0.592. Not the rattle (driven-machine inertia 1e-4 kg m^2: 0.605) and not back-flank friction "
-                  "(back-flank contacts carry 0.0 % of |F_t|)",
+    "on the worm above its pitch radius (force-weighted 4.40 mm against r1 4.19 mm; the wheel is 58 % "
+    "undercut), where the local lead angle is smaller; the same formula at each contact's own radius "
+    "gives 0.609 (test below). Finer pieces resolve it further: coarse / medium / fine 0.605 / 0.600 / "
+    "0.592. Not the rattle (driven-machine inertia 1e-4 kg m^2: 0.605) and not back-flank friction "
+    "(back-flank contacts carry 0.0 % of |F_t|)",
 }
 
 
@@ -67,11 +77,19 @@ def assert_mesh_frequency(s: dict, key: str) -> None:
     assert (w1 - w0) * s["mesh_frequency_theory_hz"] >= 5, ("steady window too short for the FFT", w0, w1)
     tol = max(0.01 * s["mesh_frequency_theory_hz"], s["mesh_frequency_resolution_hz"])
     assert abs(s[key] - s["mesh_frequency_theory_hz"]) <= tol, (
-        s[key], s["mesh_frequency_theory_hz"], s["mesh_frequency_resolution_hz"])
+        s[key],
+        s["mesh_frequency_theory_hz"],
+        s["mesh_frequency_resolution_hz"],
+    )
 
 
-@pytest.mark.parametrize("name", [pytest.param(n, marks=pytest.mark.xfail(reason=MESH_XFAIL[n], strict=True))
-                                  if n in MESH_XFAIL else n for n in SEEDS])
+@pytest.mark.parametrize(
+    "name",
+    [
+        pytest.param(n, marks=pytest.mark.xfail(reason=MESH_XFAIL[n], strict=True)) if n in MESH_XFAIL else n
+        for n in SEEDS
+    ],
+)
 def test_mesh_frequency(name):
     assert_mesh_frequency(run(name)["summary"], "mesh_frequency_hz")
 
@@ -93,8 +111,13 @@ def test_torque_balance_within_2_percent(name):
     assert abs(s["tangential_force_mean_n"] * r2 / sc.load.torque_nm - 1) < 0.02, s["tangential_force_mean_n"]
 
 
-@pytest.mark.parametrize("name", [pytest.param(n, marks=pytest.mark.xfail(reason=EFF_XFAIL[n], strict=True))
-                                  if n in EFF_XFAIL else n for n in SEEDS])
+@pytest.mark.parametrize(
+    "name",
+    [
+        pytest.param(n, marks=pytest.mark.xfail(reason=EFF_XFAIL[n], strict=True)) if n in EFF_XFAIL else n
+        for n in SEEDS
+    ],
+)
 def test_efficiency_within_3_percent_of_wedge(name):
     s = run(name)["summary"]
     assert abs(s["efficiency"] / s["efficiency_theory"] - 1) < 0.03, (s["efficiency"], s["efficiency_theory"])
@@ -102,21 +125,29 @@ def test_efficiency_within_3_percent_of_wedge(name):
 
 RADIAL_XFAIL = {
     "seat_motor": "line-of-centres radial force 237.6 N against DIN 3975's 229.1 N (+3.7 %; the plain resultant gives "
-                  "225 N, -1.8 %): with alpha_n 10 deg the radial force is the smallest component, and the 58 % "
-                  "undercut wheel leaves contacts whose normals are not the pitch-point normal turned about the worm "
-                  "axis; not explained further",
+    "225 N, -1.8 %): with alpha_n 10 deg the radial force is the smallest component, and the 58 % "
+    "undercut wheel leaves contacts whose normals are not the pitch-point normal turned about the worm "
+    "axis; not explained further",
 }
 
 
-@pytest.mark.parametrize("name", [pytest.param(n, marks=pytest.mark.xfail(reason=RADIAL_XFAIL[n], strict=True))
-                                  if n in RADIAL_XFAIL else n for n in SEEDS])
+@pytest.mark.parametrize(
+    "name",
+    [
+        pytest.param(n, marks=pytest.mark.xfail(reason=RADIAL_XFAIL[n], strict=True)) if n in RADIAL_XFAIL else n
+        for n in SEEDS
+    ],
+)
 def test_radial_force_on_the_line_of_centres_is_din_3975(name):
     """Each contact's force turned about the worm axis onto the line of centres, summed, against DIN 3975's
     F_r2 = F_t2 tan(alpha_n) cos(rho') / cos(gamma + rho') within 3 % (wormsim.contact3d.metrics.radial_force_check). The plain
     resultant's radial component is lower (screw jack about -13 %): the contacts sit around the worm at +-20-30 deg."""
     s = run(name)["summary"]
     assert abs(s["radial_force_line_of_centres_mean_n"] / s["radial_force_theory_n"] - 1) < 0.03, (
-        s["radial_force_line_of_centres_mean_n"], s["radial_force_theory_n"], s["radial_force_mean_n"])
+        s["radial_force_line_of_centres_mean_n"],
+        s["radial_force_theory_n"],
+        s["radial_force_mean_n"],
+    )
 
 
 @pytest.mark.parametrize("name", SEEDS)
@@ -126,4 +157,7 @@ def test_efficiency_within_3_percent_of_wedge_at_the_contact_radius(name):
     (wormsim.contact3d.metrics.contact_radius_check). Not a looser check: it moves the theory to the contact, not the bound."""
     s = run(name)["summary"]
     assert abs(s["efficiency"] / s["efficiency_theory_at_contact_radius"] - 1) < 0.03, (
-        s["efficiency"], s["efficiency_theory_at_contact_radius"], s["worm_contact_radius_mean_m"])
+        s["efficiency"],
+        s["efficiency_theory_at_contact_radius"],
+        s["worm_contact_radius_mean_m"],
+    )

@@ -2,6 +2,7 @@
 configurations (slices by simulation.resolution: seat_motor and screw_jack 16, involute_41 32), same criteria: ratio
 0.1 %, meshing frequency, torque balance 2 %, efficiency within 3 % of the wedge model at the pitch radius and at the
 contact radius, DIN 3975 radial force 3 %. Measured numbers of the expected failures in docs/contact3d.md."""
+
 from __future__ import annotations
 
 import pytest
@@ -25,14 +26,14 @@ def run(name: str) -> dict:
 
 MESH_XFAIL = {
     "seat_motor": "F_t's largest peak is the 3rd meshing harmonic: 89.9 Hz against z1 n1/60 = 29.97 Hz (p2p 51.5 N on "
-                  "1289 N, since the line-end interpolation of flanks.slice_weights; before it the bursts put the peak "
-                  "at 29.97 Hz); the radial force peaks at the meshing frequency (test below)",
+    "1289 N, since the line-end interpolation of flanks.slice_weights; before it the bursts put the peak "
+    "at 29.97 Hz); the radial force peaks at the meshing frequency (test below)",
     "screw_jack": "F_t's largest peak is the 3rd meshing harmonic: 66.4 Hz against z1 n1/60 = 22.14 Hz (p2p 28.4 N on "
-                  "400 N); the radial force peaks at 22.15 Hz (test below). The exact flanks' mesh stiffness has a 3rd "
-                  "harmonic of 0.35 of the 1st (wormsim.torsional.mesh_stiffness TCA); pieces showed 22 Hz under "
-                  "their facet noise",
+    "400 N); the radial force peaks at 22.15 Hz (test below). The exact flanks' mesh stiffness has a 3rd "
+    "harmonic of 0.35 of the 1st (wormsim.torsional.mesh_stiffness TCA); pieces showed 22 Hz under "
+    "their facet noise",
     "involute_41": "F_t peak 1087 Hz against 24.14 Hz: the 41-tooth wheel's mesh mode rings (p2p 55 kN on 13.8 kN), "
-                   "as with pieces (tests/test_contact3d_seeds.py); the radial force shows 24.19 Hz",
+    "as with pieces (tests/test_contact3d_seeds.py); the radial force shows 24.19 Hz",
 }
 
 

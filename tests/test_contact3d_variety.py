@@ -4,6 +4,7 @@ simulating (wormsim.contact3d.backlash.check_conjugate_interference) with the re
 
 Short runs (0.03 s at 1000 rpm: two mesh periods of a 4-start worm, half a worm turn) at coarse resolution; the ratio
 is checked to the CI tolerance (0.1 %) and torque balance (F_t r2 = load) to 2 %."""
+
 from __future__ import annotations
 
 from pathlib import Path
@@ -19,10 +20,14 @@ from wormsim.scenario import ScenarioError, load_scenario
 GEAR = Path(__file__).resolve().parent / "assets" / "other_gear.yaml"
 
 
-@pytest.mark.parametrize("overrides", [
-    ("gear.worm_starts=4", "gear.wheel_teeth=41"),          # gamma 21.8 deg, ratio 10.25
-    ("gear.hand=left", "gear.profile=ZA"),                  # 2/30, left-hand straight-sided axial profile
-], ids=["4-start", "left-ZA"])
+@pytest.mark.parametrize(
+    "overrides",
+    [
+        ("gear.worm_starts=4", "gear.wheel_teeth=41"),  # gamma 21.8 deg, ratio 10.25
+        ("gear.hand=left", "gear.profile=ZA"),  # 2/30, left-hand straight-sided axial profile
+    ],
+    ids=["4-start", "left-ZA"],
+)
 def test_other_gears_transmit_the_ratio_and_the_load(overrides):
     sc = load_scenario(GEAR, list(overrides))
     g = derive(sc.gear)
@@ -31,7 +36,7 @@ def test_other_gears_transmit_the_ratio_and_the_load(overrides):
     assert abs(s["tangential_force_mean_n"] * g.r2 / sc.load.torque_nm - 1) < 0.02, s["tangential_force_mean_n"]
 
 
-WIDE = ["gear.wheel_teeth=80", "gear.worm_starts=1", "gear.diameter_quotient=16"]   # b2 50 mm, m_x 4 mm
+WIDE = ["gear.wheel_teeth=80", "gear.worm_starts=1", "gear.diameter_quotient=16"]  # b2 50 mm, m_x 4 mm
 
 
 def test_interfering_coarse_pieces_are_refused_before_simulating_with_the_cure(tmp_path, capsys):
@@ -41,7 +46,10 @@ def test_interfering_coarse_pieces_are_refused_before_simulating_with_the_cure(t
     with pytest.raises(ScenarioError, match="simulation.resolution medium") as exc:
         build_model(load_scenario(GEAR, WIDE))
     assert "interfere" in str(exc.value) and "gear.backlash_mm" in str(exc.value)
-    assert main(["run", str(GEAR), "--out", str(tmp_path / "r"), "--no-progress"] + sum((["--set", o] for o in WIDE), [])) == 2
+    assert (
+        main(["run", str(GEAR), "--out", str(tmp_path / "r"), "--no-progress"] + sum((["--set", o] for o in WIDE), []))
+        == 2
+    )
     assert "simulation.resolution medium" in capsys.readouterr().err
     bm = build_model(load_scenario(GEAR, WIDE + ["simulation.resolution=medium"]))
     assert bm.meta["conjugate_interference_m"] == 0.0
@@ -56,23 +64,36 @@ def test_interfering_coarse_pieces_are_refused_before_simulating_with_the_cure(t
 
 FAST = ["drive.speed_rpm=3000", "contact.geometry=flanks"]
 FLANK_GEARS = {
-    "4-start-z41": ["gear.worm_starts=4", "gear.wheel_teeth=41", "simulation.duration_s=0.05"],          # gamma 21.8
-    "left-ZA": ["gear.hand=left", "gear.profile=ZA", "simulation.duration_s=0.07"],                      # 11.3
-    "left-q6-4start": ["gear.hand=left", "gear.worm_starts=4", "gear.diameter_quotient=6", "gear.wheel_teeth=37",
-                       "drive.speed_rpm=1500", "simulation.duration_s=0.07"],                            # 33.7
-    "wide-z80-q16": WIDE + ["simulation.duration_s=0.12"],                                               # 3.58
-    "ZA-a25-z60-3start": ["gear.profile=ZA", "gear.normal_pressure_angle_deg=25", "gear.wheel_teeth=60",
-                          "gear.worm_starts=3", "simulation.duration_s=0.05"],                           # 16.7
-    "narrow-b8": ["gear.face_width_mm=8", "simulation.duration_s=0.08"],                                 # 11.3
+    "4-start-z41": ["gear.worm_starts=4", "gear.wheel_teeth=41", "simulation.duration_s=0.05"],  # gamma 21.8
+    "left-ZA": ["gear.hand=left", "gear.profile=ZA", "simulation.duration_s=0.07"],  # 11.3
+    "left-q6-4start": [
+        "gear.hand=left",
+        "gear.worm_starts=4",
+        "gear.diameter_quotient=6",
+        "gear.wheel_teeth=37",
+        "drive.speed_rpm=1500",
+        "simulation.duration_s=0.07",
+    ],  # 33.7
+    "wide-z80-q16": WIDE + ["simulation.duration_s=0.12"],  # 3.58
+    "ZA-a25-z60-3start": [
+        "gear.profile=ZA",
+        "gear.normal_pressure_angle_deg=25",
+        "gear.wheel_teeth=60",
+        "gear.worm_starts=3",
+        "simulation.duration_s=0.05",
+    ],  # 16.7
+    "narrow-b8": ["gear.face_width_mm=8", "simulation.duration_s=0.08"],  # 11.3
 }
-HARMONIC = ("F_t's largest peak is a meshing harmonic at 8 slices (the contact lines' slice steps; no rattle since "
-            "the flank contacts' friction rows have their own damping, wormsim.contact3d.law (4)): ")
+HARMONIC = (
+    "F_t's largest peak is a meshing harmonic at 8 slices (the contact lines' slice steps; no rattle since "
+    "the flank contacts' friction rows have their own damping, wormsim.contact3d.law (4)): "
+)
 FLANK_MESH_XFAIL = {
     "left-ZA": HARMONIC + "499.5 Hz (5th) against 99.9 Hz, p2p 77 N on 833 N, 13.0 contacts (16 slices: 199.8 Hz)",
     "wide-z80-q16": HARMONIC + "349.7 Hz (7th) against 49.9 Hz, p2p 36 N on 312 N, 12.6 contacts",
     "ZA-a25-z60-3start": HARMONIC + "449.6 Hz (3rd) against 149.8 Hz, p2p 40 N on 416 N, 12.4 contacts",
     "narrow-b8": HARMONIC + "599.4 Hz (6th) against 99.9 Hz, p2p 115 N on 833 N, 14.9 contacts (with c_f = c_c it "
-                 "passed at 100.2 Hz only through a half rattle at the mesh frequency: 7.3 contacts, p2p 2.5 kN)",
+    "passed at 100.2 Hz only through a half rattle at the mesh frequency: 7.3 contacts, p2p 2.5 kN)",
 }
 _FLANK_RUNS: dict[str, tuple] = {}
 
@@ -91,11 +112,20 @@ def test_flanks_other_gears_ratio_torque_balance_and_efficiency(name):
     assert abs(s["ratio"] / (g.z2 / g.z1) - 1) < 1e-3, s["ratio"]
     assert abs(s["tangential_force_mean_n"] * g.r2 / sc.load.torque_nm - 1) < 0.02, s["tangential_force_mean_n"]
     assert abs(s["efficiency"] / s["efficiency_theory_at_contact_radius"] - 1) < 0.03, (
-        s["efficiency"], s["efficiency_theory_at_contact_radius"])
+        s["efficiency"],
+        s["efficiency_theory_at_contact_radius"],
+    )
 
 
-@pytest.mark.parametrize("name", [pytest.param(n, marks=pytest.mark.xfail(reason=FLANK_MESH_XFAIL[n], strict=True))
-                                  if n in FLANK_MESH_XFAIL else n for n in FLANK_GEARS])
+@pytest.mark.parametrize(
+    "name",
+    [
+        pytest.param(n, marks=pytest.mark.xfail(reason=FLANK_MESH_XFAIL[n], strict=True))
+        if n in FLANK_MESH_XFAIL
+        else n
+        for n in FLANK_GEARS
+    ],
+)
 def test_flanks_other_gears_mesh_frequency(name):
     from test_contact3d_seeds import assert_mesh_frequency
 
@@ -114,9 +144,11 @@ def test_flanks_no_friction_driven_rattle(monkeypatch):
     base = FAST + ["gear.hand=left", "gear.profile=ZA", "simulation.duration_s=0.04"]
     s_0 = simulate(load_scenario(GEAR, base + ["contact.friction=0"])).summary
     assert s_0["contacts_mean"] > 8 and s_mu["contacts_mean"] > 0.8 * s_0["contacts_mean"], (
-        s_0["contacts_mean"], s_mu["contacts_mean"])
+        s_0["contacts_mean"],
+        s_mu["contacts_mean"],
+    )
     assert s_mu["tangential_force_p2p_n"] < 0.2 * s_mu["tangential_force_mean_n"], s_mu["tangential_force_p2p_n"]
-    monkeypatch.setattr(law, "EPS_SLIP", float("inf"))       # c_f = c_c: the friction rows damped as the normal row
+    monkeypatch.setattr(law, "EPS_SLIP", float("inf"))  # c_f = c_c: the friction rows damped as the normal row
     s_cc = simulate(load_scenario(GEAR, base)).summary
     assert s_cc["contacts_mean"] < 0.5 * s_0["contacts_mean"], s_cc["contacts_mean"]
     assert abs(s_0["ratio"] / 15 - 1) < 1e-3
@@ -146,8 +178,23 @@ def test_flanks_no_grid_point_is_cut_by_the_worm():
     for th1 in np.linspace(0, 2 * math.pi / g.z1, 60, endpoint=False):
         th2 = g.hand * th1 * g.z1 / g.z2
         ks = window_teeth_at(th2, g.z2, W, -math.pi / 2 + math.pi / g.z2).astype(np.int64)
-        n = F.find_contacts(fg.xy, fg.c, fg.c_range, fg.span, fg.zeta, ks, th1, th2 - g.hand * 2 * bl,
-                            F.MARGIN_PITCH * pitch + 3 * bl, fg.params, pos, nrm, dep, meta, line)
+        n = F.find_contacts(
+            fg.xy,
+            fg.c,
+            fg.c_range,
+            fg.span,
+            fg.zeta,
+            ks,
+            th1,
+            th2 - g.hand * 2 * bl,
+            F.MARGIN_PITCH * pitch + 3 * bl,
+            fg.params,
+            pos,
+            nrm,
+            dep,
+            meta,
+            line,
+        )
         deepest.append(dep[:n].max())
     assert max(deepest) < 1.02 * expected and min(deepest) > 0.98 * expected, (min(deepest), max(deepest), expected)
 
@@ -156,10 +203,24 @@ def test_flanks_self_locking_worm_creeps():
     """z1 1, q 16: gamma 3.58 deg. With mu 0.1 (rho' = atan(0.1 / cos 20 deg) = 6.07 deg > gamma) a torque on the
     wheel must not turn the free worm (under 1 % of the frictionless speed); without friction it spins it up.
     Measured after 6 ms: 0.022 rpm at mu 0.1, 167 rpm frictionless."""
-    base = FAST + WIDE + ["drive.on=wheel", "drive.torque_nm=500", "drive.speed_rpm=null", "drive.ramp_s=0.002",
-                          "load.on=worm", "load.torque_nm=0", "load.ramp_s=0", "simulation.duration_s=0.006"]
-    speeds = {mu: abs(simulate(load_scenario(GEAR, base + [f"contact.friction={mu}"])).series["worm_speed_rpm"][-1])
-              for mu in (0.1, 0.0)}
+    base = (
+        FAST
+        + WIDE
+        + [
+            "drive.on=wheel",
+            "drive.torque_nm=500",
+            "drive.speed_rpm=null",
+            "drive.ramp_s=0.002",
+            "load.on=worm",
+            "load.torque_nm=0",
+            "load.ramp_s=0",
+            "simulation.duration_s=0.006",
+        ]
+    )
+    speeds = {
+        mu: abs(simulate(load_scenario(GEAR, base + [f"contact.friction={mu}"])).series["worm_speed_rpm"][-1])
+        for mu in (0.1, 0.0)
+    }
     assert speeds[0.0] > 10.0
     assert speeds[0.1] < 0.01 * speeds[0.0], speeds
 
@@ -167,8 +228,12 @@ def test_flanks_self_locking_worm_creeps():
 def test_flanks_undercut_wheel_is_refused(tmp_path, capsys):
     """z2 20 at alpha_n 10 deg: undercut beyond the limit, refused with exit 2 and one line (not simulated)."""
     args = ["run", str(GEAR), "--out", str(tmp_path / "r"), "--no-progress"]
-    for o in ["contact.geometry=flanks", "gear.wheel_teeth=20", "gear.normal_pressure_angle_deg=10",
-              "gear.worm_starts=1"]:
+    for o in [
+        "contact.geometry=flanks",
+        "gear.wheel_teeth=20",
+        "gear.normal_pressure_angle_deg=10",
+        "gear.worm_starts=1",
+    ]:
         args += ["--set", o]
     assert main(args) == 2
     err = capsys.readouterr().err

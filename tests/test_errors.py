@@ -1,6 +1,7 @@
 """Assembly errors and manufacturing deviations (issue 12): limits, the displaced pair's geometry, the kinematic TCA
 (meshgen.kinematic_tca) against a first-order theory on the perfect pair's contact lines, and the torsional level.
 Numbers and derivations: docs/errors.md."""
+
 from __future__ import annotations
 
 import math
@@ -66,15 +67,30 @@ def line_theory(g, th1s, side, disp):
 
 # ----------------------------------------------------------------------------- zero errors
 
+
 def test_zero_errors_take_the_perfect_pairs_path_bit_identically():
     from wormsim.run import simulate
 
     base = ["model=torsional", "simulation.duration_s=0.1"]
-    zeros = [f"errors.{k}=0" for k in ("center_distance_mm", "shaft_angle_deg", "wheel_axial_offset_mm",
-                                        "worm_axial_offset_mm", "wheel_runout_mm", "worm_runout_mm")]
+    zeros = [
+        f"errors.{k}=0"
+        for k in (
+            "center_distance_mm",
+            "shaft_angle_deg",
+            "wheel_axial_offset_mm",
+            "worm_axial_offset_mm",
+            "wheel_runout_mm",
+            "worm_runout_mm",
+        )
+    ]
     a = simulate(load_scenario(SCEN / "screw_jack.yaml", base))
-    b = simulate(load_scenario(SCEN / "screw_jack.yaml", base + zeros + ["errors.wheel_runout_phase_deg=40",
-                                                                           "errors.wheel_pitch_deviation_um=[0, 0]"]))
+    b = simulate(
+        load_scenario(
+            SCEN / "screw_jack.yaml",
+            base + zeros + ["errors.wheel_runout_phase_deg=40", "errors.wheel_pitch_deviation_um=[0, 0]"],
+        )
+    )
+
     def drop(s):
         return {k: v for k, v in s.items() if "wall" not in k}
 
@@ -99,7 +115,7 @@ def test_perfect_pair_play_is_the_backlash_and_te_is_flat():
     # j / 2 per flank: 25 um of the 0.05 mm backlash, from the exact flanks to within the grid refinement (nm)
     assert np.max(np.abs(res.gap_fwd_rad * g.r2 - g.backlash / 2)) < 5e-9
     assert np.max(np.abs(res.play_m(g) - g.backlash)) < 1e-8
-    assert np.ptp(res.te_rad(1)) < 0.5e-6       # measured 0.14 urad (grid refinement), against 2149 urad for 20 um runout
+    assert np.ptp(res.te_rad(1)) < 0.5e-6  # measured 0.14 urad (grid refinement), against 2149 urad for 20 um runout
 
 
 def test_worm_axial_offset_is_a_phase_only():
@@ -111,16 +127,20 @@ def test_worm_axial_offset_is_a_phase_only():
 
 # ----------------------------------------------------------------------------- limits (exit 2)
 
-@pytest.mark.parametrize("key,value,words", [
-    ("center_distance_mm", 0.8, "addendum"),                # (4) h_a = 0.70 mm
-    ("center_distance_mm", -0.15, "radial approach"),       # (3) 0.1405 mm (tip clearance)
-    ("wheel_runout_mm", 0.15, "radial approach"),
-    ("worm_runout_mm", 0.15, "radial approach"),
-    ("shaft_angle_deg", 0.6, "asin(j / b2)"),               # (5) 0.573 deg
-    ("wheel_axial_offset_mm", 0.4, "throat"),               # (6) 0.357 mm
-    ("worm_axial_offset_mm", 1.2, "threaded length"),       # (7) 1.10 mm
-    ("wheel_pitch_deviation_um", [0, 26], "flank clearance"),   # (8) 25 um
-])
+
+@pytest.mark.parametrize(
+    "key,value,words",
+    [
+        ("center_distance_mm", 0.8, "addendum"),  # (4) h_a = 0.70 mm
+        ("center_distance_mm", -0.15, "radial approach"),  # (3) 0.1405 mm (tip clearance)
+        ("wheel_runout_mm", 0.15, "radial approach"),
+        ("worm_runout_mm", 0.15, "radial approach"),
+        ("shaft_angle_deg", 0.6, "asin(j / b2)"),  # (5) 0.573 deg
+        ("wheel_axial_offset_mm", 0.4, "throat"),  # (6) 0.357 mm
+        ("worm_axial_offset_mm", 1.2, "threaded length"),  # (7) 1.10 mm
+        ("wheel_pitch_deviation_um", [0, 26], "flank clearance"),  # (8) 25 um
+    ],
+)
 def test_errors_beyond_their_limit_are_rejected_naming_it(key, value, words):
     sc, g = _gear("seat_motor", [f"errors.{key}={value}"])
     with pytest.raises(GeometryError) as exc:
@@ -141,9 +161,24 @@ def test_errors_within_each_limit_but_interfering_together_are_rejected():
 
 
 def test_cli_exit_2_names_the_limit(tmp_path):
-    p = subprocess.run([sys.executable, "-m", "wormsim.cli", "run", str(SCEN / "seat_motor.yaml"), "--out",
-                        str(tmp_path / "o"), "--set", "model=torsional", "--set", "errors.shaft_angle_deg=1"],
-                       capture_output=True, text=True, timeout=120)
+    p = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "wormsim.cli",
+            "run",
+            str(SCEN / "seat_motor.yaml"),
+            "--out",
+            str(tmp_path / "o"),
+            "--set",
+            "model=torsional",
+            "--set",
+            "errors.shaft_angle_deg=1",
+        ],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert p.returncode == 2, p.stderr
     assert "errors.shaft_angle_deg" in p.stderr and "Traceback" not in p.stderr
 
@@ -155,10 +190,12 @@ def test_wedge_rejects_errors():
 
 # ----------------------------------------------------------------------------- centre distance -> backlash
 
+
 @pytest.mark.parametrize("da_mm", [0.01, -0.01])
 def test_center_distance_changes_the_play_as_the_line_theory_predicts(da_mm):
     g, res = _tca("seat_motor", [f"errors.center_distance_mm={da_mm}"])
     da = da_mm * 1e-3
+
     def up(th1, P):  # the wheel seen from the worm: +y
         return np.tile([0.0, da, 0.0], (len(P), 1))
 
@@ -173,6 +210,7 @@ def test_center_distance_changes_the_play_as_the_line_theory_predicts(da_mm):
 
 # ----------------------------------------------------------------------------- runout
 
+
 @pytest.fixture(scope="module")
 def runout():
     return _tca("screw_jack", ["errors.wheel_runout_mm=0.02"], samples_per_mesh=8)
@@ -185,6 +223,7 @@ def test_wheel_runout_gives_te_2e_over_r2_and_the_line_theory_shape(runout):
     # rough rule 2 e / r2 = 1333 urad; measured 1398.7 (the radial swing adds e tan(alpha) on the flank)
     assert np.ptp(te) == pytest.approx(2 * e / g.r2, rel=0.06)
     th2 = g.hand * res.theta1_rad * g.z1 / g.z2
+
     # the pitch circle's centre, turning with the wheel: a translation of the wheel (phase 0)
     def disp(th1, P):
         a = g.hand * th1 * g.z1 / g.z2
@@ -197,10 +236,10 @@ def test_wheel_runout_gives_te_2e_over_r2_and_the_line_theory_shape(runout):
 
 def test_wheel_runout_gives_sidebands_at_f_mesh_plus_minus_f_wheel(runout):
     g, res = runout
-    n = len(res.theta1_rad)                     # one wheel revolution: FFT bins are wheel orders
+    n = len(res.theta1_rad)  # one wheel revolution: FFT bins are wheel orders
     amp = np.abs(np.fft.rfft(res.te_rad(1))) * 2 / n
-    mesh = g.z2                                 # the mesh frequency is order z2 of the wheel (z1 threads per worm turn)
-    background = np.median(amp[3:n // 2])
+    mesh = g.z2  # the mesh frequency is order z2 of the wheel (z1 threads per worm turn)
+    background = np.median(amp[3 : n // 2])
     # measured (urad): order 1: 696; 23: 2.64, 24: 3.19, 25: 2.60; background 0.033
     assert amp[mesh - 1] > 30 * background and amp[mesh + 1] > 30 * background
     assert 0.5 < amp[mesh - 1] / amp[mesh + 1] < 2
@@ -220,6 +259,7 @@ def test_pitch_deviation_steps_te_while_that_tooth_meshes():
     assert np.all(np.diff(idx) == 1)
     th2 = g.hand * res.theta1_rad[idx] * g.z1 / g.z2
     from meshgen import wheel
+
     cross = (-math.pi / 2 - wheel.tooth_angle(g, k)) % (2 * math.pi)
     assert abs(np.mean(th2) - cross) < 2 * math.pi / g.z2
     # the opposite flank does not see a tooth shifted away from it (its neighbours carry): flat
@@ -227,6 +267,7 @@ def test_pitch_deviation_steps_te_while_that_tooth_meshes():
 
 
 # ----------------------------------------------------------------------------- contact pattern
+
 
 def test_wheel_axial_offset_moves_the_pattern_across_the_face_symmetrically():
     g, ref = _tca("seat_motor")
@@ -244,12 +285,14 @@ def test_wheel_axial_offset_moves_the_pattern_across_the_face_symmetrically():
 
 # ----------------------------------------------------------------------------- torsional with errors
 
+
 def test_torsional_reports_te_with_runout_and_its_sidebands():
     from wormsim.metrics import dominant_frequency
     from wormsim.run import simulate
 
-    sc = load_scenario(SCEN / "screw_jack.yaml", ["model=torsional", "simulation.duration_s=7.5",
-                                                  "errors.wheel_runout_mm=0.02"])
+    sc = load_scenario(
+        SCEN / "screw_jack.yaml", ["model=torsional", "simulation.duration_s=7.5", "errors.wheel_runout_mm=0.02"]
+    )
     r = simulate(sc)
     s, S = r.summary, r.series
     g = derive(sc.gear)
@@ -260,8 +303,9 @@ def test_torsional_reports_te_with_runout_and_its_sidebands():
     fm = s["mesh_frequency_theory_hz"]
     fw = fm / g.z2
     t = S["t_s"]
-    sl = t > t[-1] - 6 / fw                     # the last 6 wheel revolutions: bins of fw / 6
+    sl = t > t[-1] - 6 / fw  # the last 6 wheel revolutions: bins of fw / 6
     _, df, f, amp = dominant_frequency(t[sl], S["transmission_error_rad"][sl])
+
     def near(x):
         return amp[int(np.argmin(np.abs(f - x)))]
 
@@ -273,16 +317,24 @@ def test_torsional_reports_te_with_runout_and_its_sidebands():
 
 # ----------------------------------------------------------------------------- contact3d
 
+
 def test_contact3d_hinges_and_teeth_follow_the_displaced_geometry():
     import mujoco
 
     from wormsim.contact3d.mjcf import build_model
     from wormsim.contact3d.window import repose_window
 
-    sets = ["simulation.resolution=coarse", "errors.center_distance_mm=0.02", "errors.shaft_angle_deg=0.05",
-            "errors.wheel_axial_offset_mm=0.03", "errors.wheel_runout_mm=0.01", "errors.wheel_runout_phase_deg=30",
-            "errors.worm_runout_mm=0.005", "errors.worm_axial_offset_mm=0.2",
-            "errors.wheel_pitch_deviation_um=[0, 10, -5]"]
+    sets = [
+        "simulation.resolution=coarse",
+        "errors.center_distance_mm=0.02",
+        "errors.shaft_angle_deg=0.05",
+        "errors.wheel_axial_offset_mm=0.03",
+        "errors.wheel_runout_mm=0.01",
+        "errors.wheel_runout_phase_deg=30",
+        "errors.worm_runout_mm=0.005",
+        "errors.worm_axial_offset_mm=0.2",
+        "errors.wheel_pitch_deviation_um=[0, 10, -5]",
+    ]
     sc = load_scenario(SCEN / "seat_motor.yaml", sets)
     bm = build_model(sc)
     g, dev = bm.geometry, displaced.Deviations.from_data(sc.errors)
@@ -291,8 +343,10 @@ def test_contact3d_hinges_and_teeth_follow_the_displaced_geometry():
         d.qpos[m.jnt_qposadr[m.dof_jntid[bm.worm_dof]]] = th1
         d.qpos[m.jnt_qposadr[m.dof_jntid[bm.wheel_dof]]] = th2
         mujoco.mj_kinematics(m, d)
-        for body, T in ((bm.worm_body, displaced.worm_to_assembly(g, dev, th1)),
-                        (bm.wheel_body, displaced.wheel_to_assembly(g, dev, th2))):
+        for body, T in (
+            (bm.worm_body, displaced.worm_to_assembly(g, dev, th1)),
+            (bm.wheel_body, displaced.wheel_to_assembly(g, dev, th2)),
+        ):
             assert np.allclose(d.xpos[body], T[:3, 3], atol=1e-15)
             assert np.allclose(d.xmat[body].reshape(3, 3), T[:3, :3], atol=1e-14)
     # tooth k's slot turned by 2 pi k / z2 + f_k / r2

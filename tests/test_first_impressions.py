@@ -1,4 +1,5 @@
 """What a new user sees first (issue 10): `wormsim mesh`'s printout and a model.xml that moves in the viewer."""
+
 from __future__ import annotations
 
 import math
@@ -28,6 +29,6 @@ def test_model_xml_turns_the_worm_with_zero_controls(tmp_path):
         mujoco.mj_step(m, d)
     worm = m.joint("worm_hinge").dofadr[0]
     wheel = m.joint("wheel_hinge").dofadr[0]
-    w_cmd = 600 * 2 * math.pi / 60           # minimal_contact3d.yaml: drive.speed_rpm 600 on the worm
+    w_cmd = 600 * 2 * math.pi / 60  # minimal_contact3d.yaml: drive.speed_rpm 600 on the worm
     assert abs(d.qvel[worm]) == pytest.approx(w_cmd, rel=0.02)
-    assert abs(d.qvel[wheel]) == pytest.approx(w_cmd / 30, rel=0.1)   # 30 teeth, 1 start: the wheel is driven
+    assert abs(d.qvel[wheel]) == pytest.approx(w_cmd / 30, rel=0.1)  # 30 teeth, 1 start: the wheel is driven

@@ -1,6 +1,7 @@
 """Exact-flank contact of contact3d (wormsim.contact3d.flanks, flank_step): the kernel's distance is meshgen.worm's closed
 form, the rigid conjugate pose touches with the backlash as the only gap, and the MuJoCo model built on flank contacts
 shows the specified tooth-pair stiffness (issue 13: within 5 %, as tests/test_contact3d_law.py for pieces)."""
+
 from __future__ import annotations
 
 import math
@@ -39,12 +40,16 @@ def test_kernel_distance_is_meshgen_thread_gap(name, profile):
     for side in (+1, -1):
         q = worm.flank_points(g, 0.5 * (g.r_f1 + g.r_a1), 0.3, side)
         R = np.array([[math.cos(th1), math.sin(th1), 0], [-math.sin(th1), math.cos(th1), 0], [0, 0, 1.0]])
-        x, y, zz = R.T @ q                       # the flank turned with the worm by theta1
+        x, y, zz = R.T @ q  # the flank turned with the worm by theta1
         assert abs(F.worm_gap(x, y, zz, th1, P, out)) < 1e-12
         e = 1e-9
-        grad = np.array([F.worm_gap(x + e * (i == 0), y + e * (i == 1), zz + e * (i == 2), th1, P, np.zeros(6))
-                         - F.worm_gap(x - e * (i == 0), y - e * (i == 1), zz - e * (i == 2), th1, P, np.zeros(6))
-                         for i in range(3)]) / (2 * e)
+        grad = np.array(
+            [
+                F.worm_gap(x + e * (i == 0), y + e * (i == 1), zz + e * (i == 2), th1, P, np.zeros(6))
+                - F.worm_gap(x - e * (i == 0), y - e * (i == 1), zz - e * (i == 2), th1, P, np.zeros(6))
+                for i in range(3)
+            ]
+        ) / (2 * e)
         assert np.allclose(out[:3], grad, atol=1e-5)
 
 
@@ -66,12 +71,42 @@ def test_conjugate_pose_touches_across_the_backlash(name):
         th2c = g.hand * th1 * g.z1 / g.z2
         ks = window_teeth_at(th2c, g.z2, W, tooth0).astype(np.int64)
         for s in (-0.95, 0.95):
-            n = F.find_contacts(fg.xy, fg.c, fg.c_range, fg.span, fg.zeta, ks, th1, th2c + s * bl,
-                                F.MARGIN_PITCH * pitch + 3 * bl, fg.params, pos, nrm, dep, meta, np.zeros((len(dep), 2)))
+            n = F.find_contacts(
+                fg.xy,
+                fg.c,
+                fg.c_range,
+                fg.span,
+                fg.zeta,
+                ks,
+                th1,
+                th2c + s * bl,
+                F.MARGIN_PITCH * pitch + 3 * bl,
+                fg.params,
+                pos,
+                nrm,
+                dep,
+                meta,
+                np.zeros((len(dep), 2)),
+            )
             assert n == 0, (th1, s, dep[:n].max())
         for s, flank in ((-2.0, 0), (2.0, 1)):
-            n = F.find_contacts(fg.xy, fg.c, fg.c_range, fg.span, fg.zeta, ks, th1, th2c + g.hand * s * bl,
-                                F.MARGIN_PITCH * pitch + 3 * bl, fg.params, pos, nrm, dep, meta, np.zeros((len(dep), 2)))
+            n = F.find_contacts(
+                fg.xy,
+                fg.c,
+                fg.c_range,
+                fg.span,
+                fg.zeta,
+                ks,
+                th1,
+                th2c + g.hand * s * bl,
+                F.MARGIN_PITCH * pitch + 3 * bl,
+                fg.params,
+                pos,
+                nrm,
+                dep,
+                meta,
+                np.zeros((len(dep), 2)),
+            )
             assert n >= 8 and np.all(meta[:n, 1] == flank)
             assert dep[:n].max() == pytest.approx(bl * arm0, rel=0.05)
 
@@ -88,9 +123,18 @@ def static_flanks():
     """Worm held at 0 rpm by its servo, frictionless, wheel torques 21 and 24 N m (tests/test_contact3d_law.py)."""
     from wormsim.contact3d.flank_step import FlankContacts, split_forward
 
-    sc = load_scenario(SCEN / "seat_motor.yaml", ["drive.speed_rpm=0", "drive.ramp_s=0", "load.ramp_s=0",
-                                                  "contact.geometry=flanks", "contact.friction=0",
-                                                  "contact.friction_static=null", "contact.friction_dynamic=null"])
+    sc = load_scenario(
+        SCEN / "seat_motor.yaml",
+        [
+            "drive.speed_rpm=0",
+            "drive.ramp_s=0",
+            "load.ramp_s=0",
+            "contact.geometry=flanks",
+            "contact.friction=0",
+            "contact.friction_static=null",
+            "contact.friction_dynamic=null",
+        ],
+    )
     bm = build_model(sc)
     m = bm.model
     d = mujoco.MjData(m)
@@ -104,7 +148,7 @@ def static_flanks():
         for i in range(d.ncon):
             c = d.contact[i]
             n = np.array(c.frame[:3])
-            w = float(c.solref[0] / bm.law.solref[0])       # the contact's share of its slice (slice_weights)
+            w = float(c.solref[0] / bm.law.solref[0])  # the contact's share of its slice (slice_weights)
             C.append((float(d.efc_force[c.efc_address]), -float(c.dist), c.pos[0] * n[1] - c.pos[1] * n[0], w))
         out.append((T, float(rel), np.array(C), float(np.abs(d.qvel).max())))
     return bm, out
@@ -127,5 +171,7 @@ def test_flank_static_mesh_stiffness_per_pair_within_5_percent(static_flanks):
     k_theta = (Tb - Ta) / abs(thb - tha)
     arm2 = 0.5 * sum(np.sum(C[C[:, 0] > 1e-3, 3] * C[C[:, 0] > 1e-3, 2] ** 2) for C in (Ca, Cb))
     k_pair = k_theta * bm.law.contacts_per_pair / arm2
-    print(f"flank tooth-pair stiffness {k_pair:.6g} N/m against K = {bm.law.pair_stiffness_n_per_m:.6g} ({len(Cb)} contacts)")
+    print(
+        f"flank tooth-pair stiffness {k_pair:.6g} N/m against K = {bm.law.pair_stiffness_n_per_m:.6g} ({len(Cb)} contacts)"
+    )
     assert k_pair == pytest.approx(bm.law.pair_stiffness_n_per_m, rel=0.05)

@@ -1,6 +1,7 @@
 """The path contact3d's exact flanks use to reach MuJoCo's solver (wormsim.contact3d.flank_step.split_step): a 1 kg
 box on two slide joints (x, z) above a plane, MuJoCo's collision off for both, one contact added by hand each step
 between mj_collision and mj_makeConstraint with the contact law's direct solref (wormsim.contact3d.law (1))."""
+
 from __future__ import annotations
 
 import math
@@ -15,8 +16,8 @@ XML = """<mujoco><option timestep="1e-3" integrator="implicitfast" cone="ellipti
 <worldbody><geom name="floor" type="plane" size="1 1 .1" contype="0" conaffinity="0"/>
 <body name="box" pos="0 0 0.1"><joint name="x" type="slide" axis="1 0 0"/><joint name="z" type="slide" axis="0 0 1"/>
 <geom name="b" type="box" size=".1 .1 .1" mass="1" contype="0" conaffinity="0"/></body></worldbody></mujoco>"""
-K = 1.0e5           # N/m
-D = 0.01            # impedance (wormsim.contact3d.law.IMPEDANCE)
+K = 1.0e5  # N/m
+D = 0.01  # impedance (wormsim.contact3d.law.IMPEDANCE)
 MU = 0.3
 G = 9.81
 
@@ -24,7 +25,7 @@ G = 9.81
 def _box(impratio: float = 1.0):
     m = mujoco.MjModel.from_xml_string(XML)
     m.opt.impratio = impratio
-    m.body_invweight0[1, 0] = 1.0              # A_hat = 1 / (1 kg), as wormsim.contact3d.mjcf sets it
+    m.body_invweight0[1, 0] = 1.0  # A_hat = 1 / (1 kg), as wormsim.contact3d.mjcf sets it
     d = mujoco.MjData(m)
     c_c = 0.1 * 2 * math.sqrt(K * 1.0)
     t = mujoco.MjContact()
@@ -32,7 +33,7 @@ def _box(impratio: float = 1.0):
     t.geom = [0, 1]
     t.geom1, t.geom2 = 0, 1
     t.flex = t.elem = t.vert = [-1, -1]
-    t.solref = [-K * (1 - D), -c_c * (1 - D)]   # law (1): S = k (1 - d) A_hat, B = c (1 - d) A_hat
+    t.solref = [-K * (1 - D), -c_c * (1 - D)]  # law (1): S = k (1 - d) A_hat, B = c (1 - d) A_hat
     t.solreffriction = [0.0, 0.0]
     t.solimp = [D, D, 0.001, 0.5, 2.0]
     t.friction = [MU, MU, 0, 0, 0]
@@ -59,7 +60,7 @@ def test_static_normal_force_is_the_weight_and_penetration_the_solref_mapping():
 
 
 def test_sliding_deceleration_is_mu_g():
-    m, d, add = _box(impratio=100.0)      # friction saturates above v_reg = mu f_n / (impratio c_c) ~ 5e-4 m/s
+    m, d, add = _box(impratio=100.0)  # friction saturates above v_reg = mu f_n / (impratio c_c) ~ 5e-4 m/s
     for _ in range(2000):
         split_step(m, d, add)
     d.qvel[0] = 1.0

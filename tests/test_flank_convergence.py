@@ -38,8 +38,10 @@ def _per_step(name: str, half: bool = False) -> dict:
 
 
 SLICES_XFAIL = {
-    "screw_jack": ("16 -> 32 slices: F_t p2p 14.5 -> 6.3 N (-57 %) since the friction rows' own damping "
-                   "(wormsim.contact3d.law (4)) removed the sliding-driven normal force; before it 28.4 -> 28.6 N"),
+    "screw_jack": (
+        "16 -> 32 slices: F_t p2p 14.5 -> 6.3 N (-57 %) since the friction rows' own damping "
+        "(wormsim.contact3d.law (4)) removed the sliding-driven normal force; before it 28.4 -> 28.6 N"
+    ),
     "seat_motor": "16 -> 32 slices: F_t p2p 51.5 -> 22.4 N (-56 %), TE p2p 226 -> 252 urad (+11 %)",
 }
 

@@ -3,6 +3,7 @@ maps the wheel flanks through the displaced bodies as MuJoCo places them. Checks
 path gives the nominal kernel's contacts (1e-12), and with each error the kernel's first touch is where the kinematic
 TCA (meshgen.kinematic_tca: meshgen.displaced's transforms and meshgen.worm.thread_gap, no MuJoCo) puts it. Loaded
 runs: docs/errors.md, "Loaded, exact flanks"."""
+
 from __future__ import annotations
 
 import math
@@ -43,7 +44,7 @@ def test_pose_path_with_the_nominal_poses_gives_the_nominal_contacts():
     g = bm.geometry
     total = 0
     for th1 in np.linspace(0.0, 2 * math.pi, 7):
-        for s in (-2.0, 0.5, 2.0):          # wheel turned from the conjugate angle by s backlash angles
+        for s in (-2.0, 0.5, 2.0):  # wheel turned from the conjugate angle by s backlash angles
             _pose(bm, d, fc0, th1, g.hand * th1 * g.z1 / g.z2 + s * g.backlash / (2 * g.r2))
             n = fc0.find(d)
             assert fc1.find(d) == n
@@ -135,11 +136,23 @@ def test_a_shifted_tooth_meshes_as_the_tooth_turned_by_its_pitch_deviation():
 
 # seat motor at 4 N m: its mesh approach (max penetration, measured 5.7 um) is about the kinematic TCA's marking film
 # (6 um), so the loaded pattern is comparable with the kinematic one; short and coarse for CI (3600 rpm: 60 Hz mesh)
-LIGHT = ["contact.geometry=flanks", "drive.speed_rpm=3600", "drive.ramp_s=0.01", "load.ramp_s=0.01",
-         "simulation.duration_s=0.06", "simulation.resolution=coarse", "load.torque_nm=4"]
+LIGHT = [
+    "contact.geometry=flanks",
+    "drive.speed_rpm=3600",
+    "drive.ramp_s=0.01",
+    "load.ramp_s=0.01",
+    "simulation.duration_s=0.06",
+    "simulation.resolution=coarse",
+    "load.torque_nm=4",
+]
 # screw jack at its own speed and load, short and coarse
-JACK = ["contact.geometry=flanks", "drive.ramp_s=0.02", "load.ramp_s=0.02", "simulation.duration_s=0.1",
-        "simulation.resolution=coarse"]
+JACK = [
+    "contact.geometry=flanks",
+    "drive.ramp_s=0.02",
+    "load.ramp_s=0.02",
+    "simulation.duration_s=0.1",
+    "simulation.resolution=coarse",
+]
 _RUNS: dict = {}
 
 
@@ -208,10 +221,14 @@ def test_shaft_angle_moves_the_pattern_along_the_face_and_raises_the_peak_pressu
     assert rise == pytest.approx(math.sqrt(narrow), rel=0.2)
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "seat motor, shaft angle 0.3 deg at 4 N m: contact_pressure_max_mpa 253 MPa against 318 MPa without it (mean "
-    "108 against 79 MPa; at 24 N m 765 against 791 MPa): the maximum sits in every run at the cell next to the "
-    "undercut (face -0.31 mm, rho' 0.18 mm against a median 4.5 mm), which the tilt unloads (docs/errors.md, sec. 6)"))
+@pytest.mark.xfail(
+    strict=True,
+    reason=(
+        "seat motor, shaft angle 0.3 deg at 4 N m: contact_pressure_max_mpa 253 MPa against 318 MPa without it (mean "
+        "108 against 79 MPa; at 24 N m 765 against 791 MPa): the maximum sits in every run at the cell next to the "
+        "undercut (face -0.31 mm, rho' 0.18 mm against a median 4.5 mm), which the tilt unloads (docs/errors.md, sec. 6)"
+    ),
+)
 def test_seat_motor_shaft_angle_raises_the_peak_pressure():
     _, r0 = _run("seat_motor", tuple(LIGHT))
     _, r = _run("seat_motor", tuple(LIGHT + ["errors.shaft_angle_deg=0.3"]))

@@ -2,6 +2,7 @@
 the relative radius of curvature rho' of (1) against an independent fit of the two surfaces, the Hertz formula, and
 the run outputs (keys, symmetry of the screw jack's pattern, report and recording) on the cached CI runs of
 tests/test_contact3d_seeds_flanks.py."""
+
 from __future__ import annotations
 
 import math
@@ -41,8 +42,9 @@ def rho_rel_by_surface_fit(g, zeta, rho, c, side):
     start = int(round((u - s * float(worm.half_thickness(g, r0))) / g.p_x))
     # the normal: the gradient of the thread's implicit form, numerically (static frame)
     e = 1e-8
-    grad = np.array([(worm.thread_gap(g, P0 + e * d, th1) - worm.thread_gap(g, P0 - e * d, th1)) / (2 * e)
-                     for d in np.eye(3)])
+    grad = np.array(
+        [(worm.thread_gap(g, P0 + e * d, th1) - worm.thread_gap(g, P0 - e * d, th1)) / (2 * e) for d in np.eye(3)]
+    )
     n = grad / np.linalg.norm(grad)
     e1 = np.cross(n, [1.0, 0, 0])
     e1 /= np.linalg.norm(e1)
@@ -55,10 +57,10 @@ def rho_rel_by_surface_fit(g, zeta, rho, c, side):
     qs = worm.flank_points(g, r0 + b.ravel(), phi0 + a.ravel() / r0, s, start)
     c1, s1 = math.cos(th1), math.sin(th1)
     Pq = np.column_stack([c1 * qs[:, 0] - s1 * qs[:, 1], s1 * qs[:, 0] + c1 * qs[:, 1], qs[:, 2]]) - P0
-    assert np.max(np.abs(Pq @ n)) < 0.2 * hh          # the thread patch lies on the tangent plane (same point)
+    assert np.max(np.abs(Pq @ n)) < 0.2 * hh  # the thread patch lies on the tangent plane (same point)
     Hq = _quad_hessian(np.column_stack([Pq @ e1, Pq @ e2]), Pq @ n)
     lam, V = np.linalg.eigh(Hw - Hq)
-    t = V[0, 0] * e1 + V[1, 0] * e2              # the contact line (static worm frame; wheel axis z = -y_s)
+    t = V[0, 0] * e1 + V[1, 0] * e2  # the contact line (static worm frame; wheel axis z = -y_s)
     return 1.0 / lam[1], lam, abs(t[1])
 
 
@@ -72,8 +74,8 @@ def test_relative_curvature_matches_a_fit_of_the_two_surfaces(name):
         for i in (act[len(act) // 4], act[len(act) // 2], act[3 * len(act) // 4]):
             ref, lam, tz = rho_rel_by_surface_fit(g, fg.zeta[j], fg.rho[j, i], fg.c[0, j, i], +1)
             got = 1.0 / cv.inv_rho[0, j, i]
-            assert abs(lam[0]) < 0.02 * lam[1], lam             # a line contact: one ~zero eigenvalue
-            assert abs(got / ref - 1) < 2e-3, (j, i, got, ref)    # measured: within 3e-4
+            assert abs(lam[0]) < 0.02 * lam[1], lam  # a line contact: one ~zero eigenvalue
+            assert abs(got / ref - 1) < 2e-3, (j, i, got, ref)  # measured: within 3e-4
             assert abs(cv.line_tz[0, j, i] - tz) < 0.01, (j, i, cv.line_tz[0, j, i], tz)
 
 
@@ -99,12 +101,18 @@ def test_hertz_line_pressure_is_johnsons_p0():
     R, w = 0.01, 1e5
     a = math.sqrt(4 * w * R / (math.pi * E))
     assert FO.hertz_line_pressure_pa(w, E, 1 / R) == pytest.approx(2 * w / (math.pi * a), rel=1e-12)
-    assert FO.hertz_line_pressure_pa(w, E, 1 / R) == pytest.approx(606.2e6, rel=1e-3)   # by hand
+    assert FO.hertz_line_pressure_pa(w, E, 1 / R) == pytest.approx(606.2e6, rel=1e-3)  # by hand
 
 
-KEYS = ("contact_pattern_centroid_face_mm", "contact_pattern_centroid_radius_mm", "contact_pattern_extent_face_mm",
-        "contact_pressure_max_mpa", "contact_pressure_mean_mpa", "contact_pressure_max_face_mm",
-        "contact_pressure_max_radius_mm")
+KEYS = (
+    "contact_pattern_centroid_face_mm",
+    "contact_pattern_centroid_radius_mm",
+    "contact_pattern_extent_face_mm",
+    "contact_pressure_max_mpa",
+    "contact_pressure_mean_mpa",
+    "contact_pressure_max_face_mm",
+    "contact_pressure_max_radius_mm",
+)
 
 
 @pytest.mark.parametrize("name", ["seat_motor", "screw_jack", "involute_41"])
@@ -148,9 +156,16 @@ def test_report_and_recording_show_the_pattern(tmp_path):
     from wormsim.contact3d.runner import simulate
     from wormsim.recording import recorded_data, recorded_entities
 
-    sc = load_scenario(SCENARIOS / "screw_jack.yaml", [
-        "contact.geometry=flanks", "drive.ramp_s=0.01", "load.ramp_s=0.01", "simulation.duration_s=0.03",
-        "simulation.resolution=medium"])
+    sc = load_scenario(
+        SCENARIOS / "screw_jack.yaml",
+        [
+            "contact.geometry=flanks",
+            "drive.ramp_s=0.01",
+            "load.ramp_s=0.01",
+            "simulation.duration_s=0.03",
+            "simulation.resolution=medium",
+        ],
+    )
     res = simulate(sc)
     s, grid = res.summary, res.extra["flank_pattern"]
     fig, ax = plt.subplots()
@@ -158,7 +173,7 @@ def test_report_and_recording_show_the_pattern(tmp_path):
     pcs = [c for c in ax.collections if isinstance(c, PolyCollection)]
     assert len(pcs) == 1 and len(pcs[0].get_array()) > 10
     assert float(pcs[0].get_array().max()) == pytest.approx(s["contact_pressure_max_mpa"], rel=1e-9)
-    assert "pressure" in fig.axes[-1].get_ylabel()               # the colour bar
+    assert "pressure" in fig.axes[-1].get_ylabel()  # the colour bar
     plt.close(fig)
     write_report(res, tmp_path / "report.png")
     assert (tmp_path / "report.png").stat().st_size > 10_000

@@ -1,4 +1,5 @@
 """Friction angle of seed 000: rho(Vs) = 1 / (a Vs^b + c) deg (table "Approximated formulae ...")."""
+
 import math
 
 import numpy as np

@@ -1,4 +1,5 @@
 """Derived gear dimensions (meshgen/geometry.py) against hand calculations from DIN 3975 relations."""
+
 import math
 
 import pytest
@@ -10,15 +11,15 @@ from wormsim.scenario import Gear
 def test_seed_001_seat_motor():
     # seed 001: m_n 0.7 mm, 53/1, alpha_n 10 deg, gamma 4.79 deg
     g = derive(Gear(wheel_teeth=53, normal_module_mm=0.7, normal_pressure_angle_deg=10, lead_angle_deg=4.79))
-    m_x = 0.7e-3 / math.cos(math.radians(4.79))                   # 0.70245 mm
+    m_x = 0.7e-3 / math.cos(math.radians(4.79))  # 0.70245 mm
     assert g.m_x == pytest.approx(m_x, rel=1e-12)
-    assert g.d1 == pytest.approx(m_x / math.tan(math.radians(4.79)), rel=1e-12)   # 8.383 mm
+    assert g.d1 == pytest.approx(m_x / math.tan(math.radians(4.79)), rel=1e-12)  # 8.383 mm
     assert g.d2 == pytest.approx(53 * m_x) and g.a == pytest.approx((g.d1 + g.d2) / 2)
     assert g.d1 * 1e3 == pytest.approx(8.383, abs=1e-3) and g.a * 1e3 == pytest.approx(22.806, abs=1e-3)
     # base lead angle: cos(gamma_b) = cos(gamma) cos(alpha_n) -> 11.08 deg (seed 003 relation)
     assert math.degrees(g.gamma_b) == pytest.approx(11.0775, abs=1e-3)
     assert g.r_b == pytest.approx(g.p / math.tan(g.gamma_b))
-    assert g.p == pytest.approx(g.r1 * math.tan(g.gamma))          # helix parameter = lead / 2 pi
+    assert g.p == pytest.approx(g.r1 * math.tan(g.gamma))  # helix parameter = lead / 2 pi
     assert g.ratio == 53
 
 

@@ -7,6 +7,7 @@ tests/assets/mass_scaling_reference.json with the command that made it; `python 
 again. Configuration: the seat motor with flanks at 180 rpm (3 Hz meshing frequency), 0.1 s ramps, 1.2 s: a steady
 window of three mesh periods.
 """
+
 from __future__ import annotations
 
 import json
@@ -26,8 +27,13 @@ from wormsim.gear_theory import round_down_125
 from wormsim.scenario import ScenarioError, load_scenario
 
 SEAT = SCENARIOS / "seat_motor.yaml"
-CFG = ["contact.geometry=flanks", "drive.speed_rpm=180", "drive.ramp_s=0.1", "load.ramp_s=0.1",
-       "simulation.duration_s=1.2"]
+CFG = [
+    "contact.geometry=flanks",
+    "drive.speed_rpm=180",
+    "drive.ramp_s=0.1",
+    "load.ramp_s=0.1",
+    "simulation.duration_s=1.2",
+]
 REF = ROOT / "tests" / "assets" / "mass_scaling_reference.json"
 _CACHE: dict[str, dict] = {}
 
@@ -74,24 +80,37 @@ def test_inertias_go_through_the_contact_law():
     assert p.inertias.wheel_inertia_kg_m2 == pytest.approx(300 * p1.inertias.wheel_inertia_kg_m2, rel=1e-12)
     assert b.inv_mass_hat == pytest.approx(a.inv_mass_hat / 300, rel=1e-12)
     assert b.contact_damping_n_s_per_m == pytest.approx(a.contact_damping_n_s_per_m * math.sqrt(300), rel=1e-9)
-    assert b.impratio * b.contact_damping_n_s_per_m == pytest.approx(a.impratio * a.contact_damping_n_s_per_m,
-                                                                     rel=1e-9)
+    assert b.impratio * b.contact_damping_n_s_per_m == pytest.approx(a.impratio * a.contact_damping_n_s_per_m, rel=1e-9)
     assert b.stable_limit_s == pytest.approx(a.stable_limit_s * math.sqrt(300), rel=1e-9)
 
 
 def test_summary_states_the_factor_of_an_unscaled_run_too():
-    s = simulate(load_scenario(SEAT, ["contact.geometry=flanks", "drive.speed_rpm=1800", "drive.ramp_s=0.005",
-                                      "load.ramp_s=0.005", "simulation.duration_s=0.015"])).summary
+    s = simulate(
+        load_scenario(
+            SEAT,
+            [
+                "contact.geometry=flanks",
+                "drive.speed_rpm=1800",
+                "drive.ramp_s=0.005",
+                "load.ramp_s=0.005",
+                "simulation.duration_s=0.015",
+            ],
+        )
+    ).summary
     assert s["mass_scaling"] == 1
     assert 0 < s["kinetic_energy_share"] < 1
 
 
 REFUSED = {
-    "mesh mode": (["drive.speed_rpm=1800", "drive.ramp_s=0.02", "load.ramp_s=0.02", "simulation.mass_scaling=1000"],
-                  "mesh mode"),
+    "mesh mode": (
+        ["drive.speed_rpm=1800", "drive.ramp_s=0.02", "load.ramp_s=0.02", "simulation.mass_scaling=1000"],
+        "mesh mode",
+    ),
     "short ramp": (["drive.ramp_s=0.05", "load.ramp_s=0.05", "simulation.mass_scaling=10000"], "ramp of 0.05 s"),
-    "kinetic energy": (["drive.speed_rpm=1800", "drive.ramp_s=0.02", "load.ramp_s=0.02",
-                        "simulation.mass_scaling=8"], "kinetic energy"),
+    "kinetic energy": (
+        ["drive.speed_rpm=1800", "drive.ramp_s=0.02", "load.ramp_s=0.02", "simulation.mass_scaling=8"],
+        "kinetic energy",
+    ),
     "pieces facets": (["contact.geometry=pieces", "simulation.mass_scaling=1000"], "convex pieces pass"),
     "torque drive": (["drive.speed_rpm=null", "drive.torque_nm=1", "simulation.mass_scaling=300"], "speed-driven"),
     "torsional": (["model=torsional", "simulation.mass_scaling=300"], "only model contact3d"),
@@ -112,20 +131,25 @@ def test_dynamic_or_invalid_scaling_is_refused_with_exit_2_and_one_line(case, tm
     assert "simulation.mass_scaling" in err and words in err and "Traceback" not in err
 
 
-RING_STEP_S = 3.6e-4     # 1.29 x the scaled stable limit 2.79e-4 s
+RING_STEP_S = 3.6e-4  # 1.29 x the scaled stable limit 2.79e-4 s
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "after main's flank-grid trim (flank_trim.py) the ringing band moved: S = 300, 180 rpm, 0.6 s: 3.4e-4 s runs "
-    "(efficiency 0.6127, KE 0.15 %), 3.5e-4 s 0.6143 / 0.15 %, 3.55e-4 s 0.6140 with KE 9.5 % (just under the 10 % "
-    "guard), 3.6e-4 s now trips the penetration guard at 0.38 s (322 um > 281 um), 3.8e-4 s penetration at 0.016 s: "
-    "no step found in the time left where the ringing guard alone fires"))
+@pytest.mark.xfail(
+    strict=True,
+    reason=(
+        "after main's flank-grid trim (flank_trim.py) the ringing band moved: S = 300, 180 rpm, 0.6 s: 3.4e-4 s runs "
+        "(efficiency 0.6127, KE 0.15 %), 3.5e-4 s 0.6143 / 0.15 %, 3.55e-4 s 0.6140 with KE 9.5 % (just under the 10 % "
+        "guard), 3.6e-4 s now trips the penetration guard at 0.38 s (322 um > 281 um), 3.8e-4 s penetration at 0.016 s: "
+        "no step found in the time left where the ringing guard alone fires"
+    ),
+)
 def test_ringing_guard_fails_a_scaled_run_at_too_large_a_step():
     """Measured at S = 300 (this configuration, 0.6 s): 1.7e-4 s (0.62 of the scaled limit), 2.8e-4 and 3.3e-4 s
     (1.18) run with efficiency 0.6129-0.6133; at 3.6e-4 s (1.29) the kinetic energy is 15.7 % of the work and nothing
     else fires; 3.9e-4 s trips the penetration guard, 5.6e-4 s diverges."""
-    sc = load_scenario(SEAT, CFG + ["simulation.mass_scaling=300", f"simulation.timestep_s={RING_STEP_S}",
-                                    "simulation.duration_s=0.6"])
+    sc = load_scenario(
+        SEAT, CFG + ["simulation.mass_scaling=300", f"simulation.timestep_s={RING_STEP_S}", "simulation.duration_s=0.6"]
+    )
     with pytest.raises(RingingError, match="the mass-scaled run rang"):
         simulate(sc)
 
@@ -136,8 +160,13 @@ def test_ringing_guard_on_efficiency_above_one():
     import numpy as np
 
     t = np.linspace(0.01, 1.0, 100)
-    S = {"t_s": t, "worm_speed_rpm": np.full(100, 180.0), "wheel_speed_rpm": np.full(100, 180 / 53),
-         "worm_power_w": np.full(100, 14.0), "wheel_power_w": np.full(100, -8.6)}
+    S = {
+        "t_s": t,
+        "worm_speed_rpm": np.full(100, 180.0),
+        "wheel_speed_rpm": np.full(100, 180 / 53),
+        "worm_power_w": np.full(100, 14.0),
+        "wheel_power_w": np.full(100, -8.6),
+    }
     sc = load_scenario(SEAT, CFG + ["simulation.mass_scaling=300"])
     c = msm.ScalingCheck(300.0, 555.0, 3.0, 0.1, 0.008, {})
     meta = {"mass_scaling_check": c, "shaft_inertias_kg_m2": (300 * 7.8e-8, 300 * 1.35e-6)}
@@ -155,12 +184,23 @@ def test_ringing_guard_on_efficiency_above_one():
 def _write_reference() -> None:
     cmd = ["wormsim.contact3d.runner.simulate", str(SEAT.relative_to(ROOT)), *CFG, "simulation.mass_scaling=1"]
     s = simulate(load_scenario(SEAT, CFG + ["simulation.mass_scaling=1"])).summary
-    commit = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"], capture_output=True,
-                            text=True).stdout.strip()
-    keep = ("mass_scaling", "timestep_s", "ratio", "efficiency", "tangential_force_mean_n", "steady_window_s",
-            "kinetic_energy_share", "contact_geometry", "flank_slices")
-    REF.write_text(json.dumps({"made_by": " ".join(cmd), "commit": commit,
-                               "summary": {k: s[k] for k in keep}}, indent=1) + "\n")
+    commit = subprocess.run(
+        ["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"], capture_output=True, text=True
+    ).stdout.strip()
+    keep = (
+        "mass_scaling",
+        "timestep_s",
+        "ratio",
+        "efficiency",
+        "tangential_force_mean_n",
+        "steady_window_s",
+        "kinetic_energy_share",
+        "contact_geometry",
+        "flank_slices",
+    )
+    REF.write_text(
+        json.dumps({"made_by": " ".join(cmd), "commit": commit, "summary": {k: s[k] for k in keep}}, indent=1) + "\n"
+    )
 
 
 if __name__ == "__main__":

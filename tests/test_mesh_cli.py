@@ -1,4 +1,5 @@
 """`wormsim mesh SCENARIO --out DIR`: files, frames in assembly.json, recording, input errors (exit 2)."""
+
 from __future__ import annotations
 
 import json
@@ -56,13 +57,26 @@ def test_assembly_transforms_consistent():
     assert np.allclose(assembly.wheel_to_assembly(0.2)[:3, :3] @ [1, 0, 0], [math.cos(0.2), math.sin(0.2), 0])
 
 
-@pytest.mark.parametrize("override,field", [
-    ("gear.normal_pressure_angle_deg=6", "gear.normal_pressure_angle_deg"),
-    ("gear.backlash_mm=20", "gear.backlash_mm"),
-])
+@pytest.mark.parametrize(
+    "override,field",
+    [
+        ("gear.normal_pressure_angle_deg=6", "gear.normal_pressure_angle_deg"),
+        ("gear.backlash_mm=20", "gear.backlash_mm"),
+    ],
+)
 def test_mesh_command_input_error_exit_2(override, field, tmp_path, capsys):
-    code = main(["mesh", str(ROOT / "scenarios" / "involute_41.yaml"), "--out", str(tmp_path / "o"),
-                 "--set", override, "--set", "gear.wheel_teeth=20"])
+    code = main(
+        [
+            "mesh",
+            str(ROOT / "scenarios" / "involute_41.yaml"),
+            "--out",
+            str(tmp_path / "o"),
+            "--set",
+            override,
+            "--set",
+            "gear.wheel_teeth=20",
+        ]
+    )
     assert code == 2
     err = capsys.readouterr().err
     assert field in err

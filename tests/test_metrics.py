@@ -1,4 +1,5 @@
 """wormsim.metrics on synthetic signals whose answers are known in closed form."""
+
 import math
 
 import numpy as np
@@ -10,11 +11,11 @@ from wormsim.metrics import dominant_frequency, steady_window
 
 @pytest.mark.parametrize("f_true", [7.3, 12.0, 31.77])
 def test_fft_peak_interpolation_beats_the_bin(f_true):
-    t = np.arange(0, 2.0, 1e-3)                      # bin 0.5 Hz
+    t = np.arange(0, 2.0, 1e-3)  # bin 0.5 Hz
     x = 5 + 0.2 * t + np.sin(2 * math.pi * f_true * t) + 0.3 * np.sin(2 * math.pi * 3 * f_true * t)
     f, df, _, _ = dominant_frequency(t, x)
     assert df == pytest.approx(0.5, rel=1e-3)
-    assert abs(f - f_true) < 0.1 * df                # Gaussian interpolation on a Hann window
+    assert abs(f - f_true) < 0.1 * df  # Gaussian interpolation on a Hann window
 
 
 def test_fft_search_band_excludes_facet_noise():
@@ -30,7 +31,7 @@ def test_steady_window_starts_after_ramp_and_settling_and_spans_whole_periods():
     speed = np.where(t < 0.5, t / 0.5, 1.0) + 0.3 * np.exp(-(t - 0.5).clip(0) / 0.1) * (t > 0.5)
     speed = speed + 0.01 * np.sin(2 * math.pi * t / period)
     i0, i1 = steady_window(t, speed, 0.5, period)
-    assert t[i0] > 0.5 + 0.2                          # 0.3 exp(-t/0.1) < 2 % after ~0.27 s
+    assert t[i0] > 0.5 + 0.2  # 0.3 exp(-t/0.1) < 2 % after ~0.27 s
     span = t[i1 - 1] - t[i0]
     assert span / period == pytest.approx(round(span / period), abs=0.01)
 
@@ -40,4 +41,4 @@ def test_efficiency_theory_wedge_values():
     rho = math.atan(0.05 / math.cos(a))
     assert efficiency_theory(g, a, 0.05) == pytest.approx(math.tan(g) / math.tan(g + rho))
     assert efficiency_theory(g, a, 0.0) == pytest.approx(1.0)
-    assert efficiency_theory(g, a, 0.1, backdriving=True) == 0.0      # rho' 5.8 deg > gamma 4.79 deg
+    assert efficiency_theory(g, a, 0.1, backdriving=True) == 0.0  # rho' 5.8 deg > gamma 4.79 deg

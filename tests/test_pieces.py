@@ -1,4 +1,5 @@
 """Convex collision pieces, visual meshes, mass properties, cache, and property tests over gear data."""
+
 from __future__ import annotations
 
 import io
@@ -31,8 +32,12 @@ def seat_medium():
 
 
 def _is_own_hull(m) -> bool:
-    return m.is_watertight and m.volume > 0 and m.is_convex and \
-        abs(m.convex_hull.volume - m.volume) <= 1e-9 * m.convex_hull.volume
+    return (
+        m.is_watertight
+        and m.volume > 0
+        and m.is_convex
+        and abs(m.convex_hull.volume - m.volume) <= 1e-9 * m.convex_hull.volume
+    )
 
 
 def test_pieces_are_convex_watertight(seat_medium):
@@ -66,7 +71,7 @@ def _assert_pieces_cover_flanks(gs, seed: int = 1, n: int = 3000):
     assert d.max() <= e["max_signed"] + 0.1 * e["max"] + 0.1
     # wheel: random (rho, zeta) on the conjugate active flank
     zeta = rng.uniform(-g.face_width / 2, g.face_width / 2, n)
-    lo = g.a - np.sqrt(g.r_a1 ** 2 - zeta ** 2)
+    lo = g.a - np.sqrt(g.r_a1**2 - zeta**2)
     rho = lo + rng.uniform(0, 1, n) * (wheel.tip_rho(g, zeta) - lo)
     a, b = wheel.tooth_flanks(g, rho, zeta)
     conj = wheel.space_flank(g, rho, zeta, +1).interior, wheel.space_flank(g, rho, zeta, -1).interior
@@ -86,8 +91,8 @@ def test_piece_error_shrinks_with_resolution():
     errs = {r: pieces.build_gear_set(g, r).piece_error_um for r in ("coarse", "medium", "fine")}
     assert errs["coarse"]["worm"]["max"] > errs["medium"]["worm"]["max"] > errs["fine"]["worm"]["max"]
     assert errs["coarse"]["wheel"]["rms"] > errs["medium"]["wheel"]["rms"] > errs["fine"]["wheel"]["rms"]
-    assert errs["medium"]["worm"]["max"] < 15 and errs["medium"]["wheel"]["max"] < 15   # um, seat motor
-    assert errs["medium"]["worm"]["min_signed"] >= -1e-6      # um; helical chords lie inside the thread: no bulge
+    assert errs["medium"]["worm"]["max"] < 15 and errs["medium"]["wheel"]["max"] < 15  # um, seat motor
+    assert errs["medium"]["worm"]["min_signed"] >= -1e-6  # um; helical chords lie inside the thread: no bulge
 
 
 def test_wheel_pieces_never_interfere_with_exact_worm(seat_medium):
@@ -120,9 +125,9 @@ def test_worm_pieces_never_interfere_with_exact_wheel(seat_medium):
         P, rho, zeta = P[inside], rho[inside], zeta[inside]
         pitch = 2 * math.pi / g.z2
         t0 = wheel.tooth_angle(g, 0)
-        psi = (np.arctan2(P[:, 1], P[:, 0]) - t0 + pitch / 2) % pitch - pitch / 2 + t0   # into tooth 0's sector
+        psi = (np.arctan2(P[:, 1], P[:, 0]) - t0 + pitch / 2) % pitch - pitch / 2 + t0  # into tooth 0's sector
         a, b = wheel.tooth_flanks(g, rho, zeta)
-        gap = np.maximum(a - psi, psi - b) * rho        # > 0 outside the tooth
+        gap = np.maximum(a - psi, psi - b) * rho  # > 0 outside the tooth
         worst = min(worst, gap.min())
     assert worst > 0
 
@@ -139,12 +144,12 @@ def test_visual_meshes_watertight_volume_inertia(seat_medium):
     R = lo[None] + s[:, None] * (hi - lo)[None]
     Z = np.broadcast_to(zeta[None], R.shape)
     a, b = wheel.tooth_flanks(g, R, Z)
-    w = (b - a) * (hi - lo)[None]                                   # d rho = (hi - lo) ds
+    w = (b - a) * (hi - lo)[None]  # d rho = (hi - lo) ds
     v_teeth = g.z2 * np.trapezoid(np.trapezoid(w * R, s, axis=0), zeta)
-    i_teeth = g.z2 * np.trapezoid(np.trapezoid(w * R ** 3, s, axis=0), zeta)
+    i_teeth = g.z2 * np.trapezoid(np.trapezoid(w * R**3, s, axis=0), zeta)
     r_bore = 0.35 * g.r_f2
-    v_rim = np.trapezoid(math.pi * (lo ** 2 - r_bore ** 2), zeta)
-    i_rim = np.trapezoid(math.pi / 2 * (lo ** 4 - r_bore ** 4), zeta)
+    v_rim = np.trapezoid(math.pi * (lo**2 - r_bore**2), zeta)
+    i_rim = np.trapezoid(math.pi / 2 * (lo**4 - r_bore**4), zeta)
     assert gs.wheel_visual.volume == pytest.approx(v_teeth + v_rim, rel=2e-3)
     assert gs.wheel_visual.moment_inertia[2, 2] == pytest.approx(i_teeth + i_rim, rel=2e-3)
 
@@ -168,14 +173,33 @@ def test_cache_roundtrip_and_key(tmp_path, monkeypatch):
 
 valid_gears = st.builds(
     lambda profile, hand, z1, z2, m, alpha, q, bl: Gear(
-        profile=profile, hand=hand, worm_starts=z1, wheel_teeth=z2, axial_module_mm=m,
-        normal_pressure_angle_deg=alpha, diameter_quotient=q, backlash_mm=bl * m),
-    st.sampled_from(["ZI", "ZA"]), st.sampled_from(["right", "left"]), st.integers(1, 3),
-    st.integers(28, 70), st.floats(0.5, 6.0), st.floats(18.0, 25.0), st.floats(8.0, 14.0), st.floats(0.0, 0.08))
+        profile=profile,
+        hand=hand,
+        worm_starts=z1,
+        wheel_teeth=z2,
+        axial_module_mm=m,
+        normal_pressure_angle_deg=alpha,
+        diameter_quotient=q,
+        backlash_mm=bl * m,
+    ),
+    st.sampled_from(["ZI", "ZA"]),
+    st.sampled_from(["right", "left"]),
+    st.integers(1, 3),
+    st.integers(28, 70),
+    st.floats(0.5, 6.0),
+    st.floats(18.0, 25.0),
+    st.floats(8.0, 14.0),
+    st.floats(0.0, 0.08),
+)
 
 
-@settings(max_examples=5, deadline=None, derandomize=True, phases=[Phase.explicit, Phase.generate],
-          suppress_health_check=[HealthCheck.too_slow])
+@settings(
+    max_examples=5,
+    deadline=None,
+    derandomize=True,
+    phases=[Phase.explicit, Phase.generate],
+    suppress_health_check=[HealthCheck.too_slow],
+)
 @given(valid_gears)
 def test_property_valid_gears_watertight_and_never_interfering(gear):
     g = derive(gear)
@@ -187,7 +211,7 @@ def test_property_valid_gears_watertight_and_never_interfering(gear):
         m.export(buf, file_type="stl")
         buf.seek(0)
         back = trimesh.load(buf, file_type="stl")
-        assert back.is_watertight and back.volume == pytest.approx(m.volume, rel=1e-6)   # STL is float32
+        assert back.is_watertight and back.volume == pytest.approx(m.volume, rel=1e-6)  # STL is float32
     assert all(p.is_convex and p.is_watertight for p in gs.wheel_tooth_pieces + gs.worm_pieces)
     # the reported piece error is honest for any gear, and the pieces are conservative: the worm pieces never
     # stand proud of the exact flank (ZA corrected by worm_shrink), the wheel pieces by under 3e-3 m_x
@@ -201,17 +225,33 @@ def test_property_valid_gears_watertight_and_never_interfering(gear):
 
 invalid_gears = st.one_of(
     # undercut: small pressure angle, few teeth
-    st.builds(lambda z2, alpha, m: (dict(wheel_teeth=z2, normal_pressure_angle_deg=alpha, axial_module_mm=m,
-                                         diameter_quotient=10), r"gear\.(normal_pressure_angle_deg|wheel_teeth)"),
-              st.integers(10, 24), st.floats(5.0, 9.0), st.floats(1.0, 10.0)),
+    st.builds(
+        lambda z2, alpha, m: (
+            dict(wheel_teeth=z2, normal_pressure_angle_deg=alpha, axial_module_mm=m, diameter_quotient=10),
+            r"gear\.(normal_pressure_angle_deg|wheel_teeth)",
+        ),
+        st.integers(10, 24),
+        st.floats(5.0, 9.0),
+        st.floats(1.0, 10.0),
+    ),
     # face width beyond what the root torus leaves
-    st.builds(lambda f, m: (dict(wheel_teeth=40, axial_module_mm=m, diameter_quotient=10,
-                                 face_width_mm=f * 2 * (m * 5 + m)), r"gear\.face_width_mm"),
-              st.floats(1.0, 1.2), st.floats(0.5, 5.0)),
+    st.builds(
+        lambda f, m: (
+            dict(wheel_teeth=40, axial_module_mm=m, diameter_quotient=10, face_width_mm=f * 2 * (m * 5 + m)),
+            r"gear\.face_width_mm",
+        ),
+        st.floats(1.0, 1.2),
+        st.floats(0.5, 5.0),
+    ),
     # backlash leaving no tooth
-    st.builds(lambda b, m: (dict(wheel_teeth=40, axial_module_mm=m, diameter_quotient=10, backlash_mm=b * math.pi * m),
-                            r"gear\.backlash_mm"),
-              st.floats(0.41, 0.6), st.floats(0.5, 5.0)),
+    st.builds(
+        lambda b, m: (
+            dict(wheel_teeth=40, axial_module_mm=m, diameter_quotient=10, backlash_mm=b * math.pi * m),
+            r"gear\.backlash_mm",
+        ),
+        st.floats(0.41, 0.6),
+        st.floats(0.5, 5.0),
+    ),
 )
 
 

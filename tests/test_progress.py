@@ -1,5 +1,6 @@
 """Progress reporting: a long run without a terminal (logs, CI, nohup) prints one line per 10 % of simulated time
 once it has taken LOG_AFTER_S of wall time; short runs and --no-progress stay silent."""
+
 import io
 
 from wormsim import progress as P

@@ -1,6 +1,7 @@
 """Output paths, failures and interrupts (issue 10): exit 2 "cannot write to PATH: reason" for a path that
 cannot be written, an earlier good result never lost to an interrupt, replaced only by a failed summary when a
 run fails, stale staging folders cleaned, one writer per folder."""
+
 from __future__ import annotations
 
 import errno
@@ -25,6 +26,7 @@ MOV = ROOT / "scenarios" / "mov_1.yaml"
 def _level(behaviour: str = "ok"):
     """A stand-in fidelity level: 'ok', 'fail' (SimulationError), 'interrupt' (Ctrl-C during the simulation),
     'interrupt_writing' (Ctrl-C while the report is being written into staging)."""
+
     def simulate(scenario, progress=None):
         if behaviour == "fail":
             raise SimulationError("diverged at t = 0.1 s")
@@ -58,6 +60,7 @@ def _good_result(out: Path, monkeypatch) -> dict:
 
 # ----------------------------------------------------------------------------- paths
 
+
 @pytest.mark.parametrize("command", ["run", "mesh", "model"])
 def test_out_is_an_existing_file(command, tmp_path, capsys):
     f = tmp_path / "afile"
@@ -68,8 +71,9 @@ def test_out_is_an_existing_file(command, tmp_path, capsys):
     assert f.read_bytes() == b"keep me"
 
 
-@pytest.mark.parametrize("argv", [["run", str(MOV)], ["mesh", str(MINIMAL)], ["model", str(MINIMAL)],
-                                  ["bench", "--quick"], ["schema"]])
+@pytest.mark.parametrize(
+    "argv", [["run", str(MOV)], ["mesh", str(MINIMAL)], ["model", str(MINIMAL)], ["bench", "--quick"], ["schema"]]
+)
 def test_out_under_dev_null(argv, capsys):
     assert cli.main([*argv, "--out", "/dev/null/x"]) == 2
     err = capsys.readouterr().err
@@ -79,8 +83,10 @@ def test_out_under_dev_null(argv, capsys):
 @pytest.mark.parametrize("command", ["run", "mesh"])
 def test_read_only_file_system(command, tmp_path, monkeypatch, capsys):
     """EROFS where the output folder's first file is created (root ignores chmod, so the error is injected)."""
+
     def erofs(*a, **k):
         raise OSError(errno.EROFS, os.strerror(errno.EROFS))
+
     monkeypatch.setattr(output.tempfile, "mkstemp", erofs)
     assert cli.main([command, str(MOV if command == "run" else MINIMAL), "--out", str(tmp_path / "o")]) == 2
     assert "cannot write to" in (err := capsys.readouterr().err) and "Read-only file system" in err
@@ -104,6 +110,7 @@ def test_schema_out_is_a_directory_or_has_no_parent(tmp_path, capsys):
 
 # ----------------------------------------------------------------------------- failures and interrupts
 
+
 def test_failed_run_replaces_an_earlier_result_by_a_failed_summary_only(tmp_path, monkeypatch, capsys):
     out = tmp_path / "o"
     _good_result(out, monkeypatch)
@@ -123,7 +130,7 @@ def test_interrupt_leaves_an_earlier_result_untouched(behaviour, tmp_path, monke
     assert cli.main(["run", str(MINIMAL), "--out", str(out), "--no-progress"]) == 130
     err = capsys.readouterr().err
     assert err.startswith("interrupted") and "internal error" not in err
-    assert _snapshot(out) == before           # byte for byte; no staging folder, no lock file left
+    assert _snapshot(out) == before  # byte for byte; no staging folder, no lock file left
 
 
 def test_stale_staging_of_a_killed_run_is_removed(tmp_path, monkeypatch):
@@ -133,7 +140,7 @@ def test_stale_staging_of_a_killed_run_is_removed(tmp_path, monkeypatch):
     (out / ".staging-abc123" / "report.png").write_bytes(b"half")
     (out / ".summary.json.xyz").write_text("{")
     (out / ".recording.rrd.tmp42").write_bytes(b"")
-    (out / "notes.txt").write_text("mine")          # a user's own file stays
+    (out / "notes.txt").write_text("mine")  # a user's own file stays
     monkeypatch.setattr(run, "model_module", lambda name: _level("ok"))
     assert cli.main(["run", str(MINIMAL), "--out", str(out), "--no-progress"]) == 0
     assert sorted(p.name for p in out.iterdir()) == sorted([*output.RESULT_FILES, "notes.txt"])
@@ -144,7 +151,7 @@ def test_second_writer_is_refused_naming_the_holder(tmp_path, monkeypatch, capsy
     before = _good_result(out, monkeypatch)
     capsys.readouterr()
     lock = FolderLock(out)
-    lock.acquire()              # as a concurrent run would (flock is per open file, so this process conflicts too)
+    lock.acquire()  # as a concurrent run would (flock is per open file, so this process conflicts too)
     try:
         assert cli.main(["run", str(MINIMAL), "--out", str(out), "--no-progress"]) == 2
         err = capsys.readouterr().err
@@ -153,7 +160,7 @@ def test_second_writer_is_refused_naming_the_holder(tmp_path, monkeypatch, capsy
     finally:
         lock.release()
     assert _snapshot(out) == before
-    assert cli.main(["run", str(MINIMAL), "--out", str(out), "--no-progress"]) == 0    # free again
+    assert cli.main(["run", str(MINIMAL), "--out", str(out), "--no-progress"]) == 0  # free again
 
 
 def test_lock_is_released_after_a_failure(tmp_path, monkeypatch):

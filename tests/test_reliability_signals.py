@@ -1,5 +1,6 @@
 """SIGINT, SIGTERM and SIGKILL sent to a real `wormsim run` (torsional seat motor: seconds per run), and two runs
 into one folder (issue 10)."""
+
 from __future__ import annotations
 
 import json
@@ -26,10 +27,14 @@ def _default_sigint():
 
 
 def start(out: Path, duration_s: float) -> subprocess.Popen:
-    return subprocess.Popen([str(WORMSIM), "run", str(SEAT), "--out", str(out), *TORSIONAL,
-                             "--set", f"simulation.duration_s={duration_s}"],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, preexec_fn=_default_sigint,
-                            env=dict(os.environ, WORMSIM_NO_PROGRESS="1"))
+    return subprocess.Popen(
+        [str(WORMSIM), "run", str(SEAT), "--out", str(out), *TORSIONAL, "--set", f"simulation.duration_s={duration_s}"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        preexec_fn=_default_sigint,
+        env=dict(os.environ, WORMSIM_NO_PROGRESS="1"),
+    )
 
 
 def wait_for_staging(proc: subprocess.Popen, out: Path, timeout_s: float = 120.0) -> None:
@@ -51,8 +56,12 @@ def snapshot(d: Path) -> dict:
 @pytest.fixture(scope="module")
 def good(tmp_path_factory) -> tuple[Path, dict]:
     out = tmp_path_factory.mktemp("good") / "o"
-    r = subprocess.run([str(WORMSIM), "run", str(SEAT), "--out", str(out), *TORSIONAL,
-                        "--set", "simulation.duration_s=0.5"], capture_output=True, text=True, timeout=300)
+    r = subprocess.run(
+        [str(WORMSIM), "run", str(SEAT), "--out", str(out), *TORSIONAL, "--set", "simulation.duration_s=0.5"],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     assert r.returncode == 0, r.stderr
     return out, snapshot(out)
 
@@ -64,8 +73,9 @@ def _copy(src: tuple[Path, dict], dst: Path) -> dict:
     return snapshot(dst)
 
 
-@pytest.mark.parametrize("sig, code, word", [(signal.SIGINT, 130, "interrupted"),
-                                             (signal.SIGTERM, 143, "interrupted (SIGTERM)")])
+@pytest.mark.parametrize(
+    "sig, code, word", [(signal.SIGINT, 130, "interrupted"), (signal.SIGTERM, 143, "interrupted (SIGTERM)")]
+)
 def test_signal_during_rerun_keeps_the_good_result(sig, code, word, good, tmp_path):
     out = tmp_path / "o"
     before = _copy(good, out)
@@ -86,9 +96,13 @@ def test_sigkill_leaves_staging_that_the_next_run_removes(good, tmp_path):
     proc.kill()
     proc.communicate(timeout=60)
     assert any(p.name.startswith(".staging-") for p in out.iterdir())
-    assert {k: v for k, v in snapshot(out).items() if not k.startswith(".")} == before   # result still there
-    r = subprocess.run([str(WORMSIM), "run", str(SEAT), "--out", str(out), *TORSIONAL,
-                        "--set", "simulation.duration_s=0.5"], capture_output=True, text=True, timeout=300)
+    assert {k: v for k, v in snapshot(out).items() if not k.startswith(".")} == before  # result still there
+    r = subprocess.run(
+        [str(WORMSIM), "run", str(SEAT), "--out", str(out), *TORSIONAL, "--set", "simulation.duration_s=0.5"],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     assert r.returncode == 0, r.stderr
     assert sorted(p.name for p in out.iterdir()) == sorted(RESULT_FILES)
     assert json.loads((out / "summary.json").read_text())["status"] == "ok"
@@ -100,8 +114,12 @@ def test_second_run_into_the_same_folder_is_refused(good, tmp_path):
     first = start(out, 200.0)
     wait_for_staging(first, out)
     try:
-        r = subprocess.run([str(WORMSIM), "run", str(SEAT), "--out", str(out), *TORSIONAL,
-                            "--set", "simulation.duration_s=0.1"], capture_output=True, text=True, timeout=300)
+        r = subprocess.run(
+            [str(WORMSIM), "run", str(SEAT), "--out", str(out), *TORSIONAL, "--set", "simulation.duration_s=0.1"],
+            capture_output=True,
+            text=True,
+            timeout=300,
+        )
         assert r.returncode == 2, r.stderr
         assert f"process {first.pid} is writing there" in r.stderr and r.stderr.count("\n") == 1, r.stderr
     finally:

@@ -5,6 +5,7 @@ loader with mutated seed files -- only a Scenario or exit 2, in bounded time and
 contact3d runs in a second property test with exact flanks (contact.geometry flanks, coarse: 8 slices), a few
 derandomized gears, short runs: the ratio within 0.1 % and F_t r2 within 2 % of the load, or exit 2. (With convex
 pieces, meshing one new random gear set took about 55 s on the 2-core CI machine, beyond this test's budget.)"""
+
 from __future__ import annotations
 
 import json
@@ -27,8 +28,10 @@ SEEDS = sorted((ROOT / "scenarios").glob("*.yaml")) + sorted((ROOT / "tests" / "
 @contextmanager
 def time_limit(seconds: int):
     """A hang becomes a failure (SIGALRM), not a stuck CI job."""
+
     def expire(signum, frame):
         raise TimeoutError(f"no result within {seconds} s")
+
     old = signal.signal(signal.SIGALRM, expire)
     signal.alarm(seconds)
     try:
@@ -38,30 +41,41 @@ def time_limit(seconds: int):
         signal.signal(signal.SIGALRM, old)
 
 
-gear_data = st.fixed_dictionaries({
-    "worm_starts": st.integers(1, 4),
-    "wheel_teeth": st.integers(20, 80),
-    "axial_module_mm": st.floats(0.5, 12),
-    "diameter_quotient": st.floats(6, 16),
-    "normal_pressure_angle_deg": st.floats(10, 25),
-    "hand": st.sampled_from(["right", "left"]),
-    "profile": st.sampled_from(["ZI", "ZA"]),
-})
+gear_data = st.fixed_dictionaries(
+    {
+        "worm_starts": st.integers(1, 4),
+        "wheel_teeth": st.integers(20, 80),
+        "axial_module_mm": st.floats(0.5, 12),
+        "diameter_quotient": st.floats(6, 16),
+        "normal_pressure_angle_deg": st.floats(10, 25),
+        "hand": st.sampled_from(["right", "left"]),
+        "profile": st.sampled_from(["ZI", "ZA"]),
+    }
+)
 
 
 OUTCOMES: list[int] = []
 
 
-@settings(max_examples=8, deadline=None, derandomize=True, database=None,
-          suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow])
+@settings(
+    max_examples=8,
+    deadline=None,
+    derandomize=True,
+    database=None,
+    suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow],
+)
 @given(gear=gear_data)
 def test_random_gear_runs_or_is_refused(gear, tmp_path_factory, capsys):
     m = gear["axial_module_mm"]
-    load_nm = 0.04 * m ** 3 * gear["wheel_teeth"]           # a tangential force of about 10 N/mm^2 x m x 8 m
-    scenario = {"name": "prop", "model": "torsional",
-                "gear": {**gear, "backlash_mm": 0.05 * m},
-                "drive": {"speed_rpm": 600, "ramp_s": 0.05}, "load": {"torque_nm": load_nm, "ramp_s": 0.05},
-                "simulation": {"duration_s": 0.3}}
+    load_nm = 0.04 * m**3 * gear["wheel_teeth"]  # a tangential force of about 10 N/mm^2 x m x 8 m
+    scenario = {
+        "name": "prop",
+        "model": "torsional",
+        "gear": {**gear, "backlash_mm": 0.05 * m},
+        "drive": {"speed_rpm": 600, "ramp_s": 0.05},
+        "load": {"torque_nm": load_nm, "ramp_s": 0.05},
+        "simulation": {"duration_s": 0.3},
+    }
     d = tmp_path_factory.mktemp("prop")
     (d / "s.yaml").write_text(yaml.safe_dump(scenario))
     with time_limit(120):
@@ -84,21 +98,32 @@ def test_random_gear_runs_or_is_refused(gear, tmp_path_factory, capsys):
 CONTACT3D_OUTCOMES: list[int] = []
 
 
-@settings(max_examples=3, deadline=None, derandomize=True, database=None,
-          suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow])
+@settings(
+    max_examples=3,
+    deadline=None,
+    derandomize=True,
+    database=None,
+    suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow],
+)
 @given(gear=gear_data)
 def test_random_gear_runs_at_contact3d_with_flanks_or_is_refused(gear, tmp_path_factory, capsys):
     """Any valid gear data must work at contact3d too (INTERFACE.md): exit 0 with the ratio and the torque balance,
     or exit 2 with one line. 3000 rpm, 5 ms ramps, 0.05 s (at least 2.5 mesh periods)."""
     m = gear["axial_module_mm"]
-    load_nm = 0.04 * m ** 3 * gear["wheel_teeth"]
-    scenario = {"name": "prop3d", "model": "contact3d",
-                "gear": {**gear, "backlash_mm": 0.05 * m},
-                "materials": {"worm": {"youngs_modulus_gpa": 210, "poisson_ratio": 0.3, "density_kg_m3": 7850},
-                              "wheel": {"youngs_modulus_gpa": 100, "poisson_ratio": 0.34, "density_kg_m3": 8800}},
-                "contact": {"geometry": "flanks", "friction": 0.05},
-                "drive": {"speed_rpm": 3000, "ramp_s": 0.005}, "load": {"torque_nm": load_nm, "ramp_s": 0.005},
-                "simulation": {"duration_s": 0.05, "resolution": "coarse"}}
+    load_nm = 0.04 * m**3 * gear["wheel_teeth"]
+    scenario = {
+        "name": "prop3d",
+        "model": "contact3d",
+        "gear": {**gear, "backlash_mm": 0.05 * m},
+        "materials": {
+            "worm": {"youngs_modulus_gpa": 210, "poisson_ratio": 0.3, "density_kg_m3": 7850},
+            "wheel": {"youngs_modulus_gpa": 100, "poisson_ratio": 0.34, "density_kg_m3": 8800},
+        },
+        "contact": {"geometry": "flanks", "friction": 0.05},
+        "drive": {"speed_rpm": 3000, "ramp_s": 0.005},
+        "load": {"torque_nm": load_nm, "ramp_s": 0.005},
+        "simulation": {"duration_s": 0.05, "resolution": "coarse"},
+    }
     d = tmp_path_factory.mktemp("prop3d")
     (d / "s.yaml").write_text(yaml.safe_dump(scenario))
     with time_limit(120):
@@ -113,7 +138,10 @@ def test_random_gear_runs_at_contact3d_with_flanks_or_is_refused(gear, tmp_path_
     assert s["status"] == "ok" and s["contact_geometry"] == "flanks"
     assert abs(s["ratio"] / s["ratio_theory"] - 1) < 1e-3, (gear, s["ratio"], s["ratio_theory"])
     assert abs(s["tangential_force_mean_n"] / s["tangential_force_theory_n"] - 1) < 0.02, (
-        gear, s["tangential_force_mean_n"], s["tangential_force_theory_n"])
+        gear,
+        s["tangential_force_mean_n"],
+        s["tangential_force_theory_n"],
+    )
 
 
 def test_random_gears_mostly_run_at_contact3d():
@@ -181,8 +209,13 @@ def _limits():
 
 
 def test_fuzz_scenario_loader(tmp_path):
-    r = subprocess.run([sys.executable, "-c", FUZZ_WORKER, json.dumps([str(p) for p in SEEDS]), "400", str(tmp_path)],
-                       capture_output=True, text=True, timeout=300, preexec_fn=_limits)
+    r = subprocess.run(
+        [sys.executable, "-c", FUZZ_WORKER, json.dumps([str(p) for p in SEEDS]), "400", str(tmp_path)],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        preexec_fn=_limits,
+    )
     assert r.returncode == 0, r.stderr[-3000:]
     bad = json.loads(r.stdout.strip().splitlines()[-1])
     assert bad == [], bad[:5]

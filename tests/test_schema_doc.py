@@ -1,4 +1,5 @@
 """docs/scenario.md is generated from the schema and must be current."""
+
 from pathlib import Path
 
 from wormsim.schema_doc import markdown

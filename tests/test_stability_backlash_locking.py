@@ -11,6 +11,7 @@ Self-locking boundary: rho' = atan(mu / cos alpha_n) = gamma, i.e. mu* = cos(alp
 the wedge model's boundary is tested to 1e-6 deg in tests/test_wedge.py (not repeated here); torsional and contact3d
 are tested just either side with the wheel driven by a torque and the worm free.
 """
+
 from __future__ import annotations
 
 import math
@@ -32,17 +33,30 @@ from wormsim.units import MM
 DEMO = SCEN / "seat_motor_demo.yaml"
 # the CI configurations of tests/test_contact3d_seeds.py (kept in step by hand: that module runs its seeds at import)
 CI = {
-    "seat_motor": ["drive.speed_rpm=1800", "drive.ramp_s=0.02", "load.ramp_s=0.02", "simulation.duration_s=0.25",
-                   "simulation.resolution=medium"],
-    "screw_jack": ["drive.ramp_s=0.02", "load.ramp_s=0.02", "simulation.duration_s=0.35", "simulation.resolution=medium"],
+    "seat_motor": [
+        "drive.speed_rpm=1800",
+        "drive.ramp_s=0.02",
+        "load.ramp_s=0.02",
+        "simulation.duration_s=0.25",
+        "simulation.resolution=medium",
+    ],
+    "screw_jack": [
+        "drive.ramp_s=0.02",
+        "load.ramp_s=0.02",
+        "simulation.duration_s=0.35",
+        "simulation.resolution=medium",
+    ],
     "involute_41": ["drive.ramp_s=0.02", "load.ramp_s=0.02", "simulation.duration_s=0.3", "simulation.resolution=fine"],
 }
 
 
 # ----------------------------------------------------------------------------- backlash
 
-@pytest.mark.parametrize("name, overrides", [(n, []) for n in ("seat_motor", "screw_jack", "involute_41",
-                                                                "seat_motor_demo")] + list(CI.items()))
+
+@pytest.mark.parametrize(
+    "name, overrides",
+    [(n, []) for n in ("seat_motor", "screw_jack", "involute_41", "seat_motor_demo")] + list(CI.items()),
+)
 def test_seed_scenarios_and_ci_configurations_pass_the_backlash_check(name, overrides):
     """Each seed at its own resolution and in its CI configuration builds; the clearance it reports is (1) and lies
     above the bulge (2) (wormsim.contact3d.backlash)."""
@@ -84,7 +98,9 @@ def test_backlash_below_the_bulge_is_rejected_and_just_above_it_builds():
     j_min_mm = float(re.search(r"= ([0-9.e+-]+) mm at resolution medium", msg).group(1))
     assert "gear.backlash_mm = 0.05" in msg and "simulation.resolution fine" in msg
     assert j_min_mm == pytest.approx(0.0616, abs=2e-4)
-    bm = build_model(load_scenario(SCEN / "involute_41.yaml", ["gear.backlash_mm=0.065", "simulation.resolution=medium"]))
+    bm = build_model(
+        load_scenario(SCEN / "involute_41.yaml", ["gear.backlash_mm=0.065", "simulation.resolution=medium"])
+    )
     assert flank_clearance_m(bm.geometry) > piece_bulge_m(bm.pieces.piece_error_um)
 
 
@@ -103,8 +119,9 @@ def test_pieces_leave_the_requested_play_and_interfere_at_zero_backlash():
 
 def _forward(path, overrides, duration_s):
     """Short forward run: mean worm torque and efficiency (output / input power) over the last half."""
-    sc = load_scenario(path, [f"simulation.duration_s={duration_s}", "drive.ramp_s=0.01", "load.ramp_s=0.01",
-                              *overrides])
+    sc = load_scenario(
+        path, [f"simulation.duration_s={duration_s}", "drive.ramp_s=0.01", "load.ramp_s=0.01", *overrides]
+    )
     bm = build_model(sc, check_backlash_vs_pieces=False)
     S = run_model(bm, sc).series
     k = S["t_s"] > duration_s / 2
@@ -136,13 +153,22 @@ def test_interference_below_the_limit_drags_the_mesh():
 
 # ----------------------------------------------------------------------------- self-locking boundary
 
+
 def _mu_at(g, delta_deg: float) -> float:
     """Friction coefficient at rho' = gamma + delta: mu = cos(alpha_n) tan(gamma + delta) (DIN 3975)."""
     return math.cos(g.alpha_n) * math.tan(g.gamma + math.radians(delta_deg))
 
 
-BACKDRIVE = ["drive.on=wheel", "drive.speed_rpm=null", "drive.torque_nm=2.0", "load.on=worm", "load.torque_nm=0",
-             "load.ramp_s=0", "contact.friction_static=null", "contact.friction_dynamic=null"]
+BACKDRIVE = [
+    "drive.on=wheel",
+    "drive.speed_rpm=null",
+    "drive.torque_nm=2.0",
+    "load.on=worm",
+    "load.torque_nm=0",
+    "load.ramp_s=0",
+    "contact.friction_static=null",
+    "contact.friction_dynamic=null",
+]
 
 
 def _friction(mu_s: float, mu_d: float | None = None) -> list[str]:
@@ -152,8 +178,10 @@ def _friction(mu_s: float, mu_d: float | None = None) -> list[str]:
 
 
 def _torsional_worm_speed_rpm(friction: list[str]) -> float:
-    sc = load_scenario(SCEN / "seat_motor.yaml", ["model=torsional", *BACKDRIVE, "drive.ramp_s=0.01",
-                                                  "simulation.duration_s=0.2", *friction])
+    sc = load_scenario(
+        SCEN / "seat_motor.yaml",
+        ["model=torsional", *BACKDRIVE, "drive.ramp_s=0.01", "simulation.duration_s=0.2", *friction],
+    )
     return abs(float(torsional.simulate(sc).series["worm_speed_rpm"][-1]))
 
 
@@ -175,8 +203,16 @@ def test_torsional_lock_boundary_within_0p3_deg():
 
 
 def _contact3d_worm_speed_rpm(friction: list[str], duration_s: float = 0.01) -> float:
-    sc = load_scenario(DEMO, [*BACKDRIVE, "drive.ramp_s=0.002", "simulation.resolution=coarse",
-                              f"simulation.duration_s={duration_s}", *friction])
+    sc = load_scenario(
+        DEMO,
+        [
+            *BACKDRIVE,
+            "drive.ramp_s=0.002",
+            "simulation.resolution=coarse",
+            f"simulation.duration_s={duration_s}",
+            *friction,
+        ],
+    )
     return abs(float(simulate(sc).series["worm_speed_rpm"][-1]))
 
 
@@ -204,12 +240,16 @@ def test_contact3d_lock_boundary_within_0p3_deg(demo_geometry, contact3d_free_rp
     assert below > 2e-2 * contact3d_free_rpm
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "contact3d, static friction above and dynamic below the boundary (mu_s 0.0877 = gamma + 0.3 deg, mu_d 0.0773 = "
-    "gamma - 0.3 deg), 2 N m on the seat motor demo wheel: the worm runs back at 1301 rpm (3.2 % of free), as with mu_d "
-    "alone. The wheel starts centred in its 25 um half backlash, crosses it under the torque and its first impact kicks "
-    "the 4 g worm to 58 rpm (Vs = 26 v_t) within 0.6 ms, so mu(Vs) is the dynamic value from the first contact on (a 20 "
-    "ms ramp: same, 2561 rpm at 0.03 s). 'From rest' needs a start in flank contact, which the runner does not offer"))
+@pytest.mark.xfail(
+    strict=True,
+    reason=(
+        "contact3d, static friction above and dynamic below the boundary (mu_s 0.0877 = gamma + 0.3 deg, mu_d 0.0773 = "
+        "gamma - 0.3 deg), 2 N m on the seat motor demo wheel: the worm runs back at 1301 rpm (3.2 % of free), as with mu_d "
+        "alone. The wheel starts centred in its 25 um half backlash, crosses it under the torque and its first impact kicks "
+        "the 4 g worm to 58 rpm (Vs = 26 v_t) within 0.6 ms, so mu(Vs) is the dynamic value from the first contact on (a 20 "
+        "ms ramp: same, 2561 rpm at 0.03 s). 'From rest' needs a start in flank contact, which the runner does not offer"
+    ),
+)
 def test_contact3d_static_friction_governs_from_rest(demo_geometry, contact3d_free_rpm):
     held = _contact3d_worm_speed_rpm(_friction(_mu_at(demo_geometry, +0.3), _mu_at(demo_geometry, -0.3)))
     assert held < 1e-2 * contact3d_free_rpm

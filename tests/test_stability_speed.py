@@ -14,6 +14,7 @@ identical, each step costs about 3 x); at 0.07 rad per step, where the plain run
 tunnels or runs hundreds of um deep; at 0.21 rad both tunnel, the speculative run sooner. They do not extend the
 speed range.
 """
+
 from __future__ import annotations
 
 import math
@@ -39,8 +40,17 @@ RPM = 2 * math.pi / 60
 
 
 def _jack(rpm: float, duration_s: float, *extra: str):
-    return load_scenario(JACK, COARSE + [f"drive.speed_rpm={rpm}", "drive.ramp_s=0.01", "load.ramp_s=0.01",
-                                         f"simulation.duration_s={duration_s}", *extra])
+    return load_scenario(
+        JACK,
+        COARSE
+        + [
+            f"drive.speed_rpm={rpm}",
+            "drive.ramp_s=0.01",
+            "load.ramp_s=0.01",
+            f"simulation.duration_s={duration_s}",
+            *extra,
+        ],
+    )
 
 
 def _ratio_and_torque_balance(res) -> tuple[float, float]:
@@ -58,7 +68,7 @@ def test_screw_jack_at_30x_speed_gets_a_safe_timestep_and_keeps_the_physics():
     res = simulate(sc)
     s = res.summary
     assert s["timestep_s"] == 5e-6
-    assert s["timestep_s"] < 0.4 * s["timestep_stable_limit_s"]     # the speed, not the contact, set it
+    assert s["timestep_s"] < 0.4 * s["timestep_stable_limit_s"]  # the speed, not the contact, set it
     assert s["timestep_source"].startswith("worm speed: 40000 rpm"), s["timestep_source"]
     assert s["worm_turn_per_step_max_rad"] <= MAX_WORM_TURN_PER_STEP_RAD
     d_ratio, d_torque = _ratio_and_torque_balance(res)
@@ -85,8 +95,9 @@ def test_a_scenario_timestep_too_large_for_the_speed_is_refused_with_its_allowed
     h, src = choose_timestep(_jack(1330, 0.01), bm.geometry, bm.law)
     assert h == 1e-5 and src.startswith("default"), src
     # a speed-driven wheel: the worm turns ratio x faster (2000 x 24 = 48000 rpm -> 0.035 / 5027 rad/s = 7e-6 -> 5e-6)
-    wheel = load_scenario(JACK, COARSE + ["drive.on=wheel", "drive.speed_rpm=2000", "load.on=worm",
-                                          "load.torque_nm=0.1"])
+    wheel = load_scenario(
+        JACK, COARSE + ["drive.on=wheel", "drive.speed_rpm=2000", "load.on=worm", "load.torque_nm=0.1"]
+    )
     h, src = choose_timestep(wheel, bm.geometry, bm.law)
     assert h == 5e-6 and src.startswith("worm speed: 48000 rpm"), (h, src)
     # above the contact's stable limit (2.53e-5 s) the divergence guard speaks first (it names that limit)
@@ -108,8 +119,17 @@ def test_a_torque_driven_worm_running_away_stops_at_the_overspeed_guard():
     without bound. At the default 1e-5 s the overspeed guard stops it when it turns 1.25 x 0.035 rad per step
     (measured t = 0.063 s, 41800 rpm), before its pieces tunnel through the wheel (the penetration guard fired at
     0.21 rad per step on the plain run); the message names simulation.timestep_s and the limit at that speed."""
-    sc = load_scenario(JACK, COARSE + ["drive.speed_rpm=null", "drive.torque_nm=2", "drive.ramp_s=0.005",
-                                       "load.ramp_s=0.005", "simulation.duration_s=0.1"])
+    sc = load_scenario(
+        JACK,
+        COARSE
+        + [
+            "drive.speed_rpm=null",
+            "drive.torque_nm=2",
+            "drive.ramp_s=0.005",
+            "load.ramp_s=0.005",
+            "simulation.duration_s=0.1",
+        ],
+    )
     with pytest.raises(SimulationError) as exc:
         simulate(sc)
     msg = str(exc.value)
@@ -135,7 +155,10 @@ def test_speculative_contacts_change_nothing_below_the_speed_limit():
     for key in ("tangential_force_n", "wheel_angle_rad", "max_penetration_m"):
         np.testing.assert_array_equal(spec.series[key], plain.series[key])
     d_ratio, d_torque = _ratio_and_torque_balance(spec)
-    assert abs(d_ratio) < 1e-3 and abs(d_torque) < 0.025, (spec.summary["ratio"], spec.summary["tangential_force_mean_n"])
+    assert abs(d_ratio) < 1e-3 and abs(d_torque) < 0.025, (
+        spec.summary["ratio"],
+        spec.summary["tangential_force_mean_n"],
+    )
 
 
 def test_speculative_contacts_tunnel_sooner_beyond_the_speed_limit(monkeypatch):
@@ -151,7 +174,7 @@ def test_speculative_contacts_tunnel_sooner_beyond_the_speed_limit(monkeypatch):
 
     def run(rpm, h, *extra):
         sc = _jack(rpm, 0.02, *extra)
-        bm = build_model(sc, timestep_s=h)         # past choose_timestep's speed check
+        bm = build_model(sc, timestep_s=h)  # past choose_timestep's speed check
         return run_model(bm, sc)
 
     plain = run(66500, 1e-5)
@@ -182,9 +205,19 @@ def _start(path: Path, rpm: float, duration_s: float, ramp_s: float, record_ever
     """(summary, series) of a start-up run, drive and load ramps both ramp_s (0: a step), cached."""
     key = (path, rpm, duration_s, ramp_s, record_every)
     if key not in _STARTS:
-        res = simulate(load_scenario(path, COARSE + [
-            f"drive.speed_rpm={rpm}", f"drive.ramp_s={ramp_s}", f"load.ramp_s={ramp_s}",
-            f"simulation.duration_s={duration_s}", f"simulation.record_every={record_every}"]))
+        res = simulate(
+            load_scenario(
+                path,
+                COARSE
+                + [
+                    f"drive.speed_rpm={rpm}",
+                    f"drive.ramp_s={ramp_s}",
+                    f"load.ramp_s={ramp_s}",
+                    f"simulation.duration_s={duration_s}",
+                    f"simulation.record_every={record_every}",
+                ],
+            )
+        )
         _STARTS[key] = (res.summary, res.series)
     return _STARTS[key]
 

@@ -4,6 +4,7 @@ Closed forms checked against: ratio z2 / z1; meshing frequency z1 n1 / 60 (seed 
 F_t2 r2 = load torque (statics); efficiency tan g / tan(g + rho') and tan(g - rho') / tan g with
 rho' = atan(mu / cos alpha_n) (DIN 3975, seed 000); self-locking for rho' > gamma (seed 000).
 """
+
 import json
 import math
 
@@ -21,10 +22,23 @@ from wormsim.torsional import dynamics as torsional
 from wormsim.torsional import mesh_stiffness as M
 
 SEEDS = ("seat_motor", "screw_jack", "involute_41")
-SUMMARY_KEYS = ("ratio", "ratio_theory", "mesh_frequency_hz", "mesh_frequency_theory_hz", "tangential_force_mean_n",
-                "tangential_force_p2p_n", "radial_force_mean_n", "axial_force_mean_n", "worm_torque_mean_nm",
-                "wheel_torque_mean_nm", "worm_speed_mean_rpm", "wheel_speed_mean_rpm", "efficiency",
-                "steady_window_s", "timestep_s")
+SUMMARY_KEYS = (
+    "ratio",
+    "ratio_theory",
+    "mesh_frequency_hz",
+    "mesh_frequency_theory_hz",
+    "tangential_force_mean_n",
+    "tangential_force_p2p_n",
+    "radial_force_mean_n",
+    "axial_force_mean_n",
+    "worm_torque_mean_nm",
+    "wheel_torque_mean_nm",
+    "worm_speed_mean_rpm",
+    "wheel_speed_mean_rpm",
+    "efficiency",
+    "steady_window_s",
+    "timestep_s",
+)
 
 
 def scen(name, *overrides):
@@ -79,14 +93,28 @@ def test_efficiency_is_the_wedge_law(seed_runs, name):
     eta = math.tan(g.gamma) / math.tan(g.gamma + rho_prime(s, g))
     assert abs(s["efficiency"] / eta - 1) < 0.03
     # and the worm torque is F_t2 r1 tan(g + rho') (DIN 3975 forces)
-    assert s["axial_force_mean_n"] == pytest.approx(s["tangential_force_mean_n"] * math.tan(g.gamma + rho_prime(s, g)), rel=0.02)
+    assert s["axial_force_mean_n"] == pytest.approx(
+        s["tangential_force_mean_n"] * math.tan(g.gamma + rho_prime(s, g)), rel=0.02
+    )
 
 
-@pytest.mark.parametrize("name", [
-    "seat_motor", "screw_jack",
-    pytest.param("involute_41", marks=pytest.mark.xfail(strict=True, reason=(
-        "the TCA's k(theta) of the 41/1 gear has a larger 2nd than 1st harmonic (0.032 vs 0.022 of the mean, "
-        "64 samples, 121 x 81 grid; 0.031 vs 0.025 on 241 x 161), so the transmission error's FFT peak sits at 48.3 Hz = 2 z1 n1 / 60 (theory 24.1 Hz)")))])
+@pytest.mark.parametrize(
+    "name",
+    [
+        "seat_motor",
+        "screw_jack",
+        pytest.param(
+            "involute_41",
+            marks=pytest.mark.xfail(
+                strict=True,
+                reason=(
+                    "the TCA's k(theta) of the 41/1 gear has a larger 2nd than 1st harmonic (0.032 vs 0.022 of the mean, "
+                    "64 samples, 121 x 81 grid; 0.031 vs 0.025 on 241 x 161), so the transmission error's FFT peak sits at 48.3 Hz = 2 z1 n1 / 60 (theory 24.1 Hz)"
+                ),
+            ),
+        ),
+    ],
+)
 def test_mesh_frequency_is_z1_n1_over_60(seed_runs, name):
     s = seed_runs[name][0]
     tol = max(0.01 * s["mesh_frequency_theory_hz"], s["mesh_frequency_resolution_hz"])
@@ -95,8 +123,15 @@ def test_mesh_frequency_is_z1_n1_over_60(seed_runs, name):
 
 def test_backdriving_efficiency_when_not_self_locking():
     """Screw jack driven from the wheel (rho' = 3.05 deg < gamma = 5.71 deg): eta' = tan(g - rho') / tan g."""
-    sc = scen("screw_jack", "drive.on=wheel", "drive.speed_rpm=55.4", "drive.ramp_s=0.05", "load.on=worm",
-              "load.torque_nm=0.2", "simulation.duration_s=0.3")
+    sc = scen(
+        "screw_jack",
+        "drive.on=wheel",
+        "drive.speed_rpm=55.4",
+        "drive.ramp_s=0.05",
+        "load.on=worm",
+        "load.torque_nm=0.2",
+        "simulation.duration_s=0.3",
+    )
     r = torsional.simulate(sc)
     g = derive(sc.gear)
     eta = math.tan(g.gamma - rho_prime(r.summary, g)) / math.tan(g.gamma)
@@ -105,9 +140,20 @@ def test_backdriving_efficiency_when_not_self_locking():
 
 
 def _wheel_torque_worm_free(friction):
-    sc = scen("seat_motor", "drive.on=wheel", "drive.speed_rpm=null", "drive.torque_nm=2.0", "drive.ramp_s=0.01",
-              "load.on=worm", "load.torque_nm=0", "load.ramp_s=0", f"contact.friction={friction}",
-              "contact.friction_static=null", "contact.friction_dynamic=null", "simulation.duration_s=0.2")
+    sc = scen(
+        "seat_motor",
+        "drive.on=wheel",
+        "drive.speed_rpm=null",
+        "drive.torque_nm=2.0",
+        "drive.ramp_s=0.01",
+        "load.on=worm",
+        "load.torque_nm=0",
+        "load.ramp_s=0",
+        f"contact.friction={friction}",
+        "contact.friction_static=null",
+        "contact.friction_dynamic=null",
+        "simulation.duration_s=0.2",
+    )
     return torsional.simulate(sc)
 
 
@@ -131,9 +177,18 @@ def test_not_self_locking_worm_runs_back():
 
 def test_speed_driven_wheel_of_self_locking_pair_fails_with_a_diagnosis():
     """A speed-driven wheel of a self-locking pair winds the mesh up until the teeth would skip (exit 3)."""
-    sc = scen("seat_motor", "drive.on=wheel", "drive.speed_rpm=0.68", "drive.ramp_s=0.05", "load.on=worm",
-              "load.torque_nm=0.01", "contact.friction=0.1", "contact.friction_static=null",
-              "contact.friction_dynamic=null", "simulation.duration_s=0.5")
+    sc = scen(
+        "seat_motor",
+        "drive.on=wheel",
+        "drive.speed_rpm=0.68",
+        "drive.ramp_s=0.05",
+        "load.on=worm",
+        "load.torque_nm=0.01",
+        "contact.friction=0.1",
+        "contact.friction_static=null",
+        "contact.friction_dynamic=null",
+        "simulation.duration_s=0.5",
+    )
     with pytest.raises(SimulationError, match="self-locking"):
         torsional.simulate(sc)
 
@@ -170,7 +225,7 @@ def test_mesh_stiffness_mean_in_expected_range(name):
     # the two flanks of a symmetric tooth give the same stiffness
     assert ms.k_mesh_rev_n_per_m.mean() == pytest.approx(ms.k_mesh_fwd_n_per_m.mean(), rel=0.02)
     assert np.all(ms.k_mesh_fwd_n_per_m > 0)
-    if name == "involute_41":     # no stiffness in the file: Hertz pi L E* / 4 per length
+    if name == "involute_41":  # no stiffness in the file: Hertz pi L E* / 4 per length
         assert src == "hertz"
         assert kp == pytest.approx(math.pi * effective_modulus_pa(scen(name).materials) / 4)
 
@@ -193,8 +248,15 @@ def test_backward_euler_agrees_with_error_controlled_lsoda():
         assert a[k] == pytest.approx(b[k], rel=5e-3), k
 
 
-@pytest.mark.parametrize("overrides", [("gear.hand=left",), ("gear.profile=ZA",),
-                                       ("gear.worm_starts=2", "gear.wheel_teeth=40"), ("drive.speed_rpm=-1330",)])
+@pytest.mark.parametrize(
+    "overrides",
+    [
+        ("gear.hand=left",),
+        ("gear.profile=ZA",),
+        ("gear.worm_starts=2", "gear.wheel_teeth=40"),
+        ("drive.speed_rpm=-1330",),
+    ],
+)
 def test_variants_hand_profile_starts_direction(overrides):
     """Left hand, ZA profile, two starts, reverse drive: closed forms hold and the wheel turns as INTERFACE.md says
     (positive worm rotation drives the wheel positive for a right-hand worm, negative for a left-hand one)."""
@@ -219,6 +281,10 @@ def test_driven_machine_inertia_adds_to_the_loaded_shaft():
     i1, i2 = inertias(base, g)
     j1, j2 = inertias(load_scenario(ROOT / "scenarios" / "seat_motor.yaml", ["load.inertia_kg_m2=2e-4"]), g)
     assert j1 == i1 and abs(j2 - i2 - 2e-4) < 1e-15
-    k1, k2 = inertias(load_scenario(ROOT / "scenarios" / "seat_motor.yaml", ["load.inertia_kg_m2=2e-4", "load.on=worm",
-                                                               "drive.on=wheel"]), g)
+    k1, k2 = inertias(
+        load_scenario(
+            ROOT / "scenarios" / "seat_motor.yaml", ["load.inertia_kg_m2=2e-4", "load.on=worm", "drive.on=wheel"]
+        ),
+        g,
+    )
     assert k2 == i2 and abs(k1 - i1 - 2e-4) < 1e-15

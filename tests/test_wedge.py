@@ -6,6 +6,7 @@ Closed forms used (docs/wedge.md derives them):
   efficiencies:               eta = tan g / tan(g + rho),  mu = tan(g - rho) / tan g
   standstill holds while      tan(g - rho0) <= F1 / |F2| <= tan(g + rho0)   (F2 < 0)
 """
+
 import json
 import math
 
@@ -21,13 +22,14 @@ from wormsim.scenario import load_scenario, scenario_from_dict
 from wormsim.wedge import dynamics as wedge
 
 MOV = sorted((ROOT / "scenarios").glob("mov_*.yaml"))
-G = 4.76 * math.pi / 180          # seed 000's lead angle
-F1_REST = 2 * 2178 * (7.85 / 1.35) / (1 + (7.85 / 1.35) ** 2)   # Kloss at v = 0: 727.6 N
+G = 4.76 * math.pi / 180  # seed 000's lead angle
+F1_REST = 2 * 2178 * (7.85 / 1.35) / (1 + (7.85 / 1.35) ** 2)  # Kloss at v = 0: 727.6 N
 
 
 def run_wedge(duration_s=0.3, **wedge_block):
-    sc = scenario_from_dict({"name": "t", "model": "wedge", "wedge": wedge_block,
-                             "simulation": {"duration_s": duration_s}})
+    sc = scenario_from_dict(
+        {"name": "t", "model": "wedge", "wedge": wedge_block, "simulation": {"duration_s": duration_s}}
+    )
     return wedge.simulate(sc)
 
 
@@ -44,12 +46,13 @@ def sliding(res, code):
 def test_motor_force_at_rest_is_the_kloss_value():
     p = wedge.params_from_scenario(load_scenario(ROOT / "scenarios" / "mov_1.yaml"))
     assert wedge.motor_force_n(0.0, p) == pytest.approx(727.6, abs=0.1)
-    assert wedge.motor_force_n(6.5, p) == pytest.approx(2178.0, rel=1e-12)      # peak at Vmax
-    assert wedge.motor_force_n(7.85, p) == 0.0                                  # synchronous speed
-    assert wedge.motor_force_n(8.0, p) < 0                                      # generator above it
+    assert wedge.motor_force_n(6.5, p) == pytest.approx(2178.0, rel=1e-12)  # peak at Vmax
+    assert wedge.motor_force_n(7.85, p) == 0.0  # synchronous speed
+    assert wedge.motor_force_n(8.0, p) < 0  # generator above it
 
 
 # ----------------------------------------------------------------------------- steady states
+
 
 def test_tractive_steady_state_matches_psi1_and_motor_curve():
     F2 = -10000.0
@@ -59,6 +62,7 @@ def test_tractive_steady_state_matches_psi1_and_motor_curve():
 
     def f(v):
         return wedge.motor_force_n(v, p) - math.tan(G + wedge.rho_of_speed(v, p)) * abs(F2)
+
     v_ss = brentq(f, 6.5, 7.85, xtol=1e-13)
     assert s["v1_m_s"][-1] == pytest.approx(v_ss, rel=1e-7)
     assert res.summary["speed_steady_m_s"] == pytest.approx(v_ss, rel=1e-6)
@@ -73,14 +77,16 @@ def test_tractive_steady_state_matches_psi1_and_motor_curve():
 def test_inverse_steady_state_matches_psi2_and_motor_curve():
     # an overhauling load (F2 > 0) drives the pair forward; rho = atan(0.05) = 2.86 deg < gamma
     F2 = 5000.0
-    res = run_wedge(duration_s=0.4, friction=0.05,
-                    load={"initial_force_n": -5000.0, "force_n": F2, "start_s": 0.1, "ramp_s": 0.1})
+    res = run_wedge(
+        duration_s=0.4, friction=0.05, load={"initial_force_n": -5000.0, "force_n": F2, "start_s": 0.1, "ramp_s": 0.1}
+    )
     p, s = params(res), res.series
     assert res.summary["regimes"] == ["tractive", "inverse"]
     rho = math.atan(0.05)
 
     def f(v):  # motor brakes as a generator: F1 = psi2 F2 = -tan(g - rho) F2 < 0
         return wedge.motor_force_n(v, p) + math.tan(G - rho) * F2
+
     v_ss = brentq(f, 7.85, 9.0, xtol=1e-13)
     assert s["v1_m_s"][-1] == pytest.approx(v_ss, rel=1e-7)
     assert res.summary["S1_steady_n"] == pytest.approx(-math.tan(G - rho) * F2, rel=1e-6)
@@ -102,6 +108,7 @@ def test_locked_steady_state_from_rest_under_full_load():
 
 # ----------------------------------------------------------------------------- efficiencies
 
+
 def test_efficiency_forward_is_power_ratio_and_closed_form():
     res = run_wedge(load={"force_n": -10000.0, "start_s": 0.1, "ramp_s": 0.02})
     s, sm = res.series, res.summary
@@ -117,12 +124,15 @@ def test_efficiency_forward_is_power_ratio_and_closed_form():
 
 
 def test_efficiency_backward_is_power_ratio_and_closed_form():
-    res = run_wedge(duration_s=0.4, friction=0.05,
-                    load={"initial_force_n": -5000.0, "force_n": 5000.0, "start_s": 0.1, "ramp_s": 0.1})
+    res = run_wedge(
+        duration_s=0.4,
+        friction=0.05,
+        load={"initial_force_n": -5000.0, "force_n": 5000.0, "start_s": 0.1, "ramp_s": 0.1},
+    )
     s, sm = res.series, res.summary
     rho = math.atan(0.05)
-    p_in = s["S2_n"][-1] * s["v2_m_s"][-1]          # the load drives
-    p_out = -s["S1_n"][-1] * s["v1_m_s"][-1]        # the motor absorbs
+    p_in = s["S2_n"][-1] * s["v2_m_s"][-1]  # the load drives
+    p_out = -s["S1_n"][-1] * s["v1_m_s"][-1]  # the motor absorbs
     assert p_out / p_in == pytest.approx(math.tan(G - rho) / math.tan(G), rel=1e-6)
     assert sm["efficiency_backward"] == pytest.approx(math.tan(G - rho) / math.tan(G), rel=1e-12)
 
@@ -134,6 +144,7 @@ def test_efficiency_backward_is_zero_when_self_locking():
 
 
 # ----------------------------------------------------------------------------- lock boundary
+
 
 @pytest.mark.parametrize("delta_deg, locks", [(+1e-6, True), (-1e-6, False)])
 def test_stick_without_motor_exactly_when_rho0_exceeds_gamma(delta_deg, locks):
@@ -158,7 +169,7 @@ def test_self_locking_exactly_when_rho0_exceeds_gamma(delta_deg, locks):
 @pytest.mark.parametrize("factor, backdrives", [(1.01, True), (0.99, False)])
 def test_back_driving_just_above_and_below_the_lock_boundary(factor, backdrives):
     # rho = atan(0.05) < gamma: at rest the motor's F1(0) holds the load while F1/|F2| >= tan(g - rho)
-    F_limit = F1_REST / math.tan(G - math.atan(0.05))        # 21 968 N
+    F_limit = F1_REST / math.tan(G - math.atan(0.05))  # 21 968 N
     res = run_wedge(duration_s=0.05, friction=0.05, load={"force_n": -factor * F_limit})
     sm = res.summary
     assert not sm["self_locking"]
@@ -169,6 +180,7 @@ def test_back_driving_just_above_and_below_the_lock_boundary(factor, backdrives)
 
 
 # ----------------------------------------------------------------------------- regime timelines
+
 
 def test_load_reversal_timeline_tractive_locked_inverse():
     # the valve thrust grows past what the motor can carry (stall), the pair stops and holds, then the
@@ -185,8 +197,11 @@ def test_load_reversal_timeline_tractive_locked_inverse():
 
 
 def test_sign_reversal_while_moving_switches_tractive_to_inverse_at_phi_zero():
-    res = run_wedge(duration_s=0.4, friction=0.05,
-                    load={"initial_force_n": -5000.0, "force_n": 5000.0, "start_s": 0.1, "ramp_s": 0.1})
+    res = run_wedge(
+        duration_s=0.4,
+        friction=0.05,
+        load={"initial_force_n": -5000.0, "force_n": 5000.0, "start_s": 0.1, "ramp_s": 0.1},
+    )
     p, sm = params(res), res.summary
     assert sm["regimes"] == ["tractive", "inverse"] and sm["min_speed_m_s"] >= 0
     t_sw = sm["regime_timeline"][1]["start_s"]
@@ -198,6 +213,7 @@ def test_sign_reversal_while_moving_switches_tractive_to_inverse_at_phi_zero():
 
 # ----------------------------------------------------------------------------- seed monitor
 
+
 def test_seed_monitor_runs_the_worm_backwards_from_rest_where_three_regime_locks():
     seed = wedge.simulate(load_scenario(ROOT / "scenarios" / "mov_1_from_rest_seed_monitor.yaml"))
     ours = wedge.simulate(load_scenario(ROOT / "scenarios" / "mov_1_from_rest.yaml"))
@@ -205,8 +221,11 @@ def test_seed_monitor_runs_the_worm_backwards_from_rest_where_three_regime_locks
     # the seed's monitor picks psi1 (phi > 0) and so x1'' = (F1 - F2 psi1)/(...) < 0 at rest: the motor,
     # pushing forward, is driven backwards, and it keeps calling that "tractive"
     a0 = seed.series["a1_m_s2"][0]
-    assert a0 == pytest.approx((F1_REST - 5000 * math.tan(G + math.radians(1 / 0.088)))
-                               / (11.8 + 100 * math.tan(G + math.radians(1 / 0.088)) * math.tan(G)), rel=1e-9)
+    assert a0 == pytest.approx(
+        (F1_REST - 5000 * math.tan(G + math.radians(1 / 0.088)))
+        / (11.8 + 100 * math.tan(G + math.radians(1 / 0.088)) * math.tan(G)),
+        rel=1e-9,
+    )
     assert a0 < 0 and seed.summary["min_speed_m_s"] < -1.0 and seed.summary["regimes"] == ["tractive"]
 
 
@@ -219,11 +238,15 @@ def test_seed_monitor_agrees_while_moving_forward():
 
 # ----------------------------------------------------------------------------- numerics
 
-@pytest.mark.parametrize("case", [
-    dict(duration_s=0.3, load={"force_n": -15000.0, "start_s": 0.05, "ramp_s": 0.0}),     # stall + lock
-    dict(duration_s=0.3, driven_mass_kg=200, load={"force_n": -10000.0, "start_s": 0.1, "ramp_s": 0.02}),
-    dict(duration_s=1.2, friction=0.05, load={"force_n": -25000.0, "start_s": 0.1, "ramp_s": 1.0}),
-])
+
+@pytest.mark.parametrize(
+    "case",
+    [
+        dict(duration_s=0.3, load={"force_n": -15000.0, "start_s": 0.05, "ramp_s": 0.0}),  # stall + lock
+        dict(duration_s=0.3, driven_mass_kg=200, load={"force_n": -10000.0, "start_s": 0.1, "ramp_s": 0.02}),
+        dict(duration_s=1.2, friction=0.05, load={"force_n": -25000.0, "start_s": 0.1, "ramp_s": 1.0}),
+    ],
+)
 def test_results_independent_of_solver_tolerance(case):
     coarse, fine = run_wedge(rtol=1e-6, **case), run_wedge(rtol=1e-10, **case)
     assert coarse.summary["regimes"] == fine.summary["regimes"]
@@ -237,8 +260,14 @@ def test_results_independent_of_solver_tolerance(case):
 def test_painleve_configuration_is_a_diagnosed_failure():
     # rho > gamma and m2 tan g tan(rho - g) > m1: the inverse regime's N has no consistent sign
     with pytest.raises(SimulationError, match="Painleve"):
-        run_wedge(duration_s=0.05, friction=0.5, driving_mass_kg=1.0, driven_mass_kg=100.0,
-                  initial_speed_m_s=5.0, load={"force_n": 1e5})
+        run_wedge(
+            duration_s=0.05,
+            friction=0.5,
+            driving_mass_kg=1.0,
+            driven_mass_kg=100.0,
+            initial_speed_m_s=5.0,
+            load={"force_n": 1e5},
+        )
 
 
 def test_kd_uses_the_rated_forces():
@@ -253,8 +282,20 @@ def test_kd_uses_the_rated_forces():
 
 # ----------------------------------------------------------------------------- scenario files
 
-WEDGE_KEYS = {"speed_steady_m_s", "S1_peak_n", "S2_peak_n", "S1_steady_n", "S2_steady_n", "Kd1", "Kd2",
-              "efficiency_forward", "efficiency_backward", "self_locking", "stalled", "regimes"}
+WEDGE_KEYS = {
+    "speed_steady_m_s",
+    "S1_peak_n",
+    "S2_peak_n",
+    "S1_steady_n",
+    "S2_steady_n",
+    "Kd1",
+    "Kd2",
+    "efficiency_forward",
+    "efficiency_backward",
+    "self_locking",
+    "stalled",
+    "regimes",
+}
 
 
 def test_the_mov_scenarios_exist():

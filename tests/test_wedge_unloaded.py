@@ -1,4 +1,5 @@
 """A valve with no load (issue 10): the wedge model must run to the motor's synchronous speed, not chatter."""
+
 from __future__ import annotations
 
 import math
@@ -11,8 +12,9 @@ from wormsim.scenario import load_scenario
 from wormsim.wedge.dynamics import REGIME_CODE, UNLOADED, simulate
 
 
-@pytest.mark.parametrize("overrides", [["wedge.load.force_n=0"], ["wedge.load.start_s=1000"],
-                                       ["wedge.load.force_n=0", "wedge.monitor=seed"]])
+@pytest.mark.parametrize(
+    "overrides", [["wedge.load.force_n=0"], ["wedge.load.start_s=1000"], ["wedge.load.force_n=0", "wedge.monitor=seed"]]
+)
 def test_no_load_runs_to_synchronous_speed(overrides):
     sc = load_scenario(SCENARIOS / "mov_1.yaml", overrides)
     res = simulate(sc)
@@ -27,7 +29,7 @@ def test_no_load_runs_to_synchronous_speed(overrides):
     assert np.all(s["a1_m_s2"][held] == 0.0) and np.all(s["v1_m_s"][held] == s["v1_m_s"][-1])
     # before the hold the run-up is the tractive solution, whose speed only approaches V0 from below
     assert np.all(s["v1_m_s"] <= v0 * (1 + 1e-9))
-    assert res.steps < 1000        # was: > 20000 regime changes, exit 3
+    assert res.steps < 1000  # was: > 20000 regime changes, exit 3
 
 
 def test_load_after_unloaded_hold_is_carried():

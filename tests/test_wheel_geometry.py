@@ -1,4 +1,5 @@
 """Wheel flanks: equation of meshing, tooth thickness, conjugacy with the worm over a mesh cycle, input errors."""
+
 from __future__ import annotations
 
 import math
@@ -90,7 +91,7 @@ def test_wheel_mesh_vertices_on_flanks_and_thickness(name):
     pitch = 2 * math.pi / g.z2
     k = np.round((psi[flank] - wheel.tooth_angle(g, 0)) / pitch)
     resid = np.full(flank.sum(), np.inf)
-    for dk in (-1, 0, 1):                      # the twisted teeth: a vertex may belong to a neighbour of tooth k
+    for dk in (-1, 0, 1):  # the twisted teeth: a vertex may belong to a neighbour of tooth k
         local = psi[flank] - (k + dk) * pitch
         resid = np.minimum(resid, np.minimum(np.abs(local - a), np.abs(local - b)) * rho[flank])
     assert flank.sum() > 1000 and resid.max() < 1e-9
@@ -127,8 +128,8 @@ def test_conjugacy_over_one_mesh_cycle(name):
         mins_n.append(nr.min())
     mins_ax, mins_n = np.array(mins_ax), np.array(mins_n)
     j2 = g.backlash / 2
-    assert mins_ax.min() >= j2 - 2e-8                      # no interference
-    assert mins_ax.max() <= j2 + 2e-6                      # contact at every worm angle
+    assert mins_ax.min() >= j2 - 2e-8  # no interference
+    assert mins_ax.max() <= j2 + 2e-6  # contact at every worm angle
     assert mins_n.min() >= 0
     assert mins_n.min() == pytest.approx(j2 * math.cos(g.alpha_n) * math.cos(g.gamma), abs=2e-6)
 
@@ -156,8 +157,8 @@ def test_wheel_rotates_positive_for_positive_right_hand_worm():
         r = np.hypot(P[:, 0], P[:, 1])
         ok = (r <= g.r_a1) & (r >= g.r_f1)
         gaps.append(worm.thread_gap(g, P[ok]).min())
-    assert min(gaps) < 0                              # wheel held: the turned worm interferes
-    ax, nr = clearance_to_worm(g, pts, d)             # wheel turned conjugately (positive for hand = +1)
+    assert min(gaps) < 0  # wheel held: the turned worm interferes
+    ax, nr = clearance_to_worm(g, pts, d)  # wheel turned conjugately (positive for hand = +1)
     assert assembly.wheel_angle(g, d) > 0 and nr.min() > 0
 
 
@@ -169,12 +170,15 @@ def test_left_hand_gear_is_conjugate_too():
     assert assembly.wheel_angle(g, 1.0) < 0
 
 
-@pytest.mark.parametrize("changes,match", [
-    (dict(normal_pressure_angle_deg=5.0, wheel_teeth=20), "undercut"),
-    (dict(normal_pressure_angle_deg=8.0, wheel_teeth=30), "undercut"),
-    (dict(normal_pressure_angle_deg=30.0, addendum_coef=1.5, dedendum_coef=1.8), "pointed"),
-    (dict(normal_pressure_angle_deg=25.0, addendum_coef=1.3, dedendum_coef=1.5, backlash_mm=11.0), "pointed"),
-])
+@pytest.mark.parametrize(
+    "changes,match",
+    [
+        (dict(normal_pressure_angle_deg=5.0, wheel_teeth=20), "undercut"),
+        (dict(normal_pressure_angle_deg=8.0, wheel_teeth=30), "undercut"),
+        (dict(normal_pressure_angle_deg=30.0, addendum_coef=1.5, dedendum_coef=1.8), "pointed"),
+        (dict(normal_pressure_angle_deg=25.0, addendum_coef=1.3, dedendum_coef=1.5, backlash_mm=11.0), "pointed"),
+    ],
+)
 def test_undercut_or_pointed_is_input_error(changes, match):
     g = gear_with("involute_41", **changes)
     with pytest.raises(GeometryError, match=match) as exc:
@@ -202,14 +206,15 @@ def test_worm_and_wheel_meshes_clearance_over_mesh_cycle(name):
     W = meshes._to_manifold(meshes.worm_mesh(g))
     H = meshes._to_manifold(meshes.wheel_mesh(g))
     mm = meshes.MM_PER_M
-    H = H.trim_by_plane((0.0, -1.0, 0.0), (g.r_f2 - 3 * g.m_x) * mm)            # keep y <= -(r_f2 - 3 m)
+    H = H.trim_by_plane((0.0, -1.0, 0.0), (g.r_f2 - 3 * g.m_x) * mm)  # keep y <= -(r_f2 - 3 m)
     half = (g.worm_length / 2 + 4 * g.p_x) * mm
     H = H.trim_by_plane((1.0, 0.0, 0.0), -half).trim_by_plane((-1.0, 0.0, 0.0), -half)
     normal = g.backlash / 2 * math.cos(g.alpha_n) * math.cos(g.gamma)
 
     def placed(theta1, extra=0.0):
-        m = np.linalg.inv(assembly.wheel_to_assembly(assembly.wheel_angle(g, theta1) + extra)) \
-            @ assembly.worm_to_assembly(theta1, g)
+        m = np.linalg.inv(
+            assembly.wheel_to_assembly(assembly.wheel_angle(g, theta1) + extra)
+        ) @ assembly.worm_to_assembly(theta1, g)
         m[:3, 3] *= mm
         return W.transform(m[:3, :4])
 
@@ -217,7 +222,7 @@ def test_worm_and_wheel_meshes_clearance_over_mesh_cycle(name):
     for th1 in np.linspace(0.0, 2 * math.pi / g.z1, 9)[:-1]:
         w = placed(th1)
         vols.append((w ^ H).volume())
-        gaps.append(w.min_gap(H, 3 * normal * mm) / mm)      # search length 3x the expected gap
+        gaps.append(w.min_gap(H, 3 * normal * mm) / mm)  # search length 3x the expected gap
     assert max(vols) == 0.0
     assert min(gaps) >= normal - 1e-6 and min(gaps) <= normal + 1e-7
     assert (placed(0.0, 1.5 * g.backlash / (2 * g.r2)) ^ H).volume() > 0
@@ -226,8 +231,16 @@ def test_worm_and_wheel_meshes_clearance_over_mesh_cycle(name):
 def test_zi_root_below_base_cylinder_generates_conjugate_wheel():
     """ZI with the worm root inside the base cylinder (z1 3, q 6, alpha_n 25: r_b = 1.15 r_f1): the flank is
     continued radially below r_b (worm.py); the wheel is still generated, watertight and conjugate."""
-    g = derive(Gear(worm_starts=3, diameter_quotient=6, normal_pressure_angle_deg=25, axial_module_mm=2,
-                    wheel_teeth=40, backlash_mm=0.05))
+    g = derive(
+        Gear(
+            worm_starts=3,
+            diameter_quotient=6,
+            normal_pressure_angle_deg=25,
+            axial_module_mm=2,
+            wheel_teeth=40,
+            backlash_mm=0.05,
+        )
+    )
     assert g.r_b > g.r_f1
     r = np.linspace(g.r_f1, g.r_b, 5)
     assert np.allclose(worm.half_thickness(g, r), worm.half_thickness(g, g.r_b), atol=1e-15)

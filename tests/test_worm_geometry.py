@@ -1,4 +1,5 @@
 """Worm flanks: seed 003's involute helicoid (ZI), the straight axial profile (ZA), lead and pressure angle."""
+
 from __future__ import annotations
 
 import functools
@@ -48,8 +49,8 @@ def test_zi_mesh_vertices_on_seed_involute_helicoid(name):
     mesh = meshes.worm_mesh(g, segments_per_turn=24, n_flank=6)
     V, side = _flank_vertices(g, mesh)
     assert len(V) > 100 and g.r_b < g.r_f1
-    t = np.sqrt(np.hypot(V[:, 0], V[:, 1]) ** 2 / g.r_b ** 2 - 1)
-    t1 = math.sqrt(g.r1 ** 2 / g.r_b ** 2 - 1)
+    t = np.sqrt(np.hypot(V[:, 0], V[:, 1]) ** 2 / g.r_b**2 - 1)
+    t1 = math.sqrt(g.r1**2 / g.r_b**2 - 1)
     C = g.p_x / 4 + g.p * (t1 - math.atan(t1))
     theta = (V[:, 2] - side * C) / g.p
     S = _seed_involute_helicoid(g, t, theta, side)
@@ -104,8 +105,8 @@ def test_zi_normal_pressure_angle_at_d1(name, alpha_deg):
     g = seed_geometry(name)
 
     def seed_pt(r, phi, side=1):
-        t = math.sqrt(r * r / g.r_b ** 2 - 1)
-        theta = phi - t + math.atan(t)        # polar angle of the seed point is theta + t - atan t
+        t = math.sqrt(r * r / g.r_b**2 - 1)
+        theta = phi - t + math.atan(t)  # polar angle of the seed point is theta + t - atan t
         return _seed_involute_helicoid(g, np.array(t), np.array(theta), 1)
 
     assert _normal_pressure_angle_deg(seed_pt, g.r1) == pytest.approx(alpha_deg, abs=0.01)
@@ -142,8 +143,8 @@ def test_worm_mesh_watertight_volume_inertia(seat):
     r = np.linspace(g.r_f1, g.r_a1, 2001)
     frac = 2 * worm.half_thickness(g, r) / g.p_x * g.z1
     b = g.worm_length
-    vol = math.pi * g.r_f1 ** 2 * b + np.trapezoid(frac * 2 * math.pi * r * b, r)
-    izz = math.pi * g.r_f1 ** 4 * b / 2 + np.trapezoid(frac * 2 * math.pi * r ** 3 * b, r)
+    vol = math.pi * g.r_f1**2 * b + np.trapezoid(frac * 2 * math.pi * r * b, r)
+    izz = math.pi * g.r_f1**4 * b / 2 + np.trapezoid(frac * 2 * math.pi * r**3 * b, r)
     assert mesh.volume == pytest.approx(vol, rel=2e-3)
     assert mesh.moment_inertia[2, 2] == pytest.approx(izz, rel=3e-3)
     assert np.allclose(mesh.bounds[:, 2], [-b / 2, b / 2], atol=1e-9)

@@ -6,6 +6,7 @@ the path), 3 the simulation failed (with a diagnosis), 130 / 143 interrupted by 
 Warnings (numpy, scipy) raised during a command are shown after it only when it succeeds; an error message is
 the only output of a failed command.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -30,8 +31,14 @@ EXIT_OK, EXIT_INTERNAL, EXIT_INPUT, EXIT_SIM = 0, 1, 2, 3
 def _add_scenario_args(p: argparse.ArgumentParser, out_required: bool = True) -> None:
     p.add_argument("scenario", help="scenario YAML file")
     p.add_argument("--out", required=out_required, help="output directory")
-    p.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
-                   help="override a field by its dotted path, e.g. gear.wheel_teeth=41 (repeatable)")
+    p.add_argument(
+        "--set",
+        dest="overrides",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="override a field by its dotted path, e.g. gear.wheel_teeth=41 (repeatable)",
+    )
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -48,18 +55,36 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("bench", help="speed-accuracy benchmark: bench.json and bench.png")
     p.add_argument("--quick", action="store_true", help="CI-sized subset")
     p.add_argument("--repeats", type=int, default=None, help="timed runs per case (median; default 1 quick, 3 full)")
-    p.add_argument("--scenario", action="append", default=None, dest="scenarios",
-                   help="only this seed scenario (repeatable): seat_motor, screw_jack, involute_41")
-    p.add_argument("--geometry", action="append", default=None, dest="geometries", choices=("flanks", "pieces"),
-                   help="contact3d: only this contact.geometry (repeatable; default both, for the speed-up)")
-    p.add_argument("--resolution", action="append", default=None, dest="resolutions",
-                   help="contact3d: only this resolution level (repeatable): coarse, medium, fine")
+    p.add_argument(
+        "--scenario",
+        action="append",
+        default=None,
+        dest="scenarios",
+        help="only this seed scenario (repeatable): seat_motor, screw_jack, involute_41",
+    )
+    p.add_argument(
+        "--geometry",
+        action="append",
+        default=None,
+        dest="geometries",
+        choices=("flanks", "pieces"),
+        help="contact3d: only this contact.geometry (repeatable; default both, for the speed-up)",
+    )
+    p.add_argument(
+        "--resolution",
+        action="append",
+        default=None,
+        dest="resolutions",
+        help="contact3d: only this resolution level (repeatable): coarse, medium, fine",
+    )
     p.add_argument("--out", required=True)
     p = sub.add_parser("sweep", help="parameter study on dask.distributed: sweep.csv, sweep.json, sweep.png; resumes")
     p.add_argument("sweep", help="sweep YAML file")
     p.add_argument("--out", required=True, help="output directory (rerun into it to resume)")
-    p.add_argument("--scheduler", help="address of an existing dask scheduler (default: $DASK_SCHEDULER_ADDRESS, "
-                   "else a local cluster)")
+    p.add_argument(
+        "--scheduler",
+        help="address of an existing dask scheduler (default: $DASK_SCHEDULER_ADDRESS, else a local cluster)",
+    )
     p.add_argument("--workers", type=int, help="local workers (default: one per core); with --scheduler: wait for them")
     p.add_argument("--keep-runs", action="store_true", help="also write each point's result folder into DIR/runs/")
     p.add_argument("--no-progress", action="store_true", help="no progress bar or progress lines")
@@ -87,6 +112,7 @@ def _cmd_run(args) -> int:
 # mesh, model and bench import their machinery on use (the mesh generator, MuJoCo): `wormsim run` of a wedge
 # scenario, `check` and `schema` load neither
 
+
 def _cmd_mesh(args) -> int:
     from wormsim.mesh_cmd import write_mesh_outputs
     from wormsim.output import locked_dir
@@ -113,10 +139,14 @@ def _cmd_bench(args) -> int:
     from wormsim.output import locked_dir
 
     with locked_dir(args.out, names=("bench.json", "bench_meta.json", "bench.png")):
-        run_bench(quick=args.quick, out_dir=args.out, repeats=args.repeats,
-                  scenarios=tuple(args.scenarios) if args.scenarios else None,
-                  geometries=tuple(args.geometries) if args.geometries else None,
-                  resolutions=tuple(args.resolutions) if args.resolutions else None)
+        run_bench(
+            quick=args.quick,
+            out_dir=args.out,
+            repeats=args.repeats,
+            scenarios=tuple(args.scenarios) if args.scenarios else None,
+            geometries=tuple(args.geometries) if args.geometries else None,
+            resolutions=tuple(args.resolutions) if args.resolutions else None,
+        )
     return EXIT_OK
 
 
@@ -124,11 +154,19 @@ def _cmd_sweep(args) -> int:
     from wormsim.sweep import load_sweep, run_sweep
 
     sw = load_sweep(args.sweep)
-    c = run_sweep(sw, args.out, scheduler=args.scheduler, workers=args.workers, keep_runs=args.keep_runs,
-                  progress=False if args.no_progress else None)
+    c = run_sweep(
+        sw,
+        args.out,
+        scheduler=args.scheduler,
+        workers=args.workers,
+        keep_runs=args.keep_runs,
+        progress=False if args.no_progress else None,
+    )
     out = Path(args.out)
-    print(f"sweep {sw.spec.name}: {c['points']} points: {c['ok']} ok, {c['failed']} failed "
-          f"({c['resumed']} done earlier, {c['ran']} run now)")
+    print(
+        f"sweep {sw.spec.name}: {c['points']} points: {c['ok']} ok, {c['failed']} failed "
+        f"({c['resumed']} done earlier, {c['ran']} run now)"
+    )
     print(f"wrote {out / 'sweep.csv'}, {out / 'sweep.json'}, {out / 'sweep.png'}")
     return EXIT_OK
 
@@ -148,13 +186,20 @@ def _cmd_check(args) -> int:
     from wormsim.validate import validate_geometry
 
     sc = load_scenario(args.scenario, args.overrides)
-    validate_geometry(sc)           # the same geometric checks as mesh and run
+    validate_geometry(sc)  # the same geometric checks as mesh and run
     print(yaml.safe_dump(sc.model_dump(mode="json", exclude_none=True), sort_keys=False), end="")
     return EXIT_OK
 
 
-COMMANDS = {"run": _cmd_run, "mesh": _cmd_mesh, "model": _cmd_model, "bench": _cmd_bench, "sweep": _cmd_sweep,
-            "schema": _cmd_schema, "check": _cmd_check}
+COMMANDS = {
+    "run": _cmd_run,
+    "mesh": _cmd_mesh,
+    "model": _cmd_model,
+    "bench": _cmd_bench,
+    "sweep": _cmd_sweep,
+    "schema": _cmd_schema,
+    "check": _cmd_check,
+}
 
 
 def _out_path(args) -> Path | None:
@@ -176,8 +221,8 @@ def main(argv: list[str] | None = None) -> int:
     try:
         with warnings.catch_warnings(record=True) as caught:
             code = COMMANDS[args.command](args)
-        interrupt.check()           # an interrupt that a library swallowed
-        for w in caught:            # a successful command: show what numpy/scipy warned about, after the work
+        interrupt.check()  # an interrupt that a library swallowed
+        for w in caught:  # a successful command: show what numpy/scipy warned about, after the work
             warnings.showwarning(w.message, w.category, w.filename, w.lineno)
         return code
     except ScenarioError as exc:
@@ -191,7 +236,7 @@ def main(argv: list[str] | None = None) -> int:
     except OSError as exc:
         if (sig := interrupt.pending()) is not None:
             return _interrupted(sig, args)
-        if _is_under(exc.filename, _out_path(args)):    # disk full, permissions changed under a running command
+        if _is_under(exc.filename, _out_path(args)):  # disk full, permissions changed under a running command
             print(f"error: cannot write to {exc.filename}: {exc.strerror or exc}", file=sys.stderr)
             return EXIT_INPUT
         return _internal(exc, args)
@@ -205,8 +250,10 @@ def main(argv: list[str] | None = None) -> int:
 
 def _interrupted(signum: int, args) -> int:
     name = "" if signum == signal.SIGINT else f" ({signal.Signals(signum).name})"
-    print(f"interrupted{name}" + ("; the earlier result in --out is unchanged" if args.command == "run" else ""),
-          file=sys.stderr)
+    print(
+        f"interrupted{name}" + ("; the earlier result in --out is unchanged" if args.command == "run" else ""),
+        file=sys.stderr,
+    )
     return 128 + int(signum)
 
 
@@ -214,8 +261,9 @@ def _internal(exc: BaseException, args) -> int:
     if args.debug:
         traceback.print_exception(exc)
     else:
-        print(f"internal error: {exc.__class__.__name__}: {exc} (rerun with --debug for the traceback)",
-              file=sys.stderr)
+        print(
+            f"internal error: {exc.__class__.__name__}: {exc} (rerun with --debug for the traceback)", file=sys.stderr
+        )
     return EXIT_INTERNAL
 
 

@@ -23,6 +23,7 @@ The scenario's `contact:` friction keys select mu(Vs) (friction_coefficient, sha
   friction_group: mu(Vs) = tan(rho(Vs)), rho of seed 000 above
   none given: mu = 0.05 (lubricated steel/bronze, DEFAULT_FRICTION).
 """
+
 from __future__ import annotations
 
 import math
@@ -58,7 +59,7 @@ def rho_rad(vs_m_s, group: str | None = None, friction: float | None = None):
             a, b, c = GROUPS[group]
         except KeyError:
             raise ValueError(f"friction group {group!r}: allowed I, II, III") from None
-        out = DEG / (a * vs ** b + c)
+        out = DEG / (a * vs**b + c)
     return float(out) if out.ndim == 0 else out
 
 
@@ -76,8 +77,10 @@ def friction_mode(contact: Contact) -> str:
     if contact.friction_group is not None:
         return f"group {contact.friction_group} (seed 000 rho(Vs))"
     if contact.friction_static is not None:
-        return (f"static {contact.friction_static} -> dynamic {contact.friction_dynamic} "
-                f"over {contact.transition_velocity_m_s} m/s")
+        return (
+            f"static {contact.friction_static} -> dynamic {contact.friction_dynamic} "
+            f"over {contact.transition_velocity_m_s} m/s"
+        )
     if contact.friction is not None:
         return f"constant {contact.friction}"
     return f"default constant {DEFAULT_FRICTION}"

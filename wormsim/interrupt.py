@@ -6,6 +6,7 @@ later as an unrelated TypeError, or not at all (measured: a SIGINT 0.3 s into a 
 0). `check()` re-raises a recorded interrupt; the runner calls it between phases and Progress on every update, so
 an interrupt always ends the run as an interrupt and never commits or fails a result.
 """
+
 from __future__ import annotations
 
 import signal
@@ -35,7 +36,7 @@ def install() -> dict:
         if cur in (signal.SIG_DFL, signal.default_int_handler, None):
             try:
                 old[sig] = signal.signal(sig, _handler)
-            except ValueError:          # not the main thread (an embedding application): leave signals alone
+            except ValueError:  # not the main thread (an embedding application): leave signals alone
                 pass
     return old
 

@@ -20,6 +20,7 @@
   theory tan(g) / tan(g + rho') (or tan(g - rho') / tan(g) back-driving), rho' = atan(mu / cos(alpha_n)),
   mu the mean friction coefficient applied over the window.
 """
+
 from __future__ import annotations
 
 import math
@@ -37,7 +38,7 @@ def steady_window(t: np.ndarray, speed: np.ndarray, t_start: float, period_s: fl
     if n - i_ramp < 8:
         return max(0, n - 8), n
     dt = (t[-1] - t[0]) / max(n - 1, 1)
-    half = speed[max(i_ramp, n // 2):]
+    half = speed[max(i_ramp, n // 2) :]
     ref = abs(float(np.mean(half))) if len(half) else 0.0
     w = max(1, int(round(period_s / dt))) if period_s > 0 else 1
     w = min(w, max(1, (n - i_ramp) // 4))
@@ -58,8 +59,9 @@ def steady_window(t: np.ndarray, speed: np.ndarray, t_start: float, period_s: fl
     return i0, i1
 
 
-def dominant_frequency(t: np.ndarray, x: np.ndarray, f_max_hz: float = float("inf")
-                       ) -> tuple[float, float, np.ndarray, np.ndarray]:
+def dominant_frequency(
+    t: np.ndarray, x: np.ndarray, f_max_hz: float = float("inf")
+) -> tuple[float, float, np.ndarray, np.ndarray]:
     """(f_peak_hz, resolution_hz, freqs, amplitude spectrum) of x(t) on a uniform grid: linear trend
     removed, Hann window, DC bin excluded, peak searched below f_max_hz, Gaussian interpolation of the
     peak bin."""
@@ -89,7 +91,7 @@ def window_of(S: dict, scenario, geo) -> tuple[int, int, float]:
     t = S["t_s"]
     drv = scenario.drive
     w1 = S["worm_speed_rpm"]
-    n1_guess = abs(float(np.mean(w1[len(w1) // 2:]))) if len(w1) else 0.0
+    n1_guess = abs(float(np.mean(w1[len(w1) // 2 :]))) if len(w1) else 0.0
     f_mesh_guess = geo.z1 * n1_guess / 60.0
     period = 1.0 / f_mesh_guess if f_mesh_guess > 0 else 0.0
     ramp_end = gt.ramps_end_s(scenario)
@@ -123,8 +125,16 @@ def mean_speeds_rpm(S: dict, i0: int, i1: int) -> tuple[float, float]:
     return float(n1), float(n2)
 
 
-def drive_summary(S: dict, scenario, geo, i0: int, i1: int, n1: float, n2: float,
-                  shaft_powers_w: tuple[np.ndarray, np.ndarray] | None = None) -> dict:
+def drive_summary(
+    S: dict,
+    scenario,
+    geo,
+    i0: int,
+    i1: int,
+    n1: float,
+    n2: float,
+    shaft_powers_w: tuple[np.ndarray, np.ndarray] | None = None,
+) -> dict:
     """The summary keys every gear-level model shares (INTERFACE.md contact3d list, less the meshing
     frequency, which each model takes from its own signal): ratio, forces, torques, speeds, efficiency
     (output / input power over the window) and its theory tan(g) / tan(g + rho') (or back-driving).
@@ -152,7 +162,8 @@ def drive_summary(S: dict, scenario, geo, i0: int, i1: int, n1: float, n2: float
         "mesh_frequency_theory_hz": geo.z1 * n1 / 60.0,
         "tangential_force_mean_n": abs(float(np.mean(ft))),
         "tangential_force_p2p_n": float(np.ptp(ft)) if len(ft) else float("nan"),
-        "tangential_force_theory_n": gt.tangential_force_n(abs(load.torque_nm), geo.r2) if load.on == "wheel"
+        "tangential_force_theory_n": gt.tangential_force_n(abs(load.torque_nm), geo.r2)
+        if load.on == "wheel"
         else float("nan"),
         "radial_force_mean_n": abs(float(np.mean(S["radial_force_n"][sl]))),
         "axial_force_mean_n": abs(float(np.mean(S["axial_force_n"][sl]))),

@@ -16,6 +16,7 @@ Guarantees for a run's folder DIR (README, "Reliability"):
 * A folder that cannot be written (a regular file, a read-only file system, /dev/null/x) is refused before any
   work with "cannot write to PATH: reason" (exit 2); nothing existing is touched.
 """
+
 from __future__ import annotations
 
 import errno
@@ -79,7 +80,7 @@ def write_text_atomic(path: Path, text: str) -> None:
     try:
         with os.fdopen(fd, "w") as fh:
             fh.write(text)
-        os.chmod(tmp, 0o666 & ~_umask())    # mkstemp creates 0600; a result file is as readable as any other file
+        os.chmod(tmp, 0o666 & ~_umask())  # mkstemp creates 0600; a result file is as readable as any other file
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
@@ -150,8 +151,10 @@ class FolderLock:
             except OSError as exc:
                 os.close(fd)
                 if exc.errno in (errno.EWOULDBLOCK, errno.EAGAIN, errno.EACCES):
-                    raise FolderBusy(f"cannot write to {self.path.parent}: {_holder(self.path)} is writing there "
-                                     f"(lock {self.path}); wait for it to finish or give another --out") from None
+                    raise FolderBusy(
+                        f"cannot write to {self.path.parent}: {_holder(self.path)} is writing there "
+                        f"(lock {self.path}); wait for it to finish or give another --out"
+                    ) from None
                 raise OutputPathError(f"cannot write to {self.path.parent}: {_reason(exc)}") from None
             try:
                 same = os.stat(self.path).st_ino == os.fstat(fd).st_ino
@@ -233,7 +236,7 @@ class ResultDir:
 
     def commit(self, summary: dict) -> None:
         with signals_held():
-            (self.out / "summary.json").unlink(missing_ok=True)     # no "ok" summary beside a mix of old and new
+            (self.out / "summary.json").unlink(missing_ok=True)  # no "ok" summary beside a mix of old and new
             for f in sorted(self.staging.iterdir()):
                 os.replace(f, self.out / f.name)
             write_json_atomic(self.out / "summary.json", summary)

@@ -8,6 +8,7 @@ Every fidelity level writes its recording through these helpers, so all recordin
 
 Open a recording with `rerun DIR/recording.rrd`.
 """
+
 from __future__ import annotations
 
 import os
@@ -38,8 +39,7 @@ def recording(path: str | Path, name: str):
             tmp.unlink()
 
 
-def log_series(rec: rr.RecordingStream, t_s: np.ndarray, series: dict[str, np.ndarray],
-               prefix: str = "series") -> None:
+def log_series(rec: rr.RecordingStream, t_s: np.ndarray, series: dict[str, np.ndarray], prefix: str = "series") -> None:
     """Log every 1-D numeric array of len(t_s) in `series` as a scalar plot on the sim-time timeline.
 
     Multi-column arrays (N, k) become k plots named `<name>/<i>`. Non-numeric or mismatched arrays
@@ -57,15 +57,29 @@ def log_series(rec: rr.RecordingStream, t_s: np.ndarray, series: dict[str, np.nd
             rr.send_columns(path, indexes=[times], columns=rr.Scalars.columns(scalars=cols[:, i]), recording=rec)
 
 
-def log_mesh(rec: rr.RecordingStream, path: str, vertices: np.ndarray, faces: np.ndarray,
-             color=(180, 180, 190), static: bool = True) -> None:
+def log_mesh(
+    rec: rr.RecordingStream,
+    path: str,
+    vertices: np.ndarray,
+    faces: np.ndarray,
+    color=(180, 180, 190),
+    static: bool = True,
+) -> None:
     """A triangle mesh (metres) with vertex normals, logged once (static) under `path`."""
     import trimesh
 
     mesh = trimesh.Trimesh(vertices=vertices, faces=faces, process=False)
-    rr.log(path, rr.Mesh3D(vertex_positions=mesh.vertices, triangle_indices=mesh.faces,
-                           vertex_normals=mesh.vertex_normals, albedo_factor=list(color)),
-           static=static, recording=rec)
+    rr.log(
+        path,
+        rr.Mesh3D(
+            vertex_positions=mesh.vertices,
+            triangle_indices=mesh.faces,
+            vertex_normals=mesh.vertex_normals,
+            albedo_factor=list(color),
+        ),
+        static=static,
+        recording=rec,
+    )
 
 
 def log_transforms(rec: rr.RecordingStream, path: str, t_s: np.ndarray, matrices: np.ndarray) -> None:
@@ -73,9 +87,11 @@ def log_transforms(rec: rr.RecordingStream, path: str, t_s: np.ndarray, matrices
     t_s = np.asarray(t_s, dtype=float)
     mats = np.asarray(matrices, dtype=float)
     rr.send_columns(
-        path, indexes=[rr.TimeColumn(TIMELINE, duration=t_s)],
+        path,
+        indexes=[rr.TimeColumn(TIMELINE, duration=t_s)],
         columns=rr.Transform3D.columns(translation=mats[:, :3, 3], mat3x3=mats[:, :3, :3]),
-        recording=rec)
+        recording=rec,
+    )
 
 
 def save_series_recording(path: str | Path, name: str, t_s: np.ndarray, series: dict[str, np.ndarray]) -> None:

@@ -1,5 +1,6 @@
 """Run one scenario end to end: simulate at the requested fidelity, then write the time series,
 report.png, recording.rrd and summary.json atomically (wormsim.output)."""
+
 from __future__ import annotations
 
 import importlib
@@ -42,39 +43,62 @@ def run_scenario(scenario: Scenario, out_dir: str | Path, progress: bool | None 
     an earlier result); an interrupt (KeyboardInterrupt, SIGTERM via the CLI) leaves DIR as it was
     (wormsim.output).
     """
-    validate_geometry(scenario)     # the checks `wormsim check` makes, before anything is written
+    validate_geometry(scenario)  # the checks `wormsim check` makes, before anything is written
     mod = model_module(scenario.model)
     rd = ResultDir(out_dir)
     base = {"model": scenario.model, "scenario": scenario.name}
     t0 = time.perf_counter()
     try:
-        with Progress(scenario.simulation.duration_s, label=f"{scenario.name} ({scenario.model})",
-                      enabled=progress) as bar:
+        with Progress(
+            scenario.simulation.duration_s, label=f"{scenario.name} ({scenario.model})", enabled=progress
+        ) as bar:
             res = mod.simulate(scenario, progress=bar)
         wall = time.perf_counter() - t0
         np.savez_compressed(rd.path("timeseries.npz"), **res.series)
         mod.write_report(res, rd.path("report.png"))
         mod.write_recording(res, rd.path("recording.rrd"))
-        interrupt.check()           # an interrupt swallowed on the way (a library's `except BaseException`)
-    except KeyboardInterrupt:       # Ctrl-C / SIGTERM: not a failure of the run; an earlier result stays
+        interrupt.check()  # an interrupt swallowed on the way (a library's `except BaseException`)
+    except KeyboardInterrupt:  # Ctrl-C / SIGTERM: not a failure of the run; an earlier result stays
         rd.abandon()
         raise
-    except (SimulationError, ScenarioError) as exc:     # a diagnosis (exit 3) or input found invalid (exit 2)
+    except (SimulationError, ScenarioError) as exc:  # a diagnosis (exit 3) or input found invalid (exit 2)
         if (sig := interrupt.pending()) is not None:
             rd.abandon()
             raise interrupt.Interrupted(sig) from exc
-        rd.fail({"status": "failed", "message": str(exc), **base,
-                 "wall_time_s": time.perf_counter() - t0, "sim_time_s": None, "steps": None})
+        rd.fail(
+            {
+                "status": "failed",
+                "message": str(exc),
+                **base,
+                "wall_time_s": time.perf_counter() - t0,
+                "sim_time_s": None,
+                "steps": None,
+            }
+        )
         raise
     except BaseException as exc:  # never leave a result that looks complete
-        if (sig := interrupt.pending()) is not None:     # the interrupt came back as another exception
+        if (sig := interrupt.pending()) is not None:  # the interrupt came back as another exception
             rd.abandon()
             raise interrupt.Interrupted(sig) from exc
-        rd.fail({"status": "failed", "message": f"internal error: {exc.__class__.__name__}: {exc}", **base,
-                 "wall_time_s": time.perf_counter() - t0, "sim_time_s": None, "steps": None})
+        rd.fail(
+            {
+                "status": "failed",
+                "message": f"internal error: {exc.__class__.__name__}: {exc}",
+                **base,
+                "wall_time_s": time.perf_counter() - t0,
+                "sim_time_s": None,
+                "steps": None,
+            }
+        )
         raise
-    summary = {"status": "ok", "message": "", **base, "wall_time_s": wall,
-               "sim_time_s": res.sim_time_s, "steps": res.steps, **res.summary}
+    summary = {
+        "status": "ok",
+        "message": "",
+        **base,
+        "wall_time_s": wall,
+        "sim_time_s": res.sim_time_s,
+        "steps": res.steps,
+        **res.summary,
+    }
     rd.commit(summary)
     return summary
-

@@ -8,6 +8,7 @@ Every model forbids unknown keys, so a misspelt field is an error, not a silent 
 `load_scenario` turns any validation failure into `ScenarioError`, whose message is one line
 naming the field (dotted path), the value given and what is allowed; the CLI maps it to exit 2.
 """
+
 from __future__ import annotations
 
 import json
@@ -35,10 +36,13 @@ FrictionGroup = Literal["I", "II", "III"]
 
 # ----------------------------------------------------------------------------- gear, materials
 
+
 class Gear(_Strict):
     """Worm gear data (DIN 3975 / ISO 1122 names). Exactly one module and one of lead angle / q."""
 
-    profile: Literal["ZI", "ZA"] = Field("ZI", description="ZI: involute helicoid (seed 003); ZA: straight-sided axial profile")
+    profile: Literal["ZI", "ZA"] = Field(
+        "ZI", description="ZI: involute helicoid (seed 003); ZA: straight-sided axial profile"
+    )
     hand: Literal["right", "left"] = Field("right", description="thread hand of the worm")
     worm_starts: int = Field(1, ge=1, le=8, description="z1")
     wheel_teeth: int = Field(..., ge=10, le=200, description="z2")
@@ -47,11 +51,25 @@ class Gear(_Strict):
     normal_pressure_angle_deg: float = Field(20.0, ge=5, le=30)
     lead_angle_deg: float | None = Field(None, gt=0, lt=45, description="gamma at the worm reference diameter")
     diameter_quotient: float | None = Field(None, gt=0, le=40, description="q = d1 / m_axial")
-    face_width_mm: float | None = Field(None, gt=0, le=2000, description=(
-        "wheel face width b2; default 0.75 * worm tip diameter (DIN 3975 guide); at most 1.2 worm tip diameters"))
-    worm_length_mm: float | None = Field(None, gt=0, le=10000, description=(
-        "threaded length; default covers the wheel's mesh zone; allowed 1 axial pitch to 4 x that default"))
-    backlash_mm: float = Field(0.05, ge=0, le=50, description="circumferential, at the wheel reference circle; below 0.4 axial pitch")
+    face_width_mm: float | None = Field(
+        None,
+        gt=0,
+        le=2000,
+        description=(
+            "wheel face width b2; default 0.75 * worm tip diameter (DIN 3975 guide); at most 1.2 worm tip diameters"
+        ),
+    )
+    worm_length_mm: float | None = Field(
+        None,
+        gt=0,
+        le=10000,
+        description=(
+            "threaded length; default covers the wheel's mesh zone; allowed 1 axial pitch to 4 x that default"
+        ),
+    )
+    backlash_mm: float = Field(
+        0.05, ge=0, le=50, description="circumferential, at the wheel reference circle; below 0.4 axial pitch"
+    )
     addendum_coef: float = Field(1.0, gt=0, le=1.5, description="h_a / m_axial")
     dedendum_coef: float = Field(1.2, gt=0, le=2.0, description="h_f / m_axial")
 
@@ -79,6 +97,7 @@ class Materials(_Strict):
 
 # ----------------------------------------------------------------------------- contact, drive, load
 
+
 class Contact(_Strict):
     """Tooth contact. Every key optional; defaults derived from Hertz (README, 'Contact law')."""
 
@@ -91,29 +110,47 @@ class Contact(_Strict):
     friction_dynamic: float | None = Field(None, ge=0, le=1)
     friction_group: FrictionGroup | None = Field(None, description="seed 000 rho(Vs) material group")
     transition_velocity_m_s: float = Field(1e-3, gt=0, le=10, description="static -> dynamic friction blend speed")
-    geometry: Literal["pieces", "flanks"] = Field("pieces", description=(
-        "contact3d: pieces (MuJoCo collides convex pieces) | flanks (contacts found on the exact flanks, one per "
-        "face slice; docs/contact3d.md)"))
-    slices: int | None = Field(None, ge=2, le=256, description=(
-        "flanks: slices across the face width (default by simulation.resolution: coarse 8, medium 16, fine 32)"))
+    geometry: Literal["pieces", "flanks"] = Field(
+        "pieces",
+        description=(
+            "contact3d: pieces (MuJoCo collides convex pieces) | flanks (contacts found on the exact flanks, one per "
+            "face slice; docs/contact3d.md)"
+        ),
+    )
+    slices: int | None = Field(
+        None,
+        ge=2,
+        le=256,
+        description=(
+            "flanks: slices across the face width (default by simulation.resolution: coarse 8, medium 16, fine 32)"
+        ),
+    )
 
     @model_validator(mode="after")
     def _friction(self) -> "Contact":
-        given = [self.friction is not None, self.friction_group is not None,
-                 self.friction_static is not None or self.friction_dynamic is not None]
+        given = [
+            self.friction is not None,
+            self.friction_group is not None,
+            self.friction_static is not None or self.friction_dynamic is not None,
+        ]
         if sum(given) > 1:
             raise ValueError("give one of friction / friction_group / friction_static+friction_dynamic")
         if (self.friction_static is None) != (self.friction_dynamic is None):
             raise ValueError("friction_static and friction_dynamic go together")
-        if (self.friction_static is not None and self.friction_dynamic is not None
-                and self.friction_dynamic > self.friction_static):
+        if (
+            self.friction_static is not None
+            and self.friction_dynamic is not None
+            and self.friction_dynamic > self.friction_static
+        ):
             raise ValueError("friction_dynamic must not exceed friction_static")
         return self
 
 
 class Drive(_Strict):
     on: Literal["worm", "wheel"] = Field("worm", description="driven shaft (wheel = back-driving)")
-    speed_rpm: float | None = Field(None, gt=-100000, lt=100000, description="speed-controlled drive, STEP ramp from 0 over ramp_s")
+    speed_rpm: float | None = Field(
+        None, gt=-100000, lt=100000, description="speed-controlled drive, STEP ramp from 0 over ramp_s"
+    )
     torque_nm: float | None = Field(None, gt=-1e6, lt=1e6, description="torque drive, same STEP ramp")
     ramp_s: float = Field(0.0, ge=0, le=3600, description="STEP ramp time of the drive")
 
@@ -129,25 +166,46 @@ class Load(_Strict):
     torque_nm: float = Field(0.0, gt=-1e6, lt=1e6, description="resisting torque")
     start_s: float = Field(0.0, ge=0, le=1e6, description="STEP ramp of the load starts here (may lie past the end)")
     ramp_s: float = Field(0.0, ge=0, le=3600, description="STEP ramp time of the load")
-    inertia_kg_m2: float = Field(0.0, ge=0, le=1e6, description=(
-        "driven-machine inertia rigidly on the loaded shaft (contact3d: joint armature; 0 = bare gear)"))
+    inertia_kg_m2: float = Field(
+        0.0,
+        ge=0,
+        le=1e6,
+        description=("driven-machine inertia rigidly on the loaded shaft (contact3d: joint armature; 0 = bare gear)"),
+    )
 
 
 class Simulation(_Strict):
     duration_s: float = Field(1.0, gt=0, le=3600)
-    timestep_s: float | None = Field(None, gt=0, le=0.01, description="default documented; the summary states the one used")
-    resolution: Literal["coarse", "medium", "fine"] = Field("medium", description="collision decomposition level (contact3d)")
+    timestep_s: float | None = Field(
+        None, gt=0, le=0.01, description="default documented; the summary states the one used"
+    )
+    resolution: Literal["coarse", "medium", "fine"] = Field(
+        "medium", description="collision decomposition level (contact3d)"
+    )
     integrator: Literal["implicitfast", "rk4", "euler", "implicit", "discrete"] = "implicitfast"
-    record_every: int = Field(1, ge=1, le=100000, description=(
-        "store every n-th step in the time series (forces, torques and powers: the mean over those n steps)"))
-    speculative: bool = Field(False, description=(
-        "contact3d: MuJoCo's speculative contacts (sweep fast geoms over the step against tunnelling)"))
+    record_every: int = Field(
+        1,
+        ge=1,
+        le=100000,
+        description=(
+            "store every n-th step in the time series (forces, torques and powers: the mean over those n steps)"
+        ),
+    )
+    speculative: bool = Field(
+        False,
+        description=("contact3d: MuJoCo's speculative contacts (sweep fast geoms over the step against tunnelling)"),
+    )
     mesh_stiffness_samples: int = Field(
-        64, ge=8, le=4096, description="torsional: k(theta) samples per mesh cycle (tooth contact analysis)")
-    mass_scaling: Annotated[float, Field(ge=1, le=1e8)] | Literal["auto"] = Field(1.0, description=(
-        "1 <= S <= 1e8 or auto; contact3d, quasi-static runs only: both shafts' inertias (and load.inertia_kg_m2) times this factor, so the "
-        "stable timestep grows by its square root; auto: the largest factor that keeps the kinetic energy below 1 % "
-        "of the drive's work; 1 = off. Refused for dynamic runs (docs/contact3d.md, 'Mass scaling')"))
+        64, ge=8, le=4096, description="torsional: k(theta) samples per mesh cycle (tooth contact analysis)"
+    )
+    mass_scaling: Annotated[float, Field(ge=1, le=1e8)] | Literal["auto"] = Field(
+        1.0,
+        description=(
+            "1 <= S <= 1e8 or auto; contact3d, quasi-static runs only: both shafts' inertias (and load.inertia_kg_m2) times this factor, so the "
+            "stable timestep grows by its square root; auto: the largest factor that keeps the kinetic energy below 1 % "
+            "of the drive's work; 1 = off. Refused for dynamic runs (docs/contact3d.md, 'Mass scaling')"
+        ),
+    )
 
     @field_validator("mass_scaling", mode="before")
     @classmethod
@@ -160,6 +218,7 @@ class Simulation(_Strict):
 
 # ----------------------------------------------------------------------------- wedge (seed 000)
 
+
 class WedgeMotor(_Strict):
     """Kloss induction-motor force curve of seed 000 (forces reduced to the worm pitch radius)."""
 
@@ -167,9 +226,14 @@ class WedgeMotor(_Strict):
     synchronous_speed_m_s: float = Field(7.85, gt=0, le=1000)
     peak_force_speed_m_s: float = Field(6.5, gt=0, le=1000)
     nominal_force_n: float = Field(
-        990.0, gt=0, le=1e8, description="rated force Ft1 = M_n / R1 for the dynamic factor Kd1; seed 000: 2178 N / (Mmax/Mn = 2.2)")
+        990.0,
+        gt=0,
+        le=1e8,
+        description="rated force Ft1 = M_n / R1 for the dynamic factor Kd1; seed 000: 2178 N / (Mmax/Mn = 2.2)",
+    )
     nominal_speed_m_s: float = Field(
-        7.59, gt=0, le=1000, description="rated speed n_n R1 (Ft2 uses rho there); seed 000: 2900 rpm at R1 = 25 mm")
+        7.59, gt=0, le=1000, description="rated speed n_n R1 (Ft2 uses rho there); seed 000: 2900 rpm at R1 = 25 mm"
+    )
 
     @model_validator(mode="after")
     def _order(self) -> "WedgeMotor":
@@ -196,7 +260,9 @@ class Wedge(_Strict):
     motor: WedgeMotor = WedgeMotor()
     load: WedgeLoad = WedgeLoad()
     monitor: Literal["three_regime", "seed"] = Field(
-        "three_regime", description="three_regime: tractive/inverse/locked with events; seed: seed 000's literal two-regime switch")
+        "three_regime",
+        description="three_regime: tractive/inverse/locked with events; seed: seed 000's literal two-regime switch",
+    )
     initial_speed_m_s: float = Field(0.0, ge=0, le=1000)
     rtol: float = Field(1e-8, gt=0, le=1e-2)
 
@@ -211,39 +277,75 @@ class Wedge(_Strict):
 
 # ----------------------------------------------------------------------------- assembly and manufacturing errors
 
+
 class Errors(_Strict):
     """Assembly errors and manufacturing deviations of the gear pair (issue 12), every key 0 by default.
     Their geometry, limits and signs: meshgen.displaced and docs/errors.md. The limits that depend on the gear
     (backlash, tooth depth, face width, threaded length) are checked against the derived geometry (exit 2)."""
 
-    center_distance_mm: float = Field(0.0, ge=-100, le=100, description="a - a_nominal; a larger centre distance is positive")
-    shaft_angle_deg: float = Field(0.0, ge=-10, le=10, description=(
-        "deviation of the shaft angle from 90 deg, a rotation of the wheel axis about the line of centres "
-        "(right-hand rule about the line from the worm axis to the wheel centre)"))
-    wheel_axial_offset_mm: float = Field(0.0, ge=-100, le=100, description="the wheel mid-plane off the worm axis, along the wheel axis")
-    worm_axial_offset_mm: float = Field(0.0, ge=-100, le=100, description="the worm shifted along its own axis (a phase only)")
-    wheel_runout_mm: NonNegFloat = Field(0.0, le=10, description="eccentricity of the wheel's pitch circle to its axis of rotation")
-    wheel_runout_phase_deg: float = Field(0.0, ge=-360, le=360, description=(
-        "wheel-frame polar angle of the pitch-circle centre, from the line of centres towards the worm at theta2 = 0"))
-    worm_runout_mm: NonNegFloat = Field(0.0, le=10, description="eccentricity of the worm's thread axis to its axis of rotation")
+    center_distance_mm: float = Field(
+        0.0, ge=-100, le=100, description="a - a_nominal; a larger centre distance is positive"
+    )
+    shaft_angle_deg: float = Field(
+        0.0,
+        ge=-10,
+        le=10,
+        description=(
+            "deviation of the shaft angle from 90 deg, a rotation of the wheel axis about the line of centres "
+            "(right-hand rule about the line from the worm axis to the wheel centre)"
+        ),
+    )
+    wheel_axial_offset_mm: float = Field(
+        0.0, ge=-100, le=100, description="the wheel mid-plane off the worm axis, along the wheel axis"
+    )
+    worm_axial_offset_mm: float = Field(
+        0.0, ge=-100, le=100, description="the worm shifted along its own axis (a phase only)"
+    )
+    wheel_runout_mm: NonNegFloat = Field(
+        0.0, le=10, description="eccentricity of the wheel's pitch circle to its axis of rotation"
+    )
+    wheel_runout_phase_deg: float = Field(
+        0.0,
+        ge=-360,
+        le=360,
+        description=(
+            "wheel-frame polar angle of the pitch-circle centre, from the line of centres towards the worm at theta2 = 0"
+        ),
+    )
+    worm_runout_mm: NonNegFloat = Field(
+        0.0, le=10, description="eccentricity of the worm's thread axis to its axis of rotation"
+    )
     wheel_pitch_deviation_um: list[Annotated[float, Field(ge=-10000, le=10000)]] = Field(
-        default_factory=list, max_length=200, description=(
+        default_factory=list,
+        max_length=200,
+        description=(
             "per wheel tooth from tooth 0: the tooth shifted along the reference circle, positive in the wheel's positive "
-            "sense (single pitch deviation f_pt,k = entry k - entry k-1); missing teeth 0"))
+            "sense (single pitch deviation f_pt,k = entry k - entry k-1); missing teeth 0"
+        ),
+    )
 
     def is_zero(self) -> bool:
         """No deviation at all (the phase alone, without a runout, is none)."""
-        return not (self.center_distance_mm or self.shaft_angle_deg or self.wheel_axial_offset_mm
-                    or self.worm_axial_offset_mm or self.wheel_runout_mm or self.worm_runout_mm
-                    or any(self.wheel_pitch_deviation_um))
+        return not (
+            self.center_distance_mm
+            or self.shaft_angle_deg
+            or self.wheel_axial_offset_mm
+            or self.worm_axial_offset_mm
+            or self.wheel_runout_mm
+            or self.worm_runout_mm
+            or any(self.wheel_pitch_deviation_um)
+        )
+
 
 # ----------------------------------------------------------------------------- scenario
+
 
 class Scenario(_Strict):
     name: str = Field(..., pattern=r"^[a-z0-9_-]+$", description="case name, used in outputs")
     description: str = Field("", description="free text")
     model: Literal["contact3d", "torsional", "wedge"] = Field(
-        "contact3d", description="fidelity level: 3D tooth contact (MuJoCo), 2-DOF torsional, or 1-DOF wedge (seed 000)")
+        "contact3d", description="fidelity level: 3D tooth contact (MuJoCo), 2-DOF torsional, or 1-DOF wedge (seed 000)"
+    )
     gear: Gear | None = None
     materials: Materials = Materials()
     contact: Contact = Contact()
@@ -256,15 +358,19 @@ class Scenario(_Strict):
     @model_validator(mode="after")
     def _blocks(self) -> "Scenario":
         if self.model != "contact3d" and self.simulation.mass_scaling != 1:
-            raise ValueError(f"simulation.mass_scaling = {self.simulation.mass_scaling}: only model contact3d scales "
-                             f"masses (torsional runs the 20 s seat motor in seconds without it); allowed: "
-                             f"simulation.mass_scaling = 1 with model {self.model}")
+            raise ValueError(
+                f"simulation.mass_scaling = {self.simulation.mass_scaling}: only model contact3d scales "
+                f"masses (torsional runs the 20 s seat motor in seconds without it); allowed: "
+                f"simulation.mass_scaling = 1 with model {self.model}"
+            )
         if self.model == "wedge":
             if self.wedge is None:
                 raise ValueError("model: wedge needs a wedge: block")
             if not self.errors.is_zero():
-                raise ValueError("errors: the wedge model has no gear geometry to displace; use model: torsional or "
-                                 "contact3d, or set every errors key to 0")
+                raise ValueError(
+                    "errors: the wedge model has no gear geometry to displace; use model: torsional or "
+                    "contact3d, or set every errors key to 0"
+                )
         else:
             if self.gear is None:
                 raise ValueError(f"model: {self.model} needs a gear: block")
@@ -277,11 +383,11 @@ class Scenario(_Strict):
 
 # ----------------------------------------------------------------------------- loading
 
-MAX_FILE_BYTES = 256_000        # a scenario file is a few kB; larger input is refused before parsing (pure-Python YAML)
-MAX_DEPTH = 32                  # nesting of blocks/lists (the schema needs 4)
-MAX_NODES = 100_000             # YAML nodes after alias expansion ("billion laughs": 373 bytes -> 1e9 nodes)
-MAX_PROBLEMS = 10               # validation problems listed; the rest is counted
-MAX_SHOWN = 60                  # characters of a value quoted in a message
+MAX_FILE_BYTES = 256_000  # a scenario file is a few kB; larger input is refused before parsing (pure-Python YAML)
+MAX_DEPTH = 32  # nesting of blocks/lists (the schema needs 4)
+MAX_NODES = 100_000  # YAML nodes after alias expansion ("billion laughs": 373 bytes -> 1e9 nodes)
+MAX_PROBLEMS = 10  # validation problems listed; the rest is counted
+MAX_SHOWN = 60  # characters of a value quoted in a message
 
 
 class _Loader(yaml.SafeLoader):
@@ -295,8 +401,9 @@ class _Loader(yaml.SafeLoader):
         try:
             if self._depth > MAX_DEPTH:
                 mark = self.peek_event().start_mark
-                raise ScenarioError(f"nested deeper than {MAX_DEPTH} levels at line {mark.line + 1}; "
-                                    "a scenario needs at most 4")
+                raise ScenarioError(
+                    f"nested deeper than {MAX_DEPTH} levels at line {mark.line + 1}; a scenario needs at most 4"
+                )
             return super().compose_node(parent, index)
         finally:
             self._depth -= 1
@@ -307,7 +414,8 @@ _Loader.yaml_implicit_resolvers = {
     for ch, resolvers in yaml.SafeLoader.yaml_implicit_resolvers.items()
 }
 _Loader.add_implicit_resolver(
-    "tag:yaml.org,2002:bool", re.compile(r"^(?:true|True|TRUE|false|False|FALSE)$"), list("tTfF"))
+    "tag:yaml.org,2002:bool", re.compile(r"^(?:true|True|TRUE|false|False|FALSE)$"), list("tTfF")
+)
 
 
 def _expanded_size(root) -> int:
@@ -318,10 +426,13 @@ def _expanded_size(root) -> int:
         node, done = stack.pop()
         if id(node) in size:
             continue
-        children = [c for pair in node.value for c in pair] if isinstance(node, yaml.MappingNode) else (
-            node.value if isinstance(node, yaml.SequenceNode) else [])
+        children = (
+            [c for pair in node.value for c in pair]
+            if isinstance(node, yaml.MappingNode)
+            else (node.value if isinstance(node, yaml.SequenceNode) else [])
+        )
         if done:
-            size[id(node)] = 1 + sum(size.get(id(c), 0) for c in children)   # a cycle counts 0 (refused below)
+            size[id(node)] = 1 + sum(size.get(id(c), 0) for c in children)  # a cycle counts 0 (refused below)
         else:
             stack.append((node, True))
             stack.extend((c, False) for c in children if id(c) not in size)
@@ -338,8 +449,10 @@ def yaml_load(text: str, source: str = "scenario"):
                 return None
             n = _expanded_size(node)
             if n > MAX_NODES:
-                raise ScenarioError(f"{source}: {n:.3g} YAML values (aliases expanded); allowed at most {MAX_NODES} "
-                                    "(a scenario has about 100)")
+                raise ScenarioError(
+                    f"{source}: {n:.3g} YAML values (aliases expanded); allowed at most {MAX_NODES} "
+                    "(a scenario has about 100)"
+                )
             return loader.construct_document(node)
         finally:
             loader.dispose()
@@ -350,9 +463,9 @@ def yaml_load(text: str, source: str = "scenario"):
         where = f" at line {mark.line + 1}" if mark else ""
         problem = getattr(exc, "problem", None) or exc.__class__.__name__
         raise ScenarioError(f"{source}: not valid YAML{where} ({_abbrev(problem)})") from None
-    except RecursionError:      # a cycle or a depth the composer guard did not see (constructor)
+    except RecursionError:  # a cycle or a depth the composer guard did not see (constructor)
         raise ScenarioError(f"{source}: nested too deeply (allowed at most {MAX_DEPTH} levels)") from None
-    except (ValueError, TypeError, OverflowError) as exc:       # constructors of odd tags/values
+    except (ValueError, TypeError, OverflowError) as exc:  # constructors of odd tags/values
         raise ScenarioError(f"{source}: a value cannot be read ({exc.__class__.__name__}: {_abbrev(exc)})") from None
 
 
@@ -371,11 +484,11 @@ def _abbrev(value, limit: int = MAX_SHOWN) -> str:
     if text is None:
         try:
             text = json.dumps(value, default=str) if not isinstance(value, str) or len(value) < 10 * limit else None
-        except (ValueError, TypeError, RecursionError):     # ints beyond the str conversion limit, cycles
+        except (ValueError, TypeError, RecursionError):  # ints beyond the str conversion limit, cycles
             text = None
         if text is None:
             text = f"<{type(value).__name__}>"
-    return text if len(text) <= limit else text[:limit - 3] + "..."
+    return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
 def _field_info(loc: tuple):
@@ -393,8 +506,11 @@ def _field_info(loc: tuple):
         info = model.model_fields[part]
         model = None
         ann = info.annotation
-        for cand in (typing.get_args(ann) if isinstance(ann, types.UnionType) or typing.get_origin(ann) is typing.Union
-                     else (ann,)):
+        for cand in (
+            typing.get_args(ann)
+            if isinstance(ann, types.UnionType) or typing.get_origin(ann) is typing.Union
+            else (ann,)
+        ):
             if isinstance(cand, type) and issubclass(cand, BaseModel):
                 model = cand
     return info
@@ -418,8 +534,18 @@ def _allowed_range(loc: tuple) -> str | None:
     return f"allowed: {lo or ''}{str(loc[-1])}{hi or ''}"
 
 
-NUMBER_ERRORS = ("finite_number", "greater_than", "greater_than_equal", "less_than", "less_than_equal",
-                 "float_parsing", "float_type", "int_parsing", "int_type", "int_from_float")
+NUMBER_ERRORS = (
+    "finite_number",
+    "greater_than",
+    "greater_than_equal",
+    "less_than",
+    "less_than_equal",
+    "float_parsing",
+    "float_type",
+    "int_parsing",
+    "int_type",
+    "int_from_float",
+)
 
 
 def format_validation_error(err: ValidationError, source: str = "scenario") -> str:
@@ -449,7 +575,7 @@ def parse_override(text: str) -> tuple[list[str], Any]:
     path = [p for p in key.strip().split(".") if p]
     if not path:
         raise ScenarioError(f"--set {text}: empty KEY")
-    value = yaml_load(raw, f"--set {key.strip()[:2 * MAX_SHOWN]}") if raw.strip() else ""
+    value = yaml_load(raw, f"--set {key.strip()[: 2 * MAX_SHOWN]}") if raw.strip() else ""
     return path, value
 
 
@@ -461,7 +587,7 @@ def set_path(data: dict, path: list[str], value: Any, source: str) -> dict:
         if nxt is None:
             nxt = node[key] = {}
         if not isinstance(nxt, dict):
-            raise ScenarioError(f"{source}: '{'.'.join(path[:i + 1])}' is not a block")
+            raise ScenarioError(f"{source}: '{'.'.join(path[: i + 1])}' is not a block")
         node = nxt
     node[path[-1]] = value
     return data

@@ -3,6 +3,7 @@
 `python -m wormsim.schema_doc > docs/scenario.md` regenerates it; tests/test_schema_doc.py fails when
 the committed file is out of date, so the documentation cannot drift from the code.
 """
+
 from __future__ import annotations
 
 import typing
@@ -12,9 +13,18 @@ from pydantic_core import PydanticUndefined
 
 from wormsim import scenario as S
 
-BLOCKS = [("(top level)", S.Scenario), ("gear", S.Gear), ("materials.worm / materials.wheel", S.Material),
-          ("contact", S.Contact), ("drive", S.Drive), ("load", S.Load), ("simulation", S.Simulation),
-          ("wedge", S.Wedge), ("wedge.motor", S.WedgeMotor), ("wedge.load", S.WedgeLoad)]
+BLOCKS = [
+    ("(top level)", S.Scenario),
+    ("gear", S.Gear),
+    ("materials.worm / materials.wheel", S.Material),
+    ("contact", S.Contact),
+    ("drive", S.Drive),
+    ("load", S.Load),
+    ("simulation", S.Simulation),
+    ("wedge", S.Wedge),
+    ("wedge.motor", S.WedgeMotor),
+    ("wedge.load", S.WedgeLoad),
+]
 
 
 def _type_name(ann) -> str:
@@ -53,10 +63,13 @@ def _default(field) -> str:
 
 
 def markdown() -> str:
-    lines = ["# Scenario file reference", "",
-             "Generated from `wormsim/scenario.py` by `python -m wormsim.schema_doc`; do not edit by hand.",
-             "Units are in the key names. Unknown keys are errors. "
-             "`wormsim schema` prints the same as JSON schema.", ""]
+    lines = [
+        "# Scenario file reference",
+        "",
+        "Generated from `wormsim/scenario.py` by `python -m wormsim.schema_doc`; do not edit by hand.",
+        "Units are in the key names. Unknown keys are errors. `wormsim schema` prints the same as JSON schema.",
+        "",
+    ]
     for title, model in BLOCKS:
         lines += [f"## `{title}`", ""]
         if model.__doc__:
@@ -66,11 +79,14 @@ def markdown() -> str:
             desc = (f.description or "").replace("|", "\\|")
             lines.append(f"| `{name}` | {_type_name(f.annotation)} | {_default(f)} | {_bounds(f)} | {desc} |")
         lines.append("")
-    lines += ["Cross-field rules: exactly one of `gear.normal_module_mm` / `gear.axial_module_mm`; exactly one of",
-              "`gear.lead_angle_deg` / `gear.diameter_quotient`; `gear.dedendum_coef` > `gear.addendum_coef`; one of",
-              "`contact.friction` / `contact.friction_group` / `contact.friction_static` + `contact.friction_dynamic`",
-              "(dynamic <= static); exactly one of `drive.speed_rpm` / `drive.torque_nm`; `drive.on` != `load.on`;",
-              "`model: wedge` needs a `wedge:` block, the other models need `gear:` and `drive:`.", ""]
+    lines += [
+        "Cross-field rules: exactly one of `gear.normal_module_mm` / `gear.axial_module_mm`; exactly one of",
+        "`gear.lead_angle_deg` / `gear.diameter_quotient`; `gear.dedendum_coef` > `gear.addendum_coef`; one of",
+        "`contact.friction` / `contact.friction_group` / `contact.friction_static` + `contact.friction_dynamic`",
+        "(dynamic <= static); exactly one of `drive.speed_rpm` / `drive.torque_nm`; `drive.on` != `load.on`;",
+        "`model: wedge` needs a `wedge:` block, the other models need `gear:` and `drive:`.",
+        "",
+    ]
     return "\n".join(lines)
 
 

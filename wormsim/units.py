@@ -1,12 +1,13 @@
 """The one place where user units (mm, deg, rpm, GPa) become SI (m, rad, rad/s, Pa) and back."""
+
 import math
 
 import numpy as np
 
-MM = 1e-3                      # m per mm
-GPA = 1e9                      # Pa per GPa
-DEG = math.pi / 180.0          # rad per deg
-RPM = 2.0 * math.pi / 60.0     # (rad/s) per rpm
+MM = 1e-3  # m per mm
+GPA = 1e9  # Pa per GPa
+DEG = math.pi / 180.0  # rad per deg
+RPM = 2.0 * math.pi / 60.0  # (rad/s) per rpm
 
 
 def rpm_to_rad_s(n_rpm: float) -> float:

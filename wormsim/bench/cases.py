@@ -1,4 +1,5 @@
 """The bench grid: seed variants, resolutions and timesteps per level, and relative errors against the reference."""
+
 from __future__ import annotations
 
 import importlib.util
@@ -12,20 +13,20 @@ from wormsim.contact3d.timestep import default_timestep
 from wormsim.run import LEVELS
 from wormsim.scenario import ScenarioError, load_scenario
 
-SCENARIOS = files("wormsim.scenarios")     # the seed scenarios, shipped as package data
+SCENARIOS = files("wormsim.scenarios")  # the seed scenarios, shipped as package data
 ERROR_KEYS = ("ratio", "tangential_force_mean_n", "tangential_force_p2p_n", "mesh_frequency_hz", "efficiency")
 
 
 @dataclass(frozen=True)
 class BenchCase:
-    scenario: str                 # stem of scenarios/<stem>.yaml
-    model: str                    # fidelity level
-    resolution: dict              # free-form description of the level's resolution
+    scenario: str  # stem of scenarios/<stem>.yaml
+    model: str  # fidelity level
+    resolution: dict  # free-form description of the level's resolution
     timestep_s: float | None
     overrides: tuple[str, ...] = field(default_factory=tuple)
-    reference: bool = False       # the converged reference of its scenario
-    finer: bool = False           # the finer run that checks the reference
-    timestep_factor: float | None = None   # contact3d: timestep_s / the default timestep of its geometry
+    reference: bool = False  # the converged reference of its scenario
+    finer: bool = False  # the finer run that checks the reference
+    timestep_factor: float | None = None  # contact3d: timestep_s / the default timestep of its geometry
 
 
 def _level_available(model: str) -> bool:
@@ -42,7 +43,7 @@ VARIANTS = {
 }
 DURATION_S = {"seat_motor": 0.25, "screw_jack": 0.3, "involute_41": 0.3}
 QUICK_DURATION_S = 0.15
-GEOMETRIES = ("flanks", "pieces")   # contact3d's contact.geometry, both benched so one run gives the speed-up
+GEOMETRIES = ("flanks", "pieces")  # contact3d's contact.geometry, both benched so one run gives the speed-up
 
 
 def contact3d_default_timestep(name: str, overrides: tuple[str, ...] = ()) -> float:
@@ -52,10 +53,13 @@ def contact3d_default_timestep(name: str, overrides: tuple[str, ...] = ()) -> fl
     return default_timestep(prepare(sc).law)
 
 
-def bench_cases(quick: bool, models: tuple[str, ...] | None = None,
-                scenarios: tuple[str, ...] | None = None,
-                geometries: tuple[str, ...] | None = None,
-                resolutions: tuple[str, ...] | None = None) -> list[BenchCase]:
+def bench_cases(
+    quick: bool,
+    models: tuple[str, ...] | None = None,
+    scenarios: tuple[str, ...] | None = None,
+    geometries: tuple[str, ...] | None = None,
+    resolutions: tuple[str, ...] | None = None,
+) -> list[BenchCase]:
     """The grid. contact3d, for each contact.geometry (flanks, pieces): resolution levels x timesteps of 2, 1 and 1/2
     times its default (the default is 0.4 x the explicit stability limit, so 2x probes the edge); the reference is
     the finest level of the scenario's default geometry at the default step, checked against half that step.
@@ -67,16 +71,18 @@ def bench_cases(quick: bool, models: tuple[str, ...] | None = None,
     if scenarios is not None:
         unknown = sorted(set(scenarios) - set(VARIANTS))
         if unknown:
-            raise ScenarioError(f"bench --scenario: {', '.join(unknown)} is not a seed scenario; "
-                                f"allowed: {', '.join(VARIANTS)}")
+            raise ScenarioError(
+                f"bench --scenario: {', '.join(unknown)} is not a seed scenario; allowed: {', '.join(VARIANTS)}"
+            )
         names = tuple(n for n in VARIANTS if n in scenarios)
     geos = tuple(g for g in GEOMETRIES if geometries is None or g in geometries)
     levels = ("coarse", "medium") if quick else ("coarse", "medium", "fine")
     if resolutions is not None:
         unknown = sorted(set(resolutions) - {"coarse", "medium", "fine"})
         if unknown:
-            raise ScenarioError(f"bench --resolution: {', '.join(unknown)} is not a level; "
-                                "allowed: coarse, medium, fine")
+            raise ScenarioError(
+                f"bench --resolution: {', '.join(unknown)} is not a level; allowed: coarse, medium, fine"
+            )
         levels = tuple(lv for lv in ("coarse", "medium", "fine") if lv in resolutions)
     out: list[BenchCase] = []
     for name in names:
@@ -86,19 +92,33 @@ def bench_cases(quick: bool, models: tuple[str, ...] | None = None,
             default_geo = load_scenario(SCENARIOS / f"{name}.yaml", list(common)).contact.geometry
             ref_geo = default_geo if default_geo in geos else geos[0]
             for geo in geos:
-                out += _contact3d_cases(name, common + (f"contact.geometry={geo}",), geo, levels,
-                                        (2.0, 1.0) if quick else (2.0, 1.0, 0.5), reference=geo == ref_geo)
+                out += _contact3d_cases(
+                    name,
+                    common + (f"contact.geometry={geo}",),
+                    geo,
+                    levels,
+                    (2.0, 1.0) if quick else (2.0, 1.0, 0.5),
+                    reference=geo == ref_geo,
+                )
         if _level_available("torsional") and (models is None or "torsional" in models):
             # resolution = k(theta) samples per mesh cycle; the default timestep is one sample's worth of worm
             # rotation at full speed (wormsim.torsional.dynamics.default_timestep), so this sweeps both
-            for n in ((16, 64) if quick else (16, 32, 64, 128, 256)):
-                out.append(BenchCase(name, "torsional", {"level": "mesh-stiffness table", "mesh_stiffness_samples": n},
-                                     None, common + ("model=torsional", f"simulation.mesh_stiffness_samples={n}")))
+            for n in (16, 64) if quick else (16, 32, 64, 128, 256):
+                out.append(
+                    BenchCase(
+                        name,
+                        "torsional",
+                        {"level": "mesh-stiffness table", "mesh_stiffness_samples": n},
+                        None,
+                        common + ("model=torsional", f"simulation.mesh_stiffness_samples={n}"),
+                    )
+                )
     return out
 
 
-def _contact3d_cases(name: str, common: tuple[str, ...], geo: str, levels: tuple[str, ...],
-                     factors: tuple[float, ...], reference: bool) -> list[BenchCase]:
+def _contact3d_cases(
+    name: str, common: tuple[str, ...], geo: str, levels: tuple[str, ...], factors: tuple[float, ...], reference: bool
+) -> list[BenchCase]:
     """One geometry's resolution x timestep grid; with `reference`, the finest level at the default step is the
     reference and the same at half the step its check (`finer`)."""
     h = contact3d_default_timestep(name, common)
@@ -106,19 +126,35 @@ def _contact3d_cases(name: str, common: tuple[str, ...], geo: str, levels: tuple
     for lvl in levels:
         for f in factors:
             dt = float(f"{h * f:.4g}")
-            out.append(BenchCase(name, "contact3d", {"level": lvl, "geometry": geo}, dt,
-                                 common + (f"simulation.resolution={lvl}", f"simulation.timestep_s={dt}"),
-                                 reference=reference and lvl == levels[-1] and f == 1.0, timestep_factor=f))
+            out.append(
+                BenchCase(
+                    name,
+                    "contact3d",
+                    {"level": lvl, "geometry": geo},
+                    dt,
+                    common + (f"simulation.resolution={lvl}", f"simulation.timestep_s={dt}"),
+                    reference=reference and lvl == levels[-1] and f == 1.0,
+                    timestep_factor=f,
+                )
+            )
     if not reference:
         return out
     dt = float(f"{h / 2:.4g}")
     same = next((i for i, c in enumerate(out) if c.resolution["level"] == levels[-1] and c.timestep_s == dt), None)
-    if same is not None:     # the grid already runs the finest level at h/2: that run is the check
+    if same is not None:  # the grid already runs the finest level at h/2: that run is the check
         out[same] = BenchCase(**{**out[same].__dict__, "finer": True})
     else:
-        out.append(BenchCase(name, "contact3d", {"level": levels[-1], "geometry": geo}, dt,
-                             common + (f"simulation.resolution={levels[-1]}", f"simulation.timestep_s={dt}"),
-                             finer=True, timestep_factor=0.5))
+        out.append(
+            BenchCase(
+                name,
+                "contact3d",
+                {"level": levels[-1], "geometry": geo},
+                dt,
+                common + (f"simulation.resolution={levels[-1]}", f"simulation.timestep_s={dt}"),
+                finer=True,
+                timestep_factor=0.5,
+            )
+        )
     return out
 
 

@@ -14,6 +14,7 @@ check, notes, and "stability": the last stable contact3d timestep per seed and h
 stability_edge), bench.png (error against wall time per simulated second, log axes, one curve per
 level, Pareto front marked).
 """
+
 from __future__ import annotations
 
 import os
@@ -51,9 +52,13 @@ def pareto_front(cost: np.ndarray, error: np.ndarray) -> np.ndarray:
 
 def machine_info() -> dict:
     """Platform, CPU count and the 1-minute load average (wall times are only comparable at the same load)."""
-    return {"platform": platform.platform(), "python": platform.python_version(),
-            "processor": platform.processor() or platform.machine(), "cpu_count": os.cpu_count(),
-            "load_average_1min": os.getloadavg()[0] if hasattr(os, "getloadavg") else None}
+    return {
+        "platform": platform.platform(),
+        "python": platform.python_version(),
+        "processor": platform.processor() or platform.machine(),
+        "cpu_count": os.cpu_count(),
+        "load_average_1min": os.getloadavg()[0] if hasattr(os, "getloadavg") else None,
+    }
 
 
 def _run_case(case: BenchCase, repeats: int) -> tuple[dict, float, float]:
@@ -64,7 +69,7 @@ def _run_case(case: BenchCase, repeats: int) -> tuple[dict, float, float]:
     warm.simulation.duration_s = 20 * (sc.simulation.timestep_s or 1e-4)
     try:
         simulate(warm)
-    except Exception:   # a too-short run may fail its own checks (or its metrics); the timed runs report real failures
+    except Exception:  # a too-short run may fail its own checks (or its metrics); the timed runs report real failures
         pass
     walls, res = [], None
     for _ in range(repeats):
@@ -83,9 +88,18 @@ def speedups(records: list[dict]) -> dict:
         res = r.get("resolution") or {}
         if r["model"] != "contact3d" or res.get("geometry") != "flanks" or r["status"] != "ok":
             continue
-        p = next((q for q in records if q["model"] == "contact3d" and q["scenario"] == r["scenario"]
-                  and q["status"] == "ok" and q.get("timestep_factor") == r.get("timestep_factor")
-                  and (q.get("resolution") or {}) == {**res, "geometry": "pieces"}), None)
+        p = next(
+            (
+                q
+                for q in records
+                if q["model"] == "contact3d"
+                and q["scenario"] == r["scenario"]
+                and q["status"] == "ok"
+                and q.get("timestep_factor") == r.get("timestep_factor")
+                and (q.get("resolution") or {}) == {**res, "geometry": "pieces"}
+            ),
+            None,
+        )
         if p is None or not r.get("wall_s_per_sim_s"):
             continue
         r["speedup_vs_pieces"] = p["wall_s_per_sim_s"] / r["wall_s_per_sim_s"]
@@ -94,9 +108,15 @@ def speedups(records: list[dict]) -> dict:
     return out
 
 
-def run_bench(quick: bool, out_dir: str | Path, repeats: int | None = None,
-              models: tuple[str, ...] | None = None, scenarios: tuple[str, ...] | None = None,
-              geometries: tuple[str, ...] | None = None, resolutions: tuple[str, ...] | None = None) -> list[dict]:
+def run_bench(
+    quick: bool,
+    out_dir: str | Path,
+    repeats: int | None = None,
+    models: tuple[str, ...] | None = None,
+    scenarios: tuple[str, ...] | None = None,
+    geometries: tuple[str, ...] | None = None,
+    resolutions: tuple[str, ...] | None = None,
+) -> list[dict]:
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     if repeats is not None and repeats < 1:
@@ -109,22 +129,49 @@ def run_bench(quick: bool, out_dir: str | Path, repeats: int | None = None,
             summary, wall, sim_s = _run_case(case, repeats)
         except SimulationError as exc:
             notes.append(f"{case.scenario} {case.model} {case.resolution} dt={case.timestep_s}: failed: {exc}")
-            records.append({"scenario": case.scenario, "model": case.model, "resolution": case.resolution,
-                            "timestep_s": case.timestep_s, "timestep_factor": case.timestep_factor,
-                            "wall_s": None, "sim_s": None, "realtime_factor": None,
-                            "status": "failed", "message": str(exc), "error": {}})
+            records.append(
+                {
+                    "scenario": case.scenario,
+                    "model": case.model,
+                    "resolution": case.resolution,
+                    "timestep_s": case.timestep_s,
+                    "timestep_factor": case.timestep_factor,
+                    "wall_s": None,
+                    "sim_s": None,
+                    "realtime_factor": None,
+                    "status": "failed",
+                    "message": str(exc),
+                    "error": {},
+                }
+            )
             continue
-        rec = {"scenario": case.scenario, "model": case.model, "resolution": case.resolution,
-               "timestep_s": summary.get("timestep_s", case.timestep_s), "timestep_factor": case.timestep_factor,
-               "wall_s": wall, "sim_s": sim_s,
-               "realtime_factor": sim_s / wall if wall > 0 else None,
-               "wall_s_per_sim_s": wall / sim_s if sim_s else None, "status": "ok",
-               "reference": case.reference, "finer": case.finer, "error": {}}
+        rec = {
+            "scenario": case.scenario,
+            "model": case.model,
+            "resolution": case.resolution,
+            "timestep_s": summary.get("timestep_s", case.timestep_s),
+            "timestep_factor": case.timestep_factor,
+            "wall_s": wall,
+            "sim_s": sim_s,
+            "realtime_factor": sim_s / wall if wall > 0 else None,
+            "wall_s_per_sim_s": wall / sim_s if sim_s else None,
+            "status": "ok",
+            "reference": case.reference,
+            "finer": case.finer,
+            "error": {},
+        }
         summaries[id(rec)] = summary
         records.append(rec)
-    meta = {"machine": machine_start, "load_average_1min_end": machine_info()["load_average_1min"],
-            "quick": quick, "repeats": repeats, "scenarios": sorted({r["scenario"] for r in records}),
-            "reference_check": {}, "speedup_flanks_vs_pieces": speedups(records), "notes": notes}
+    meta = {
+        "machine": machine_start,
+        "load_average_1min_end": machine_info()["load_average_1min"],
+        "quick": quick,
+        "repeats": repeats,
+        "scenarios": sorted({r["scenario"] for r in records}),
+        "reference_check": {},
+        "speedup_flanks_vs_pieces": speedups(records),
+        "notes": notes,
+    }
     for scen in {r["scenario"] for r in records}:
         ref = next((r for r in records if r["scenario"] == scen and r.get("reference") and r["status"] == "ok"), None)
         if ref is None:
@@ -139,22 +186,29 @@ def run_bench(quick: bool, out_dir: str | Path, repeats: int | None = None,
             meta["reference_check"][scen] = finer["error"]
     if _level_available("contact3d") and (models is None or "contact3d" in models):
         # the timestep sweep of each seed until a guard fires (stability_edge); quick: the seat motor only
-        meta["stability"] = stability_map(quick, scenarios, tuple(g for g in GEOMETRIES
-                                                                   if geometries is None or g in geometries))
+        meta["stability"] = stability_map(
+            quick, scenarios, tuple(g for g in GEOMETRIES if geometries is None or g in geometries)
+        )
     write_json_atomic(out / "bench.json", records)
     write_json_atomic(out / "bench_meta.json", meta)
     plot_bench(records, out / "bench.png")
     return records
 
 
-ERROR_LABELS = {"ratio": "ratio", "tangential_force_mean_n": "mean tangential force",
-                "tangential_force_p2p_n": "tangential force peak-to-peak", "mesh_frequency_hz": "meshing frequency",
-                "efficiency": "efficiency"}
+ERROR_LABELS = {
+    "ratio": "ratio",
+    "tangential_force_mean_n": "mean tangential force",
+    "tangential_force_p2p_n": "tangential force peak-to-peak",
+    "mesh_frequency_hz": "meshing frequency",
+    "efficiency": "efficiency",
+}
 PANEL_KEYS = ("tangential_force_mean_n", "tangential_force_p2p_n", "efficiency")
 ERROR_FLOOR = 1e-6
-NOTE_ERROR_1 = ("An error near 1 (100 %) is a value near 0 against a reference that is not: the torsional level's "
-                "tangential-force ripple comes from its nearly smooth k(theta) table alone, far below the ripple of "
-                "contact3d's contacts.")
+NOTE_ERROR_1 = (
+    "An error near 1 (100 %) is a value near 0 against a reference that is not: the torsional level's "
+    "tangential-force ripple comes from its nearly smooth k(theta) table alone, far below the ripple of "
+    "contact3d's contacts."
+)
 
 
 def curve_label(r: dict) -> str:
@@ -172,16 +226,22 @@ def plot_bench(records: list[dict], path: Path, keys: tuple[str, ...] = PANEL_KE
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    ok = [r for r in records if r["status"] == "ok" and r.get("wall_s_per_sim_s") and not r.get("finer")
-          and not r.get("reference")]
+    ok = [
+        r
+        for r in records
+        if r["status"] == "ok" and r.get("wall_s_per_sim_s") and not r.get("finer") and not r.get("reference")
+    ]
     fig, axes = plt.subplots(1, len(keys), figsize=(5.2 * len(keys), 5.0), constrained_layout=True, squeeze=False)
     labels = sorted({curve_label(r) for r in ok})
     colors = {lab: plt.cm.tab10(i % 10) for i, lab in enumerate(labels)}
     for ax, key in zip(axes[0], keys):
-        pts = [(r["wall_s_per_sim_s"], max(r["error"][key], ERROR_FLOOR), curve_label(r))
-               for r in ok if r["error"].get(key) is not None]
+        pts = [
+            (r["wall_s_per_sim_s"], max(r["error"][key], ERROR_FLOOR), curve_label(r))
+            for r in ok
+            if r["error"].get(key) is not None
+        ]
         for label in labels:
-            sel = sorted((p for p in pts if p[2] == label), key=lambda p: p[0])     # in order of cost
+            sel = sorted((p for p in pts if p[2] == label), key=lambda p: p[0])  # in order of cost
             if sel:
                 ax.plot([p[0] for p in sel], [p[1] for p in sel], "o-", color=colors[label], label=label, alpha=0.85)
         for k, scen in enumerate(sorted({p[2].split(",")[0] for p in pts})):
@@ -189,8 +249,9 @@ def plot_bench(records: list[dict], path: Path, keys: tuple[str, ...] = PANEL_KE
             c, e = np.array([p[0] for p in sel]), np.array([p[1] for p in sel])
             m = pareto_front(c, e)
             order = np.argsort(c[m])
-            ax.plot(c[m][order], e[m][order], "k--", lw=1.0, alpha=0.6,
-                    label="Pareto front (per gear)" if k == 0 else None)
+            ax.plot(
+                c[m][order], e[m][order], "k--", lw=1.0, alpha=0.6, label="Pareto front (per gear)" if k == 0 else None
+            )
         ax.set_xscale("log")
         ax.set_yscale("log")
         ax.set_title(ERROR_LABELS.get(key, key))
@@ -205,8 +266,11 @@ def plot_bench(records: list[dict], path: Path, keys: tuple[str, ...] = PANEL_KE
                 names.append(n)
     if handles:
         fig.legend(handles, names, loc="outside lower center", ncol=min(4, len(names)), fontsize=8)
-    fig.suptitle("wormsim bench: accuracy against speed (reference: the finest contact3d run of each gear at its "
-                 "default step)\n" + NOTE_ERROR_1, fontsize=9)
+    fig.suptitle(
+        "wormsim bench: accuracy against speed (reference: the finest contact3d run of each gear at its "
+        "default step)\n" + NOTE_ERROR_1,
+        fontsize=9,
+    )
     tmp = path.with_name(f".{path.name}.tmp.png")
     fig.savefig(tmp, dpi=110)
     plt.close(fig)

@@ -1,4 +1,5 @@
 """Stability edge of contact3d: the timestep doubled until a guard fires; failures classified."""
+
 from __future__ import annotations
 
 import time
@@ -32,8 +33,13 @@ STABILITY_RESOLUTION = {"seat_motor": "coarse", "screw_jack": "coarse", "involut
 STABILITY_DURATION_S = 0.05
 # each guard's exception (wormsim.errors) -> the class name bench_meta.json holds
 FAILURE_CLASSES: tuple[tuple[type[SimulationError], str], ...] = (
-    (DivergedError, "diverged"), (TeethJumpedError, "teeth_jumped"), (PenetrationError, "penetration"),
-    (LockedError, "locked"), (OverspeedError, "overspeed"), (RingingError, "ringing"))
+    (DivergedError, "diverged"),
+    (TeethJumpedError, "teeth_jumped"),
+    (PenetrationError, "penetration"),
+    (LockedError, "locked"),
+    (OverspeedError, "overspeed"),
+    (RingingError, "ringing"),
+)
 
 
 def classify_failure(exc: BaseException) -> str:
@@ -57,9 +63,14 @@ def angle_ratio(series: dict, window_s) -> float | None:
     return abs(float(series["worm_angle_rad"][i1] - series["worm_angle_rad"][i0]) / d2)
 
 
-def stability_edge(scenario_name: str, factors: tuple[float, ...] = STABILITY_FACTORS,
-                   duration_s: float = STABILITY_DURATION_S, overrides: tuple[str, ...] = (),
-                   resolution: str | None = None, tolerances: dict | None = None) -> dict:
+def stability_edge(
+    scenario_name: str,
+    factors: tuple[float, ...] = STABILITY_FACTORS,
+    duration_s: float = STABILITY_DURATION_S,
+    overrides: tuple[str, ...] = (),
+    resolution: str | None = None,
+    tolerances: dict | None = None,
+) -> dict:
     """Sweep the contact3d timestep upward from its default h0 (wormsim.contact3d.timestep.default_timestep: 0.4 x
     the explicit limit of the contact spring-damper, rounded down to 1-2-5) by `factors` on a short run of
     scenarios/<scenario_name>.yaml, until a run fails.
@@ -85,9 +96,19 @@ def stability_edge(scenario_name: str, factors: tuple[float, ...] = STABILITY_FA
     for f in factors:
         dt = float(f"{h0 * f:.4g}")
         sc = load_scenario(SCENARIOS / f"{scenario_name}.yaml", list(base) + [f"simulation.timestep_s={dt}"])
-        run = {"factor": f, "timestep_s": dt, "timestep_over_limit": dt / limit, "status": "ok", "failure": None,
-               "message": "", "ratio": None, "ratio_angles": None, "tangential_force_mean_n": None, "drift": {},
-               "wall_s": None}
+        run = {
+            "factor": f,
+            "timestep_s": dt,
+            "timestep_over_limit": dt / limit,
+            "status": "ok",
+            "failure": None,
+            "message": "",
+            "ratio": None,
+            "ratio_angles": None,
+            "tangential_force_mean_n": None,
+            "drift": {},
+            "wall_s": None,
+        }
         t0 = time.perf_counter()
         try:
             res = simulate(sc)
@@ -102,8 +123,11 @@ def stability_edge(scenario_name: str, factors: tuple[float, ...] = STABILITY_FA
             run["drift"] = relative_errors(s, ref, tuple(tol))
             bad = [k for k, lim in tol.items() if run["drift"][k] is None or run["drift"][k] > lim]
             if bad:
-                run.update(status="inaccurate", failure="inaccurate",
-                           message="drift beyond tolerance (or no steady value) in " + ", ".join(bad))
+                run.update(
+                    status="inaccurate",
+                    failure="inaccurate",
+                    message="drift beyond tolerance (or no steady value) in " + ", ".join(bad),
+                )
         run["wall_s"] = time.perf_counter() - t0
         runs.append(run)
         if run["status"] != "ok":
@@ -111,26 +135,36 @@ def stability_edge(scenario_name: str, factors: tuple[float, ...] = STABILITY_FA
     ok = [r for r in runs if r["status"] == "ok"]
     last = ok[-1] if ok else None
     first_bad = next((r for r in runs if r["status"] != "ok"), None)
-    return {"scenario": scenario_name, "overrides": list(base), "duration_s": duration_s,
-            "default_timestep_s": h0, "stable_limit_s": limit, "tolerances": tol,
-            "last_stable_timestep_s": last["timestep_s"] if last else None,
-            "last_stable_factor": last["factor"] if last else None,
-            "failure": first_bad["failure"] if first_bad else None,
-            "failed_timestep_s": first_bad["timestep_s"] if first_bad else None,
-            "failure_message": first_bad["message"] if first_bad else "",
-            "runs": runs}
+    return {
+        "scenario": scenario_name,
+        "overrides": list(base),
+        "duration_s": duration_s,
+        "default_timestep_s": h0,
+        "stable_limit_s": limit,
+        "tolerances": tol,
+        "last_stable_timestep_s": last["timestep_s"] if last else None,
+        "last_stable_factor": last["factor"] if last else None,
+        "failure": first_bad["failure"] if first_bad else None,
+        "failed_timestep_s": first_bad["timestep_s"] if first_bad else None,
+        "failure_message": first_bad["message"] if first_bad else "",
+        "runs": runs,
+    }
 
 
-def stability_map(quick: bool, scenarios: tuple[str, ...] | None = None,
-                  geometries: tuple[str, ...] = ("pieces",)) -> dict:
+def stability_map(
+    quick: bool, scenarios: tuple[str, ...] | None = None, geometries: tuple[str, ...] = ("pieces",)
+) -> dict:
     """stability_edge for each seed's bench variant (VARIANTS) at STABILITY_RESOLUTION and each contact.geometry;
     quick: the seat motor only (about half a minute). Keyed by scenario (and "/flanks" for the flank contacts),
     written to bench_meta.json under "stability"."""
     names = ("seat_motor",) if quick else tuple(VARIANTS)
     if scenarios is not None:
         names = tuple(n for n in names if n in scenarios)
-    dur = STABILITY_DURATION_S     # 1.5 mesh periods of the seat motor at 1800 rpm; shorter runs: no steady window
-    return {n + ("" if geo == "pieces" else f"/{geo}"):
-            stability_edge(n, duration_s=dur, overrides=VARIANTS[n] + (f"contact.geometry={geo}",),
-                           resolution=STABILITY_RESOLUTION[n])
-            for n in names for geo in geometries}
+    dur = STABILITY_DURATION_S  # 1.5 mesh periods of the seat motor at 1800 rpm; shorter runs: no steady window
+    return {
+        n + ("" if geo == "pieces" else f"/{geo}"): stability_edge(
+            n, duration_s=dur, overrides=VARIANTS[n] + (f"contact.geometry={geo}",), resolution=STABILITY_RESOLUTION[n]
+        )
+        for n in names
+        for geo in geometries
+    }

@@ -2,6 +2,7 @@
 
 law.py (contact-law mapping), mjcf.py (the MjSpec model), backlash.py (checks before a run), runner.py (stepping,
 guards), metrics.py (summary), report.py (report.png, recording.rrd)."""
+
 from wormsim.contact3d.report import write_recording, write_report
 from wormsim.contact3d.runner import simulate
 

@@ -26,6 +26,7 @@ is rejected with j_min; a backlash just above j_min gives a pair that touches bo
 `piece_play` measures what the model really has (the wheel's free rotation between its flanks with the worm
 held, at the rigid-conjugate pose, over one mesh cycle); it checks (2) in the tests and gives the docs' numbers.
 """
+
 from __future__ import annotations
 
 import math
@@ -38,7 +39,7 @@ from wormsim.contact3d.window import repose_window
 from wormsim.scenario import ScenarioError
 from wormsim.units import MM
 
-UM = 1e-3 * MM              # m per micrometre (piece_error_um)
+UM = 1e-3 * MM  # m per micrometre (piece_error_um)
 
 
 def flank_clearance_m(geo: GearGeometry) -> float:
@@ -49,6 +50,7 @@ def flank_clearance_m(geo: GearGeometry) -> float:
 def piece_bulge_m(piece_error_um: dict) -> float:
     """b of (2): residual bulge of the worm pieces plus that of the wheel pieces (conjugate flanks or fillet zone,
     whichever bulges more), from meshgen's piece_error_um (negative min_signed = bulge)."""
+
     def bulge(part: str) -> float:
         e = piece_error_um.get(part)
         return max(0.0, -float(e["min_signed"])) if e else 0.0
@@ -66,7 +68,7 @@ def _round_up(x: float, digits: int = 2) -> float:
     if x <= 0:
         return 0.0
     e = math.floor(math.log10(x)) - digits + 1
-    return math.ceil(x / 10 ** e * (1 - 1e-12)) * 10 ** e
+    return math.ceil(x / 10**e * (1 - 1e-12)) * 10**e
 
 
 def check_backlash(geo: GearGeometry, piece_error_um: dict, resolution: str) -> dict:
@@ -77,16 +79,20 @@ def check_backlash(geo: GearGeometry, piece_error_um: dict, resolution: str) -> 
     if c <= b:
         j_mm = geo.backlash / MM
         quoted = _round_up(j_min / MM * (1 + 1e-6) + 1e-9)
-        what = ("zero backlash (both flanks touching) is a preloaded pair, which contact3d's rigid collision pieces "
-                "cannot hold" if geo.backlash == 0 else
-                f"gear.backlash_mm = {j_mm:.4g} leaves a flank-normal clearance (j/2) cos(alpha_n) cos(gamma) of "
-                f"{c / UM:.3g} um per flank")
+        what = (
+            "zero backlash (both flanks touching) is a preloaded pair, which contact3d's rigid collision pieces "
+            "cannot hold"
+            if geo.backlash == 0
+            else f"gear.backlash_mm = {j_mm:.4g} leaves a flank-normal clearance (j/2) cos(alpha_n) cos(gamma) of "
+            f"{c / UM:.3g} um per flank"
+        )
         raise ScenarioError(
             f"{what}: at simulation.resolution {resolution} the collision pieces bulge up to {b / UM:.3g} um beyond "
             f"the exact flanks, so worm and wheel pieces can interfere at the conjugate pose: a preload that drags on "
             f"both flanks (jams the mesh); give gear.backlash_mm > {quoted:.2g} mm (j_min = 2 b / (cos(alpha_n) "
             f"cos(gamma)) = {j_min / MM:.3g} mm at resolution {resolution})"
-            + (", or simulation.resolution fine (its pieces bulge least)" if resolution != "fine" else ""))
+            + (", or simulation.resolution fine (its pieces bulge least)" if resolution != "fine" else "")
+        )
     return {"flank_clearance_m": c, "piece_bulge_m": b, "backlash_min_m": j_min}
 
 
@@ -106,7 +112,7 @@ def conjugate_interference_m(bm, n_angles: int = 16) -> float:
         restore()
 
 
-INTERFERENCE_TOLERANCE = 0.05    # of the working deflection F_n / K_pair (a preload of 5 % of the working load)
+INTERFERENCE_TOLERANCE = 0.05  # of the working deflection F_n / K_pair (a preload of 5 % of the working load)
 
 
 def check_conjugate_interference(bm, resolution: str, working_normal_force_n: float) -> float:
@@ -120,13 +126,17 @@ def check_conjugate_interference(bm, resolution: str, working_normal_force_n: fl
     if pen > tol:
         g = bm.geometry
         finer = FINER.get(resolution)
-        cure = (f"use simulation.resolution {finer} (allowed: coarse, medium, fine; finer pieces bulge less) or "
-                if finer else "")
+        cure = (
+            f"use simulation.resolution {finer} (allowed: coarse, medium, fine; finer pieces bulge less) or "
+            if finer
+            else ""
+        )
         raise ScenarioError(
             f"at simulation.resolution {resolution} the collision pieces of worm and wheel interfere by "
             f"{pen / UM:.3g} um at the rigid-conjugate pose (gear.backlash_mm = {g.backlash / MM:.4g} leaves "
             f"{flank_clearance_m(g) / UM:.3g} um per flank; allowed: {tol / UM:.3g} um, 5 % of the working "
-            f"deflection): the mesh would start jammed; {cure}raise gear.backlash_mm")
+            f"deflection): the mesh would start jammed; {cure}raise gear.backlash_mm"
+        )
     return pen
 
 
@@ -151,7 +161,7 @@ def _depth_probe(bm):
         repose_window(bm, th2)
         mujoco.mj_kinematics(m, d)
         mujoco.mj_collision(m, d)
-        return max(0.0, -float(np.min(d.contact.dist[:d.ncon]))) if d.ncon else 0.0
+        return max(0.0, -float(np.min(d.contact.dist[: d.ncon]))) if d.ncon else 0.0
 
     def restore() -> None:
         m.body_quat[bm.slot_bodies] = quat0

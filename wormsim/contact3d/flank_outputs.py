@@ -33,6 +33,7 @@ of F_n along zeta, the load of a slice spread evenly over its width); contact_pr
 (contact_pressure_max_face_mm, _radius_mm); contact_pressure_mean_mpa = the F_n-weighted mean of p_H. The per-cell
 grid (flank, slice, profile point: load F_n dt and the largest p_H) is what report.png and the recording draw.
 """
+
 from __future__ import annotations
 
 import functools
@@ -47,20 +48,20 @@ from meshgen import wheel, worm
 from meshgen.geometry import GearGeometry
 from wormsim.contact3d.flanks import N_PROFILE, flank_grid
 
-H_STEP_MX = 0.02            # finite-difference step of (1), in axial modules
-EXTENT_LOAD_SHARE = 0.95    # contact_pattern_extent_face_mm: the face span holding this share of the load
+H_STEP_MX = 0.02  # finite-difference step of (1), in axial modules
+EXTENT_LOAD_SHARE = 0.95  # contact_pattern_extent_face_mm: the face span holding this share of the load
 
 
 @dataclass(frozen=True)
 class FlankCurvature:
     """(1) and (2) on the kernel's grid; nan where the grid point is not active."""
 
-    inv_rho: np.ndarray      # (2, S, N) 1 / rho' across the contact line, 1/m
-    line_tz: np.ndarray      # (2, S, N) |t . e_z| of the contact line's unit tangent
-    line_len: np.ndarray     # (2, S, N) contact-line length inside the slice (2), m
-    rho: np.ndarray          # (S, N) flank radius of the grid points, m
-    zeta: np.ndarray         # (S,) slice centres, m
-    slice_width: float       # b2 / S, m
+    inv_rho: np.ndarray  # (2, S, N) 1 / rho' across the contact line, 1/m
+    line_tz: np.ndarray  # (2, S, N) |t . e_z| of the contact line's unit tangent
+    line_len: np.ndarray  # (2, S, N) contact-line length inside the slice (2), m
+    rho: np.ndarray  # (S, N) flank radius of the grid points, m
+    zeta: np.ndarray  # (S,) slice centres, m
+    slice_width: float  # b2 / S, m
 
 
 def wheel_point(g: GearGeometry, zeta, rho, side: int) -> np.ndarray:
@@ -97,14 +98,15 @@ def curvature_at(g: GearGeometry, zeta, rho, c, side: int, h: float | None = Non
     Jz = (Xm[1, 0] - Xm[-1, 0]) / (2 * h)
     Jr = (Xm[0, 1] - Xm[0, -1]) / (2 * h)
     Hm = np.stack([np.stack([hzz, hzr], -1), np.stack([hzr, hrr], -1)], -2)
-    M = np.stack([np.stack([(Jz * Jz).sum(-1), (Jz * Jr).sum(-1)], -1),
-                  np.stack([(Jz * Jr).sum(-1), (Jr * Jr).sum(-1)], -1)], -2)
+    M = np.stack(
+        [np.stack([(Jz * Jz).sum(-1), (Jz * Jr).sum(-1)], -1), np.stack([(Jz * Jr).sum(-1), (Jr * Jr).sum(-1)], -1)], -2
+    )
     # generalized eigenproblem via the Cholesky factor of the metric: L^-1 H L^-T
     Lc = np.linalg.cholesky(M)
     Li = np.linalg.inv(Lc)
     A = Li @ Hm @ np.swapaxes(Li, -1, -2)
     lam, V = np.linalg.eigh(A)
-    v_min = np.einsum("...ji,...j->...i", Li, V[..., :, 0])        # L^-T y: the parameter direction
+    v_min = np.einsum("...ji,...j->...i", Li, V[..., :, 0])  # L^-T y: the parameter direction
     t = v_min[..., 0, None] * Jz + v_min[..., 1, None] * Jr
     tz = np.abs(t[..., 2]) / np.linalg.norm(t, axis=-1)
     gnorm = np.hypot(gz, gr)
@@ -138,8 +140,7 @@ def flank_curvature(g: GearGeometry, slices: int, n_profile: int = N_PROFILE) ->
     prof = np.nansum(seg, axis=2)
     with np.errstate(divide="ignore", invalid="ignore"):
         length = np.minimum(width / tz, prof[:, :, None])
-    return FlankCurvature(inv_rho=inv_rho, line_tz=tz, line_len=length, rho=fg.rho, zeta=fg.zeta,
-                          slice_width=width)
+    return FlankCurvature(inv_rho=inv_rho, line_tz=tz, line_len=length, rho=fg.rho, zeta=fg.zeta, slice_width=width)
 
 
 def hertz_line_pressure_pa(line_load_n_per_m, e_star_pa: float, inv_rho_per_m):
@@ -179,7 +180,7 @@ def _rows(i, adr, efc_force, meta, weight, inv_rho, line_len, e_star, out, m):
         if adr[c] < 0 or weight[c] <= 0.0:
             continue
         sg, j, f = int(meta[c, 1]), int(meta[c, 2]), meta[c, 3]
-        fn = efc_force[adr[c]]                  # the normal row: the force on the wheel along +n
+        fn = efc_force[adr[c]]  # the normal row: the force on the wheel along +n
         k = _lerp(inv_rho, sg, j, f)
         L = weight[c] * _lerp(line_len, sg, j, f)
         o = out[m]
@@ -199,7 +200,7 @@ class PatternLog:
         self.cv = flank_curvature(g, fc.grid.slices, fc.grid.rho.shape[1])
         self.rho3 = np.ascontiguousarray(np.broadcast_to(self.cv.rho, self.cv.inv_rho.shape))
         self.e_star = e_star_pa
-        self.buf = np.zeros((4096, 6), dtype=np.float32)      # 24 bytes per contact and sample
+        self.buf = np.zeros((4096, 6), dtype=np.float32)  # 24 bytes per contact and sample
         self.m = 0
 
     def record(self, i: int, d: mujoco.MjData) -> None:
@@ -211,15 +212,14 @@ class PatternLog:
             return
         if self.m + n > len(self.buf):
             self.buf = np.concatenate([self.buf, np.zeros_like(self.buf)])
-        adr = d.contact.efc_address[d.ncon - n:d.ncon]
+        adr = d.contact.efc_address[d.ncon - n : d.ncon]
         cv = self.cv
-        self.m = _rows(i, adr, d.efc_force, fc.meta, fc.weight, cv.inv_rho, cv.line_len, self.e_star, self.buf,
-                       self.m)
+        self.m = _rows(i, adr, d.efc_force, fc.meta, fc.weight, cv.inv_rho, cv.line_len, self.e_star, self.buf, self.m)
 
     def table(self) -> np.ndarray:
         """The log as float64 rows (i, sigma, j, f, F_n, p_H, zeta, rho): zeta the slice centre, rho the flank radius
         at the contact's profile position."""
-        T = self.buf[:self.m].astype(float)
+        T = self.buf[: self.m].astype(float)
         if not len(T):
             return np.zeros((0, 8))
         j = T[:, 2].astype(np.int64)
@@ -234,26 +234,33 @@ class PatternLog:
         sel = T[inwin[T[:, 0].astype(int)]] if len(T) else T
         sel = sel[sel[:, 4] > 0] if len(sel) else sel
         nan = float("nan")
-        keys = {"contact_pattern_centroid_face_mm": nan, "contact_pattern_centroid_radius_mm": nan,
-                "contact_pattern_extent_face_mm": nan, "contact_pressure_max_mpa": nan,
-                "contact_pressure_mean_mpa": nan, "contact_pressure_max_face_mm": nan,
-                "contact_pressure_max_radius_mm": nan,
-                "contact_pattern_source": "loaded (contact3d exact flanks), contact normal force-weighted over the "
-                                          "steady window"}
+        keys = {
+            "contact_pattern_centroid_face_mm": nan,
+            "contact_pattern_centroid_radius_mm": nan,
+            "contact_pattern_extent_face_mm": nan,
+            "contact_pressure_max_mpa": nan,
+            "contact_pressure_mean_mpa": nan,
+            "contact_pressure_max_face_mm": nan,
+            "contact_pressure_max_radius_mm": nan,
+            "contact_pattern_source": "loaded (contact3d exact flanks), contact normal force-weighted over the "
+            "steady window",
+        }
         if not len(sel):
             return keys
         fn, p, z, r = sel[:, 4], sel[:, 5], sel[:, 6], sel[:, 7]
         W = fn.sum()
         imax = int(np.nanargmax(p))
-        keys.update({
-            "contact_pattern_centroid_face_mm": float((fn * z).sum() / W * 1e3),
-            "contact_pattern_centroid_radius_mm": float((fn * r).sum() / W * 1e3),
-            "contact_pattern_extent_face_mm": float(self.extent_face_m(sel) * 1e3),
-            "contact_pressure_max_mpa": float(p[imax] * 1e-6),
-            "contact_pressure_mean_mpa": float((fn * p).sum() / W * 1e-6),
-            "contact_pressure_max_face_mm": float(z[imax] * 1e3),
-            "contact_pressure_max_radius_mm": float(r[imax] * 1e3),
-        })
+        keys.update(
+            {
+                "contact_pattern_centroid_face_mm": float((fn * z).sum() / W * 1e3),
+                "contact_pattern_centroid_radius_mm": float((fn * r).sum() / W * 1e3),
+                "contact_pattern_extent_face_mm": float(self.extent_face_m(sel) * 1e3),
+                "contact_pressure_max_mpa": float(p[imax] * 1e-6),
+                "contact_pressure_mean_mpa": float((fn * p).sum() / W * 1e-6),
+                "contact_pressure_max_face_mm": float(z[imax] * 1e3),
+                "contact_pressure_max_radius_mm": float(r[imax] * 1e3),
+            }
+        )
         return keys
 
     def extent_face_m(self, sel: np.ndarray) -> float:
@@ -281,8 +288,14 @@ class PatternLog:
             i = np.clip(np.rint(T[:, 3]).astype(int), 0, N - 1)
             np.add.at(load, (sg, j, i), T[:, 4])
             np.maximum.at(pmax, (sg, j, i), T[:, 5])
-        return {"load": load, "pressure_max_pa": pmax, "rho_m": self.cv.rho, "zeta_m": self.cv.zeta,
-                "slice_width_m": self.cv.slice_width, "xy_m": self.fc.grid.xy}
+        return {
+            "load": load,
+            "pressure_max_pa": pmax,
+            "rho_m": self.cv.rho,
+            "zeta_m": self.cv.zeta,
+            "slice_width_m": self.cv.slice_width,
+            "xy_m": self.fc.grid.xy,
+        }
 
 
 def draw_pattern(ax, fig, grid: dict, geo: GearGeometry, summary: dict) -> None:
@@ -315,23 +328,44 @@ def draw_pattern(ax, fig, grid: dict, geo: GearGeometry, summary: dict) -> None:
         ax.plot([], [], " ", label=f"95 % of the load within {ext:.2f} mm of face")
     pz, prr = summary.get("contact_pressure_max_face_mm"), summary.get("contact_pressure_max_radius_mm")
     if pz is not None and np.isfinite(pz):
-        ax.plot([pz], [prr], "*", color="lime", mec="k", ms=12,
-                label=f"p_H max {summary['contact_pressure_max_mpa']:.0f} MPa "
-                      f"(mean {summary['contact_pressure_mean_mpa']:.0f} MPa)")
+        ax.plot(
+            [pz],
+            [prr],
+            "*",
+            color="lime",
+            mec="k",
+            ms=12,
+            label=f"p_H max {summary['contact_pressure_max_mpa']:.0f} MPa "
+            f"(mean {summary['contact_pressure_mean_mpa']:.0f} MPa)",
+        )
     zf = np.linspace(-geo.face_width / 2, geo.face_width / 2, 101)
     edge = 0.5 * geo.face_width * 1e3
-    for r_, lab in ((wheel.tip_rho(geo, zf), "wheel tip"), (np.full_like(zf, geo.r2), "r2 (reference)"),
-                    (wheel.root_rho(geo, zf), "wheel root")):
+    for r_, lab in (
+        (wheel.tip_rho(geo, zf), "wheel tip"),
+        (np.full_like(zf, geo.r2), "r2 (reference)"),
+        (wheel.root_rho(geo, zf), "wheel root"),
+    ):
         ax.plot(zf * 1e3, r_ * 1e3, color="0.4", lw=0.7, ls="--", zorder=1)
-        ax.text(1.04 * edge, r_[-1] * 1e3, lab, fontsize=9, va="center", ha="left", zorder=3,
-                bbox=dict(facecolor="white", edgecolor="0.6", alpha=0.9, pad=1.5))
+        ax.text(
+            1.04 * edge,
+            r_[-1] * 1e3,
+            lab,
+            fontsize=9,
+            va="center",
+            ha="left",
+            zorder=3,
+            bbox=dict(facecolor="white", edgecolor="0.6", alpha=0.9, pad=1.5),
+        )
     ax.set_xlim(-0.6 * geo.face_width * 1e3, 0.85 * geo.face_width * 1e3)
     lo = min(geo.r_f2, float(np.nanmin(R)) * 1e-3) * 1e3
     hi = max(geo.r_a2, float(np.nanmax(R)) * 1e-3) * 1e3
     ax.set_ylim(lo - 0.1 * (hi - lo), hi + 0.25 * (hi - lo))
     ax.legend(fontsize=7, loc="upper left")
-    ax.set(xlabel="across the face: wheel axis position, 0 at the mid-plane [mm]", ylabel="wheel radius [mm]",
-           title=f"contact pattern on the wheel flank ({'AB'[sg]}, exact flanks, steady window)")
+    ax.set(
+        xlabel="across the face: wheel axis position, 0 at the mid-plane [mm]",
+        ylabel="wheel radius [mm]",
+        title=f"contact pattern on the wheel flank ({'AB'[sg]}, exact flanks, steady window)",
+    )
 
 
 def log_pattern(rec, path: str, grid: dict, geo: GearGeometry) -> None:
@@ -350,8 +384,18 @@ def log_pattern(rec, path: str, grid: dict, geo: GearGeometry) -> None:
     base = np.column_stack([xy[sg, j, i, 0], xy[sg, j, i, 1], grid["zeta_m"][j]])
     ang = 2 * np.pi * np.arange(geo.z2) / geo.z2
     c, s = np.cos(ang)[:, None], np.sin(ang)[:, None]
-    pts = np.stack([c * base[None, :, 0] - s * base[None, :, 1], s * base[None, :, 0] + c * base[None, :, 1],
-                    np.broadcast_to(base[None, :, 2], c.shape[:1] + base.shape[:1])], axis=-1).reshape(-1, 3)
+    pts = np.stack(
+        [
+            c * base[None, :, 0] - s * base[None, :, 1],
+            s * base[None, :, 0] + c * base[None, :, 1],
+            np.broadcast_to(base[None, :, 2], c.shape[:1] + base.shape[:1]),
+        ],
+        axis=-1,
+    ).reshape(-1, 3)
     rgb = (matplotlib.colormaps["inferno"](p / max(float(p.max()), 1e-300))[:, :3] * 255).astype(np.uint8)
-    rr.log(path, rr.Points3D(pts, colors=np.tile(rgb, (geo.z2, 1)), radii=0.3 * grid["slice_width_m"]),
-           static=True, recording=rec)
+    rr.log(
+        path,
+        rr.Points3D(pts, colors=np.tile(rgb, (geo.z2, 1)), radii=0.3 * grid["slice_width_m"]),
+        static=True,
+        recording=rec,
+    )

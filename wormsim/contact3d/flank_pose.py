@@ -25,6 +25,7 @@ conjugate angle over the flank grid, per metre along the flank; its 99th percent
 grid's ragged edges). Measured on the seat motor with a 0.1 mm axial offset: 0.60 pitch; 0.37 pitch missed contacts
 27 um deep (docs/errors.md, section 6).
 """
+
 from __future__ import annotations
 
 import math
@@ -32,8 +33,8 @@ import math
 import numba
 import numpy as np
 
-N_WORM_PARAMS = 13          # len(wormsim.contact3d.flanks.worm_params(g)): the nominal kernel's P
-WHEEL = N_WORM_PARAMS       # offsets into the displaced P (module docstring)
+N_WORM_PARAMS = 13  # len(wormsim.contact3d.flanks.worm_params(g)): the nominal kernel's P
+WHEEL = N_WORM_PARAMS  # offsets into the displaced P (module docstring)
 WORM = WHEEL + 12
 SHIFT = WORM + 12
 
@@ -81,22 +82,26 @@ def to_static(x, y, z, P, out):
     wz = P[WHEEL + 8] * x + P[WHEEL + 9] * y + P[WHEEL + 10] * z + P[WHEEL + 11]
     out[3], out[4], out[5] = wx, wy, wz
     dx, dy, dz = wx - P[WORM + 3], wy - P[WORM + 7], wz - P[WORM + 11]
-    return (P[WORM] * dx + P[WORM + 4] * dy + P[WORM + 8] * dz,
-            P[WORM + 1] * dx + P[WORM + 5] * dy + P[WORM + 9] * dz,
-            P[WORM + 2] * dx + P[WORM + 6] * dy + P[WORM + 10] * dz)
+    return (
+        P[WORM] * dx + P[WORM + 4] * dy + P[WORM + 8] * dz,
+        P[WORM + 1] * dx + P[WORM + 5] * dy + P[WORM + 9] * dz,
+        P[WORM + 2] * dx + P[WORM + 6] * dy + P[WORM + 10] * dz,
+    )
 
 
 @numba.njit(cache=True, inline="always")
 def static_dir_to_world(nx, ny, nz, P):
     """A direction of the static worm frame in the world (A's rotation)."""
-    return (P[WORM] * nx + P[WORM + 1] * ny + P[WORM + 2] * nz,
-            P[WORM + 4] * nx + P[WORM + 5] * ny + P[WORM + 6] * nz,
-            P[WORM + 8] * nx + P[WORM + 9] * ny + P[WORM + 10] * nz)
+    return (
+        P[WORM] * nx + P[WORM + 1] * ny + P[WORM + 2] * nz,
+        P[WORM + 4] * nx + P[WORM + 5] * ny + P[WORM + 6] * nz,
+        P[WORM + 8] * nx + P[WORM + 9] * ny + P[WORM + 10] * nz,
+    )
 
 
 def wheel_body_points(P: np.ndarray, pos: np.ndarray) -> np.ndarray:
     """World points -> the wheel body frame (X_g^-1)."""
-    X = P[WHEEL:WHEEL + 12].reshape(3, 4)
+    X = P[WHEEL : WHEEL + 12].reshape(3, 4)
     return (pos - X[:, 3]) @ X[:, :3]
 
 
@@ -105,8 +110,13 @@ def error_margin_rad(g, grid, dev, quantile: float = 0.99) -> float:
     flank in (zeta, rho) by differences on the grid (d/drho along the profile; d/dzeta across the slices at fixed
     rho, with the profile's own slope taken out), its `quantile` over the active points (the largest values sit at
     the grid's ragged edges, where the differences straddle a fold)."""
-    delta = (abs(dev.center_distance) + abs(dev.wheel_axial_offset) + abs(dev.worm_runout) + abs(dev.wheel_runout)
-             + 0.5 * g.face_width * abs(math.sin(dev.shaft_angle)))
+    delta = (
+        abs(dev.center_distance)
+        + abs(dev.wheel_axial_offset)
+        + abs(dev.worm_runout)
+        + abs(dev.wheel_runout)
+        + 0.5 * g.face_width * abs(math.sin(dev.shaft_angle))
+    )
     if delta == 0.0 or grid.slices < 2:
         return 0.0 if delta == 0.0 else delta * 2 * math.pi / g.z2 / g.face_width
     vals = []

@@ -20,6 +20,7 @@ Every flank contact is between the worm's visual geom and the wheel's visual geo
 never collides them itself): their bodies give the contact Jacobian, body_invweight0 the contact law's A_hat, and the
 model's contact sensor (worm against the wheel's subtree) sees the contacts like collision contacts.
 """
+
 from __future__ import annotations
 
 import math
@@ -47,7 +48,7 @@ class FlankContacts:
         self.depth = np.zeros(cap)
         self.meta = np.zeros((cap, 4))
         self.line = np.zeros((cap, 2))
-        self.weight = np.zeros(cap)          # each contact's share of its slice (flanks.slice_weights)
+        self.weight = np.zeros(cap)  # each contact's share of its slice (flanks.slice_weights)
         self.slices = slices
         self.frame = np.zeros((cap, 9))
         self.n = 0
@@ -68,7 +69,7 @@ class FlankContacts:
         t.vert = [-1, -1]
         t.solref = law.solref
         self.solref = np.asarray(law.solref, dtype=float)
-        t.solreffriction = law.solreffriction   # friction rows' own damping, wormsim.contact3d.law (4)
+        t.solreffriction = law.solreffriction  # friction rows' own damping, wormsim.contact3d.law (4)
         self.solreffriction = np.asarray(law.solreffriction, dtype=float)
         t.solimp = law.solimp
         t.includemargin = 0.0
@@ -112,8 +113,23 @@ class FlankContacts:
         g = self.grid
         if self.displaced:
             self._set_pose(self.params, d.xpos, d.xmat, self.bm.worm_body, self.bm.wheel_body, th1)
-        n = find_contacts(g.xy, g.c, g.c_range, g.span, g.zeta, self.window(th2), th1, th2,
-                          self.margin0, self.params, self.pos, self.nrm, self.depth, self.meta, self.line)
+        n = find_contacts(
+            g.xy,
+            g.c,
+            g.c_range,
+            g.span,
+            g.zeta,
+            self.window(th2),
+            th1,
+            th2,
+            self.margin0,
+            self.params,
+            self.pos,
+            self.nrm,
+            self.depth,
+            self.meta,
+            self.line,
+        )
         self.n = n = slice_weights(self.meta, self.line, n, self.slices, self.pos, self.nrm, self.depth, self.weight)
         contact_frames(self.nrm, n, self.frame)
         return n
@@ -127,16 +143,16 @@ class FlankContacts:
         t = self.template
         for _ in range(n):
             if mujoco.mj_addContact(m, d, t):
-                break                               # arena full: MuJoCo warns (mjWARN_CONTACTFULL)
+                break  # arena full: MuJoCo warns (mjWARN_CONTACTFULL)
         k1 = d.ncon
         c = d.contact
-        c.dist[k0:k1] = -self.depth[:k1 - k0]
-        c.pos[k0:k1] = self.pos[:k1 - k0]
-        c.frame[k0:k1] = self.frame[:k1 - k0]
+        c.dist[k0:k1] = -self.depth[: k1 - k0]
+        c.pos[k0:k1] = self.pos[: k1 - k0]
+        c.frame[k0:k1] = self.frame[: k1 - k0]
         # each contact's stiffness and damping scaled by its share of its slice (direct solref: -k, -b)
-        c.solref[k0:k1] = np.multiply.outer(self.weight[:k1 - k0], self.solref)
+        c.solref[k0:k1] = np.multiply.outer(self.weight[: k1 - k0], self.solref)
         if self.solreffriction[1] != 0.0:
-            c.solreffriction[k0:k1] = np.multiply.outer(self.weight[:k1 - k0], self.solreffriction)
+            c.solreffriction[k0:k1] = np.multiply.outer(self.weight[: k1 - k0], self.solreffriction)
 
     def step(self, m: mujoco.MjModel, d: mujoco.MjData) -> None:
         split_step(m, d, self.add)
@@ -194,7 +210,7 @@ def flank_contact_details(fc: FlankContacts, d: mujoco.MjData):
     adr = adr[ok]
     f = np.zeros((len(adr), 3))
     f[:, 0] = d.efc_force[adr]
-    if fc.template.dim == 3:             # elliptic cone rows (normal, two tangents); dim 1: the normal only
+    if fc.template.dim == 3:  # elliptic cone rows (normal, two tangents); dim 1: the normal only
         f[:, 1] = d.efc_force[adr + 1]
         f[:, 2] = d.efc_force[adr + 2]
     F = np.einsum("ni,nij->nj", f, frame)
@@ -202,7 +218,7 @@ def flank_contact_details(fc: FlankContacts, d: mujoco.MjData):
     th2 = float(d.qpos[fc.qa2])
     ang = -(th2 + 2 * math.pi * ks / bm.geometry.z2)
     pw = pos
-    if fc.displaced:            # via the displaced wheel body's frame (wormsim.contact3d.flank_pose)
+    if fc.displaced:  # via the displaced wheel body's frame (wormsim.contact3d.flank_pose)
         from wormsim.contact3d.flank_pose import tooth_shift_of, wheel_body_points
 
         pos = wheel_body_points(fc.params, pos)

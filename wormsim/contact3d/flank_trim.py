@@ -10,6 +10,7 @@ the wheel through the whole mesh window at the conjugate worm angle (theta1 = th
 distance from the thread (the kernel's closed form, flanks.worm_gap) is taken at every position; a point whose least
 distance is below -TRIM_TOL_M is cut away (nan), like the hob-tip-cut root points.
 """
+
 from __future__ import annotations
 
 import math
@@ -19,8 +20,8 @@ import numpy as np
 
 from wormsim.contact3d.flanks import worm_gap
 
-TRIM_TOL_M = 5e-8         # generated points: least distance >= 0 (measured); cut points: -1 to -29 um
-POSITIONS_PER_PITCH = 64   # wheel positions per pitch in the sweep
+TRIM_TOL_M = 5e-8  # generated points: least distance >= 0 (measured); cut points: -1 to -29 um
+POSITIONS_PER_PITCH = 64  # wheel positions per pitch in the sweep
 
 
 @numba.njit(cache=True)
@@ -28,7 +29,7 @@ def least_gap(xy, zeta, theta2, P, gap):
     """Least signed distance of every point xy (F, S, N, 2) (wheel frame, tooth 0) from the worm thread over the
     wheel angles theta2 (worm at the conjugate angle); nan points stay nan."""
     out = np.empty(6)
-    ratio = P[12]                     # hand z1 / z2
+    ratio = P[12]  # hand z1 / z2
     a = P[10]
     for f in range(xy.shape[0]):
         for j in range(xy.shape[1]):

@@ -33,6 +33,7 @@ slice_weights scales each by the share of its slice the contact line covers (the
 The kernel repeats the worm's H(r) (meshgen.worm.half_thickness, ZI/ZA) in compiled form; tests/test_flank_contact.py
 pins the kernel's distance to meshgen.worm.thread_gap.
 """
+
 from __future__ import annotations
 
 import functools
@@ -46,10 +47,10 @@ from meshgen import wheel, worm
 from meshgen.geometry import GearGeometry
 from wormsim.contact3d.flank_pose import N_WORM_PARAMS, static_dir_to_world, to_static, tooth_angle
 
-N_PROFILE = 64              # points along the profile per slice (the parabola refines between them)
-SLICES = {"coarse": 8, "medium": 16, "fine": 32}   # default slices across the face per simulation.resolution
-MARGIN_PITCH = 0.10         # candidate points: conjugate angle within this fraction of a pitch (plus the backlash
-                            # angle and the transmission error, find_contacts' margin) of the wheel angle
+N_PROFILE = 64  # points along the profile per slice (the parabola refines between them)
+SLICES = {"coarse": 8, "medium": 16, "fine": 32}  # default slices across the face per simulation.resolution
+MARGIN_PITCH = 0.10  # candidate points: conjugate angle within this fraction of a pitch (plus the backlash
+# angle and the transmission error, find_contacts' margin) of the wheel angle
 
 
 @dataclass(frozen=True)
@@ -57,23 +58,39 @@ class FlankGrid:
     """Tooth 0's two active flanks on (slice, profile) grids; wheel frame, SI."""
 
     slices: int
-    zeta: np.ndarray        # (S,) slice centres
-    rho: np.ndarray         # (S, N) radius of the profile points
-    psi: np.ndarray         # (2, S, N) polar angle (flank A, flank B), nan where not an active flank point
-    xy: np.ndarray          # (2, S, N, 2) the points' (x, y) in the wheel frame (rho cos psi, rho sin psi)
-    c: np.ndarray           # (2, S, N) conjugate wheel angle, nan where not active
-    c_range: np.ndarray     # (2, S, 2) min and max of c per flank and slice (whole slices are skipped by it)
-    span: np.ndarray        # (2, S, 2) first and last active profile index per flank and slice (c is monotone
-                            # between them; -1, -1 where a slice has none)
-    params: np.ndarray      # worm scalars for the kernel (worm_params)
+    zeta: np.ndarray  # (S,) slice centres
+    rho: np.ndarray  # (S, N) radius of the profile points
+    psi: np.ndarray  # (2, S, N) polar angle (flank A, flank B), nan where not an active flank point
+    xy: np.ndarray  # (2, S, N, 2) the points' (x, y) in the wheel frame (rho cos psi, rho sin psi)
+    c: np.ndarray  # (2, S, N) conjugate wheel angle, nan where not active
+    c_range: np.ndarray  # (2, S, 2) min and max of c per flank and slice (whole slices are skipped by it)
+    span: np.ndarray  # (2, S, 2) first and last active profile index per flank and slice (c is monotone
+    # between them; -1, -1 where a slice has none)
+    params: np.ndarray  # worm scalars for the kernel (worm_params)
 
 
 def worm_params(g: GearGeometry) -> np.ndarray:
     """Scalars of meshgen.worm's closed form, in the order the kernel reads them."""
     zi = 1.0 if g.profile == "ZI" else 0.0
-    t1 = math.sqrt(max(g.r1 ** 2 / g.r_b ** 2 - 1.0, 0.0)) if zi else 0.0
-    return np.array([g.p, g.p_x, g.r_f1, g.r_a1, g.worm_length / 2, zi, g.r_b, math.tan(g.alpha_x),
-                     t1 - math.atan(t1), g.r1, g.a, 2 * math.pi / g.z2, g.hand * g.z1 / g.z2], dtype=float)
+    t1 = math.sqrt(max(g.r1**2 / g.r_b**2 - 1.0, 0.0)) if zi else 0.0
+    return np.array(
+        [
+            g.p,
+            g.p_x,
+            g.r_f1,
+            g.r_a1,
+            g.worm_length / 2,
+            zi,
+            g.r_b,
+            math.tan(g.alpha_x),
+            t1 - math.atan(t1),
+            g.r1,
+            g.a,
+            2 * math.pi / g.z2,
+            g.hand * g.z1 / g.z2,
+        ],
+        dtype=float,
+    )
 
 
 @functools.lru_cache(maxsize=16)
@@ -81,7 +98,7 @@ def flank_grid(g: GearGeometry, slices: int, n_profile: int = N_PROFILE) -> Flan
     """The grids of the module docstring (meshgen.wheel's envelope, both flanks of tooth 0)."""
     bw = g.face_width
     zeta = -bw / 2 + (np.arange(slices) + 0.5) * bw / slices
-    lo = np.maximum(g.a - np.sqrt(np.maximum(g.r_a1 ** 2 - zeta ** 2, 0.0)), wheel.root_rho(g, zeta))
+    lo = np.maximum(g.a - np.sqrt(np.maximum(g.r_a1**2 - zeta**2, 0.0)), wheel.root_rho(g, zeta))
     hi = wheel.tip_rho(g, zeta)
     s = np.linspace(0.0, 1.0, n_profile)
     R = lo[:, None] + (hi - lo)[:, None] * s[None, :]
@@ -107,8 +124,9 @@ def flank_grid(g: GearGeometry, slices: int, n_profile: int = N_PROFILE) -> Flan
     first = np.where(act.any(axis=2), np.argmax(act, axis=2), -1)
     last = np.where(act.any(axis=2), n_profile - 1 - np.argmax(act[:, :, ::-1], axis=2), -1)
     span = np.stack([first, last], axis=-1).astype(np.int64)
-    return FlankGrid(slices=slices, zeta=zeta, rho=R, psi=psi, xy=xy, c=c, c_range=rng, span=span,
-                     params=worm_params(g))
+    return FlankGrid(
+        slices=slices, zeta=zeta, rho=R, psi=psi, xy=xy, c=c, c_range=rng, span=span, params=worm_params(g)
+    )
 
 
 def _cut_by_worm(g: GearGeometry, R: np.ndarray, psi0: np.ndarray, zeta: np.ndarray) -> np.ndarray:
@@ -225,7 +243,7 @@ def find_contacts(xy, c, c_range, span, zeta, ks, theta1, theta2, margin, P, pos
         ang = theta2 + pitch * k
         dk = 0.0
         if P.shape[0] > N_WORM_PARAMS:
-            ang, dk = tooth_angle(k, P)      # wheel body frame, pitch deviation dk (flank_pose)
+            ang, dk = tooth_angle(k, P)  # wheel body frame, pitch deviation dk (flank_pose)
         ca, sa = math.cos(ang), math.sin(ang)
         for sg in range(2):
             target = theta2 + pitch * (k + sg) + dk
@@ -243,7 +261,7 @@ def find_contacts(xy, c, c_range, span, zeta, ks, theta1, theta2, margin, P, pos
                 while b - a > 1:
                     mid = (a + b) // 2
                     cm = c[sg, j, mid]
-                    if cm != cm:            # a point trimmed inside the row (flank_trim): scan the row instead
+                    if cm != cm:  # a point trimmed inside the row (flank_trim): scan the row instead
                         a = -1
                         break
                     if (cm < target) == inc:
@@ -319,12 +337,12 @@ def find_contacts(xy, c, c_range, span, zeta, ks, theta1, theta2, margin, P, pos
                             break
                         ia = ibn
                         if gaps[ia] >= 0.0:
-                            break       # past the parabola's reach: the linear crossings from here on are >= 0
+                            break  # past the parabola's reach: the linear crossings from here on are >= 0
                 gline = best + qa * x_l + qb * x_l * x_l
                 if gmin >= 0.0 and gline >= 0.0:
                     continue
                 if gmin == np.inf:
-                    x = x_l      # no edge inside reach: the line's point (only its weight can make it carry)
+                    x = x_l  # no edge inside reach: the line's point (only its weight can make it carry)
                 # the contact point and normal at fractional index f, linear between the grid points around it
                 f = ib + x
                 i0 = min(int(math.floor(f)), N - 2)
@@ -407,9 +425,9 @@ def contact_frames(nrm, n, frame):
         a0, a1, a2 = nrm[i, 0], nrm[i, 1], nrm[i, 2]
         # tangent 1: normal x (the axis least aligned with it)
         if abs(a0) < 0.5:
-            t0, t1, t2 = 0.0, a2, -a1          # n x e_x
+            t0, t1, t2 = 0.0, a2, -a1  # n x e_x
         else:
-            t0, t1, t2 = -a2, 0.0, a0          # e_y x n
+            t0, t1, t2 = -a2, 0.0, a0  # e_y x n
         tn = math.sqrt(t0 * t0 + t1 * t1 + t2 * t2)
         t0, t1, t2 = t0 / tn, t1 / tn, t2 / tn
         b0 = a1 * t2 - a2 * t1

@@ -84,6 +84,7 @@ so that f_n,slip stays below EPS_SLIP of a contact's share F_n / n_ref of the no
 sliding speed Vs = omega1 r1 / cos(gamma); impratio (3) is then taken with c_f, so friction still saturates above
 the transition velocity.
 """
+
 from __future__ import annotations
 
 import math
@@ -94,29 +95,29 @@ import numpy as np
 from wormsim.gear_theory import DEFAULT_DAMPING_RATIO, MAX_DAMPING_RATIO, effective_modulus_pa
 from wormsim.scenario import Contact, Materials
 
-STABLE_LIMIT_PAIRS = 3      # tooth pairs in contact at once that the stable limit allows for
-EPS_SLIP = 0.01             # (4): the sliding contact's spurious normal force, share of its static load
-IMPEDANCE = 0.01            # d: added mass in the contact normal is d/(1-d) = 1 % of the mesh's effective mass
+STABLE_LIMIT_PAIRS = 3  # tooth pairs in contact at once that the stable limit allows for
+EPS_SLIP = 0.01  # (4): the sliding contact's spurious normal force, share of its static load
+IMPEDANCE = 0.01  # d: added mass in the contact normal is d/(1-d) = 1 % of the mesh's effective mass
 
 
 @dataclass(frozen=True)
 class ContactLaw:
     """Numbers of the mapping (1); SI units."""
 
-    pair_stiffness_n_per_m: float       # K, one tooth pair (linear, secant)
-    stiffness_source: str               # "scenario" | "hertz"
-    exponent: float                     # ADAMS e (reported, not representable)
-    contacts_per_pair: int              # n_ref
-    contact_stiffness_n_per_m: float    # k_c = K / n_ref
+    pair_stiffness_n_per_m: float  # K, one tooth pair (linear, secant)
+    stiffness_source: str  # "scenario" | "hertz"
+    exponent: float  # ADAMS e (reported, not representable)
+    contacts_per_pair: int  # n_ref
+    contact_stiffness_n_per_m: float  # k_c = K / n_ref
     contact_damping_requested_n_s_per_m: float
-    contact_damping_n_s_per_m: float    # c_c used (capped at critical)
-    effective_mass_kg: float            # 1 / A_hat: mesh effective mass at a contact's normal
-    inv_mass_hat: float                 # A_hat (1/kg)
-    impedance: float                    # d
-    solref: tuple[float, float]         # (-S, -B)
+    contact_damping_n_s_per_m: float  # c_c used (capped at critical)
+    effective_mass_kg: float  # 1 / A_hat: mesh effective mass at a contact's normal
+    inv_mass_hat: float  # A_hat (1/kg)
+    impedance: float  # d
+    solref: tuple[float, float]  # (-S, -B)
     solimp: tuple[float, float, float, float, float]
-    impratio: float = 1.0               # MuJoCo opt.impratio: R_normal / R_friction, (3)
-    friction_damping_n_s_per_m: float | None = None   # c_f of the friction rows, (4); None: c_c (solref)
+    impratio: float = 1.0  # MuJoCo opt.impratio: R_normal / R_friction, (3)
+    friction_damping_n_s_per_m: float | None = None  # c_f of the friction rows, (4); None: c_c (solref)
 
     @property
     def friction_damping(self) -> float:
@@ -151,8 +152,11 @@ class ContactLaw:
     @property
     def damping_ratio(self) -> float:
         """zeta of one tooth pair (n_ref contacts) against the mesh's effective mass."""
-        return self.contact_damping_n_s_per_m * self.contacts_per_pair / (
-            2 * math.sqrt(self.pair_stiffness_n_per_m * self.effective_mass_kg))
+        return (
+            self.contact_damping_n_s_per_m
+            * self.contacts_per_pair
+            / (2 * math.sqrt(self.pair_stiffness_n_per_m * self.effective_mass_kg))
+        )
 
 
 def hertz_line_stiffness_n_per_m(materials: Materials, contact_length_m: float) -> float:
@@ -160,8 +164,9 @@ def hertz_line_stiffness_n_per_m(materials: Materials, contact_length_m: float) 
     return math.pi * contact_length_m * effective_modulus_pa(materials) / 4.0
 
 
-def contact_law(contact: Contact, materials: Materials, face_width_m: float, contacts_per_pair: int,
-                inv_mass_hat: float) -> ContactLaw:
+def contact_law(
+    contact: Contact, materials: Materials, face_width_m: float, contacts_per_pair: int, inv_mass_hat: float
+) -> ContactLaw:
     """Map the scenario's contact block onto per-contact solref/solimp by (1).
 
     `inv_mass_hat` is A_hat = 1 / m_eff, the constraint-space inverse mass the model assigns to every
@@ -174,7 +179,7 @@ def contact_law(contact: Contact, materials: Materials, face_width_m: float, con
     n_ref = max(int(contacts_per_pair), 1)
     k_c = k_pair / n_ref
     m_eff = 1.0 / inv_mass_hat
-    c_crit = 2.0 * math.sqrt(k_pair * m_eff) / n_ref      # per contact: critical damping of one pair
+    c_crit = 2.0 * math.sqrt(k_pair * m_eff) / n_ref  # per contact: critical damping of one pair
     if contact.damping_n_s_per_m is not None:
         c_req = contact.damping_n_s_per_m / n_ref
     else:
@@ -184,15 +189,24 @@ def contact_law(contact: Contact, materials: Materials, face_width_m: float, con
     s = k_c * (1 - d) * inv_mass_hat
     b = c_c * (1 - d) * inv_mass_hat
     return ContactLaw(
-        pair_stiffness_n_per_m=k_pair, stiffness_source=source, exponent=contact.exponent,
-        contacts_per_pair=n_ref, contact_stiffness_n_per_m=k_c,
-        contact_damping_requested_n_s_per_m=c_req, contact_damping_n_s_per_m=c_c,
-        effective_mass_kg=m_eff, inv_mass_hat=inv_mass_hat, impedance=d,
-        solref=(-s, -b), solimp=(d, d, 0.001, 0.5, 2.0))
+        pair_stiffness_n_per_m=k_pair,
+        stiffness_source=source,
+        exponent=contact.exponent,
+        contacts_per_pair=n_ref,
+        contact_stiffness_n_per_m=k_c,
+        contact_damping_requested_n_s_per_m=c_req,
+        contact_damping_n_s_per_m=c_c,
+        effective_mass_kg=m_eff,
+        inv_mass_hat=inv_mass_hat,
+        impedance=d,
+        solref=(-s, -b),
+        solimp=(d, d, 0.001, 0.5, 2.0),
+    )
 
 
-def friction_damping_n_s_per_m(law: ContactLaw, mu_max: float, normal_force_n: float, sliding_speed_m_s: float,
-                               eps: float | None = None) -> float:
+def friction_damping_n_s_per_m(
+    law: ContactLaw, mu_max: float, normal_force_n: float, sliding_speed_m_s: float, eps: float | None = None
+) -> float:
     """(4): c_f = min(c_c, eps F_n / (n_ref mu_max Vs)), eps = EPS_SLIP; c_c where there is no friction, load or
     sliding speed."""
     eps = EPS_SLIP if eps is None else eps

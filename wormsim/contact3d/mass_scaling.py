@@ -33,6 +33,7 @@ through the mesh at the wedge efficiency), at the end of the ramps (where the sh
 the run: the sampled speeds (the rattle included) and the runner's step-by-step drive power.
 `auto` takes the largest S that passes every check, rounded down to 1-2-5 (1 when none does).
 """
+
 from __future__ import annotations
 
 import math
@@ -45,16 +46,16 @@ from wormsim.errors import RingingError
 from wormsim.scenario import Scenario, ScenarioError
 from wormsim.units import rpm_to_rad_s
 
-KE_SHARE_TARGET = 0.01          # kinetic energy at most 1 % of the drive's work
-MODE_TO_MESH_MIN = 100.0        # scaled mesh mode at least 100 x the meshing frequency (seat motor, 36 rpm: at 50 x
-                                # the F_t spectrum peaked at the scaled mode, at 113 x at z1 n1 / 60)
-FACET_TO_MODE_MIN = 20.0        # contact.geometry pieces: scaled mode at least 20 x the piece-passing frequency
-RAMP_PERIODS_MIN = 10.0         # ramps at least 10 scaled mesh-mode periods (S = 1e4 failed 0.05 s ramps: 5.7)
-SCALED_STEP_FRACTION = 0.35     # default step of a scaled run: this fraction of the scaled stable limit
-SCALED_SAMPLES = 2000           # automatic record_every of a scaled run aims at this many samples (the per-sample
-                                # bookkeeping cost more than the scaled steps; samples are means over their steps)
-RINGING_KE_SHARE = 10 * KE_SHARE_TARGET     # measured share beyond this, or efficiency > 1: the run rang
-AUTO_MAX = 1e8                  # the schema's upper bound
+KE_SHARE_TARGET = 0.01  # kinetic energy at most 1 % of the drive's work
+MODE_TO_MESH_MIN = 100.0  # scaled mesh mode at least 100 x the meshing frequency (seat motor, 36 rpm: at 50 x
+# the F_t spectrum peaked at the scaled mode, at 113 x at z1 n1 / 60)
+FACET_TO_MODE_MIN = 20.0  # contact.geometry pieces: scaled mode at least 20 x the piece-passing frequency
+RAMP_PERIODS_MIN = 10.0  # ramps at least 10 scaled mesh-mode periods (S = 1e4 failed 0.05 s ramps: 5.7)
+SCALED_STEP_FRACTION = 0.35  # default step of a scaled run: this fraction of the scaled stable limit
+SCALED_SAMPLES = 2000  # automatic record_every of a scaled run aims at this many samples (the per-sample
+# bookkeeping cost more than the scaled steps; samples are means over their steps)
+RINGING_KE_SHARE = 10 * KE_SHARE_TARGET  # measured share beyond this, or efficiency > 1: the run rang
+AUTO_MAX = 1e8  # the schema's upper bound
 
 
 @dataclass(frozen=True)
@@ -62,11 +63,11 @@ class ScalingCheck:
     """What the checks found for a factor S (SI)."""
 
     factor: float
-    mode_hz: float              # scaled mesh mode of one tooth pair
-    mesh_hz: float              # z1 n1 / 60 at the commanded speed
-    ramp_s: float               # the shortest ramp that counts
+    mode_hz: float  # scaled mesh mode of one tooth pair
+    mesh_hz: float  # z1 n1 / 60 at the commanded speed
+    ramp_s: float  # the shortest ramp that counts
     ke_share_estimate: float
-    factor_limits: dict         # the largest S each check allows
+    factor_limits: dict  # the largest S each check allows
     facet_hz: float = float("nan")  # contact.geometry pieces: worm pieces per turn x n1 / 60
 
 
@@ -89,9 +90,19 @@ def kinetic_energy_j(inertias_kg_m2: tuple[float, float], w1_rad_s, w2_rad_s):
     return 0.5 * (inertias_kg_m2[0] * np.square(w1_rad_s) + inertias_kg_m2[1] * np.square(w2_rad_s))
 
 
-def check(scenario: Scenario, ratio: float, z1: int, gamma: float, alpha_n: float, mu: float,
-          pair_stiffness_n_per_m: float, inv_mass_hat: float, inertias_kg_m2: tuple[float, float],
-          factor: float, segments_per_turn: int = 0) -> ScalingCheck:
+def check(
+    scenario: Scenario,
+    ratio: float,
+    z1: int,
+    gamma: float,
+    alpha_n: float,
+    mu: float,
+    pair_stiffness_n_per_m: float,
+    inv_mass_hat: float,
+    inertias_kg_m2: tuple[float, float],
+    factor: float,
+    segments_per_turn: int = 0,
+) -> ScalingCheck:
     """The quasi-static checks for factor S with the UNSCALED A_hat and shaft inertias (I1 + J1, I2 + J2);
     segments_per_turn: the worm's convex pieces per turn (contact.geometry pieces; 0 for flanks)."""
     drv = gt.gear_drive(scenario)
@@ -111,9 +122,16 @@ def check(scenario: Scenario, ratio: float, z1: int, gamma: float, alpha_n: floa
         # KE share at S: S ke1 / (work + S ke1) <= target
         "kinetic_energy": KE_SHARE_TARGET * work / ((1 - KE_SHARE_TARGET) * ke1) if ke1 > 0 else float("inf"),
     }
-    ke_s = factor * ke1 / (work + factor * ke1) if ke1 > 0 else 0.0       # at standstill: no kinetic energy
-    return ScalingCheck(factor, mode1_hz / math.sqrt(factor), mesh_hz, ramp, ke_s, limits,
-                        facet_hz if segments_per_turn else float("nan"))
+    ke_s = factor * ke1 / (work + factor * ke1) if ke1 > 0 else 0.0  # at standstill: no kinetic energy
+    return ScalingCheck(
+        factor,
+        mode1_hz / math.sqrt(factor),
+        mesh_hz,
+        ramp,
+        ke_s,
+        limits,
+        facet_hz if segments_per_turn else float("nan"),
+    )
 
 
 def refuse_if_dynamic(c: ScalingCheck, requested) -> None:
@@ -124,20 +142,28 @@ def refuse_if_dynamic(c: ScalingCheck, requested) -> None:
     lim = min(c.factor_limits.values())
     allowed = f"allowed here: 1 <= simulation.mass_scaling <= {max(1.0, lim):.3g} (or auto)"
     if c.mode_hz < MODE_TO_MESH_MIN * c.mesh_hz:
-        raise ScenarioError(f"{head}: the scaled mesh mode {c.mode_hz:.3g} Hz comes within {MODE_TO_MESH_MIN:g} x the "
-                            f"meshing frequency {c.mesh_hz:.3g} Hz (z1 n1 / 60) and its harmonics; {allowed}")
+        raise ScenarioError(
+            f"{head}: the scaled mesh mode {c.mode_hz:.3g} Hz comes within {MODE_TO_MESH_MIN:g} x the "
+            f"meshing frequency {c.mesh_hz:.3g} Hz (z1 n1 / 60) and its harmonics; {allowed}"
+        )
     if c.factor > c.factor_limits.get("facets", float("inf")):
         facet_hz = c.facet_hz
-        raise ScenarioError(f"{head}: the scaled mesh mode {c.mode_hz:.3g} Hz comes within {FACET_TO_MODE_MIN:g} x the "
-                            f"frequency at which the worm's convex pieces pass ({facet_hz:.3g} Hz, contact.geometry "
-                            f"pieces); use contact.geometry flanks, or {allowed}")
+        raise ScenarioError(
+            f"{head}: the scaled mesh mode {c.mode_hz:.3g} Hz comes within {FACET_TO_MODE_MIN:g} x the "
+            f"frequency at which the worm's convex pieces pass ({facet_hz:.3g} Hz, contact.geometry "
+            f"pieces); use contact.geometry flanks, or {allowed}"
+        )
     if c.ramp_s < RAMP_PERIODS_MIN / c.mode_hz:
-        raise ScenarioError(f"{head}: the ramp of {c.ramp_s:.3g} s is shorter than {RAMP_PERIODS_MIN:g} periods of the "
-                            f"scaled mesh mode ({RAMP_PERIODS_MIN / c.mode_hz:.3g} s at {c.mode_hz:.3g} Hz); lengthen "
-                            f"drive.ramp_s / load.ramp_s, or {allowed}")
+        raise ScenarioError(
+            f"{head}: the ramp of {c.ramp_s:.3g} s is shorter than {RAMP_PERIODS_MIN:g} periods of the "
+            f"scaled mesh mode ({RAMP_PERIODS_MIN / c.mode_hz:.3g} s at {c.mode_hz:.3g} Hz); lengthen "
+            f"drive.ramp_s / load.ramp_s, or {allowed}"
+        )
     if c.ke_share_estimate > KE_SHARE_TARGET:
-        raise ScenarioError(f"{head}: the kinetic energy would be {100 * c.ke_share_estimate:.3g} % of the drive's "
-                            f"work at the end of the ramps (at most {100 * KE_SHARE_TARGET:g} %); {allowed}")
+        raise ScenarioError(
+            f"{head}: the kinetic energy would be {100 * c.ke_share_estimate:.3g} % of the drive's "
+            f"work at the end of the ramps (at most {100 * KE_SHARE_TARGET:g} %); {allowed}"
+        )
 
 
 def resolve(scenario: Scenario, **kw) -> ScalingCheck:
@@ -145,12 +171,17 @@ def resolve(scenario: Scenario, **kw) -> ScalingCheck:
     1-2-5 rounded down, 1 when even S = 1 fails a check). kw: check's arguments less `factor`."""
     ms = scenario.simulation.mass_scaling
     if ms == 1:
-        return check(scenario, factor=1.0, **kw) if gt.gear_drive(scenario).speed_rpm is not None else \
-            ScalingCheck(1.0, float("nan"), float("nan"), float("nan"), float("nan"), {})
+        return (
+            check(scenario, factor=1.0, **kw)
+            if gt.gear_drive(scenario).speed_rpm is not None
+            else ScalingCheck(1.0, float("nan"), float("nan"), float("nan"), float("nan"), {})
+        )
     if gt.gear_drive(scenario).speed_rpm is None:
-        raise ScenarioError(f"simulation.mass_scaling = {ms}: needs a speed-driven drive (drive.speed_rpm): with "
-                            "drive.torque_nm the speed, the meshing frequency and the kinetic energy are not known "
-                            "before the run; allowed: simulation.mass_scaling = 1 with a torque drive")
+        raise ScenarioError(
+            f"simulation.mass_scaling = {ms}: needs a speed-driven drive (drive.speed_rpm): with "
+            "drive.torque_nm the speed, the meshing frequency and the kinetic energy are not known "
+            "before the run; allowed: simulation.mass_scaling = 1 with a torque drive"
+        )
     c1 = check(scenario, factor=1.0, **kw)
     if ms == "auto":
         s = min(AUTO_MAX, *c1.factor_limits.values())
@@ -161,8 +192,9 @@ def resolve(scenario: Scenario, **kw) -> ScalingCheck:
     return c
 
 
-def measured_ke_share(S: dict, inertias_kg_m2: tuple[float, float], t_from_s: float,
-                      drive_power_w: np.ndarray) -> float:
+def measured_ke_share(
+    S: dict, inertias_kg_m2: tuple[float, float], t_from_s: float, drive_power_w: np.ndarray
+) -> float:
     """The measured share (module docstring) from the runner's series: KE at each sample's end from the sampled speeds,
     W from the drive shaft's interval-mean power (every step's T w) times the interval."""
     t = S["t_s"]
@@ -181,7 +213,7 @@ def measured_ke_share(S: dict, inertias_kg_m2: tuple[float, float], t_from_s: fl
 def floor_2_digits(x: float) -> float:
     """x rounded down to two significant digits, as its decimal value (2.4e-04, not 2.4 * 10.0 ** -4)."""
     e = math.floor(math.log10(x)) - 1
-    return float(f"{math.floor(x / 10 ** e * (1 + 1e-12))}e{e}")
+    return float(f"{math.floor(x / 10**e * (1 + 1e-12))}e{e}")
 
 
 def run_summary(S: dict, scenario: Scenario, meta: dict, summary: dict) -> dict:
@@ -191,24 +223,31 @@ def run_summary(S: dict, scenario: Scenario, meta: dict, summary: dict) -> dict:
     c: ScalingCheck = meta["mass_scaling_check"]
     drive_power = S["worm_power_w"] if scenario.drive.on == "worm" else S["wheel_power_w"]
     share = measured_ke_share(S, meta["shaft_inertias_kg_m2"], gt.ramps_end_s(scenario), drive_power)
-    out = {"mass_scaling": c.factor, "kinetic_energy_share": share,
-           "kinetic_energy_share_estimate": c.ke_share_estimate,
-           "mass_scaling_mesh_mode_hz": c.mode_hz, "mass_scaling_requested": scenario.simulation.mass_scaling}
+    out = {
+        "mass_scaling": c.factor,
+        "kinetic_energy_share": share,
+        "kinetic_energy_share_estimate": c.ke_share_estimate,
+        "mass_scaling_mesh_mode_hz": c.mode_hz,
+        "mass_scaling_requested": scenario.simulation.mass_scaling,
+    }
     if c.factor > 1:
         eff = summary.get("efficiency", float("nan"))
         why = []
         if eff > 1:
             why.append(f"efficiency {eff:.3g} > 1 (more power out than in)")
         if not share <= RINGING_KE_SHARE:
-            why.append(f"kinetic energy {100 * share:.3g} % of the drive's work (target {100 * KE_SHARE_TARGET:g} %, "
-                       f"limit {100 * RINGING_KE_SHARE:g} %)")
+            why.append(
+                f"kinetic energy {100 * share:.3g} % of the drive's work (target {100 * KE_SHARE_TARGET:g} %, "
+                f"limit {100 * RINGING_KE_SHARE:g} %)"
+            )
         if why:
             h, lim = summary["timestep_s"], summary["timestep_stable_limit_s"]
             raise RingingError(
                 f"the mass-scaled run rang (simulation.mass_scaling = {c.factor:g}, timestep {h:.3g} s, {h / lim:.2f} "
                 f"of the scaled stable limit {lim:.3g} s): {'; '.join(why)}; its means are not quasi-static. Leave "
                 f"simulation.timestep_s unset (default {SCALED_STEP_FRACTION} x the limit) or lower "
-                f"simulation.mass_scaling")
+                f"simulation.mass_scaling"
+            )
     return out
 
 
@@ -216,9 +255,13 @@ def note(c: ScalingCheck, requested, timestep_s: float) -> str:
     """The line a scaled run prints before it starts."""
     if c.factor == 1:
         lim = min(c.factor_limits.values()) if c.factor_limits else float("nan")
-        return (f"mass scaling: {requested} -> 1 (off): the run is dynamic (the checks allow at most {lim:.3g}); "
-                f"docs/contact3d.md, 'Mass scaling'")
-    return (f"mass scaling: inertias x {c.factor:g} ({requested}), timestep {timestep_s:.3g} s, mesh mode "
-            f"{c.mode_hz:.3g} Hz, kinetic energy ~{100 * c.ke_share_estimate:.2g} % of the work: quasi-static means "
-            f"only (ratio, mean forces, efficiency); F_t p2p, transmission error, rattle and start-up peaks are not "
-            f"physical")
+        return (
+            f"mass scaling: {requested} -> 1 (off): the run is dynamic (the checks allow at most {lim:.3g}); "
+            f"docs/contact3d.md, 'Mass scaling'"
+        )
+    return (
+        f"mass scaling: inertias x {c.factor:g} ({requested}), timestep {timestep_s:.3g} s, mesh mode "
+        f"{c.mode_hz:.3g} Hz, kinetic energy ~{100 * c.ke_share_estimate:.2g} % of the work: quasi-static means "
+        f"only (ratio, mean forces, efficiency); F_t p2p, transmission error, rattle and start-up peaks are not "
+        f"physical"
+    )

@@ -1,6 +1,7 @@
 """contact3d summary metrics: the common drive summary (wormsim.metrics) plus the meshing frequency searched below
 half the piece-passing frequency, contact statistics, the radial force on the line of centres, the efficiency theory
 at the contacts' radius and the start-up peak."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -50,8 +51,10 @@ def contact_radius_check(S: dict, sl: slice) -> dict:
     r, e = S["worm_contact_radius_m"][sl], S["efficiency_theory_at_contact_radius"][sl]
     if not np.isfinite(r).any():
         return {"worm_contact_radius_mean_m": float("nan"), "efficiency_theory_at_contact_radius": float("nan")}
-    return {"worm_contact_radius_mean_m": float(np.nanmean(r)),
-            "efficiency_theory_at_contact_radius": float(np.nanmean(e))}
+    return {
+        "worm_contact_radius_mean_m": float(np.nanmean(r)),
+        "efficiency_theory_at_contact_radius": float(np.nanmean(e)),
+    }
 
 
 def radial_force_check(S: dict, scenario, geo, sl: slice) -> dict:
@@ -68,8 +71,10 @@ def radial_force_check(S: dict, scenario, geo, sl: slice) -> dict:
     rho = gt.virtual_friction_angle_rad(mu, geo.alpha_n)
     s = -1.0 if scenario.drive.on == "wheel" else 1.0
     ft = abs(float(np.mean(S["tangential_force_n"][sl])))
-    return {"radial_force_line_of_centres_mean_n": abs(float(np.mean(S["radial_force_line_of_centres_n"][sl]))),
-            "radial_force_theory_n": gt.radial_force_n(ft, geo.alpha_n, geo.gamma, s * rho)}
+    return {
+        "radial_force_line_of_centres_mean_n": abs(float(np.mean(S["radial_force_line_of_centres_n"][sl]))),
+        "radial_force_theory_n": gt.radial_force_n(ft, geo.alpha_n, geo.gamma, s * rho),
+    }
 
 
 def startup_peak(S: dict, i0: int, i1: int) -> dict:

@@ -21,6 +21,7 @@ Built with mujoco.MjSpec from the template `models/worm_pair.xml` (see models/RE
 - a contact sensor (worm against the wheel's subtree, reduce="netforce") gives the resultant tooth force
   every step, which wormsim.contact3d.runner averages over each record interval.
 """
+
 from __future__ import annotations
 
 import math
@@ -49,11 +50,15 @@ from wormsim.geometry import derive, displaced_pair, gear_set
 from wormsim.scenario import Scenario, ScenarioError
 from wormsim.units import rpm_to_rad_s
 
-TEMPLATE = files("wormsim.models") / "worm_pair.xml"   # models/, shipped as package data
-MESH_SENSOR_DATA = 1 | 2 | 4 | 16    # contact sensor fields found, force, torque, pos (mjtConDataField bits)
-INTEGRATORS = {"implicitfast": mujoco.mjtIntegrator.mjINT_IMPLICITFAST, "rk4": mujoco.mjtIntegrator.mjINT_RK4,
-               "euler": mujoco.mjtIntegrator.mjINT_EULER, "implicit": mujoco.mjtIntegrator.mjINT_IMPLICIT,
-               "discrete": mujoco.mjtIntegrator.mjINT_DISCRETE}
+TEMPLATE = files("wormsim.models") / "worm_pair.xml"  # models/, shipped as package data
+MESH_SENSOR_DATA = 1 | 2 | 4 | 16  # contact sensor fields found, force, torque, pos (mjtConDataField bits)
+INTEGRATORS = {
+    "implicitfast": mujoco.mjtIntegrator.mjINT_IMPLICITFAST,
+    "rk4": mujoco.mjtIntegrator.mjINT_RK4,
+    "euler": mujoco.mjtIntegrator.mjINT_EULER,
+    "implicit": mujoco.mjtIntegrator.mjINT_IMPLICIT,
+    "discrete": mujoco.mjtIntegrator.mjINT_DISCRETE,
+}
 
 
 @dataclass
@@ -70,20 +75,20 @@ class BuiltModel:
     wheel_dof: int
     drive_actuator: int
     load_actuator: int
-    worm_geoms: np.ndarray              # collision geom ids
-    wheel_slot_geoms: np.ndarray        # (W, n_pieces) collision geom ids
-    slot_bodies: np.ndarray             # (W,) body ids of the window slots (children of the wheel)
+    worm_geoms: np.ndarray  # collision geom ids
+    wheel_slot_geoms: np.ndarray  # (W, n_pieces) collision geom ids
+    slot_bodies: np.ndarray  # (W,) body ids of the window slots (children of the wheel)
     window_teeth: int
-    tooth0_angle_rad: float             # angle of tooth 0's centre in the wheel frame at theta2 = 0
-    direction: int                      # +1/-1: expected sign of (load shaft speed) / (drive command)
-    drive_sign: int                     # sign of the drive command
+    tooth0_angle_rad: float  # angle of tooth 0's centre in the wheel frame at theta2 = 0
+    direction: int  # +1/-1: expected sign of (load shaft speed) / (drive command)
+    drive_sign: int  # sign of the drive command
     pieces: GearSet
-    timestep_s: float                   # the model's timestep (model.opt.timestep), chosen before the build
+    timestep_s: float  # the model's timestep (model.opt.timestep), chosen before the build
     timestep_source: str
     meta: dict = field(default_factory=dict)
-    tooth_shift_rad: np.ndarray | None = None   # (z2,) pitch deviations f_k / r2 (errors:, meshgen.displaced)
-    kinematic_tca: KinematicTCA | None = None   # of the displaced pair (errors: only)
-    deviations: Deviations | None = None        # the errors: block in SI (None for the perfect pair)
+    tooth_shift_rad: np.ndarray | None = None  # (z2,) pitch deviations f_k / r2 (errors:, meshgen.displaced)
+    kinematic_tca: KinematicTCA | None = None  # of the displaced pair (errors: only)
+    deviations: Deviations | None = None  # the errors: block in SI (None for the perfect pair)
 
 
 @dataclass(frozen=True)
@@ -107,12 +112,13 @@ class Prepared:
     pieces: GearSet
     inertias: Inertias
     law: ContactLaw
-    inv_mass_worm: float     # arm1^2 / (I1 + J1): the worm's share of A_hat
-    inv_mass_wheel: float    # arm2^2 / (I2 + J2)
-    scaling: ScalingCheck | None = None   # simulation.mass_scaling: the factor used and its checks (inertias x it)
+    inv_mass_worm: float  # arm1^2 / (I1 + J1): the worm's share of A_hat
+    inv_mass_wheel: float  # arm2^2 / (I2 + J2)
+    scaling: ScalingCheck | None = None  # simulation.mass_scaling: the factor used and its checks (inertias x it)
 
 
 # ----------------------------------------------------------------------------- geometry helpers
+
 
 def _mat2quat(R: np.ndarray) -> np.ndarray:
     q = np.zeros(4)
@@ -127,8 +133,8 @@ def _axial_inertia(mesh, density: float, r_in: float, r_out: float, length: floa
         m.density = density
         mp = m.mass_properties
         return float(mp["mass"]), float(mp["inertia"][2, 2])
-    mass = density * math.pi * (r_out ** 2 - r_in ** 2) * length
-    return mass, 0.5 * mass * (r_out ** 2 + r_in ** 2)
+    mass = density * math.pi * (r_out**2 - r_in**2) * length
+    return mass, 0.5 * mass * (r_out**2 + r_in**2)
 
 
 def nominal_normal_force_n(scenario: Scenario, geo: GearGeometry) -> float:
@@ -178,6 +184,7 @@ def _tooth0_angle(gs: GearSet) -> float:
 
 # ----------------------------------------------------------------------------- before the build
 
+
 def shaft_inertias(scenario: Scenario, geo: GearGeometry, gs: GearSet) -> Inertias:
     mats = scenario.materials
     m1, I1 = _axial_inertia(gs.worm_visual, mats.worm.density_kg_m3, 0.0, geo.r1, geo.worm_length)
@@ -201,31 +208,48 @@ def prepare(scenario: Scenario, gs: GearSet | None = None) -> Prepared:
     # n_ref: the pieces across the face width, or with contact.geometry flanks the flank contacts' slices
     slabs = flank_slices(scenario) if scenario.contact.geometry == "flanks" else max(1, _slabs_per_flank(gs))
     # simulation.mass_scaling (wormsim.contact3d.mass_scaling): every inertia x S before the law takes them
-    law1 = contact_law(scenario.contact, scenario.materials, geo.face_width, slabs, arm1 ** 2 / I1 + arm2 ** 2 / I2)
+    law1 = contact_law(scenario.contact, scenario.materials, geo.face_width, slabs, arm1**2 / I1 + arm2**2 / I2)
     scaling = mass_scaling.resolve(
-        scenario, ratio=geo.ratio, z1=geo.z1, gamma=geo.gamma, alpha_n=geo.alpha_n,
-        mu=float(friction_coefficient(scenario.contact, 1.0)), pair_stiffness_n_per_m=law1.pair_stiffness_n_per_m,
-        inv_mass_hat=law1.inv_mass_hat, inertias_kg_m2=(I1, I2),
-        segments_per_turn=0 if scenario.contact.geometry == "flanks" else gs.resolution.worm_segments_per_turn or 0)
+        scenario,
+        ratio=geo.ratio,
+        z1=geo.z1,
+        gamma=geo.gamma,
+        alpha_n=geo.alpha_n,
+        mu=float(friction_coefficient(scenario.contact, 1.0)),
+        pair_stiffness_n_per_m=law1.pair_stiffness_n_per_m,
+        inv_mass_hat=law1.inv_mass_hat,
+        inertias_kg_m2=(I1, I2),
+        segments_per_turn=0 if scenario.contact.geometry == "flanks" else gs.resolution.worm_segments_per_turn or 0,
+    )
     S = scaling.factor
     if S != 1:
         ine = Inertias(*(S * v for v in astuple(ine)))
-    a1, a2 = arm1 ** 2 / (S * I1), arm2 ** 2 / (S * I2)
+    a1, a2 = arm1**2 / (S * I1), arm2**2 / (S * I2)
     law = contact_law(scenario.contact, scenario.materials, geo.face_width, slabs, a1 + a2)
     mu0 = float(friction_coefficient(scenario.contact, 0.0))
     mu_max = max(mu0, float(friction_coefficient(scenario.contact, 1.0)))
     f_n = nominal_normal_force_n(scenario, geo)
-    if scenario.contact.geometry == "flanks":       # the flank contacts' own friction-row damping, law (4)
-        law = replace(law, friction_damping_n_s_per_m=friction_damping_n_s_per_m(
-            law, mu_max, f_n, nominal_sliding_speed_m_s(scenario, geo)))
+    if scenario.contact.geometry == "flanks":  # the flank contacts' own friction-row damping, law (4)
+        law = replace(
+            law,
+            friction_damping_n_s_per_m=friction_damping_n_s_per_m(
+                law, mu_max, f_n, nominal_sliding_speed_m_s(scenario, geo)
+            ),
+        )
     law = replace(law, impratio=friction_impratio(law, mu_max, f_n, scenario.contact.transition_velocity_m_s))
     return Prepared(geo, gs, ine, law, a1, a2, scaling)
 
 
 # ----------------------------------------------------------------------------- build
 
-def build_model(scenario: Scenario, gs: GearSet | None = None, check_backlash_vs_pieces: bool = True,
-                window_teeth: int | None = None, timestep_s: float | None = None) -> BuiltModel:
+
+def build_model(
+    scenario: Scenario,
+    gs: GearSet | None = None,
+    check_backlash_vs_pieces: bool = True,
+    window_teeth: int | None = None,
+    timestep_s: float | None = None,
+) -> BuiltModel:
     """The compiled contact3d model. check_backlash_vs_pieces=False skips wormsim.contact3d.backlash's checks (only
     to measure what happens below their limit). window_teeth: wheel tooth slots with collision (default
     window_size; geo.z2 = every tooth, for a standalone file that the viewer can turn without re-posing).
@@ -234,66 +258,98 @@ def build_model(scenario: Scenario, gs: GearSet | None = None, check_backlash_vs
     geo, gs, law = p.geometry, p.pieces, p.law
     flanks = scenario.contact.geometry == "flanks"
     if flanks:
-        check_backlash_vs_pieces = False        # no pieces collide (wormsim.contact3d.flank_step)
+        check_backlash_vs_pieces = False  # no pieces collide (wormsim.contact3d.flank_step)
     # backlash against the pieces' residual bulge (wormsim.contact3d.backlash (2)): exit 2 before the teeth start jammed
-    backlash_meta = check_backlash(geo, gs.piece_error_um, scenario.simulation.resolution) \
-        if check_backlash_vs_pieces and gs.piece_error_um else {}
-    h, h_source = choose_timestep(scenario, geo, law, p.scaling.factor) if timestep_s is None else (
-        timestep_s, "given to build_model")
+    backlash_meta = (
+        check_backlash(geo, gs.piece_error_um, scenario.simulation.resolution)
+        if check_backlash_vs_pieces and gs.piece_error_um
+        else {}
+    )
+    h, h_source = (
+        choose_timestep(scenario, geo, law, p.scaling.factor)
+        if timestep_s is None
+        else (timestep_s, "given to build_model")
+    )
 
-    pair = displaced_pair(scenario.errors, geo)      # errors: (issue 12), None for the perfect pair
+    pair = displaced_pair(scenario.errors, geo)  # errors: (issue 12), None for the perfect pair
     dev, kin = pair if pair is not None else (None, None)
     shift = dev.tooth_angle_shift(geo, np.arange(geo.z2)) if dev is not None and any(dev.tooth_shift) else None
 
     spec = mujoco.MjSpec.from_file(str(TEMPLATE))
     spec.modelname = scenario.name
     _place_bodies(spec, geo, p.inertias, dev)
-    worm_names, slot_names, W = _add_geoms(spec, geo, gs, law, float(friction_coefficient(scenario.contact, 0.0)),
-                                           window_teeth, shift, flanks)
+    worm_names, slot_names, W = _add_geoms(
+        spec, geo, gs, law, float(friction_coefficient(scenario.contact, 0.0)), window_teeth, shift, flanks
+    )
     kv, drive_sign = _add_actuators(spec, scenario, geo)
-    spec.joint(f"{scenario.load.on}_hinge").armature = max(p.inertias.worm_load_inertia_kg_m2,
-                                                           p.inertias.wheel_load_inertia_kg_m2)   # x mass_scaling
+    spec.joint(f"{scenario.load.on}_hinge").armature = max(
+        p.inertias.worm_load_inertia_kg_m2, p.inertias.wheel_load_inertia_kg_m2
+    )  # x mass_scaling
     _set_options(spec, scenario, law, h)
     _add_mesh_sensor(spec)
     model = spec.compile()
 
     ine = p.inertias
-    meta = {"contact_geometry": scenario.contact.geometry,
-            "worm_mass_kg": ine.worm_mass_kg, "wheel_mass_kg": ine.wheel_mass_kg,
-            "worm_inertia_kg_m2": ine.worm_inertia_kg_m2, "wheel_inertia_kg_m2": ine.wheel_inertia_kg_m2,
-            "window_teeth": W, "worm_pieces": len(gs.worm_pieces), "tooth_pieces": len(gs.wheel_tooth_pieces),
-            **backlash_meta}
+    meta = {
+        "contact_geometry": scenario.contact.geometry,
+        "worm_mass_kg": ine.worm_mass_kg,
+        "wheel_mass_kg": ine.wheel_mass_kg,
+        "worm_inertia_kg_m2": ine.worm_inertia_kg_m2,
+        "wheel_inertia_kg_m2": ine.wheel_inertia_kg_m2,
+        "window_teeth": W,
+        "worm_pieces": len(gs.worm_pieces),
+        "tooth_pieces": len(gs.wheel_tooth_pieces),
+        **backlash_meta,
+    }
     if kv is not None:
         meta["drive_kv_nm_s"] = kv
     meta["load_inertia_kg_m2"] = scenario.load.inertia_kg_m2
     meta["mass_scaling"] = p.scaling.factor
     meta["mass_scaling_check"] = p.scaling
-    meta["shaft_inertias_kg_m2"] = (ine.worm_inertia_kg_m2 + ine.worm_load_inertia_kg_m2,
-                                    ine.wheel_inertia_kg_m2 + ine.wheel_load_inertia_kg_m2)
+    meta["shaft_inertias_kg_m2"] = (
+        ine.worm_inertia_kg_m2 + ine.worm_load_inertia_kg_m2,
+        ine.wheel_inertia_kg_m2 + ine.wheel_load_inertia_kg_m2,
+    )
 
     def oid(kind: mujoco.mjtObj, name: str) -> int:
         return mujoco.mj_name2id(model, kind, name)
 
-    slot_geoms = np.array([[oid(mujoco.mjtObj.mjOBJ_GEOM, n) for n in row] for row in slot_names],
-                          dtype=int).reshape(W, -1)      # (W, 0) with contact.geometry flanks
+    slot_geoms = np.array([[oid(mujoco.mjtObj.mjOBJ_GEOM, n) for n in row] for row in slot_names], dtype=int).reshape(
+        W, -1
+    )  # (W, 0) with contact.geometry flanks
     slot_bodies = np.array([oid(mujoco.mjtObj.mjOBJ_BODY, f"slot{i}") for i in range(W)])
     _set_inv_mass_hat(model, law, p.inv_mass_worm, p.inv_mass_wheel, slot_bodies)
     bm = BuiltModel(
-        model=model, spec=spec, geometry=geo, law=law,
-        worm_body=oid(mujoco.mjtObj.mjOBJ_BODY, "worm"), wheel_body=oid(mujoco.mjtObj.mjOBJ_BODY, "wheel"),
+        model=model,
+        spec=spec,
+        geometry=geo,
+        law=law,
+        worm_body=oid(mujoco.mjtObj.mjOBJ_BODY, "worm"),
+        wheel_body=oid(mujoco.mjtObj.mjOBJ_BODY, "wheel"),
         worm_dof=int(model.jnt_dofadr[oid(mujoco.mjtObj.mjOBJ_JOINT, "worm_hinge")]),
         wheel_dof=int(model.jnt_dofadr[oid(mujoco.mjtObj.mjOBJ_JOINT, "wheel_hinge")]),
         drive_actuator=oid(mujoco.mjtObj.mjOBJ_ACTUATOR, "drive"),
         load_actuator=oid(mujoco.mjtObj.mjOBJ_ACTUATOR, "load"),
         worm_geoms=np.array([oid(mujoco.mjtObj.mjOBJ_GEOM, n) for n in worm_names], dtype=int),
-        wheel_slot_geoms=slot_geoms, slot_bodies=slot_bodies, window_teeth=W, tooth0_angle_rad=_tooth0_angle(gs),
-        direction=expected_direction(scenario, geo), drive_sign=drive_sign, pieces=gs,
-        timestep_s=h, timestep_source=h_source, meta=meta, tooth_shift_rad=shift, kinematic_tca=kin,
-        deviations=dev)
+        wheel_slot_geoms=slot_geoms,
+        slot_bodies=slot_bodies,
+        window_teeth=W,
+        tooth0_angle_rad=_tooth0_angle(gs),
+        direction=expected_direction(scenario, geo),
+        drive_sign=drive_sign,
+        pieces=gs,
+        timestep_s=h,
+        timestep_source=h_source,
+        meta=meta,
+        tooth_shift_rad=shift,
+        kinematic_tca=kin,
+        deviations=dev,
+    )
     if check_backlash_vs_pieces:
         # the model itself at the rigid-conjugate pose (wormsim.contact3d.backlash.check_conjugate_interference): exit 2
         meta["conjugate_interference_m"] = check_conjugate_interference(
-            bm, scenario.simulation.resolution, nominal_normal_force_n(scenario, geo))
+            bm, scenario.simulation.resolution, nominal_normal_force_n(scenario, geo)
+        )
     return bm
 
 
@@ -311,12 +367,14 @@ def _place_bodies(spec: mujoco.MjSpec, geo: GearGeometry, ine: Inertias, dev: De
         _place_displaced(spec, geo, dev)
     # transverse moments of a solid cylinder of the part's length, Izz / 2 + m L^2 / 12: irrelevant on a hinge,
     # but they must satisfy the triangle inequality with a margin that survives the 6 digits of a written MJCF
-    for body, mass, izz, length in ((worm_b, ine.worm_mass_kg, ine.worm_inertia_kg_m2, geo.worm_length),
-                                    (wheel_b, ine.wheel_mass_kg, ine.wheel_inertia_kg_m2, geo.face_width)):
+    for body, mass, izz, length in (
+        (worm_b, ine.worm_mass_kg, ine.worm_inertia_kg_m2, geo.worm_length),
+        (wheel_b, ine.wheel_mass_kg, ine.wheel_inertia_kg_m2, geo.face_width),
+    ):
         body.explicitinertial = True
         body.mass = mass
         body.ipos = [0, 0, 0]
-        ixx = izz / 2 + mass * length ** 2 / 12
+        ixx = izz / 2 + mass * length**2 / 12
         body.inertia = [ixx, ixx, izz]
 
 
@@ -340,9 +398,16 @@ def _add_mesh(spec: mujoco.MjSpec, name: str, mesh: trimesh.Trimesh) -> None:
     me.inertia = mujoco.mjtMeshInertia.mjMESH_INERTIA_CONVEX
 
 
-def _add_geoms(spec: mujoco.MjSpec, geo: GearGeometry, gs: GearSet, law: ContactLaw, mu0: float,
-               window_teeth: int | None, tooth_shift_rad: np.ndarray | None = None, flanks: bool = False
-               ) -> tuple[list[str], list[list[str]], int]:
+def _add_geoms(
+    spec: mujoco.MjSpec,
+    geo: GearGeometry,
+    gs: GearSet,
+    law: ContactLaw,
+    mu0: float,
+    window_teeth: int | None,
+    tooth_shift_rad: np.ndarray | None = None,
+    flanks: bool = False,
+) -> tuple[list[str], list[list[str]], int]:
     """Visual meshes, the worm's collision pieces and the wheel's window of W slots (one rigid child body per
     slot, no joint: re-posing a slot moves its body, so MuJoCo's per-body bounding-volume hierarchy, built at
     compile time in the body frame, stays valid). Returns (worm geom names, slot geom names, W). flanks
@@ -357,12 +422,14 @@ def _add_geoms(spec: mujoco.MjSpec, geo: GearGeometry, gs: GearSet, law: Contact
 
     _add_mesh(spec, "worm_visual", gs.worm_visual)
     _add_mesh(spec, "wheel_visual", gs.wheel_visual)
-    for b, name, rgba in ((worm_b, "worm_visual", (0.55, 0.6, 0.7, 1)),
-                          (wheel_b, "wheel_visual", (0.85, 0.65, 0.3, 1))):
+    for b, name, rgba in (
+        (worm_b, "worm_visual", (0.55, 0.6, 0.7, 1)),
+        (wheel_b, "wheel_visual", (0.85, 0.65, 0.3, 1)),
+    ):
         g = b.add_geom(default=spec.find_default("visual"))
         g.name, g.meshname, g.rgba = name, name, rgba
         if flanks:
-            set_contact(g)          # the flank contacts' geoms (wormsim.contact3d.flank_step): friction, solref
+            set_contact(g)  # the flank contacts' geoms (wormsim.contact3d.flank_step): friction, solref
     worm_names = []
     for i, piece in enumerate([] if flanks else gs.worm_pieces):
         _add_mesh(spec, f"worm_piece_{i}", piece)
@@ -400,8 +467,9 @@ def _add_actuators(spec: mujoco.MjSpec, scenario: Scenario, geo: GearGeometry) -
     a.name, a.target, a.trntype = "drive", f"{drv.on}_hinge", mujoco.mjtTrn.mjTRN_JOINT
     kv = None
     if drv.speed_rpm is not None:
-        kv = gt.servo_gain_nm_s(scenario, geo.ratio, geo.gamma, geo.alpha_n,
-                                float(friction_coefficient(scenario.contact, 1.0)))
+        kv = gt.servo_gain_nm_s(
+            scenario, geo.ratio, geo.gamma, geo.alpha_n, float(friction_coefficient(scenario.contact, 1.0))
+        )
         a.set_to_velocity(kv=kv)
         drive_sign = int(np.sign(drv.speed_rpm)) or 1
     else:
@@ -419,7 +487,7 @@ def _add_actuators(spec: mujoco.MjSpec, scenario: Scenario, geo: GearGeometry) -
 def _set_options(spec: mujoco.MjSpec, scenario: Scenario, law: ContactLaw, timestep_s: float) -> None:
     o = spec.option
     o.timestep = timestep_s
-    o.impratio = law.impratio      # friction rows' hardness, wormsim.contact3d.law (3)
+    o.impratio = law.impratio  # friction rows' hardness, wormsim.contact3d.law (3)
     if scenario.simulation.speculative:
         o.enableflags |= int(mujoco.mjtEnableBit.mjENBL_SPECULATIVE)
     o.integrator = INTEGRATORS[scenario.simulation.integrator]
@@ -432,12 +500,13 @@ def _add_mesh_sensor(spec: mujoco.MjSpec) -> None:
     sen.objtype, sen.objname = mujoco.mjtObj.mjOBJ_BODY, "worm"
     sen.reftype, sen.refname = mujoco.mjtObj.mjOBJ_XBODY, "wheel"
     sen.intprm[0] = MESH_SENSOR_DATA
-    sen.intprm[1] = 3       # reduce = netforce
-    sen.intprm[2] = 1       # num
+    sen.intprm[1] = 3  # reduce = netforce
+    sen.intprm[2] = 1  # num
 
 
-def _set_inv_mass_hat(model: mujoco.MjModel, law: ContactLaw, a_worm: float, a_wheel: float,
-                      slot_bodies: np.ndarray) -> None:
+def _set_inv_mass_hat(
+    model: mujoco.MjModel, law: ContactLaw, a_worm: float, a_wheel: float, slot_bodies: np.ndarray
+) -> None:
     """Make MuJoCo's diagonal approximation of a worm-wheel contact row equal A_hat (wormsim.contact3d.law (1)):
     body_invweight0[worm] + body_invweight0[slot body] = A_hat."""
     wb = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "worm")
@@ -449,6 +518,7 @@ def _set_inv_mass_hat(model: mujoco.MjModel, law: ContactLaw, a_worm: float, a_w
 
 
 # ----------------------------------------------------------------------------- standalone MJCF
+
 
 def write_model(scenario: Scenario, out_dir: str | Path) -> Path:
     """DIR/model.xml + DIR/meshes/*.stl: opens with `python -m mujoco.viewer --mjcf DIR/model.xml`.
@@ -469,7 +539,7 @@ def write_model(scenario: Scenario, out_dir: str | Path) -> Path:
     for act in spec.actuators:
         bias = list(act.biasprm)
         if act.name == "drive" and gt.gear_drive(scenario).speed_rpm is not None:
-            bias[0] = act.gainprm[0] * drive_final       # velocity servo: kv (ctrl + w_final - qdot)
+            bias[0] = act.gainprm[0] * drive_final  # velocity servo: kv (ctrl + w_final - qdot)
         else:
             bias[0] = drive_final if act.name == "drive" else load_final
         act.biastype = mujoco.mjtBias.mjBIAS_AFFINE
@@ -485,5 +555,5 @@ def write_model(scenario: Scenario, out_dir: str | Path) -> Path:
     spec.modelfiledir = str(out.resolve())
     path = out / "model.xml"
     path.write_text(spec.to_xml())
-    mujoco.MjModel.from_xml_path(str(path))      # fail here, not in the user's viewer
+    mujoco.MjModel.from_xml_path(str(path))  # fail here, not in the user's viewer
     return path

@@ -12,6 +12,7 @@ wheel meshes under /assembly/worm and /assembly/wheel moved by their 4x4 transfo
 pattern on every wheel tooth, coloured by pressure (/assembly/wheel/contact_pattern, flank_outputs.log_pattern),
 and in report.png the pattern as a band on the wheel flank coloured by pressure (flank_outputs.draw_pattern).
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -23,10 +24,10 @@ from wormsim.recording import log_mesh, log_series, log_transforms, recording
 from wormsim.result import Result
 
 MAX_FRAMES = 1500
-ARROW_N_PER_MM = None      # chosen per run: the mean tooth force maps to 5 mm
+ARROW_N_PER_MM = None  # chosen per run: the mean tooth force maps to 5 mm
 
 
-SPEED_INTERVALS = 40       # the speeds panel shows the means over this many equal intervals of the run
+SPEED_INTERVALS = 40  # the speeds panel shows the means over this many equal intervals of the run
 
 
 def _interval_means(t: np.ndarray, *ys: np.ndarray, n: int):
@@ -64,31 +65,45 @@ def write_report(result: Result, path) -> None:
     tm, worm_m, wheel_m = _interval_means(t, worm, wheel, n=SPEED_INTERVALS)
     a.plot(t, wheel, lw=0.4, color="C1", alpha=0.25)
     a.plot(t, worm, lw=0.4, color="C0", alpha=0.25)
-    a.plot(tm, wheel_m, "-", color="C1", lw=1.6,
-           label=f"wheel (mean of {t[-1] / SPEED_INTERVALS * 1e3:.3g} ms intervals)")
+    a.plot(
+        tm, wheel_m, "-", color="C1", lw=1.6, label=f"wheel (mean of {t[-1] / SPEED_INTERVALS * 1e3:.3g} ms intervals)"
+    )
     a.plot(tm, worm_m, "--", color="C0", lw=1.6, label="worm / (z2/z1) (interval means)")
     a.axvspan(w0, w1, color="0.9", zorder=-1)
     top = 1.6 * max(float(np.max(worm_m)), float(np.max(wheel_m)), 1e-9)
-    a.set_ylim(min(0.0, 1.2 * float(min(np.min(worm_m), np.min(wheel_m)))), top)   # the raw rattle is clipped
-    a.set(xlabel="time [s]", ylabel="speed [rpm] (raw traces faint, clipped)",
-          title=f"speeds: ratio {s['ratio']:.4g} (theory {s['ratio_theory']:.4g}), efficiency {s['efficiency']:.3f} "
-                f"(theory {s['efficiency_theory']:.3f})")
+    a.set_ylim(min(0.0, 1.2 * float(min(np.min(worm_m), np.min(wheel_m)))), top)  # the raw rattle is clipped
+    a.set(
+        xlabel="time [s]",
+        ylabel="speed [rpm] (raw traces faint, clipped)",
+        title=f"speeds: ratio {s['ratio']:.4g} (theory {s['ratio_theory']:.4g}), efficiency {s['efficiency']:.3f} "
+        f"(theory {s['efficiency_theory']:.3f})",
+    )
     a.legend(fontsize=8)
     a = ax[1, 0]
     _, df, fr, sp = dominant_frequency(t[sl], S["tangential_force_n"][sl])
     if len(fr):
         a.semilogy(fr[1:], np.maximum(sp[1:], 1e-9), lw=0.7)
-        a.axvline(s["mesh_frequency_theory_hz"], color="r", ls="--", lw=0.8,
-                  label=f"z1 n1/60 = {s['mesh_frequency_theory_hz']:.4g} Hz")
-        a.axvline(s["mesh_frequency_hz"], color="g", ls=":", lw=1.0,
-                  label=f"peak {s['mesh_frequency_hz']:.4g} Hz (bin {df:.3g} Hz)")
+        a.axvline(
+            s["mesh_frequency_theory_hz"],
+            color="r",
+            ls="--",
+            lw=0.8,
+            label=f"z1 n1/60 = {s['mesh_frequency_theory_hz']:.4g} Hz",
+        )
+        a.axvline(
+            s["mesh_frequency_hz"],
+            color="g",
+            ls=":",
+            lw=1.0,
+            label=f"peak {s['mesh_frequency_hz']:.4g} Hz (bin {df:.3g} Hz)",
+        )
         a.set_xlim(0, min(fr[-1], 10 * max(s["mesh_frequency_theory_hz"], df)))
     a.set(xlabel="frequency [Hz]", ylabel="|F_t| amplitude [N]", title="spectrum of the tangential force (Hann)")
     a.legend(fontsize=8)
     a = ax[1, 1]
     P = result.extra.get("points_tooth0")
     F = result.extra.get("forces_world")
-    if "flank_pattern" in result.extra:      # exact flanks: the loaded band coloured by pressure (flank_outputs)
+    if "flank_pattern" in result.extra:  # exact flanks: the loaded band coloured by pressure (flank_outputs)
         from wormsim.contact3d.flank_outputs import draw_pattern
 
         draw_pattern(a, fig, result.extra["flank_pattern"], result.extra["built"].geometry, s)
@@ -103,16 +118,30 @@ def write_report(result: Result, path) -> None:
         for rr_, lab in ((geo.r2, "r2 (reference)"), (geo.r_a2, "r_a2 (tip)"), (geo.r_f2, "r_f2 (root)")):
             a.axhline(rr_ * 1e3, color="0.4", lw=0.7, ls="--", zorder=1)
             # labels in the margin right of the face (x > b2/2), where no contact point lies
-            a.text(0.52 * geo.face_width * 1e3, rr_ * 1e3, lab, fontsize=9, va="center", ha="left", zorder=3,
-                   bbox=dict(facecolor="white", edgecolor="0.6", alpha=0.9, pad=1.5))
+            a.text(
+                0.52 * geo.face_width * 1e3,
+                rr_ * 1e3,
+                lab,
+                fontsize=9,
+                va="center",
+                ha="left",
+                zorder=3,
+                bbox=dict(facecolor="white", edgecolor="0.6", alpha=0.9, pad=1.5),
+            )
         a.set_xlim(-0.6 * geo.face_width * 1e3, 0.85 * geo.face_width * 1e3)
         a.set(xlabel="across the face (wheel z) [mm]", ylabel="radius [mm]", title="contact pattern on a wheel tooth")
-    scaled = s.get("mass_scaling", 1) > 1       # wormsim.contact3d.mass_scaling: say so where the plots are
-    fig.suptitle(f"{result.summary.get('scenario', '')} contact3d: dt {s['timestep_s']:.3g} s, resolution "
-                 f"{s['resolution']}, steady window {w0:.3g}-{w1:.3g} s" + (
-                     f"\nMASS SCALING x {s['mass_scaling']:g} (kinetic energy {100 * s['kinetic_energy_share']:.2g} % "
-                     f"of the work): means only; force fluctuation, speeds' rattle and start-up peaks are not physical"
-                     if scaled else ""), color="C3" if scaled else "k")
+    scaled = s.get("mass_scaling", 1) > 1  # wormsim.contact3d.mass_scaling: say so where the plots are
+    fig.suptitle(
+        f"{result.summary.get('scenario', '')} contact3d: dt {s['timestep_s']:.3g} s, resolution "
+        f"{s['resolution']}, steady window {w0:.3g}-{w1:.3g} s"
+        + (
+            f"\nMASS SCALING x {s['mass_scaling']:g} (kinetic energy {100 * s['kinetic_energy_share']:.2g} % "
+            f"of the work): means only; force fluctuation, speeds' rattle and start-up peaks are not physical"
+            if scaled
+            else ""
+        ),
+        color="C3" if scaled else "k",
+    )
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
@@ -133,16 +162,19 @@ def write_recording(result: Result, path) -> None:
         Tg = np.stack([assembly.wheel_to_assembly(float(a)) for a in S["wheel_angle_rad"][idx]])
         log_transforms(rec, "assembly/worm", t[idx], Tw)
         log_transforms(rec, "assembly/wheel", t[idx], Tg)
-        if "flank_pattern" in result.extra:     # exact flanks: the loaded pattern on the wheel, coloured by pressure
+        if "flank_pattern" in result.extra:  # exact flanks: the loaded pattern on the wheel, coloured by pressure
             from wormsim.contact3d.flank_outputs import log_pattern
 
             log_pattern(rec, "assembly/wheel/contact_pattern", result.extra["flank_pattern"], geo)
         P, F = result.extra["points_world"], result.extra["forces_world"]
         fmean = np.nanmean(np.linalg.norm(F.reshape(-1, 3), axis=1)) if np.isfinite(F).any() else 1.0
-        scale = 5e-3 / max(fmean, 1e-9)           # mean contact force -> 5 mm arrow
+        scale = 5e-3 / max(fmean, 1e-9)  # mean contact force -> 5 mm arrow
         for i in idx:
             ok = np.isfinite(P[i, :, 0])
             rr.set_time("sim_time", duration=float(t[i]), recording=rec)
             rr.log("assembly/contacts/points", rr.Points3D(P[i, ok], radii=2e-4, colors=(230, 40, 40)), recording=rec)
-            rr.log("assembly/contacts/forces", rr.Arrows3D(origins=P[i, ok], vectors=F[i, ok] * scale,
-                                                           colors=(40, 200, 40)), recording=rec)
+            rr.log(
+                "assembly/contacts/forces",
+                rr.Arrows3D(origins=P[i, ok], vectors=F[i, ok] * scale, colors=(40, 200, 40)),
+                recording=rec,
+            )

@@ -25,6 +25,7 @@ rate cancel exactly what would fold onto 0 Hz), and whose angles and speeds are 
 
 The timestep is the model's, chosen before it was built (wormsim.contact3d.timestep.choose_timestep).
 """
+
 from __future__ import annotations
 
 import math
@@ -57,11 +58,11 @@ from wormsim.result import Result
 from wormsim.scenario import Scenario
 from wormsim.units import rad_s_to_rpm
 
-MAX_POINTS = 48             # contact points kept per sample (for the pattern and the recording)
-TARGET_SAMPLES = 20000      # automatic record_every aims at about this many samples per run (each the mean
-                            # over its interval, so decimation does not alias the contact vibration)
-_ROWS3 = np.arange(3)       # the normal and two tangent rows of an elliptic-cone contact
-JUMP_PITCH = 0.5            # transmission error (in pitches) that counts as teeth jumping
+MAX_POINTS = 48  # contact points kept per sample (for the pattern and the recording)
+TARGET_SAMPLES = 20000  # automatic record_every aims at about this many samples per run (each the mean
+# over its interval, so decimation does not alias the contact vibration)
+_ROWS3 = np.arange(3)  # the normal and two tangent rows of an elliptic-cone contact
+JUMP_PITCH = 0.5  # transmission error (in pitches) that counts as teeth jumping
 
 
 def _record_every(scenario: Scenario, dt: float, n_steps: int, scaled: bool = False) -> int:
@@ -88,9 +89,9 @@ def contact_details(bm: BuiltModel, d: mujoco.MjData, window_ks: np.ndarray):
     pos = np.asarray(con.pos[:n])[ok]
     dist = np.asarray(con.dist[:n])[ok]
     f = d.efc_force[adr[:, None] + _ROWS3]
-    F = np.einsum("ni,nij->nj", f, frame)              # force on geom2, world frame
+    F = np.einsum("ni,nij->nj", f, frame)  # force on geom2, world frame
     wheel_is_2 = bm.model.geom_bodyid[geom[:, 1]] != bm.worm_body
-    F = np.where(wheel_is_2[:, None], F, -F)           # force on the wheel
+    F = np.where(wheel_is_2[:, None], F, -F)  # force on the wheel
     wheel_geom = np.where(wheel_is_2, geom[:, 1], geom[:, 0])
     # tooth index of each contact: slot -> tooth in the current window
     W = bm.window_teeth
@@ -131,11 +132,13 @@ def diverged_error(t: float, dt: float, bm: BuiltModel, what: str) -> Simulation
             f"diverged at t = {t:.4g} s ({what}): timestep {dt:.3g} s is above the contact's stable limit "
             f"{lim:.3g} s (contact stiffness {bm.law.pair_stiffness_n_per_m:.3g} N/m per tooth pair); set "
             f"simulation.timestep_s <= {h0:.3g} s (the default for this contact: leave it unset) or lower "
-            f"contact.stiffness_n_per_m")
+            f"contact.stiffness_n_per_m"
+        )
     return DivergedError(
         f"diverged at t = {t:.4g} s ({what}) at timestep {dt:.3g} s, within the contact's stable limit {lim:.3g} s: "
         f"a torque or speed step the light shafts cannot follow; lengthen drive.ramp_s / load.ramp_s, lower "
-        f"load.torque_nm")
+        f"load.torque_nm"
+    )
 
 
 def jump_error(t: float, te_pitch: float, dt: float, bm: BuiltModel, scenario: Scenario) -> SimulationError:
@@ -150,7 +153,8 @@ def jump_error(t: float, te_pitch: float, dt: float, bm: BuiltModel, scenario: S
         f"within the contact's stable limit {lim:.3g} s: the load overpowers the mesh (load {scenario.load.torque_nm} "
         f"N m over {scenario.load.ramp_s} s, contact stiffness {bm.law.pair_stiffness_n_per_m:.3g} N/m per tooth "
         f"pair); lower load.torque_nm or lengthen load.ramp_s, or raise contact.stiffness_n_per_m (with a smaller "
-        f"simulation.timestep_s)")
+        f"simulation.timestep_s)"
+    )
 
 
 def overspeed_error(t: float, w1: float, dt: float) -> SimulationError:
@@ -162,7 +166,8 @@ def overspeed_error(t: float, w1: float, dt: float) -> SimulationError:
         f"step of {dt:.3g} s, beyond the {MAX_WORM_TURN_PER_STEP_RAD} rad contact3d resolves (the thread passes "
         f"through the wheel's teeth between steps); set simulation.timestep_s <= {lim:.3g} s (or leave it unset for "
         f"a speed-driven worm), or lower the drive (drive.speed_rpm / drive.torque_nm); simulation.speculative does "
-        f"not prevent it (measured: it tunnels sooner, docs/stability_speed.md)")
+        f"not prevent it (measured: it tunnels sooner, docs/stability_speed.md)"
+    )
 
 
 def locked_error(t: float, w_drive: float, w_cmd: float, bm: BuiltModel, scenario: Scenario) -> SimulationError:
@@ -170,8 +175,10 @@ def locked_error(t: float, w_drive: float, w_cmd: float, bm: BuiltModel, scenari
     standstill, rho' = atan(mu_static / cos alpha_n) >= gamma (DIN 3975: back-driving efficiency
     tan(gamma - rho') / tan(gamma) <= 0), the diagnosis says so; otherwise the mesh is jammed."""
     geo = bm.geometry
-    head = (f"the drive locked at t = {t:.4g} s: the {scenario.drive.on} turns at {rad_s_to_rpm(w_drive):.3g} rpm "
-            f"against a command of {rad_s_to_rpm(w_cmd):.3g} rpm")
+    head = (
+        f"the drive locked at t = {t:.4g} s: the {scenario.drive.on} turns at {rad_s_to_rpm(w_drive):.3g} rpm "
+        f"against a command of {rad_s_to_rpm(w_cmd):.3g} rpm"
+    )
     mu0 = float(friction_coefficient(scenario.contact, 0.0))
     rho = gt.virtual_friction_angle_rad(mu0, geo.alpha_n)
     if scenario.drive.on == "wheel" and rho >= geo.gamma:
@@ -181,10 +188,12 @@ def locked_error(t: float, w_drive: float, w_cmd: float, bm: BuiltModel, scenari
             f"standstill friction mu = {mu0:.3g} >= lead angle gamma = {math.degrees(geo.gamma):.2f} deg), so the "
             f"wheel cannot turn the worm; drive the worm (drive.on=worm, load.on=wheel), or, to back-drive, lower "
             f"the friction below mu = tan(gamma) cos(alpha_n) = {mu_max:.3g} or raise gear.lead_angle_deg above "
-            f"{math.degrees(rho):.2f} deg")
+            f"{math.degrees(rho):.2f} deg"
+        )
     return LockedError(
         f"{head}: the mesh is jammed; check gear.backlash_mm, the load torque {scenario.load.torque_nm} N m "
-        f"against what the drive can deliver, and the friction")
+        f"against what the drive can deliver, and the friction"
+    )
 
 
 def penetration_error(t: float, pen: float, pen_lim: float, dt: float, bm: BuiltModel) -> SimulationError:
@@ -193,7 +202,8 @@ def penetration_error(t: float, pen: float, pen_lim: float, dt: float, bm: Built
         f"penetration {pen * 1e6:.1f} um at t = {t:.4g} s exceeds the tolerance {pen_lim * 1e6:.1f} um "
         f"(0.4 m_x): contact too soft for the load or timestep {dt:.3g} s too large (stable limit "
         f"~{bm.law.stable_limit_s:.2g} s); raise contact.stiffness_n_per_m, lower simulation.timestep_s or lower "
-        f"load.torque_nm")
+        f"load.torque_nm"
+    )
 
 
 _SLOT_CACHE: dict[int, np.ndarray] = {}
@@ -210,12 +220,31 @@ def _slot_lookup(bm: BuiltModel) -> np.ndarray:
     return _SLOT_CACHE[key]
 
 
-SERIES = ("t_s", "worm_angle_rad", "wheel_angle_rad", "worm_speed_rpm", "wheel_speed_rpm",
-          "worm_torque_nm", "wheel_torque_nm", "drive_command", "tangential_force_n", "radial_force_n",
-          "axial_force_n", "contacts", "teeth_in_contact", "max_penetration_m", "friction_coefficient",
-          "transmission_error_rad", "wheel_contact_torque_nm", "worm_power_w", "wheel_power_w",
-          "tangential_force_abs_max_n", "radial_force_line_of_centres_n", "worm_contact_radius_m",
-          "efficiency_theory_at_contact_radius")
+SERIES = (
+    "t_s",
+    "worm_angle_rad",
+    "wheel_angle_rad",
+    "worm_speed_rpm",
+    "wheel_speed_rpm",
+    "worm_torque_nm",
+    "wheel_torque_nm",
+    "drive_command",
+    "tangential_force_n",
+    "radial_force_n",
+    "axial_force_n",
+    "contacts",
+    "teeth_in_contact",
+    "max_penetration_m",
+    "friction_coefficient",
+    "transmission_error_rad",
+    "wheel_contact_torque_nm",
+    "worm_power_w",
+    "wheel_power_w",
+    "tangential_force_abs_max_n",
+    "radial_force_line_of_centres_n",
+    "worm_contact_radius_m",
+    "efficiency_theory_at_contact_radius",
+)
 
 
 class _Guards:
@@ -287,7 +316,7 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
         from wormsim.contact3d.flank_step import FlankContacts, flank_contact_details, split_forward
 
         fc = FlankContacts(bm, bm.law.contacts_per_pair)
-        pattern = PatternLog(fc, gt.effective_modulus_pa(scenario.materials))   # contact pattern and stress
+        pattern = PatternLog(fc, gt.effective_modulus_pa(scenario.materials))  # contact pattern and stress
         split_forward(m, d, fc.add)
         window = None
         step_fn = fc.step
@@ -328,7 +357,7 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
             nc += sd[s0]
             f0, f1, f2 = sd[s0 + 1], sd[s0 + 2], sd[s0 + 3]
             fx += f0
-            if abs(f0) > fpk:                   # the per-step peak (the start-up impact is shorter than an interval)
+            if abs(f0) > fpk:  # the per-step peak (the start-up impact is shorter than an interval)
                 fpk = abs(f0)
             fy += f1
             fz += f2
@@ -380,32 +409,46 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
         if progress is not None:
             progress.update(t)
     wall = time.perf_counter() - t_wall
-    summary = _run_summary(S, scenario, bm, rec, guards.turn_max, len(coll), 1e6 * wall / max(n_rec * rec, 1),
-                           flanks=fc is not None)
+    summary = _run_summary(
+        S, scenario, bm, rec, guards.turn_max, len(coll), 1e6 * wall / max(n_rec * rec, 1), flanks=fc is not None
+    )
     extra = {"points_tooth0": pts, "points_world": pts_world, "forces_world": forces, "built": bm}
-    if pattern is not None:                 # the loaded contact pattern and Hertz stress (flank_outputs)
+    if pattern is not None:  # the loaded contact pattern and Hertz stress (flank_outputs)
         summary.update(pattern.summary(S["t_s"], summary["steady_window_s"]))
         extra["flank_pattern"] = pattern.grid(S["t_s"], summary["steady_window_s"])
-    summary.update(mass_scaling.run_summary(S, scenario, bm.meta, summary))   # and the ringing guard (exit 3)
-    if bm.kinematic_tca is not None:       # errors: the displaced exact flanks' kinematic TE and play (issue 12)
+    summary.update(mass_scaling.run_summary(S, scenario, bm.meta, summary))  # and the ringing guard (exit 3)
+    if bm.kinematic_tca is not None:  # errors: the displaced exact flanks' kinematic TE and play (issue 12)
         kin = bm.kinematic_tca.summary(bm.geometry, gt.working_flank(scenario, bm.geometry.hand))
         summary.update({k: v for k, v in kin.items() if not k.startswith("contact_pattern")})
-    return Result(model="contact3d", summary=summary, series=S, steps=n_rec * rec, sim_time_s=float(d.time),
-                  extra=extra)
+    return Result(
+        model="contact3d", summary=summary, series=S, steps=n_rec * rec, sim_time_s=float(d.time), extra=extra
+    )
 
 
-def _run_summary(S: dict, scenario: Scenario, bm: BuiltModel, rec: int, turn_max: float, collision_geoms: int,
-                 step_wall_us: float, flanks: bool = False) -> dict:
+def _run_summary(
+    S: dict,
+    scenario: Scenario,
+    bm: BuiltModel,
+    rec: int,
+    turn_max: float,
+    collision_geoms: int,
+    step_wall_us: float,
+    flanks: bool = False,
+) -> dict:
     """contact3d_summary plus what the run used: timestep, contact law, friction, window, contact geometry
     (contact.geometry; flank_slices: the flank contacts per tooth flank, None for pieces), cost."""
     law = bm.law
     return {
         **contact3d_summary(S, scenario, bm),
-        "scenario": scenario.name, "timestep_s": bm.timestep_s, "timestep_stable_limit_s": law.stable_limit_s,
+        "scenario": scenario.name,
+        "timestep_s": bm.timestep_s,
+        "timestep_stable_limit_s": law.stable_limit_s,
         "timestep_source": bm.timestep_source,
         "worm_turn_per_step_max_rad": turn_max,
-        "speculative": scenario.simulation.speculative, "resolution": scenario.simulation.resolution,
-        "integrator": scenario.simulation.integrator, "record_every": rec,
+        "speculative": scenario.simulation.speculative,
+        "resolution": scenario.simulation.resolution,
+        "integrator": scenario.simulation.integrator,
+        "record_every": rec,
         "contact_pair_stiffness_n_per_m": law.pair_stiffness_n_per_m,
         "contact_stiffness_source": law.stiffness_source,
         "contact_exponent_reported": law.exponent,
@@ -415,7 +458,8 @@ def _run_summary(S: dict, scenario: Scenario, bm: BuiltModel, rec: int, turn_max
         "contact_damping_ratio": law.damping_ratio,
         "friction": friction_mode(scenario.contact),
         "friction_impratio": law.impratio,
-        "window_teeth": bm.window_teeth, "collision_geoms": collision_geoms,
+        "window_teeth": bm.window_teeth,
+        "collision_geoms": collision_geoms,
         "contact_geometry": bm.meta.get("contact_geometry", "pieces"),
         "flank_slices": law.contacts_per_pair if flanks else None,
         "step_wall_us": step_wall_us,
@@ -427,6 +471,5 @@ def simulate(scenario: Scenario, progress=None) -> Result:
     """Build the model (its timestep chosen before the build) and run it."""
     bm = build_model(scenario)
     if progress is not None and scenario.simulation.mass_scaling != 1:
-        progress.note(mass_scaling.note(bm.meta["mass_scaling_check"], scenario.simulation.mass_scaling,
-                                        bm.timestep_s))
+        progress.note(mass_scaling.note(bm.meta["mass_scaling_check"], scenario.simulation.mass_scaling, bm.timestep_s))
     return run_model(bm, scenario, progress)

@@ -67,6 +67,7 @@ Summary keys and their computation: those of contact3d (wormsim.metrics: steady 
 that mesh_frequency_hz is the FFT peak of the transmission error, not of the tangential force (see
 torsional_summary; the force's peak is reported as force_peak_full_band_hz).
 """
+
 from __future__ import annotations
 
 import math
@@ -86,7 +87,7 @@ from wormsim.scenario import Scenario
 from wormsim.torsional.mesh_stiffness import MeshStiffness, mesh_stiffness, per_length_stiffness
 from wormsim.units import rad_s_to_rpm, step
 
-CHORD_ITER = 4              # backward Euler: Newton iterations that reuse the first Jacobian of a step
+CHORD_ITER = 4  # backward Euler: Newton iterations that reuse the first Jacobian of a step
 MAX_SAMPLES = 20000
 SAMPLES_PER_MESH_PERIOD = 64
 RTOL, ATOL_ANGLE = 1e-7, 1e-10
@@ -97,11 +98,11 @@ def inertias(scenario: Scenario, g: GearGeometry) -> tuple[float, float]:
     """(I1, I2) in kg m^2: solid cylinders (module docstring), plus the driven-machine inertia
     load.inertia_kg_m2 on the loaded shaft (rigid on it, as contact3d's joint armature)."""
     mats = scenario.materials
-    m1 = mats.worm.density_kg_m3 * math.pi * g.r1 ** 2 * g.worm_length
-    m2 = mats.wheel.density_kg_m3 * math.pi * g.r2 ** 2 * g.face_width
+    m1 = mats.worm.density_kg_m3 * math.pi * g.r1**2 * g.worm_length
+    m2 = mats.wheel.density_kg_m3 * math.pi * g.r2**2 * g.face_width
     j = scenario.load.inertia_kg_m2
     j1, j2 = (j, 0.0) if scenario.load.on == "worm" else (0.0, j)
-    return 0.5 * m1 * g.r1 ** 2 + j1, 0.5 * m2 * g.r2 ** 2 + j2
+    return 0.5 * m1 * g.r1**2 + j1, 0.5 * m2 * g.r2**2 + j2
 
 
 class _Mesh:
@@ -125,18 +126,18 @@ class _Mesh:
         self.kr = ms.k_theta_rev_nm_per_rad.tolist()
         self.k_mean = float(np.mean(ms.k_theta_fwd_nm_per_rad))
         # damping along the line of action: requested, capped at MAX_DAMPING_RATIO of critical of the mesh mode
-        k_lin = self.k_mean / self.arm0 ** 2
-        m_eff = 1.0 / (self.arm0 ** 2 / I2 + (self.hz * self.arm0) ** 2 / I1)   # mesh mode mass on the line of action
+        k_lin = self.k_mean / self.arm0**2
+        m_eff = 1.0 / (self.arm0**2 / I2 + (self.hz * self.arm0) ** 2 / I1)  # mesh mode mass on the line of action
         self.c_crit = 2.0 * math.sqrt(k_lin * m_eff)
         c_req = c.damping_n_s_per_m if c.damping_n_s_per_m is not None else gt.DEFAULT_DAMPING_RATIO * self.c_crit
         self.c_req = c_req
         self.c_lin = min(c_req, gt.MAX_DAMPING_RATIO * self.c_crit)
-        self.c_theta_per_k = self.c_lin * self.arm0 ** 2 / self.k_mean
+        self.c_theta_per_k = self.c_lin * self.arm0**2 / self.k_mean
         self.d_max = c.penetration_depth_m
         self.vt = c.transition_velocity_m_s
         self.v_sign = SIGN_VELOCITY_FRACTION * self.vt
         self.mu = friction_coefficient_scalar(c)
-        self.omega_mesh = math.sqrt(self.k_mean * (1.0 / I2 + self.hz ** 2 / I1))
+        self.omega_mesh = math.sqrt(self.k_mean * (1.0 / I2 + self.hz**2 / I1))
 
     def k_at(self, th1: float, table: list) -> float:
         x = (th1 % self.period) / self.period * self.N
@@ -178,7 +179,7 @@ class _Mesh:
         return 0.0, 0.0
 
     def _torque(self, th1, w1, side, dlt, ddlt, K) -> tuple[float, float]:
-        blend = step(self.arm0 * dlt, 0.0, 0.0, self.d_max, 1.0)    # IMPACT's damping ramp over d_max
+        blend = step(self.arm0 * dlt, 0.0, 0.0, self.d_max, 1.0)  # IMPACT's damping ramp over d_max
         T = K * dlt + self.c_theta_per_k * K * blend * ddlt
         if T <= 0.0:
             return 0.0, 0.0
@@ -205,7 +206,7 @@ class _Mesh:
         phase = np.mod(th1, self.period) / self.period * self.N
         kf = np.interp(phase, np.arange(self.N + 1), self.kf + self.kf[:1])
         kr = np.interp(phase, np.arange(self.N + 1), self.kr + self.kr[:1])
-        k = np.where(e >= 0, kf, kr) / self.arm0 ** 2
+        k = np.where(e >= 0, kf, kr) / self.arm0**2
         if self.kin is None:
             deflection = self.arm0 * np.maximum(np.abs(e) - self.gap, 0.0)
         else:
@@ -260,7 +261,7 @@ def integrate_backward_euler(acc, duration: float, h: float, max_iter: int = 30)
         for it in range(max_iter):
             a1, a2 = acc(t1, x1, u1, x2, u2)
             nfev += 1
-            if it == 0 or it >= CHORD_ITER:     # chord (simplified) Newton first, full Newton if it stalls
+            if it == 0 or it >= CHORD_ITER:  # chord (simplified) Newton first, full Newton if it stalls
                 d = FD_TH + 1e-9 * abs(x1)
                 b1, b2 = acc(t1, x1 + d, u1, x2, u2)
                 j10, j30 = (b1 - a1) / d, (b2 - a2) / d
@@ -290,12 +291,17 @@ def integrate_backward_euler(acc, duration: float, h: float, max_iter: int = 30)
             x1, u1, x2, u2 = x1 + dp1, u1 + dw1, x2 + dp2, u2 + dw2
             if not math.isfinite(x1 + u1 + x2 + u2):
                 break
-            if (abs(dp1) <= TOL_TH + 1e-10 * abs(x1) and abs(dp2) <= TOL_TH + 1e-10 * abs(x2)
-                    and abs(dw1) <= TOL_W + 1e-10 * abs(u1) and abs(dw2) <= TOL_W + 1e-10 * abs(u2)):
+            if (
+                abs(dp1) <= TOL_TH + 1e-10 * abs(x1)
+                and abs(dp2) <= TOL_TH + 1e-10 * abs(x2)
+                and abs(dw1) <= TOL_W + 1e-10 * abs(u1)
+                and abs(dw2) <= TOL_W + 1e-10 * abs(u2)
+            ):
                 return (x1, u1, x2, u2)
         if depth >= 10:
             raise SimulationError(
-                f"torsional: implicit step did not converge at t = {t1:.4g} s even at timestep {hh:.3g} s")
+                f"torsional: implicit step did not converge at t = {t1:.4g} s even at timestep {hh:.3g} s"
+            )
         ym = solve_step(y0, y0, t1 - hh / 2, hh / 2, depth + 1)
         return solve_step(ym, ym, t1, hh / 2, depth + 1)
 
@@ -313,8 +319,16 @@ def _integrate_scipy(rhs, duration: float, h: float, ms: MeshStiffness, w1_full:
     t_eval = np.arange(n + 1) * h
     max_step = min(ms.period_rad / ms.samples / max(w1_full, 1e-9), duration / 20)
     atol = np.array([ATOL_ANGLE, ATOL_ANGLE * 1e3, ATOL_ANGLE, ATOL_ANGLE * 1e3])
-    sol = solve_ivp(rhs, (0.0, duration), [0.0, 0.0, 0.0, 0.0], method=method, t_eval=t_eval,
-                    rtol=RTOL, atol=atol, max_step=max_step)
+    sol = solve_ivp(
+        rhs,
+        (0.0, duration),
+        [0.0, 0.0, 0.0, 0.0],
+        method=method,
+        t_eval=t_eval,
+        rtol=RTOL,
+        atol=atol,
+        max_step=max_step,
+    )
     if sol.status != 0:
         raise DivergedError(f"torsional integration ({method}) failed at t = {sol.t[-1]:.4g} s: {sol.message}")
     return sol.t, sol.y, sol.nfev
@@ -330,8 +344,9 @@ def simulate(scenario: Scenario, progress=None, method: str = "implicit") -> Res
     if scipy_method is None and method != "implicit":
         raise ValueError(f"torsional method {method!r}: allowed implicit, {', '.join(SCIPY_METHODS.values())}")
     g = derive(scenario.gear)
-    kp, src = per_length_stiffness(scenario.contact.stiffness_n_per_m, g.face_width,
-                                   gt.effective_modulus_pa(scenario.materials))
+    kp, src = per_length_stiffness(
+        scenario.contact.stiffness_n_per_m, g.face_width, gt.effective_modulus_pa(scenario.materials)
+    )
     t_ms = time.perf_counter()
     ms = mesh_stiffness(g, kp, src, scenario.simulation.mesh_stiffness_samples)
     t_ms = time.perf_counter() - t_ms
@@ -342,8 +357,11 @@ def simulate(scenario: Scenario, progress=None, method: str = "implicit") -> Res
     drv = scenario.drive
     cmds = gt.commands(scenario, g.hand)
     speed_driven = drv.speed_rpm is not None
-    kv = gt.servo_gain_nm_s(scenario, g.ratio, g.gamma, g.alpha_n, float(friction_coefficient(scenario.contact, 1.0))) \
-        if speed_driven else 0.0
+    kv = (
+        gt.servo_gain_nm_s(scenario, g.ratio, g.gamma, g.alpha_n, float(friction_coefficient(scenario.contact, 1.0)))
+        if speed_driven
+        else 0.0
+    )
     worm_drive = drv.on == "worm"
     drive_f, load_f = cmds.drive, cmds.load
 
@@ -378,43 +396,68 @@ def simulate(scenario: Scenario, progress=None, method: str = "implicit") -> Res
         progress.update(duration)
     th1, w1, th2, w2 = Y
     if not np.all(np.isfinite(Y)):
-        raise DivergedError(
-            f"torsional integration diverged (timestep {h:.3g} s); lower simulation.timestep_s")
+        raise DivergedError(f"torsional integration diverged (timestep {h:.3g} s); lower simulation.timestep_s")
     out = mesh.outputs(th1, w1, th2, w2)
     cmd = np.array([drive_f(x) for x in t])
     _guards(scenario, g, t, w1, w2, out, cmd)
     tq = np.array([shaft_torques(ti, a, b) for ti, a, b in zip(t, w1, w2)])
     S = {
-        "t_s": t, "worm_angle_rad": th1, "wheel_angle_rad": th2,
-        "worm_speed_rpm": rad_s_to_rpm(w1), "wheel_speed_rpm": rad_s_to_rpm(w2),
-        "worm_torque_nm": tq[:, 0], "wheel_torque_nm": tq[:, 1], "drive_command": cmd,
-        "teeth_in_contact": np.where(out["mesh_deflection_m"] > 0, np.interp(
-            np.mod(th1, ms.period_rad) / ms.period_rad * ms.samples, np.arange(ms.samples + 1),
-            np.append(ms.teeth_fwd, ms.teeth_fwd[0])), 0.0),
+        "t_s": t,
+        "worm_angle_rad": th1,
+        "wheel_angle_rad": th2,
+        "worm_speed_rpm": rad_s_to_rpm(w1),
+        "wheel_speed_rpm": rad_s_to_rpm(w2),
+        "worm_torque_nm": tq[:, 0],
+        "wheel_torque_nm": tq[:, 1],
+        "drive_command": cmd,
+        "teeth_in_contact": np.where(
+            out["mesh_deflection_m"] > 0,
+            np.interp(
+                np.mod(th1, ms.period_rad) / ms.period_rad * ms.samples,
+                np.arange(ms.samples + 1),
+                np.append(ms.teeth_fwd, ms.teeth_fwd[0]),
+            ),
+            0.0,
+        ),
         **out,
     }
     summary = torsional_summary(S, scenario, g, ms)
-    summary.update({
-        "scenario": scenario.name, "timestep_s": h,
-        "solver": solver,
-        "solver_rhs_evaluations": int(nfev),
-        "solve_wall_s": wall, "mesh_stiffness_wall_s": t_ms,
-        "worm_inertia_kg_m2": I1, "wheel_inertia_kg_m2": I2,
-        "inertia_source": "solid cylinders r1 x b1, r2 x b2 (+ load.inertia_kg_m2 on the loaded shaft)",
-        "mesh_natural_frequency_hz": mesh.omega_mesh / (2 * math.pi),
-        "contact_damping_requested_n_s_per_m": mesh.c_req, "contact_damping_used_n_s_per_m": mesh.c_lin,
-        "contact_damping_ratio": mesh.c_lin / mesh.c_crit, "drive_kv_nm_s": kv if speed_driven else None,
-        "backlash_angle_rad": 2 * mesh.gap, "friction": friction_mode(scenario.contact),
-        **ms.summary(),
-    })
+    summary.update(
+        {
+            "scenario": scenario.name,
+            "timestep_s": h,
+            "solver": solver,
+            "solver_rhs_evaluations": int(nfev),
+            "solve_wall_s": wall,
+            "mesh_stiffness_wall_s": t_ms,
+            "worm_inertia_kg_m2": I1,
+            "wheel_inertia_kg_m2": I2,
+            "inertia_source": "solid cylinders r1 x b1, r2 x b2 (+ load.inertia_kg_m2 on the loaded shaft)",
+            "mesh_natural_frequency_hz": mesh.omega_mesh / (2 * math.pi),
+            "contact_damping_requested_n_s_per_m": mesh.c_req,
+            "contact_damping_used_n_s_per_m": mesh.c_lin,
+            "contact_damping_ratio": mesh.c_lin / mesh.c_crit,
+            "drive_kv_nm_s": kv if speed_driven else None,
+            "backlash_angle_rad": 2 * mesh.gap,
+            "friction": friction_mode(scenario.contact),
+            **ms.summary(),
+        }
+    )
     if kin is not None:
         side = gt.working_flank(scenario, g.hand)
         summary.update(kin.summary(g, side))
         te = kin.te_rad(side)
         S["transmission_error_kinematic_rad"] = np.interp(
-            np.mod(th1, kin.period_rad), np.append(kin.theta1_rad, kin.period_rad), np.append(te, te[0]))
-    return Result(model="torsional", summary=summary, series=S, steps=len(t) - 1, sim_time_s=float(t[-1]),
-                  extra={"mesh_stiffness": ms})
+            np.mod(th1, kin.period_rad), np.append(kin.theta1_rad, kin.period_rad), np.append(te, te[0])
+        )
+    return Result(
+        model="torsional",
+        summary=summary,
+        series=S,
+        steps=len(t) - 1,
+        sim_time_s=float(t[-1]),
+        extra={"mesh_stiffness": ms},
+    )
 
 
 def _guards(scenario, g, t, w1, w2, out, cmd) -> None:
@@ -432,12 +475,15 @@ def _guards(scenario, g, t, w1, w2, out, cmd) -> None:
         vs = abs(float(w1[i])) * g.r1 / math.cos(g.gamma)
         if drv.on == "wheel" and vs < 10 * scenario.contact.transition_velocity_m_s:
             rho = gt.virtual_friction_angle_rad(float(out["friction_coefficient"][i]), g.alpha_n)
-            why = (f"the pair is self-locking (rho' = {math.degrees(rho):.2f} deg > "
-                   f"gamma = {math.degrees(g.gamma):.2f} "
-                   f"deg): the wheel cannot drive the worm, which creeps at Vs = {vs * 1e3:.2g} mm/s")
+            why = (
+                f"the pair is self-locking (rho' = {math.degrees(rho):.2f} deg > "
+                f"gamma = {math.degrees(g.gamma):.2f} "
+                f"deg): the wheel cannot drive the worm, which creeps at Vs = {vs * 1e3:.2g} mm/s"
+            )
         raise PenetrationError(
             f"mesh deflection {dmax * 1e6:.1f} um at t = {t[i]:.4g} s exceeds 0.4 m_x = {lim * 1e6:.1f} um: "
-            f"the teeth would skip; {why}")
+            f"the teeth would skip; {why}"
+        )
 
 
 def _locked_guard(scenario, t, w1, w2, cmd) -> None:
@@ -451,7 +497,8 @@ def _locked_guard(scenario, t, w1, w2, cmd) -> None:
             raise LockedError(
                 f"the drive locked at t = {t[i0]:.4g} s: {rad_s_to_rpm(float(w_drive[i0])):.3g} rpm against a "
                 f"command of {rad_s_to_rpm(float(cmd[i0])):.3g} rpm (self-locking: the wheel cannot drive the worm "
-                f"when rho' > gamma; or the load {scenario.load.torque_nm} N m is too high)")
+                f"when rho' > gamma; or the load {scenario.load.torque_nm} N m is too high)"
+            )
 
 
 def torsional_summary(S: dict, scenario: Scenario, g: GearGeometry, ms: MeshStiffness) -> dict:

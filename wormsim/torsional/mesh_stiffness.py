@@ -48,6 +48,7 @@ is 2 pi / z1 of worm rotation; samples are taken at theta1 = i (2 pi / z1) / N, 
 Cache: in-process (functools) and on disk next to meshgen's gear sets (meshgen.cache, env
 WORMSIM_CACHE), keyed by the gear geometry, the per-length stiffness, the sample count and CODE_VERSION.
 """
+
 from __future__ import annotations
 
 import functools
@@ -61,27 +62,27 @@ from meshgen.cache import cached
 from meshgen.geometry import GearGeometry
 
 CODE_VERSION = "mesh-stiffness-2"
-GRID_ZETA = 121             # TCA grid across the face width (mean k within ~1.5 % of a 241 x 161 grid)
-GRID_S = 81                 # TCA grid along the profile (worm tip reach .. wheel tip)
+GRID_ZETA = 121  # TCA grid across the face width (mean k within ~1.5 % of a 241 x 161 grid)
+GRID_S = 81  # TCA grid along the profile (worm tip reach .. wheel tip)
 
 
 @dataclass(frozen=True)
 class MeshStiffness:
     """k(theta1) tables over one mesh cycle (worm angle 0 .. 2 pi / z1, N samples, periodic); SI."""
 
-    theta1_rad: np.ndarray          # (N,) sample angles
-    period_rad: float               # 2 pi / z1
-    k_theta_fwd_nm_per_rad: np.ndarray   # (N,) K_theta, side +1 (4)
-    k_theta_rev_nm_per_rad: np.ndarray   # (N,) side -1
-    k_mesh_fwd_n_per_m: np.ndarray       # (N,) along the line of action, K_theta / arm0^2
+    theta1_rad: np.ndarray  # (N,) sample angles
+    period_rad: float  # 2 pi / z1
+    k_theta_fwd_nm_per_rad: np.ndarray  # (N,) K_theta, side +1 (4)
+    k_theta_rev_nm_per_rad: np.ndarray  # (N,) side -1
+    k_mesh_fwd_n_per_m: np.ndarray  # (N,) along the line of action, K_theta / arm0^2
     k_mesh_rev_n_per_m: np.ndarray
-    length_fwd_m: np.ndarray        # (N,) total contact-line length, side +1
+    length_fwd_m: np.ndarray  # (N,) total contact-line length, side +1
     length_rev_m: np.ndarray
-    teeth_fwd: np.ndarray           # (N,) wheel teeth in contact, side +1
+    teeth_fwd: np.ndarray  # (N,) wheel teeth in contact, side +1
     teeth_rev: np.ndarray
-    arm0_m: float                   # r2 cos(alpha_n) cos(gamma)
-    stiffness_per_length_n_per_m2: float   # k'
-    stiffness_source: str           # "scenario" | "hertz"
+    arm0_m: float  # r2 cos(alpha_n) cos(gamma)
+    stiffness_per_length_n_per_m2: float  # k'
+    stiffness_source: str  # "scenario" | "hertz"
     samples: int
 
     def summary(self) -> dict:
@@ -107,15 +108,15 @@ def per_length_stiffness(stiffness_n_per_m: float | None, face_width_m: float, e
 class _Field:
     """The active flank of one side on the (zeta, s) grid."""
 
-    c: np.ndarray           # (1) contact wheel angle, masked where not an active conjugate point
-    xyz: np.ndarray         # (nz, ns, 3) wheel-frame flank points
-    arm: np.ndarray         # (nz, ns) (3)
+    c: np.ndarray  # (1) contact wheel angle, masked where not an active conjugate point
+    xyz: np.ndarray  # (nz, ns, 3) wheel-frame flank points
+    arm: np.ndarray  # (nz, ns) (3)
 
 
 def _flank_field(g: GearGeometry, side: int) -> _Field:
     zeta = np.linspace(-g.face_width / 2, g.face_width / 2, GRID_ZETA)
     s = np.linspace(0.0, 1.0, GRID_S)
-    lo = g.a - np.sqrt(np.maximum(g.r_a1 ** 2 - zeta ** 2, 0.0))       # worm tip reach at beta = -pi/2
+    lo = g.a - np.sqrt(np.maximum(g.r_a1**2 - zeta**2, 0.0))  # worm tip reach at beta = -pi/2
     hi = wheel.tip_rho(g, zeta)
     lo = np.maximum(lo, wheel.root_rho(g, zeta))
     Z, S = np.meshgrid(zeta, s, indexing="ij")
@@ -133,7 +134,7 @@ def _flank_field(g: GearGeometry, side: int) -> _Field:
     dR_dz, dR_ds = np.gradient(R, zeta, s)
     f_rho = dpsi_ds / np.where(np.abs(dR_ds) > 0, dR_ds, 1e-30)
     f_zeta = dpsi_dz - f_rho * dR_dz
-    arm = 1.0 / np.sqrt(f_rho ** 2 + 1.0 / R ** 2 + f_zeta ** 2)
+    arm = 1.0 / np.sqrt(f_rho**2 + 1.0 / R**2 + f_zeta**2)
     xyz = np.stack([R * np.cos(psi), R * np.sin(psi), Z], axis=-1)
     return _Field(c=c, xyz=xyz, arm=arm)
 
@@ -145,8 +146,12 @@ def _bilinear(F: np.ndarray, i: np.ndarray, j: np.ndarray) -> np.ndarray:
     a, b = i - i0, j - j0
     if F.ndim == 3:
         a, b = a[:, None], b[:, None]
-    return ((1 - a) * (1 - b) * F[i0, j0] + a * (1 - b) * F[i0 + 1, j0]
-            + (1 - a) * b * F[i0, j0 + 1] + a * b * F[i0 + 1, j0 + 1])
+    return (
+        (1 - a) * (1 - b) * F[i0, j0]
+        + a * (1 - b) * F[i0 + 1, j0]
+        + (1 - a) * b * F[i0, j0 + 1]
+        + a * b * F[i0 + 1, j0 + 1]
+    )
 
 
 def _lines_at(fld: _Field, gen, theta2: float, pitch2: float) -> tuple[float, float, int]:
@@ -195,13 +200,21 @@ def compute(g: GearGeometry, stiffness_per_length: float, source: str, samples: 
         out[tag] = (stiffness_per_length * I, L, T)
     arm0 = g.r2 * math.cos(g.alpha_n) * math.cos(g.gamma)
     return MeshStiffness(
-        theta1_rad=th1, period_rad=period,
-        k_theta_fwd_nm_per_rad=out["fwd"][0], k_theta_rev_nm_per_rad=out["rev"][0],
-        k_mesh_fwd_n_per_m=out["fwd"][0] / arm0 ** 2, k_mesh_rev_n_per_m=out["rev"][0] / arm0 ** 2,
-        length_fwd_m=out["fwd"][1], length_rev_m=out["rev"][1],
-        teeth_fwd=out["fwd"][2], teeth_rev=out["rev"][2],
-        arm0_m=arm0, stiffness_per_length_n_per_m2=stiffness_per_length, stiffness_source=source,
-        samples=samples)
+        theta1_rad=th1,
+        period_rad=period,
+        k_theta_fwd_nm_per_rad=out["fwd"][0],
+        k_theta_rev_nm_per_rad=out["rev"][0],
+        k_mesh_fwd_n_per_m=out["fwd"][0] / arm0**2,
+        k_mesh_rev_n_per_m=out["rev"][0] / arm0**2,
+        length_fwd_m=out["fwd"][1],
+        length_rev_m=out["rev"][1],
+        teeth_fwd=out["fwd"][2],
+        teeth_rev=out["rev"][2],
+        arm0_m=arm0,
+        stiffness_per_length_n_per_m2=stiffness_per_length,
+        stiffness_source=source,
+        samples=samples,
+    )
 
 
 def stiffness_at(g: GearGeometry, stiffness_per_length: float, theta1_rad, side: int = 1) -> np.ndarray:
@@ -211,14 +224,22 @@ def stiffness_at(g: GearGeometry, stiffness_per_length: float, theta1_rad, side:
     fld = _flank_field(g, side)
     gen = contourpy.contour_generator(z=fld.c, name="serial", corner_mask=True)
     th = np.atleast_1d(np.asarray(theta1_rad, float))
-    return np.array([stiffness_per_length * _lines_at(fld, gen, g.hand * t1 * g.z1 / g.z2, 2 * math.pi / g.z2)[0]
-                     for t1 in th])
+    return np.array(
+        [stiffness_per_length * _lines_at(fld, gen, g.hand * t1 * g.z1 / g.z2, 2 * math.pi / g.z2)[0] for t1 in th]
+    )
 
 
 @functools.lru_cache(maxsize=32)
-def mesh_stiffness(g: GearGeometry, stiffness_per_length: float, source: str, samples: int,
-                   use_cache: bool = True) -> MeshStiffness:
+def mesh_stiffness(
+    g: GearGeometry, stiffness_per_length: float, source: str, samples: int, use_cache: bool = True
+) -> MeshStiffness:
     """compute(), cached in process and on disk (module docstring)."""
-    parts = {"g": asdict(g), "kp": stiffness_per_length, "src": source, "n": samples, "v": CODE_VERSION,
-             "grid": (GRID_ZETA, GRID_S)}
+    parts = {
+        "g": asdict(g),
+        "kp": stiffness_per_length,
+        "src": source,
+        "n": samples,
+        "v": CODE_VERSION,
+        "grid": (GRID_ZETA, GRID_S),
+    }
     return cached("meshk", parts, lambda: compute(g, stiffness_per_length, source, samples), use_cache)

@@ -49,6 +49,7 @@ Dynamic factors (seed 000): Kd1 = |S1 peak| / Ft1, Kd2 = |S2 peak| / Ft2 with Ft
 rated force (wedge.motor.nominal_force_n) and Ft2 = Ft1 / tan(g + rho(Vs_n)) the static wedge
 relation at the rated speed (wedge.motor.nominal_speed_m_s).
 """
+
 from __future__ import annotations
 
 import math
@@ -66,9 +67,9 @@ from wormsim.units import DEG, step
 TRACTIVE, INVERSE, LOCKED, UNLOADED = "tractive", "inverse", "locked", "unloaded"
 REGIME_CODE = {LOCKED: 0, TRACTIVE: 1, INVERSE: 2, UNLOADED: 3}
 EQUILIBRIUM_FORCE_TOL = 1e-9  # of wedge.motor.peak_force_n: a load this small counts as none (unloaded equilibrium)
-GRID_POINTS = 4001          # uniform output samples over the run (plus solver steps and events)
-MAX_SEGMENTS = 20000        # a guard against endless stick-slip chatter
-STEADY_FRACTION = 0.1       # steady values: time average over the last 10 % of the run
+GRID_POINTS = 4001  # uniform output samples over the run (plus solver steps and events)
+MAX_SEGMENTS = 20000  # a guard against endless stick-slip chatter
+STEADY_FRACTION = 0.1  # steady values: time average over the last 10 % of the run
 
 
 @dataclass(frozen=True)
@@ -98,18 +99,29 @@ class WedgeParams:
 def params_from_scenario(scenario) -> WedgeParams:
     w = scenario.wedge
     return WedgeParams(
-        gamma_rad=w.lead_angle_deg * DEG, m1_kg=w.driving_mass_kg, m2_kg=w.driven_mass_kg,
-        group=w.friction_group if w.friction is None else None, friction=w.friction,
-        peak_force_n=w.motor.peak_force_n, sync_speed_m_s=w.motor.synchronous_speed_m_s,
-        peak_speed_m_s=w.motor.peak_force_speed_m_s, nominal_force_n=w.motor.nominal_force_n,
+        gamma_rad=w.lead_angle_deg * DEG,
+        m1_kg=w.driving_mass_kg,
+        m2_kg=w.driven_mass_kg,
+        group=w.friction_group if w.friction is None else None,
+        friction=w.friction,
+        peak_force_n=w.motor.peak_force_n,
+        sync_speed_m_s=w.motor.synchronous_speed_m_s,
+        peak_speed_m_s=w.motor.peak_force_speed_m_s,
+        nominal_force_n=w.motor.nominal_force_n,
         nominal_speed_m_s=w.motor.nominal_speed_m_s,
-        load_initial_n=w.load.initial_force_n, load_final_n=w.load.force_n,
-        load_start_s=w.load.start_s, load_ramp_s=w.load.ramp_s,
-        monitor=w.monitor, v0_m_s=w.initial_speed_m_s, duration_s=scenario.simulation.duration_s,
-        rtol=w.rtol)
+        load_initial_n=w.load.initial_force_n,
+        load_final_n=w.load.force_n,
+        load_start_s=w.load.start_s,
+        load_ramp_s=w.load.ramp_s,
+        monitor=w.monitor,
+        v0_m_s=w.initial_speed_m_s,
+        duration_s=scenario.simulation.duration_s,
+        rtol=w.rtol,
+    )
 
 
 # ----------------------------------------------------------------------------- closed forms
+
 
 def motor_force_n(v1_m_s, p: WedgeParams):
     """Kloss curve (seed 000): F1 = 2 Fmax / (V + 1/V) = 2 Fmax V / (1 + V^2), V = (V0 - v)/(V0 - Vmax).
@@ -202,6 +214,7 @@ def rated_forces_n(p: WedgeParams) -> tuple[float, float]:
 
 # ----------------------------------------------------------------------------- integration
 
+
 def _sign(x: float) -> int:
     return 1 if x > 0 else -1
 
@@ -216,15 +229,18 @@ def _choose_k(s: int, sigma: int, v1: float, p: WedgeParams) -> int:
     if normal_denominator(k, rho_of_speed(v1, p), p) <= 0:
         raise SimulationError(
             "the sliding equations have no unique solution (Painleve's paradox: m2 tan(gamma) tan(rho - gamma) "
-            ">= m1); raise wedge.driving_mass_kg or lower the friction")
+            ">= m1); raise wedge.driving_mass_kg or lower the friction"
+        )
     return k
 
 
 def _locked_until(t0: float, t1: float, F1_0: float, p: WedgeParams, rho0: float) -> float | None:
     """First time in (t0, t1] where the stick margin turns negative, or None. F2 is monotone between
     breakpoints and the stick set is an interval in F2, so checking t1 and bisecting suffices."""
+
     def margin(t):
         return stick_margin(F1_0, load_force_n(t, p), p.gamma_rad, rho0)
+
     if margin(t1) >= 0:
         return None
     lo, hi = t0, t1
@@ -268,20 +284,30 @@ def simulate_params(p: WedgeParams, progress=None, name: str = "wedge") -> Resul
     atol = np.array([1e-3, 1e-2]) * p.rtol
     seed_monitor = p.monitor == "seed"
 
-    segs: list[dict] = []           # {"regime", "t", "x", "v", "a", "k"}
+    segs: list[dict] = []  # {"regime", "t", "x", "v", "a", "k"}
     t, x, v = 0.0, 0.0, float(p.v0_m_s)
     sigma_hint: int | None = None
     steps = 0
     while t < T * (1 - 1e-12):
         if len(segs) > MAX_SEGMENTS:
-            raise SimulationError(f"more than {MAX_SEGMENTS} regime changes by t = {t:.6g} s (stick-slip chatter); "
-                                  "lower wedge.rtol or check the friction law")
+            raise SimulationError(
+                f"more than {MAX_SEGMENTS} regime changes by t = {t:.6g} s (stick-slip chatter); "
+                "lower wedge.rtol or check the friction law"
+            )
         t_end = next(b for b in stops if b > t * (1 + 1e-12) + 1e-15)
         F1, F2 = motor_force_n(v, p), load_force_n(t, p)
         if segs and segs[-1]["regime"] == UNLOADED and _unloaded_equilibrium(t, t_end, p):
-            ts = _segment_times(grid, t, t_end)         # still no load past a breakpoint: stay on the equilibrium
-            segs.append({"regime": UNLOADED, "t": ts, "x": x + v * (ts - t), "v": np.full_like(ts, v),
-                         "a": np.zeros_like(ts), "k": 0})
+            ts = _segment_times(grid, t, t_end)  # still no load past a breakpoint: stay on the equilibrium
+            segs.append(
+                {
+                    "regime": UNLOADED,
+                    "t": ts,
+                    "x": x + v * (ts - t),
+                    "v": np.full_like(ts, v),
+                    "a": np.zeros_like(ts),
+                    "k": 0,
+                }
+            )
             t, x = t_end, float(x + v * (t_end - t))
             continue
         if v == 0.0 and not seed_monitor:
@@ -289,8 +315,16 @@ def simulate_params(p: WedgeParams, progress=None, name: str = "wedge") -> Resul
                 t_break = _locked_until(t, t_end, F1, p, rho0)
                 t_stop = t_end if t_break is None else t_break
                 ts = _segment_times(grid, t, t_stop)
-                segs.append({"regime": LOCKED, "t": ts, "x": np.full_like(ts, x), "v": np.zeros_like(ts),
-                             "a": np.zeros_like(ts), "k": 0})
+                segs.append(
+                    {
+                        "regime": LOCKED,
+                        "t": ts,
+                        "x": np.full_like(ts, x),
+                        "v": np.zeros_like(ts),
+                        "a": np.zeros_like(ts),
+                        "k": 0,
+                    }
+                )
                 t = t_stop
                 sigma_hint = None
                 if progress is not None:
@@ -304,8 +338,10 @@ def simulate_params(p: WedgeParams, progress=None, name: str = "wedge") -> Resul
         sigma_hint = None
         k = sigma if seed_monitor else _choose_k(s, sigma, v, p)
         if v == 0.0 and not seed_monitor and accel_sliding(F1, F2, k, rho0, p) * s <= 0:
-            raise SimulationError(f"breakaway at t = {t:.6g} s found no consistent sliding direction "
-                                  "(marginal stick); this is a bug in the wedge model, please report it")
+            raise SimulationError(
+                f"breakaway at t = {t:.6g} s found no consistent sliding direction "
+                "(marginal stick); this is a bug in the wedge model, please report it"
+            )
 
         def rhs(tt, y, k=k):
             vv = y[1]
@@ -313,16 +349,20 @@ def simulate_params(p: WedgeParams, progress=None, name: str = "wedge") -> Resul
 
         def ev_phi(tt, y):
             return phi_numerator(motor_force_n(y[1], p), load_force_n(tt, p), p)
+
         ev_phi.terminal, ev_phi.direction = True, -sigma
         events = [ev_phi]
         if not seed_monitor:
+
             def ev_stop(tt, y):
                 return y[1]
+
             ev_stop.terminal, ev_stop.direction = True, -s
             events.append(ev_stop)
 
-        sol = solve_ivp(rhs, (t, t_end), [x, v], method="DOP853", rtol=p.rtol, atol=atol,
-                        events=events, dense_output=True)
+        sol = solve_ivp(
+            rhs, (t, t_end), [x, v], method="DOP853", rtol=p.rtol, atol=atol, events=events, dense_output=True
+        )
         if sol.status < 0:
             raise SimulationError(f"the integrator failed at t = {t:.6g} s: {sol.message}")
         steps += max(len(sol.t) - 1, 0)
@@ -343,8 +383,16 @@ def simulate_params(p: WedgeParams, progress=None, name: str = "wedge") -> Resul
             v = 0.0
         elif hit_phi and _unloaded_equilibrium(t, t_end, p):
             ts = _segment_times(grid, t, t_end)
-            segs.append({"regime": UNLOADED, "t": ts, "x": x + v * (ts - t), "v": np.full_like(ts, v),
-                         "a": np.zeros_like(ts), "k": 0})
+            segs.append(
+                {
+                    "regime": UNLOADED,
+                    "t": ts,
+                    "x": x + v * (ts - t),
+                    "v": np.full_like(ts, v),
+                    "a": np.zeros_like(ts),
+                    "k": 0,
+                }
+            )
             t, x = t_end, float(x + v * (t_end - t))
         elif hit_phi:
             sigma_hint = -sigma
@@ -355,6 +403,7 @@ def simulate_params(p: WedgeParams, progress=None, name: str = "wedge") -> Resul
 
 
 # ----------------------------------------------------------------------------- results
+
 
 def _time_mean(t: np.ndarray, y: np.ndarray, t0: float) -> float:
     m = t >= t0
@@ -375,9 +424,21 @@ def _assemble(segs: list[dict], p: WedgeParams, steps: int, name: str) -> Result
     rho = np.where(code == 0, rho_static(p), rho_of_speed(v1, p))
     S1 = F1 - p.m1_kg * a1
     S2 = F2 - p.m2_kg * tan_g * a1
-    series = {"t_s": t, "x1_m": x1, "v1_m_s": v1, "a1_m_s2": a1, "x2_m": x1 * tan_g, "v2_m_s": v1 * tan_g,
-              "vs_m_s": v1 / math.cos(g), "F1_n": F1, "F2_n": F2, "S1_n": S1, "S2_n": S2,
-              "rho_deg": rho / DEG, "regime_code": code}
+    series = {
+        "t_s": t,
+        "x1_m": x1,
+        "v1_m_s": v1,
+        "a1_m_s2": a1,
+        "x2_m": x1 * tan_g,
+        "v2_m_s": v1 * tan_g,
+        "vs_m_s": v1 / math.cos(g),
+        "F1_n": F1,
+        "F2_n": F2,
+        "S1_n": S1,
+        "S2_n": S2,
+        "rho_deg": rho / DEG,
+        "regime_code": code,
+    }
 
     timeline: list[list] = []
     for s in segs:
@@ -395,21 +456,36 @@ def _assemble(segs: list[dict], p: WedgeParams, steps: int, name: str) -> Result
     rho0 = rho_static(p)
     summary = {
         "speed_steady_m_s": v_ss,
-        "S1_peak_n": float(S1[i1]), "S2_peak_n": float(S2[i2]),
-        "S1_peak_time_s": float(t[i1]), "S2_peak_time_s": float(t[i2]),
-        "S1_steady_n": _time_mean(t, S1, t_ss), "S2_steady_n": _time_mean(t, S2, t_ss),
-        "Kd1": abs(float(S1[i1])) / Ft1, "Kd2": abs(float(S2[i2])) / Ft2,
-        "Ft1_n": Ft1, "Ft2_n": Ft2,
+        "S1_peak_n": float(S1[i1]),
+        "S2_peak_n": float(S2[i2]),
+        "S1_peak_time_s": float(t[i1]),
+        "S2_peak_time_s": float(t[i2]),
+        "S1_steady_n": _time_mean(t, S1, t_ss),
+        "S2_steady_n": _time_mean(t, S2, t_ss),
+        "Kd1": abs(float(S1[i1])) / Ft1,
+        "Kd2": abs(float(S2[i2])) / Ft2,
+        "Ft1_n": Ft1,
+        "Ft2_n": Ft2,
         **_summary_efficiencies(g, rho_ss, rho0),
-        "rho_steady_deg": rho_ss / DEG, "rho_static_deg": rho0 / DEG, "lead_angle_deg": g / DEG,
+        "rho_steady_deg": rho_ss / DEG,
+        "rho_static_deg": rho0 / DEG,
+        "lead_angle_deg": g / DEG,
         "self_locking": bool(rho0 > g),
         "stalled": bool(np.max(np.abs(x1)) == 0.0),
         "locked_at_end": bool(code[-1] == 0),
-        "x1_end_m": float(x1[-1]), "min_speed_m_s": float(np.min(v1)), "max_speed_m_s": float(np.max(v1)),
+        "x1_end_m": float(x1[-1]),
+        "min_speed_m_s": float(np.min(v1)),
+        "max_speed_m_s": float(np.max(v1)),
         "regimes": regimes,
         "regime_timeline": [{"regime": r, "start_s": t0, "end_s": t1} for r, t0, t1 in timeline],
         "monitor": p.monitor,
         "steady_window_s": [t_ss, p.duration_s],
     }
-    return Result(model="wedge", summary=summary, series=series, steps=steps, sim_time_s=float(t[-1]),
-                  extra={"params": p, "name": name})
+    return Result(
+        model="wedge",
+        summary=summary,
+        series=series,
+        steps=steps,
+        sim_time_s=float(t[-1]),
+        extra={"params": p, "name": name},
+    )
