@@ -5,7 +5,7 @@ BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed-stamp
 DEMO   ?= scenarios/seat_motor_demo.yaml
 
-.PHONY: demo test lint install bench images clean
+.PHONY: demo test test-long lint install bench images clean
 
 # public modules whose types are checked (the API of wormsim/__init__.py and the shared theory)
 TYPED  := wormsim/__init__.py wormsim/scenario.py wormsim/run.py wormsim/result.py wormsim/errors.py \
@@ -28,6 +28,10 @@ lint: $(STAMP)
 
 test: lint
 	$(BIN)/python -m pytest -q
+
+# the tests kept out of `make test` for time (tests/conftest.py LONG_TESTS): about 5 minutes more
+test-long: $(STAMP)
+	$(BIN)/python -m pytest -q -m long
 
 bench: $(STAMP)
 	$(BIN)/wormsim bench --out out/bench
