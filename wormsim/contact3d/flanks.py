@@ -225,17 +225,26 @@ def find_contacts(xy, c, c_range, span, zeta, ks, theta1, theta2, margin, P, pos
     the worm's edge or the line's depth is positive (depth may then be 0). The candidate window is margin plus the
     transmission error |theta2 - hand z1 / z2 theta1| (wrapped to a pitch), so a wheel pushed far into the
     worm keeps its contacts."""
+    N = c.shape[2]
+    work = (np.empty(6), np.empty(N), np.empty(N), np.empty((N, 3)), np.empty((N, 3)), np.empty(N, dtype=np.int64))
+    return _find_contacts(
+        xy, c, c_range, span, zeta, ks, theta1, theta2, margin, P, (pos, nrm, depth, meta, line), work
+    )
+
+
+@numba.njit(cache=True, _nrt=False)
+def _find_contacts(xy, c, c_range, span, zeta, ks, theta1, theta2, margin, P, out, work):
+    """find_contacts with its work arrays passed in, compiled without numba's reference counting (_nrt=False): the
+    inlined helpers take arrays, and with it every helper call cost an atomic incref/decref pair per array (about
+    60 % of the kernel's time; docs/contact3d.md, "Exact flanks: cost")."""
+    pos, nrm, depth, meta, line = out
+    tmp, gaps, exc, pts, nrs, stamp = work
     S, N = c.shape[1], c.shape[2]
     pitch = P[11]
     te = theta2 - P[12] * theta1
     te = (te + pitch / 2) % pitch - pitch / 2
     margin = margin + abs(te)
-    tmp = np.empty(6)
-    gaps = np.empty(N)
-    exc = np.empty(N)
-    pts = np.empty((N, 3))
-    nrs = np.empty((N, 3))
-    stamp = np.full(N, -1, dtype=np.int64)
+    stamp[:] = -1
     sid = 0
     n = 0
     for kk in range(ks.shape[0]):
