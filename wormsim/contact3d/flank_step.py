@@ -12,9 +12,9 @@ template disables it). Validated on a 1 kg box with collision off and the contac
 (tests/test_flank_contact_path.py): static normal force = weight, penetration = the solref mapping, sliding
 deceleration = mu g.
 
-A contact is added by copying a template mjContact (mj_addContact allocates it in the arena), then its per-contact
-fields (dist, pos, frame) are written for all contacts at once through d.contact's numpy views: setting them on the
-template one contact at a time costs about 4x more from Python (docs/contact3d.md, "Exact flanks: cost").
+A contact is added by copying a template mjContact with its per-contact fields (dist, pos, frame, solref) written in
+(mj_addContact allocates it in the arena), all of a step's contacts from compiled code in one Python call
+(wormsim.contact3d.flank_handoff; docs/contact3d.md, "Exact flanks: cost").
 
 Every flank contact is between the worm's visual geom and the wheel's visual geom (contype/conaffinity 0, so MuJoCo
 never collides them itself): their bodies give the contact Jacobian, body_invweight0 the contact law's A_hat, and the
@@ -28,6 +28,7 @@ import math
 import mujoco
 import numpy as np
 
+from wormsim.contact3d.flank_handoff import ContactBuffer
 from wormsim.contact3d.flanks import MARGIN_PITCH, contact_frames, find_contacts, flank_grid, slice_weights
 
 
@@ -77,7 +78,9 @@ class FlankContacts:
         t.frame = [0, 0, 1, 1, 0, 0, 0, 1, 0]
         self.template = t
         self.mu = None
+        self.buffer = None
         self.set_friction(float(m.geom_friction[gw, 0]))
+        self.buffer = ContactBuffer(m, t, cap)  # the bulk hand-off (wormsim.contact3d.flank_handoff)
         # errors: (issue 12): the kernel gets the displaced bodies' poses each step (wormsim.contact3d.flank_pose)
         self.params = self.grid.params
         dev = getattr(bm, "deviations", None)
@@ -96,6 +99,8 @@ class FlankContacts:
             self.template.dim = 3 if mu > 0 else 1
             self.template.friction = [mu, mu, 0.0, 0.0, 0.0]
             self.mu = mu
+            if self.buffer is not None:
+                self.buffer.set_template(self.template)
 
     def window(self, theta2: float) -> np.ndarray:
         """Tooth indices of the mesh window (wormsim.contact3d.mjcf.window_teeth_at), updated by whole pitches."""
@@ -135,7 +140,14 @@ class FlankContacts:
         return n
 
     def add(self, m: mujoco.MjModel, d: mujoco.MjData) -> None:
-        """Find the flank contacts and append them to d.contact (after mj_collision)."""
+        """Find the flank contacts and append them to d.contact (after mj_collision), in bulk from compiled code
+        (wormsim.contact3d.flank_handoff; `add_loop` is the same from Python, one mj_addContact per contact)."""
+        n = self.find(d)
+        if n:
+            self.buffer.add(m, d, n, self.depth, self.pos, self.frame, self.weight, self.solref, self.solreffriction)
+
+    def add_loop(self, m: mujoco.MjModel, d: mujoco.MjData) -> None:
+        """`add` from Python: the template added once per contact, then its fields written through d.contact's views."""
         n = self.find(d)
         if n == 0:
             return

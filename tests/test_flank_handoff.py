@@ -1,0 +1,55 @@
+"""The bulk hand-off of the flank contacts (wormsim.contact3d.flank_handoff) gives MuJoCo the same contacts, bit for
+bit, as adding them one by one from Python (FlankContacts.add_loop), and so the same solve."""
+
+from pathlib import Path
+
+import mujoco
+import numpy as np
+
+from wormsim.contact3d.flank_step import FlankContacts, split_forward
+from wormsim.contact3d.mjcf import build_model
+from wormsim.scenario import load_scenario
+
+SCEN = Path(__file__).resolve().parents[1] / "scenarios"
+FIELDS = ("dist", "pos", "frame", "includemargin", "friction", "solref", "solreffriction", "solimp", "mu", "dim")
+FIELDS += ("geom", "geom1", "geom2", "flex", "elem", "vert", "exclude", "efc_address")
+
+
+def _compare(m, d, fc, dim):
+    d2 = mujoco.MjData(m)
+    mujoco.mj_copyData(d2, m, d)
+    split_forward(m, d, fc.add)
+    split_forward(m, d2, fc.add_loop)
+    assert d.ncon == d2.ncon >= 8
+    for f in FIELDS:
+        a, b = np.asarray(getattr(d.contact, f)), np.asarray(getattr(d2.contact, f))
+        assert np.array_equal(a, b), f
+    assert d.nefc == d2.nefc
+    assert np.array_equal(d.efc_force, d2.efc_force)
+    assert np.array_equal(d.qacc, d2.qacc)
+    assert np.all(np.asarray(d.contact.dim) == dim)
+
+
+def test_bulk_handoff_equals_python_loop():
+    sc = load_scenario(
+        SCEN / "screw_jack.yaml",
+        [
+            "contact.geometry=flanks",
+            "simulation.resolution=coarse",
+            "drive.speed_rpm=0",
+            "drive.ramp_s=0",
+            "load.ramp_s=0",
+        ],
+    )
+    bm = build_model(sc)
+    m = bm.model
+    d = mujoco.MjData(m)
+    fc = FlankContacts(bm, bm.law.contacts_per_pair)
+    split_forward(m, d, fc.add)
+    d.ctrl[bm.drive_actuator] = 0.0
+    d.ctrl[bm.load_actuator] = -12.0
+    for _ in range(1500):  # the wheel turns through the backlash and comes to rest on the worm
+        fc.step(m, d)
+    _compare(m, d, fc, 3)
+    fc.set_friction(0.0)  # a new template (frictionless: dim 1) refills the records
+    _compare(m, d, fc, 1)

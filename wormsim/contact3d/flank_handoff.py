@@ -1,0 +1,111 @@
+"""Bulk hand-off of the exact-flank contacts to MuJoCo (wormsim.contact3d.flank_step): all of a step's contacts are
+written and added from compiled code, one Python call per step.
+
+Each contact is laid out in a buffer of mjContact records that this module owns: every record starts as a copy of
+the template contact (as MuJoCo's mj_addContact stores it, so geoms, dim, friction, solimp and the rest are MuJoCo's
+own bytes), the per-contact fields (dist, pos, frame, solref, solreffriction) are written into it by `_fill`, and
+`_add_all` calls MuJoCo's C function mj_addContact (mujoco.h: "Add contact to d->contact list; return 0 if success;
+1 if buffer full") on each record: MuJoCo copies it into d.contact exactly as the Python binding would. Field
+offsets and the record size come from the binding's own views of d.contact (the struct is mjdata.h's mjContact, whose
+first field is dist), so no layout is written here. The C function is the one in the shared library the mujoco
+package loaded (libmujoco in its folder; dlopen returns the loaded copy).
+
+Cost (docs/contact3d.md, "Exact flanks: cost"): the Python loop of mj_addContact and the per-field numpy writes
+cost about 3 us per contact; here the C call is about 0.2 us per contact.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import glob
+import os
+
+import mujoco
+import numba
+import numpy as np
+
+FIELDS = ("pos", "frame", "solref", "solreffriction")  # per-contact fields written besides dist
+
+
+def _library() -> ctypes.CDLL:
+    folder = os.path.dirname(mujoco.__file__)
+    paths = sorted(
+        glob.glob(os.path.join(folder, "libmujoco.so*")) + glob.glob(os.path.join(folder, "libmujoco*.dylib"))
+    )
+    if not paths:
+        raise ImportError(f"no libmujoco shared library in {folder}")
+    return ctypes.CDLL(paths[0])
+
+
+_mj_add_contact = _library().mj_addContact
+_mj_add_contact.argtypes = [ctypes.c_uint64, ctypes.c_uint64, ctypes.c_uint64]  # const mjModel*, mjData*, mjContact*
+_mj_add_contact.restype = ctypes.c_int
+
+
+@numba.njit(cache=False)  # calls a ctypes function: its address is not the same in another process, so not cached
+def _add_all(m_addr, d_addr, buf_addr, size, n):
+    """mj_addContact on records 0..n-1 of the buffer; returns how many were added (it stops when the arena is full,
+    where MuJoCo has warned with mjWARN_CONTACTFULL)."""
+    for i in range(n):
+        if _mj_add_contact(m_addr, d_addr, buf_addr + i * size) != 0:
+            return i
+    return n
+
+
+@numba.njit(cache=True)
+def _fill(rec, off, n, depth, pos, frame, weight, solref, solreffriction, friction_ref):
+    """Per-contact fields of records 0..n-1 (rec: the buffer as float64 rows; off: the offsets of dist, pos, frame,
+    solref, solreffriction in float64 units): dist = -depth; solref (and, where friction_ref, solreffriction) scaled
+    by the contact's share of its slice (direct solref: -k, -b)."""
+    o0, o1, o2, o3, o4 = off[0], off[1], off[2], off[3], off[4]
+    for i in range(n):
+        r = rec[i]
+        r[o0] = -depth[i]
+        for a in range(3):
+            r[o1 + a] = pos[i, a]
+        for a in range(9):
+            r[o2 + a] = frame[i, a]
+        w = weight[i]
+        r[o3], r[o3 + 1] = w * solref[0], w * solref[1]
+        if friction_ref:
+            r[o4], r[o4 + 1] = w * solreffriction[0], w * solreffriction[1]
+
+
+class ContactBuffer:
+    """mjContact records for up to `cap` contacts of one model, all copies of a template (module docstring)."""
+
+    def __init__(self, m: mujoco.MjModel, template: mujoco.MjContact, cap: int):
+        self.m = m
+        self.cap = cap
+        self._scratch = None
+        self.bytes = None
+        self.set_template(template)
+
+    def set_template(self, template: mujoco.MjContact) -> None:
+        """Refill every record from the template (as mj_addContact stores it) and read the field offsets."""
+        d = self._scratch
+        if d is None or mujoco.mj_addContact(self.m, d, template):  # appended to a scratch MjData (new when full)
+            self._scratch = d = mujoco.MjData(self.m)
+            if mujoco.mj_addContact(self.m, d, template):
+                raise RuntimeError("mj_addContact: no room for one contact in a fresh MjData")
+        c = d.contact
+        dist = np.asarray(c.dist)
+        size = dist.strides[0]
+        base = dist.ctypes.data + (d.ncon - 1) * size
+        raw = np.frombuffer((ctypes.c_char * size).from_address(base), dtype=np.uint8)
+        if self.bytes is None:
+            self.size = size
+            self.bytes = np.ascontiguousarray(np.tile(raw, (self.cap, 1)))
+            self.rec = self.bytes.view(np.float64)
+            off = [0] + [np.asarray(getattr(c, f)).ctypes.data - dist.ctypes.data for f in FIELDS]
+            if any(o % 8 for o in off):
+                raise RuntimeError(f"mjContact field offsets not float64-aligned: {off}")
+            self.off = np.array(off, dtype=np.int64) // 8
+        else:
+            self.bytes[:] = raw
+
+    def add(self, m, d, n, depth, pos, frame, weight, solref, solreffriction) -> int:
+        """Writes n contacts' fields and appends them to d.contact; returns how many MuJoCo took."""
+        n = min(n, self.cap)
+        _fill(self.rec, self.off, n, depth, pos, frame, weight, solref, solreffriction, solreffriction[1] != 0.0)
+        return _add_all(m._address, d._address, self.bytes.ctypes.data, self.size, n)
