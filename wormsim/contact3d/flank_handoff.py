@@ -3,8 +3,8 @@ written and added from compiled code, one Python call per step.
 
 Each contact is laid out in a buffer of mjContact records that this module owns: every record starts as a copy of
 the template contact (as MuJoCo's mj_addContact stores it, so geoms, dim, friction, solimp and the rest are MuJoCo's
-own bytes), the per-contact fields (dist, pos, frame, solref, solreffriction) are written into it by `_fill`, and
-`_add_all` calls MuJoCo's C function mj_addContact (mujoco.h: "Add contact to d->contact list; return 0 if success;
+own bytes), the per-contact fields (dist, pos, frame, solref, solreffriction) are written into it by `_fill_add`, which
+then calls MuJoCo's C function mj_addContact (mujoco.h: "Add contact to d->contact list; return 0 if success;
 1 if buffer full") on each record: MuJoCo copies it into d.contact exactly as the Python binding would. Field
 offsets and the record size come from the binding's own views of d.contact (the struct is mjdata.h's mjContact, whose
 first field is dist), so no layout is written here. The C function is the one in the shared library the mujoco
@@ -42,21 +42,13 @@ _mj_add_contact.argtypes = [ctypes.c_uint64, ctypes.c_uint64, ctypes.c_uint64]  
 _mj_add_contact.restype = ctypes.c_int
 
 
-@numba.njit(cache=False)  # calls a ctypes function: its address is not the same in another process, so not cached
-def _add_all(m_addr, d_addr, buf_addr, size, n):
-    """mj_addContact on records 0..n-1 of the buffer; returns how many were added (it stops when the arena is full,
-    where MuJoCo has warned with mjWARN_CONTACTFULL)."""
-    for i in range(n):
-        if _mj_add_contact(m_addr, d_addr, buf_addr + i * size) != 0:
-            return i
-    return n
-
-
 @numba.njit(cache=True)
-def _fill(rec, off, n, depth, pos, frame, weight, solref, solreffriction, friction_ref):
-    """Per-contact fields of records 0..n-1 (rec: the buffer as float64 rows; off: the offsets of dist, pos, frame,
-    solref, solreffriction in float64 units): dist = -depth; solref (and, where friction_ref, solreffriction) scaled
-    by the contact's share of its slice (direct solref: -k, -b)."""
+def _fill_add(add, m_addr, d_addr, rec, size, off, n, depth, pos, frame, weight, solref, solreffriction, friction_ref):
+    """Writes the per-contact fields of records 0..n-1 (rec: the buffer as float64 rows; off: the offsets of dist,
+    pos, frame, solref, solreffriction in float64 units): dist = -depth, solref (and, where friction_ref,
+    solreffriction) scaled by the contact's share of its slice (direct solref: -k, -b); then add(m, d, record)
+    (mj_addContact, passed in so that the compiled function can be cached) on each. Returns how many were added (it
+    stops when the arena is full, where MuJoCo has warned with mjWARN_CONTACTFULL)."""
     o0, o1, o2, o3, o4 = off[0], off[1], off[2], off[3], off[4]
     for i in range(n):
         r = rec[i]
@@ -69,6 +61,11 @@ def _fill(rec, off, n, depth, pos, frame, weight, solref, solreffriction, fricti
         r[o3], r[o3 + 1] = w * solref[0], w * solref[1]
         if friction_ref:
             r[o4], r[o4 + 1] = w * solreffriction[0], w * solreffriction[1]
+    base = rec.ctypes.data
+    for i in range(n):
+        if add(m_addr, d_addr, base + i * size) != 0:
+            return i
+    return n
 
 
 class ContactBuffer:
@@ -107,5 +104,21 @@ class ContactBuffer:
     def add(self, m, d, n, depth, pos, frame, weight, solref, solreffriction) -> int:
         """Writes n contacts' fields and appends them to d.contact; returns how many MuJoCo took."""
         n = min(n, self.cap)
-        _fill(self.rec, self.off, n, depth, pos, frame, weight, solref, solreffriction, solreffriction[1] != 0.0)
-        return _add_all(m._address, d._address, self.bytes.ctypes.data, self.size, n)
+        fr = solreffriction[1] != 0.0
+        rec, off = self.rec, self.off
+        return _fill_add(
+            _mj_add_contact,
+            m._address,
+            d._address,
+            rec,
+            self.size,
+            off,
+            n,
+            depth,
+            pos,
+            frame,
+            weight,
+            solref,
+            solreffriction,
+            fr,
+        )
