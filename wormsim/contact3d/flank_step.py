@@ -26,6 +26,7 @@ from __future__ import annotations
 import math
 
 import mujoco
+import numba
 import numpy as np
 
 from wormsim.contact3d.flank_handoff import ContactBuffer
@@ -207,7 +208,8 @@ def split_forward(m: mujoco.MjModel, d: mujoco.MjData, add_contacts) -> None:
 def flank_contact_details(fc: FlankContacts, d: mujoco.MjData):
     """As wormsim.contact3d.runner.contact_details for flank contacts: (n teeth touching, max penetration, points in
     the frame of wheel tooth 0, forces on the wheel (world), points (world)). The kernel's contacts are d.contact's
-    last fc.n entries; the force on the wheel (geom 2) is the elliptic-cone rows turned into the world frame."""
+    last fc.n entries; the force on the wheel (geom 2) is the elliptic-cone rows turned into the world frame
+    (`_contact_forces`, compiled: this runs at every sample)."""
     bm = fc.bm
     n = min(fc.n, d.ncon)
     if n == 0:
@@ -215,28 +217,64 @@ def flank_contact_details(fc: FlankContacts, d: mujoco.MjData):
         return 0, 0.0, z, z, z
     k0 = d.ncon - n
     con = d.contact
-    adr = np.asarray(con.efc_address[k0:])
-    ok = adr >= 0
-    frame = np.asarray(con.frame[k0:])[ok].reshape(-1, 3, 3)
-    pos = np.asarray(con.pos[k0:])[ok]
-    adr = adr[ok]
-    f = np.zeros((len(adr), 3))
-    f[:, 0] = d.efc_force[adr]
-    if fc.template.dim == 3:  # elliptic cone rows (normal, two tangents); dim 1: the normal only
-        f[:, 1] = d.efc_force[adr + 1]
-        f[:, 2] = d.efc_force[adr + 2]
-    F = np.einsum("ni,nij->nj", f, frame)
-    ks = fc.meta[:n, 0][ok]
-    th2 = float(d.qpos[fc.qa2])
-    ang = -(th2 + 2 * math.pi * ks / bm.geometry.z2)
-    pw = pos
+    out = np.empty((3, n, 3))
+    m, nteeth = _contact_forces(
+        con.efc_address[k0:],
+        con.frame[k0:],
+        con.pos[k0:],
+        d.efc_force,
+        fc.template.dim == 3,
+        fc.meta,
+        float(d.qpos[fc.qa2]),
+        bm.geometry.z2,
+        out,
+    )
+    p0, F, pw = out[0, :m], out[1, :m], out[2, :m]
     if fc.displaced:  # via the displaced wheel body's frame (wormsim.contact3d.flank_pose)
         from wormsim.contact3d.flank_pose import tooth_shift_of, wheel_body_points
 
-        pos = wheel_body_points(fc.params, pos)
+        adr = np.asarray(con.efc_address[k0:])
+        ks = fc.meta[:n, 0][adr >= 0]
+        pos = wheel_body_points(fc.params, pw)
         ang = -(2 * math.pi * ks / bm.geometry.z2 + tooth_shift_of(fc.params, ks))
-    c, s = np.cos(ang), np.sin(ang)
-    p0 = np.stack([c * pos[:, 0] - s * pos[:, 1], s * pos[:, 0] + c * pos[:, 1], pos[:, 2]], axis=1)
-    touching = ks[np.linalg.norm(F, axis=1) > 0] if len(ks) else ks
-    pen = float(fc.depth[:n].max())
-    return int(np.unique(touching).size), pen, p0, F, pw
+        c, s = np.cos(ang), np.sin(ang)
+        p0 = np.stack([c * pos[:, 0] - s * pos[:, 1], s * pos[:, 0] + c * pos[:, 1], pos[:, 2]], axis=1)
+    return nteeth, float(fc.depth[:n].max()), p0, F, pw
+
+
+@numba.njit(cache=True)
+def _contact_forces(adr, frame, pos, efc_force, cone3, meta, th2, z2, out):
+    """flank_contact_details' loop over the contacts with a constraint row (adr >= 0), in order: out[0] the point
+    turned into the frame of wheel tooth 0 (angle -(th2 + 2 pi k / z2) about z), out[1] the force on the wheel (the
+    normal row and, with an elliptic cone (cone3), the two tangent rows, through the contact frame), out[2] the
+    point; returns (their number, the number of distinct teeth with a nonzero force)."""
+    m = 0
+    teeth = np.empty(adr.shape[0])
+    nt = 0
+    for c in range(adr.shape[0]):
+        a = adr[c]
+        if a < 0:
+            continue
+        f0 = efc_force[a]
+        f1 = efc_force[a + 1] if cone3 else 0.0
+        f2 = efc_force[a + 2] if cone3 else 0.0
+        fr = frame[c]
+        for i in range(3):
+            out[1, m, i] = f0 * fr[i] + f1 * fr[3 + i] + f2 * fr[6 + i]
+        x, y, z = pos[c, 0], pos[c, 1], pos[c, 2]
+        k = meta[c, 0]
+        ang = -(th2 + 2 * math.pi * k / z2)
+        ca, sa = math.cos(ang), math.sin(ang)
+        out[0, m, 0], out[0, m, 1], out[0, m, 2] = ca * x - sa * y, sa * x + ca * y, z
+        out[2, m, 0], out[2, m, 1], out[2, m, 2] = x, y, z
+        if out[1, m, 0] != 0.0 or out[1, m, 1] != 0.0 or out[1, m, 2] != 0.0:
+            new = True
+            for t in range(nt):
+                if teeth[t] == k:
+                    new = False
+                    break
+            if new:
+                teeth[nt] = k
+                nt += 1
+        m += 1
+    return m, nt
