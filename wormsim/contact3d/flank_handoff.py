@@ -23,6 +23,9 @@ import os
 import mujoco
 import numba
 import numpy as np
+from llvmlite import ir
+from numba import types
+from numba.extending import intrinsic
 
 FIELDS = ("pos", "frame", "solref", "solreffriction")  # per-contact fields written besides dist
 
@@ -37,18 +40,32 @@ def _library() -> ctypes.CDLL:
     return ctypes.CDLL(paths[0])
 
 
-_mj_add_contact = _library().mj_addContact
-_mj_add_contact.argtypes = [ctypes.c_uint64, ctypes.c_uint64, ctypes.c_uint64]  # const mjModel*, mjData*, mjContact*
-_mj_add_contact.restype = ctypes.c_int
+_MJ_ADD_CONTACT = ctypes.cast(_library().mj_addContact, ctypes.c_void_p).value  # int mj_addContact(m, d, con)
+
+
+@intrinsic
+def _call_add(typingctx, fn, m_addr, d_addr, c_addr):
+    """int fn(const mjModel*, mjData*, const mjContact*) called through its address (all four int64): the address is
+    an argument, so the caller can be cached, and no ctypes object is unboxed per call."""
+    sig = types.int32(types.int64, types.int64, types.int64, types.int64)
+
+    def codegen(context, builder, signature, args):
+        fnty = ir.FunctionType(ir.IntType(32), [ir.IntType(8).as_pointer()] * 3)
+        f = builder.inttoptr(args[0], fnty.as_pointer())
+        return builder.call(f, [builder.inttoptr(a, ir.IntType(8).as_pointer()) for a in args[1:]])
+
+    return sig, codegen
 
 
 @numba.njit(cache=True)
-def _fill_add(add, m_addr, d_addr, rec, size, off, n, depth, pos, frame, weight, solref, solreffriction, friction_ref):
-    """Writes the per-contact fields of records 0..n-1 (rec: the buffer as float64 rows; off: the offsets of dist,
-    pos, frame, solref, solreffriction in float64 units): dist = -depth, solref (and, where friction_ref,
-    solreffriction) scaled by the contact's share of its slice (direct solref: -k, -b); then add(m, d, record)
-    (mj_addContact, passed in so that the compiled function can be cached) on each. Returns how many were added (it
-    stops when the arena is full, where MuJoCo has warned with mjWARN_CONTACTFULL)."""
+def _fill_add(
+    fn, m_addr, d_addr, rec, base, size, off, n, depth, pos, frame, weight, solref, solreffriction, friction_ref
+):
+    """Writes the per-contact fields of records 0..n-1 (rec: the buffer as float64 rows, at address base, size bytes
+    each; off: the offsets of dist, pos, frame, solref, solreffriction in float64 units): dist = -depth, solref (and,
+    where friction_ref, solreffriction) scaled by the contact's share of its slice (direct solref: -k, -b); then
+    mj_addContact (at address fn) on each. Returns how many were added (it stops when the arena is full, where MuJoCo
+    has warned with mjWARN_CONTACTFULL)."""
     o0, o1, o2, o3, o4 = off[0], off[1], off[2], off[3], off[4]
     for i in range(n):
         r = rec[i]
@@ -61,9 +78,8 @@ def _fill_add(add, m_addr, d_addr, rec, size, off, n, depth, pos, frame, weight,
         r[o3], r[o3 + 1] = w * solref[0], w * solref[1]
         if friction_ref:
             r[o4], r[o4 + 1] = w * solreffriction[0], w * solreffriction[1]
-    base = rec.ctypes.data
     for i in range(n):
-        if add(m_addr, d_addr, base + i * size) != 0:
+        if _call_add(fn, m_addr, d_addr, base + i * size) != 0:
             return i
     return n
 
@@ -94,6 +110,7 @@ class ContactBuffer:
             self.size = size
             self.bytes = np.ascontiguousarray(np.tile(raw, (self.cap, 1)))
             self.rec = self.bytes.view(np.float64)
+            self.address = self.bytes.ctypes.data  # refilled in place below, so it stays
             off = [0] + [np.asarray(getattr(c, f)).ctypes.data - dist.ctypes.data for f in FIELDS]
             if any(o % 8 for o in off):
                 raise RuntimeError(f"mjContact field offsets not float64-aligned: {off}")
@@ -107,10 +124,11 @@ class ContactBuffer:
         fr = solreffriction[1] != 0.0
         rec, off = self.rec, self.off
         return _fill_add(
-            _mj_add_contact,
+            _MJ_ADD_CONTACT,
             m._address,
             d._address,
             rec,
+            self.address,
             self.size,
             off,
             n,
