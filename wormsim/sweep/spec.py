@@ -6,12 +6,15 @@
     grid: {contact.stiffness_n_per_m: [2.0e8, 4.39e8], drive.speed_rpm: {linspace: [1000, 2000, 3]}}
     zip: {a.b: [1, 2, 3], c.d: [4, 5, 6]}     # same lengths, taken side by side
     random: {n: 20, seed: 1, vary: {gear.backlash_mm: {uniform: [0.05, 0.1]}, load.torque_nm: {normal: [12, 1]}}}
+    random: {n: 100, seed: 3, vary: {errors.wheel_pitch_deviation_um: {uniform: [-5, 5], size: 24}}}  # a list each
 
 Points: the cartesian product of the grid axes, the zip group (one axis of rows) and the random group (one axis
 of n draws), in that order, the last axis varying fastest. A value list is a YAML list; {linspace: [a, b, n]} is
 numpy.linspace; {logspace: [a, b, n]} is n values from a to b evenly spaced in log (numpy.geomspace: a and b are
 the end values, not exponents). Random draws use numpy.random.default_rng(seed), one path after another in the
-order written, so a sweep file gives the same points on every machine.
+order written, so a sweep file gives the same points on every machine (and a rerun into the same folder resumes:
+the points, hence their scenario hashes, are the same). With size: N a draw is a list of N values (one per wheel
+tooth, say), drawn point after point.
 
 Every point is validated as a scenario (wormsim.scenario.scenario_from_dict) before anything runs; a bad point
 raises ScenarioError naming the point, its swept values and the field (exit 2). Each point carries the hash of
@@ -107,15 +110,28 @@ def _parse_axes(section: str, axes: Any) -> dict:
     return out
 
 
+_SIZE = Field(None, ge=1, le=1000, description="draw a list of this many values per point (e.g. one per wheel tooth)")
+
+
 class Uniform(_Strict):
     uniform: tuple[float, float] = Field(..., description="[low, high]")
+    size: int | None = _SIZE
+
+    @model_validator(mode="after")
+    def _order(self) -> "Uniform":
+        if self.uniform[0] > self.uniform[1]:
+            raise ValueError(f"uniform [{self.uniform[0]}, {self.uniform[1]}]: low must be <= high")
+        return self
 
     def draw(self, rng: np.random.Generator, n: int) -> list:
-        return rng.uniform(self.uniform[0], self.uniform[1], n).tolist()
+        if self.size is None:
+            return rng.uniform(self.uniform[0], self.uniform[1], n).tolist()
+        return rng.uniform(self.uniform[0], self.uniform[1], (n, self.size)).tolist()
 
 
 class Normal(_Strict):
     normal: tuple[float, float] = Field(..., description="[mean, standard deviation]")
+    size: int | None = _SIZE
 
     @model_validator(mode="after")
     def _sd(self) -> "Normal":
@@ -124,14 +140,18 @@ class Normal(_Strict):
         return self
 
     def draw(self, rng: np.random.Generator, n: int) -> list:
-        return rng.normal(self.normal[0], self.normal[1], n).tolist()
+        if self.size is None:
+            return rng.normal(self.normal[0], self.normal[1], n).tolist()
+        return rng.normal(self.normal[0], self.normal[1], (n, self.size)).tolist()
 
 
 class Random(_Strict):
     n: int = Field(..., ge=1, le=MAX_POINTS, description="number of draws")
     seed: int = Field(0, ge=0, description="numpy.random.default_rng seed")
     vary: dict[str, Uniform | Normal] = Field(
-        ..., min_length=1, description="PATH: {uniform: [a, b]} | {normal: [mean, sd]}"
+        ...,
+        min_length=1,
+        description="PATH: {uniform: [a, b]} | {normal: [mean, sd]}, either with size: N for a list of N draws",
     )
 
     @field_validator("vary", mode="before")
@@ -141,10 +161,12 @@ class Random(_Strict):
             return v
         out = {}
         for p, d in v.items():
-            kind = next(iter(d), None) if isinstance(d, dict) and len(d) == 1 else None
+            keys = [k for k in d if k != "size"] if isinstance(d, dict) else []
+            kind = keys[0] if len(keys) == 1 else None
             if kind not in ("uniform", "normal"):
                 raise ValueError(
                     f"random.vary.{p} = {d!r}: expected {{uniform: [low, high]}} or {{normal: [mean, sd]}}"
+                    " (optionally with size: N)"
                 )
             try:
                 out[p] = (Uniform if kind == "uniform" else Normal).model_validate(d)
