@@ -16,12 +16,16 @@ import argparse
 import csv
 import json
 import shutil
+import sys
 from pathlib import Path
 
 import matplotlib.pyplot as plt  # Agg where there is no display
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "sweeps"))
+from tolerance_grade import RUNS as _RUNS  # noqa: E402
+
 IMG, CSV_DIR = ROOT / "docs" / "img", ROOT / "docs" / "sweeps"
 GEARS = ("screw_jack", "seat_motor")
 STUDY_OUT = [
@@ -100,33 +104,69 @@ def study() -> None:
 
 # ----------------------------------------------------------------------------- tolerance study (section 8)
 
+# predictors of the magnitude outputs: the signed centre distance (negative closes the mesh), the sizes of the
+# errors whose sign only mirrors the pattern, the runouts, and the single pitch deviations of the teeth that mesh
+# in the run's steady window (a run covers about one mesh cycle: the other teeth do not mesh)
 TOL_IN = [
+    ("errors.center_distance_mm", "centre distance"),
+    ("abs_wheel_axial_offset_mm", "abs wheel axial offset"),
+    ("abs_shaft_angle_deg", "abs shaft angle"),
+    ("errors.wheel_runout_mm", "wheel runout"),
+    ("errors.worm_runout_mm", "worm runout"),
+    ("local_fpt_um", "f_pt of the meshing teeth"),
+]
+# the pattern's centroid moves with the sign of the shaft angle and the axial offset
+TOL_IN_SIGNED = [
     ("errors.center_distance_mm", "centre distance"),
     ("errors.wheel_axial_offset_mm", "wheel axial offset"),
     ("errors.shaft_angle_deg", "shaft angle"),
     ("errors.wheel_runout_mm", "wheel runout"),
     ("errors.worm_runout_mm", "worm runout"),
-    ("pitch_rms_um", "pitch (rms shift)"),
+    ("local_fpt_um", "f_pt of the meshing teeth"),
 ]
 TOL_OUT = STUDY_OUT[:5] + [("contact_pattern_centroid_face_mm", "pattern centroid [mm]")]
 
 
-def _tol_rows(src: Path) -> list[dict]:
+def _meshing_fpt_um(gear: str, shifts: np.ndarray, t0: float, t1: float) -> float:
+    """Largest |single pitch deviation| (neighbour difference of the tooth shifts) among the teeth that cross the
+    line of centres in the steady window [t0, t1], widened by one pitch each side (the contact zone)."""
+    from meshgen import wheel
+    from meshgen.geometry import derive
+    from wormsim.scenario import load_scenario
+
+    sc = load_scenario(ROOT / "scenarios" / f"{gear}.yaml", [f"{k}={v}" for k, v in _RUNS[gear].items()])
+    g = derive(sc.gear)
+    w2 = sc.drive.speed_rpm * 2 * np.pi / 60 * g.z1 / g.z2
+    ramp = sc.drive.ramp_s
+    a, b = w2 * (t0 - ramp / 2), w2 * (t1 - ramp / 2)  # wheel angle (the ramp's smooth step: half its time)
+    pitch = 2 * np.pi / g.z2
+    z = len(shifts)
+    worst = 0.0
+    for k in range(z):
+        cross = (-np.pi / 2 - wheel.tooth_angle(g, k)) % (2 * np.pi)
+        if a - pitch <= cross <= b + pitch or a - pitch <= cross - 2 * np.pi <= b + pitch:
+            worst = max(worst, abs(shifts[k] - shifts[k - 1]), abs(shifts[(k + 1) % z] - shifts[k]))
+    return float(worst)
+
+
+def _tol_rows(src: Path, gear: str) -> list[dict]:
     with src.open(newline="") as fh:
         rows = [r for r in csv.DictReader(fh) if r["status"] == "ok"]
     out = []
     for r in rows:
         d = {k: _num(v) for k, v in r.items()}
         shifts = np.array(json.loads(r["errors.wheel_pitch_deviation_um"]))
-        d["pitch_rms_um"] = float(np.sqrt(np.mean(shifts**2)))
+        d["local_fpt_um"] = _meshing_fpt_um(gear, shifts, d["startup_time_s"], d["sim_time_s"])
+        d["abs_wheel_axial_offset_mm"] = abs(d["errors.wheel_axial_offset_mm"])
+        d["abs_shaft_angle_deg"] = abs(d["errors.shaft_angle_deg"])
         out.append(d)
     return out
 
 
-def regression(rows: list[dict], key: str) -> tuple[dict, float, int]:
+def regression(rows: list[dict], key: str, inputs: list) -> tuple[dict, float, int]:
     """Standardised coefficients of a least-squares fit of output `key` on the errors, R^2 and the rows used."""
     use = [r for r in rows if r.get(key) is not None and np.isfinite(r[key])]
-    X = np.array([[r[p] for p, _ in TOL_IN] for r in use], float)
+    X = np.array([[r[p] for p, _ in inputs] for r in use], float)
     y = np.array([r[key] for r in use], float)
     Xs = (X - X.mean(0)) / X.std(0)
     ys = (y - y.mean()) / y.std() if y.std() > 0 else y * 0
@@ -134,7 +174,7 @@ def regression(rows: list[dict], key: str) -> tuple[dict, float, int]:
     coef, *_ = np.linalg.lstsq(A, ys, rcond=None)
     resid = ys - A @ coef
     r2 = 1 - float(resid @ resid) / float(ys @ ys) if ys.any() else 0.0
-    return {p: float(c) for (p, _), c in zip(TOL_IN, coef[1:], strict=True)}, r2, len(use)
+    return {p: float(c) for (p, _), c in zip(inputs, coef[1:], strict=True)}, r2, len(use)
 
 
 def tolerance(runs: Path) -> None:
@@ -145,7 +185,7 @@ def tolerance(runs: Path) -> None:
             continue
         CSV_DIR.mkdir(parents=True, exist_ok=True)
         shutil.copy(src, CSV_DIR / f"{gear}_tolerance.csv")
-        rows = _tol_rows(src)
+        rows = _tol_rows(src, gear)
         print(f"\n{gear}: {len(rows)} ok points")
         if len(rows) < len(TOL_IN) + 2:
             continue
@@ -162,20 +202,21 @@ def tolerance(runs: Path) -> None:
         print("| --- | --- |" + " --- |" * len(TOL_IN))
         fits = {}
         for key, label in TOL_OUT:
-            beta, r2, _ = regression(rows, key)
-            fits[key] = beta
-            print(f"| {label} | {r2:.2f} | " + " | ".join(f"{beta[p]:+.2f}" for p, _ in TOL_IN) + " |")
+            inputs = TOL_IN_SIGNED if key == "contact_pattern_centroid_face_mm" else TOL_IN
+            beta, r2, _ = regression(rows, key, inputs)
+            fits[key] = (beta, dict(inputs))
+            print(f"| {label} | {r2:.2f} | " + " | ".join(f"{b:+.2f}" for b in beta.values()) + " |")
         fig, axes = plt.subplots(2, len(TOL_OUT), figsize=(3.0 * len(TOL_OUT), 5.6))
-        names = dict(TOL_IN)
         for i, (key, label) in enumerate(TOL_OUT):
             v = np.array([r[key] for r in rows if r.get(key) is not None], float)
             axes[0][i].hist(v, bins=15, color="tab:blue", alpha=0.8)
             axes[0][i].set_xlabel(label, fontsize=8)
             axes[0][i].set_ylabel("points" if i == 0 else "", fontsize=8)
-            top = max(fits[key], key=lambda p: abs(fits[key][p]))
+            beta, names = fits[key]
+            top = max(beta, key=lambda p: abs(beta[p]))
             xs = [r[top] for r in rows if r.get(key) is not None]
             axes[1][i].scatter(xs, v, s=8)
-            axes[1][i].set_xlabel(f"{names[top]} (beta {fits[key][top]:+.2f})", fontsize=8)
+            axes[1][i].set_xlabel(f"{names[top]} (beta {beta[top]:+.2f})", fontsize=8)
             axes[1][i].set_ylabel(label, fontsize=8)
             for ax in axes[:, i]:
                 ax.tick_params(labelsize=7)
