@@ -15,11 +15,11 @@ from dataclasses import replace
 import mujoco
 import numpy as np
 import pytest
+from _contact3d_stepper import Stepper
 from conftest import SCENARIOS as SCEN
 
 from wormsim.contact3d.law import friction_regularisation_velocity_m_s, friction_utilisation
 from wormsim.contact3d.mjcf import build_model
-from wormsim.contact3d.window import repose_window
 from wormsim.friction import friction_coefficient
 from wormsim.gear_theory import commands, mesh_arms_m
 from wormsim.scenario import ScenarioError, load_scenario
@@ -28,9 +28,11 @@ DURATION_S = 0.05  # 10 000 steps of 5 us; contacts read over the last 40 % (aft
 
 
 def sliding_contacts(rpm: float, impratio: float | None = None) -> tuple[np.ndarray, float, object]:
-    """Seat motor (seed 001 gear, load and contact law; coarse pieces) with the worm at `rpm`: rows
-    (f_n, |f_t|, mu, |v_t|) of every loaded contact sampled every 20 steps over the last 40 % of the run,
-    the sliding speed Vs, and the model. mu(Vs) is set as wormsim.contact3d.runner sets it."""
+    """Seat motor (seed 001 gear, load and contact law; coarse, the default contact.geometry) with the worm at `rpm`:
+    rows (f_n, |f_t|, mu, |v_t|, w) of every loaded contact sampled every 20 steps over the last 40 % of the run, the
+    sliding speed Vs, and the model. w: the contact's share of the law's stiffness and damping (1 for pieces; a flank
+    contact's share of its face slice, wormsim.contact3d.flanks.slice_weights). mu(Vs) is set as
+    wormsim.contact3d.runner sets it."""
     sc = load_scenario(
         SCEN / "seat_motor.yaml",
         [
@@ -46,20 +48,21 @@ def sliding_contacts(rpm: float, impratio: float | None = None) -> tuple[np.ndar
     if impratio is not None:
         m.opt.impratio = impratio
     d = mujoco.MjData(m)
-    coll = np.concatenate([bm.worm_geoms, bm.wheel_slot_geoms.ravel()])
-    qa_wheel = m.jnt_qposadr[m.dof_jntid[bm.wheel_dof]]
-    window = repose_window(bm, 0.0)
+    st = Stepper(bm, d)
     chunk, rows = 20, []
     f_floor = 1e-3 * sc.load.torque_nm / geo.r2
     cmds = commands(sc, bm.direction)
     for _ in range(int(round(DURATION_S / m.opt.timestep)) // chunk):
         d.ctrl[bm.drive_actuator], d.ctrl[bm.load_actuator] = cmds.drive(d.time), cmds.load(d.time)
-        mujoco.mj_step(m, d, nstep=chunk)
-        window = repose_window(bm, float(d.qpos[qa_wheel]), window)
+        st.step(chunk)
         vs = abs(float(d.qvel[bm.worm_dof])) * geo.r1 / math.cos(geo.gamma)
-        m.geom_friction[coll, 0] = friction_coefficient(sc.contact, vs)
+        st.set_friction(friction_coefficient(sc.contact, vs))
         if d.time > 0.6 * DURATION_S:
             u = friction_utilisation(m, d)
+            w = np.ones(d.ncon)
+            if st.fc is not None and st.fc.n:
+                w[d.ncon - st.fc.n :] = st.fc.weight[: st.fc.n]
+            u = np.column_stack([u, w[np.asarray(d.contact.efc_address[: d.ncon]) >= 0]])
             rows.append(u[u[:, 0] > f_floor])
     vs_cmd = abs(rpm) * 2 * math.pi / 60 * geo.r1 / math.cos(geo.gamma)
     return np.concatenate(rows), vs_cmd, bm
@@ -81,7 +84,8 @@ def test_friction_saturates_on_sliding_contacts(rpm):
 def test_soft_friction_rows_are_viscous_below_the_cone():
     """The diagnosis itself, so that it stays checked: with impratio 1 (the old setting) friction at 36 rpm is
     under-applied (mean utilisation < 0.5) and every unsaturated contact's f_t / v_t is the slope of
-    wormsim.contact3d.law (2), b / (A_hat + R_f) = c_c at impratio 1 (within 2 %)."""
+    wormsim.contact3d.law (2), impratio w c_f = w c_f at impratio 1 (within 2 %; c_f = c_c for pieces, the flank
+    contacts' own friction-row damping (4) for flanks, w as in sliding_contacts)."""
     C, vs, bm = sliding_contacts(36.0, impratio=1.0)
     util = C[:, 1] / (C[:, 2] * C[:, 0])
     assert util.mean() < 0.5, util.mean()
@@ -89,19 +93,23 @@ def test_soft_friction_rows_are_viscous_below_the_cone():
     assert inside.sum() >= 100
     law = replace(bm.law, impratio=1.0)
     v_reg = np.array([friction_regularisation_velocity_m_s(law, mu, fn) for mu, fn in zip(C[inside, 2], C[inside, 0])])
-    slope = C[inside, 2] * C[inside, 0] / v_reg  # = impratio c_c = c_c
+    slope = C[inside, 4] * C[inside, 2] * C[inside, 0] / v_reg  # = w impratio c_f = w c_f
     ratio = C[inside, 1] / C[inside, 3] / slope
     assert np.all(np.abs(ratio - 1) < 0.02), np.percentile(ratio, [0, 50, 100])
 
 
 def test_impratio_follows_the_working_load():
-    """(3): impratio = mu_max F_n / (c_c v_t) for the seat motor (by hand: F_n = 24 N m / (r2 cos 10 deg cos 4.79 deg),
-    mu_max 0.08, v_t 1e-3 m/s), and the model carries it."""
+    """(3): impratio = mu_max F_n / (c_f v_t) for the seat motor (by hand: F_n = 24 N m / (r2 cos 10 deg cos 4.79 deg),
+    mu_max 0.08, v_t 1e-3 m/s), and the model carries it. c_f of the flank contacts (the default geometry) by (4):
+    min(c_c, 0.01 F_n / (n_ref mu_max Vs)), Vs = omega1 r1 / cos(gamma) at 36 rpm."""
     sc = load_scenario(SCEN / "seat_motor.yaml", ["simulation.resolution=coarse"])
     bm = build_model(sc)
     g = bm.geometry
     f_n = 24.0 / (g.r2 * math.cos(math.radians(10)) * math.cos(math.radians(4.79)))
-    expected = 0.08 * f_n / (bm.law.contact_damping_n_s_per_m * 1e-3)
+    vs = 36 * 2 * math.pi / 60 * g.r1 / math.cos(g.gamma)
+    c_f = min(bm.law.contact_damping_n_s_per_m, 0.01 * f_n / (bm.law.contacts_per_pair * 0.08 * vs))
+    assert bm.law.friction_damping == pytest.approx(c_f, rel=1e-3)
+    expected = 0.08 * f_n / (c_f * 1e-3)
     assert bm.law.impratio == pytest.approx(expected, rel=1e-3)
     assert bm.model.opt.impratio == pytest.approx(bm.law.impratio)
 

@@ -31,6 +31,9 @@ from wormsim.torsional import dynamics as torsional
 from wormsim.units import MM
 
 DEMO = SCEN / "seat_motor_demo.yaml"
+# the backlash check is the collision pieces' (their bulge beyond the exact flanks): its tests pin contact.geometry
+# pieces; the flank contacts are found on the exact flanks and need no such margin
+PIECES = ["contact.geometry=pieces"]
 # the CI configurations of tests/test_contact3d_seeds.py (kept in step by hand: that module runs its seeds at import)
 CI = {
     "seat_motor": [
@@ -59,8 +62,8 @@ CI = {
 )
 def test_seed_scenarios_and_ci_configurations_pass_the_backlash_check(name, overrides):
     """Each seed at its own resolution and in its CI configuration builds; the clearance it reports is (1) and lies
-    above the bulge (2) (wormsim.contact3d.backlash)."""
-    bm = build_model(load_scenario(SCEN / f"{name}.yaml", overrides))
+    above the bulge (2) (wormsim.contact3d.backlash). contact.geometry pieces."""
+    bm = build_model(load_scenario(SCEN / f"{name}.yaml", overrides + PIECES))
     g, meta = bm.geometry, bm.meta
     assert meta["flank_clearance_m"] == pytest.approx(0.5 * g.backlash * math.cos(g.alpha_n) * math.cos(g.gamma))
     assert meta["piece_bulge_m"] == pytest.approx(piece_bulge_m(bm.pieces.piece_error_um))
@@ -70,14 +73,16 @@ def test_seed_scenarios_and_ci_configurations_pass_the_backlash_check(name, over
 
 def test_zero_backlash_exits_2_naming_the_field_and_the_smallest_backlash(tmp_path, capsys):
     """j = 0 is a preloaded pair: exit 2 before any simulation, a failed summary.json, and a message naming
-    gear.backlash_mm with the smallest backlash allowed at this resolution; that value then builds."""
+    gear.backlash_mm with the smallest backlash allowed at this resolution; that value then builds. contact.geometry
+    pieces."""
     out = tmp_path / "zero"
-    rc = cli.main(["run", str(DEMO), "--out", str(out), "--no-progress", "--set", "gear.backlash_mm=0"])
+    args = ["run", str(DEMO), "--out", str(out), "--no-progress", "--set", "gear.backlash_mm=0", "--set", PIECES[0]]
+    rc = cli.main(args)
     assert rc == 2
     err = capsys.readouterr().err
     assert "gear.backlash_mm >" in err and "preloaded pair" in err and "simulation.resolution fine" in err, err
     quoted = float(re.search(r"gear\.backlash_mm > ([0-9.e+-]+) mm", err).group(1))
-    sc = load_scenario(DEMO, [f"gear.backlash_mm={quoted}"])
+    sc = load_scenario(DEMO, [f"gear.backlash_mm={quoted}", *PIECES])
     bm = build_model(sc)
     g = bm.geometry
     j_min = min_backlash_m(g, piece_bulge_m(bm.pieces.piece_error_um))
@@ -90,8 +95,8 @@ def test_zero_backlash_exits_2_naming_the_field_and_the_smallest_backlash(tmp_pa
 def test_backlash_below_the_bulge_is_rejected_and_just_above_it_builds():
     """involute_41 (82.5 mm face) at medium: the pieces bulge 28.8 um beyond the flanks; j = 0.05 mm leaves 23.3 um per
     flank: ScenarioError quoting j_min = 2 b / (cos(alpha_n) cos(gamma)) = 0.0616 mm and resolution fine as the other
-    cure; j = 0.065 mm builds."""
-    ov = ["gear.backlash_mm=0.05", "simulation.resolution=medium"]
+    cure; j = 0.065 mm builds. contact.geometry pieces."""
+    ov = ["gear.backlash_mm=0.05", "simulation.resolution=medium", *PIECES]
     with pytest.raises(ScenarioError) as exc:
         build_model(load_scenario(SCEN / "involute_41.yaml", ov))
     msg = str(exc.value)
@@ -99,7 +104,7 @@ def test_backlash_below_the_bulge_is_rejected_and_just_above_it_builds():
     assert "gear.backlash_mm = 0.05" in msg and "simulation.resolution fine" in msg
     assert j_min_mm == pytest.approx(0.0616, abs=2e-4)
     bm = build_model(
-        load_scenario(SCEN / "involute_41.yaml", ["gear.backlash_mm=0.065", "simulation.resolution=medium"])
+        load_scenario(SCEN / "involute_41.yaml", ["gear.backlash_mm=0.065", "simulation.resolution=medium", *PIECES])
     )
     assert flank_clearance_m(bm.geometry) > piece_bulge_m(bm.pieces.piece_error_um)
 
@@ -108,12 +113,12 @@ def test_pieces_leave_the_requested_play_and_interfere_at_zero_backlash():
     """What MuJoCo really collides (wormsim.contact3d.backlash.piece_play, seat motor demo gear, coarse, 8 worm angles over a
     mesh cycle): with j = 0.01 mm the wheel's free play between its flanks is j within 1 um (measured 9.57-10.27 um)
     and nothing touches at the conjugate pose; with j = 0 (check bypassed) the pieces overlap there (measured
-    0.21 um): the model cannot represent a zero-clearance pair."""
-    bm = build_model(load_scenario(DEMO, ["gear.backlash_mm=0.01"]))
+    0.21 um): the pieces cannot represent a zero-clearance pair. contact.geometry pieces."""
+    bm = build_model(load_scenario(DEMO, ["gear.backlash_mm=0.01", *PIECES]))
     p = piece_play(bm)
     assert p["interference_max_m"] == 0.0
     assert abs(p["play_min_m"] - 0.01 * MM) < 1 * UM and abs(p["play_max_m"] - 0.01 * MM) < 1 * UM
-    bm0 = build_model(load_scenario(DEMO, ["gear.backlash_mm=0"]), check_backlash_vs_pieces=False)
+    bm0 = build_model(load_scenario(DEMO, ["gear.backlash_mm=0", *PIECES]), check_backlash_vs_pieces=False)
     assert piece_play(bm0)["interference_max_m"] > 0.0
 
 
@@ -141,10 +146,10 @@ def test_near_zero_backlash_does_not_change_a_loaded_forward_drive():
 def test_interference_below_the_limit_drags_the_mesh():
     """Why the check exists: involute_41 at coarse (bulge 14 um, j_min 0.030 mm) with j = 0 (check bypassed) starts
     with the pieces overlapping (measured 1.65 um at t = 0) and the preload drags on the back flanks: efficiency 0.571
-    against 0.655 with j = 0.2 mm (theory 0.672). The check rejects that input."""
+    against 0.655 with j = 0.2 mm (theory 0.672). The check rejects that input. contact.geometry pieces."""
+    coarse = ["simulation.resolution=coarse", *PIECES]
     with pytest.raises(ScenarioError, match=r"gear\.backlash_mm >"):
-        build_model(load_scenario(SCEN / "involute_41.yaml", ["gear.backlash_mm=0", "simulation.resolution=coarse"]))
-    coarse = ["simulation.resolution=coarse"]
+        build_model(load_scenario(SCEN / "involute_41.yaml", ["gear.backlash_mm=0", *coarse]))
     _, eta_nom = _forward(SCEN / "involute_41.yaml", coarse + ["gear.backlash_mm=0.2"], 0.03)
     _, eta_zero = _forward(SCEN / "involute_41.yaml", coarse + ["gear.backlash_mm=0"], 0.03)
     assert eta_nom > 0.63
@@ -263,6 +268,7 @@ def test_contact3d_mesh_force_sets_friction_hardness_for_a_torque_driven_wheel()
     bm = build_model(sc)
     g = bm.geometry
     f_n = 2.0 / (g.r2 * math.cos(g.alpha_n) * math.cos(g.gamma))
-    expected = 0.0877 * f_n / (bm.law.contact_damping_n_s_per_m * sc.contact.transition_velocity_m_s)
+    # c_f: the friction rows' damping (c_c for pieces; wormsim.contact3d.law (4) for the flank contacts)
+    expected = 0.0877 * f_n / (bm.law.friction_damping * sc.contact.transition_velocity_m_s)
     assert bm.law.impratio == pytest.approx(expected, rel=1e-9)
     assert np.isfinite(bm.law.impratio) and bm.law.impratio > 100

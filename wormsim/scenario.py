@@ -110,11 +110,11 @@ class Contact(_Strict):
     friction_dynamic: float | None = Field(None, ge=0, le=1)
     friction_group: FrictionGroup | None = Field(None, description="seed 000 rho(Vs) material group")
     transition_velocity_m_s: float = Field(1e-3, gt=0, le=10, description="static -> dynamic friction blend speed")
-    geometry: Literal["pieces", "flanks"] = Field(
-        "pieces",
+    geometry: Literal["flanks", "pieces"] = Field(
+        "flanks",
         description=(
-            "contact3d: pieces (MuJoCo collides convex pieces) | flanks (contacts found on the exact flanks, one per "
-            "face slice; docs/contact3d.md)"
+            "contact3d: flanks (contacts found on the exact flanks, one per face slice: the working flanks) | pieces "
+            "(MuJoCo collides convex pieces: also tips, edges, teeth jumping; slower, facet ripple; docs/contact3d.md)"
         ),
     )
     slices: int | None = Field(

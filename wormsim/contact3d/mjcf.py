@@ -528,7 +528,11 @@ def write_model(scenario: Scenario, out_dir: str | Path) -> Path:
     contact stiffness differs from a wormsim run's. Its drive and load act with both controls at zero: the
     scenario's final drive command (speed or torque) and load torque are the actuators' constant bias terms
     (without the STEP ramps), so the viewer's play button turns the worm; a control adds to them.
+    It always carries the collision pieces (contact.geometry pieces): the flank contacts are found by wormsim's own
+    step (wormsim.contact3d.flank_step), which a plain MuJoCo viewer does not run.
     """
+    if scenario.contact.geometry != "pieces":
+        scenario = scenario.model_copy(update={"contact": scenario.contact.model_copy(update={"geometry": "pieces"})})
     out = Path(out_dir)
     (out / "meshes").mkdir(parents=True, exist_ok=True)
     geo = derive(scenario.gear) if scenario.gear is not None else None
