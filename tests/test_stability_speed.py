@@ -36,6 +36,8 @@ from wormsim.scenario import load_scenario
 
 JACK = SCENARIOS / "screw_jack.yaml"
 COARSE = ["simulation.resolution=coarse"]
+# MuJoCo's speculative contacts are its collision's (the convex pieces): their tests pin contact.geometry pieces
+PIECES = ["contact.geometry=pieces"]
 RPM = 2 * math.pi / 60
 
 
@@ -145,9 +147,9 @@ def test_a_torque_driven_worm_running_away_stops_at_the_overspeed_guard():
 def test_speculative_contacts_change_nothing_below_the_speed_limit():
     """26600 rpm (20 x, 0.028 rad per step at 1e-5 s): the speculative flag is set in the model, and the run's time
     series are identical to the plain run's (no geom sweeps past MuJoCo's fast-geom threshold into a new contact);
-    measured cost 1368 against 478 us per step."""
-    plain = simulate(_jack(26600, 0.02))
-    spec_sc = _jack(26600, 0.02, "simulation.speculative=true")
+    measured cost 1368 against 478 us per step. contact.geometry pieces."""
+    plain = simulate(_jack(26600, 0.02, *PIECES))
+    spec_sc = _jack(26600, 0.02, "simulation.speculative=true", *PIECES)
     spec = simulate(spec_sc)
     assert spec.extra["built"].model.opt.enableflags & int(mujoco.mjtEnableBit.mjENBL_SPECULATIVE)
     assert not plain.extra["built"].model.opt.enableflags & int(mujoco.mjtEnableBit.mjENBL_SPECULATIVE)
@@ -169,11 +171,11 @@ def test_speculative_contacts_tunnel_sooner_beyond_the_speed_limit(monkeypatch):
         11 um); the speculative run tunnels (penetration guard, 1685 um) or runs with the thread 480 to 710 um deep
         in the teeth;
       - 99750 rpm at 2e-5 s (0.209 rad per step): both tunnel (penetration guard), the speculative run sooner
-        (4.5 to 5.8 ms against 8.6 to 13.4 ms)."""
+        (4.5 to 5.8 ms against 8.6 to 13.4 ms). contact.geometry pieces."""
     monkeypatch.setattr(sim_mod, "OVERSPEED_GUARD", math.inf)
 
     def run(rpm, h, *extra):
-        sc = _jack(rpm, 0.02, *extra)
+        sc = _jack(rpm, 0.02, *extra, *PIECES)
         bm = build_model(sc, timestep_s=h)  # past choose_timestep's speed check
         return run_model(bm, sc)
 

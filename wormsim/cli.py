@@ -50,7 +50,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p = sub.add_parser("mesh", help="geometry only: worm.stl, wheel.stl, assembly.json, recording.rrd")
     _add_scenario_args(p)
-    p = sub.add_parser("model", help="write a standalone MJCF (model.xml + mesh assets, collision pieces) for MuJoCo's viewer")
+    p = sub.add_parser(
+        "model", help="write a standalone MJCF (model.xml + mesh assets, collision pieces) for MuJoCo's viewer"
+    )
     _add_scenario_args(p)
     p = sub.add_parser("bench", help="speed-accuracy benchmark: bench.json and bench.png")
     p.add_argument("--quick", action="store_true", help="CI-sized subset")
