@@ -13,6 +13,9 @@ Speculative contacts (simulation.speculative): below the speed limit they change
 identical, each step costs about 3 x); at 0.07 rad per step, where the plain run completes, the speculative run
 tunnels or runs hundreds of um deep; at 0.21 rad both tunnel, the speculative run sooner. They do not extend the
 speed range.
+
+The speculative-contact tests pin contact.geometry pieces (MuJoCo's own collision); the others run the default
+(flanks); numbers quoted from the pieces era say so.
 """
 
 from __future__ import annotations
@@ -224,23 +227,30 @@ def _start(path: Path, rpm: float, duration_s: float, ramp_s: float, record_ever
     return _STARTS[key]
 
 
-# (scenario, worm rpm, run s, ramp s, step peak / steady mean >, step peak / steady max >); measured factors in the
-# test's docstring
+# (scenario, worm rpm, run s, ramp s, step peak / steady mean >, step peak / steady max >, ramp peak / steady max <,
+# step peak / ramp peak >); measured factors in the test's docstring
 STARTUP_CASES = [
-    pytest.param(JACK, 6650, 0.04, 0.01, 20.0, 5.0, id="screw_jack"),
-    pytest.param(SEAT_DEMO, 9000, 0.03, 0.01, 2.5, 2.2, id="seat_motor_demo"),
+    pytest.param(JACK, 6650, 0.04, 0.01, 20.0, 20.0, 3.0, 5.0, id="screw_jack"),
+    pytest.param(SEAT_DEMO, 9000, 0.03, 0.01, 1.8, 1.7, 1.1, 1.5, id="seat_motor_demo"),
 ]
 
 
-@pytest.mark.parametrize("path, rpm, duration_s, ramp_s, over_mean, over_max", STARTUP_CASES)
-def test_startup_impact_step_against_ramp(path, rpm, duration_s, ramp_s, over_mean, over_max):
-    """Drive and load stepped at t = 0 (ramp_s = 0) against ramps, coarse pieces, default timesteps. Measured:
-    screw jack at 6650 rpm (5 x): step peak 11931 N within 0.2 ms, 29.9 x the steady mean F_t (400 N) and 7.7 x the
-    steady window's own max |F_t| (1557 N; the jack's mesh fluctuates by 1443 N p2p); penetration 18 um against the
-    1000 um guard; with 0.01 s ramps the start-up peak 1410 N stays below the steady max 1601 N.
-    Seat motor demo gear at 9000 rpm: step peak 3822 N, 2.97 x the mean 1289 N and 2.67 x the steady max 1431 N;
-    penetration 27 um against 281 um; with ramps 1429 N = 1.11 x the mean, 1.00 x the steady max.
-    No guard fires and both runs keep the ratio."""
+@pytest.mark.parametrize(
+    "path, rpm, duration_s, ramp_s, over_mean, over_max, ramp_over_max, step_over_ramp", STARTUP_CASES
+)
+def test_startup_impact_step_against_ramp(
+    path, rpm, duration_s, ramp_s, over_mean, over_max, ramp_over_max, step_over_ramp
+):
+    """Drive and load stepped at t = 0 (ramp_s = 0) against ramps, coarse, the default contact.geometry (flanks),
+    default timesteps. Measured: screw jack at 6650 rpm (5 x): step peak 10473 N, 26.2 x the steady mean F_t (400 N)
+    and 25.4 x the steady window's own max |F_t| (412 N); penetration 15.3 um against the 1000 um guard; with 0.01 s
+    ramps the start-up peak is 1069 N (9.8 x less than the step's, still 2.59 x the steady max: the wheel crosses its
+    half backlash under the load ramp and strikes the flank), penetration 1.54 um.
+    Seat motor demo gear at 9000 rpm: step peak 2555 N, 1.98 x the mean 1289 N and 1.87 x the steady max 1367 N;
+    penetration 64 um against 281 um; with ramps 1353 N = 1.05 x the mean, 0.99 x the steady max, 1.89 x less than the
+    step's, penetration 34.8 um. No guard fires and both runs keep the ratio.
+    (With pieces, before flanks were the default: jack step peak 11931 N, ramp peak 1410 N hidden under the facets'
+    steady max 1601 N; seat step 3822 N, ramp 1429 N.)"""
     step, ramp = _start(path, rpm, duration_s, 0)[0], _start(path, rpm, duration_s, ramp_s)[0]
     for s in (step, ramp):
         assert abs(s["ratio"] / s["ratio_theory"] - 1) < 1e-3, s["ratio"]
@@ -249,8 +259,8 @@ def test_startup_impact_step_against_ramp(path, rpm, duration_s, ramp_s, over_me
     peak = step["startup_tangential_force_peak_n"]
     assert peak > over_mean * step["tangential_force_mean_n"], (peak, step["tangential_force_mean_n"])
     assert peak > over_max * step["tangential_force_max_n"], (peak, step["tangential_force_max_n"])
-    assert ramp["startup_tangential_force_peak_n"] < 1.1 * ramp["tangential_force_max_n"]
-    assert peak > 2.5 * ramp["startup_tangential_force_peak_n"]
+    assert ramp["startup_tangential_force_peak_n"] < ramp_over_max * ramp["tangential_force_max_n"]
+    assert peak > step_over_ramp * ramp["startup_tangential_force_peak_n"]
     assert step["startup_penetration_max_um"] > 1.5 * ramp["startup_penetration_max_um"]
 
 
@@ -258,7 +268,8 @@ def test_startup_peak_is_per_step_whatever_record_every():
     """The start-up impact lasts a fraction of a millisecond. With record_every = 100 (1 ms samples) the recorded
     F_t (the interval mean) shows 515 N of the screw jack's step start; the summary's start-up peak, from every
     step's |F_t| (series tangential_force_abs_max_n), gives 12628 N against 11931 N at record_every = 1 (the
-    friction coefficient and the collision window are updated once per interval, so the runs differ a little)."""
+    friction coefficient and the collision window are updated once per interval, so the runs differ a little; numbers
+    measured with pieces, before flanks were the default)."""
     s1, _ = _start(JACK, 6650, 0.04, 0)
     s100, series = _start(JACK, 6650, 0.04, 0, record_every=100)
     assert s100["record_every"] == 100
