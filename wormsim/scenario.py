@@ -143,6 +143,11 @@ class Contact(_Strict):
             and self.friction_dynamic > self.friction_static
         ):
             raise ValueError("friction_dynamic must not exceed friction_static")
+        if self.geometry == "pieces" and self.slices is not None:
+            raise ValueError(
+                f"contact.slices = {self.slices} applies to contact.geometry flanks only (pieces: one contact per "
+                f"piece pair); allowed: contact.slices unset with contact.geometry pieces"
+            )
         return self
 
 
@@ -362,6 +367,12 @@ class Scenario(_Strict):
                 f"simulation.mass_scaling = {self.simulation.mass_scaling}: only model contact3d scales "
                 f"masses (torsional runs the 20 s seat motor in seconds without it); allowed: "
                 f"simulation.mass_scaling = 1 with model {self.model}"
+            )
+        if self.model == "contact3d" and self.simulation.speculative and self.contact.geometry == "flanks":
+            raise ValueError(
+                "simulation.speculative = true: MuJoCo's speculative contacts act on its collision of convex pieces, "
+                "not on the contacts found on the exact flanks; allowed: simulation.speculative = false with "
+                "contact.geometry flanks, or contact.geometry pieces"
             )
         if self.model == "wedge":
             if self.wedge is None:

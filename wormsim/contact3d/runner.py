@@ -144,16 +144,23 @@ def diverged_error(t: float, dt: float, bm: BuiltModel, what: str) -> Simulation
 def jump_error(t: float, te_pitch: float, dt: float, bm: BuiltModel, scenario: Scenario) -> SimulationError:
     """Transmission error beyond half a pitch. Above the stable timestep this is the integration running away
     (reported as divergence: a stiffer contact would make it worse); within it the teeth really passed each
-    other: the load overpowers the mesh."""
+    other: the load overpowers the mesh. With contact.geometry flanks (the working flanks only: no tips, edges or
+    roots) the jump itself is not modelled, and the message says so."""
     lim = bm.law.stable_limit_s
     if dt > lim:
         return diverged_error(t, dt, bm, f"the transmission error ran away to {te_pitch:.2f} pitch")
+    flanks_note = (
+        "; contact.geometry flanks models the working flanks only (no tips or edges), so the jump itself is not "
+        "simulated: contact.geometry pieces models it"
+        if bm.meta.get("contact_geometry") == "flanks"
+        else ""
+    )
     return TeethJumpedError(
         f"teeth jumped a pitch at t = {t:.4g} s (transmission error {te_pitch:.2f} pitch) at timestep {dt:.3g} s, "
         f"within the contact's stable limit {lim:.3g} s: the load overpowers the mesh (load {scenario.load.torque_nm} "
         f"N m over {scenario.load.ramp_s} s, contact stiffness {bm.law.pair_stiffness_n_per_m:.3g} N/m per tooth "
         f"pair); lower load.torque_nm or lengthen load.ramp_s, or raise contact.stiffness_n_per_m (with a smaller "
-        f"simulation.timestep_s)"
+        f"simulation.timestep_s){flanks_note}"
     )
 
 
