@@ -35,6 +35,7 @@ DEMO = SCEN / "seat_motor_demo.yaml"
 # the backlash check is the collision pieces' (their bulge beyond the exact flanks): its tests pin contact.geometry
 # pieces; the flank contacts are found on the exact flanks and need no such margin
 PIECES = ["contact.geometry=pieces"]
+DEMO_PIECES = ["simulation.resolution=coarse", *PIECES]  # the demo as it was before flanks: coarse pieces
 # the CI configurations of tests/test_contact3d_seeds.py (kept in step by hand: that module runs its seeds at import)
 CI = {
     "seat_motor": [
@@ -77,13 +78,15 @@ def test_zero_backlash_exits_2_naming_the_field_and_the_smallest_backlash(tmp_pa
     gear.backlash_mm with the smallest backlash allowed at this resolution; that value then builds. contact.geometry
     pieces."""
     out = tmp_path / "zero"
-    args = ["run", str(DEMO), "--out", str(out), "--no-progress", "--set", "gear.backlash_mm=0", "--set", PIECES[0]]
+    args = ["run", str(DEMO), "--out", str(out), "--no-progress", "--set", "gear.backlash_mm=0"]
+    for kv in DEMO_PIECES:
+        args += ["--set", kv]
     rc = cli.main(args)
     assert rc == 2
     err = capsys.readouterr().err
     assert "gear.backlash_mm >" in err and "preloaded pair" in err and "simulation.resolution fine" in err, err
     quoted = float(re.search(r"gear\.backlash_mm > ([0-9.e+-]+) mm", err).group(1))
-    sc = load_scenario(DEMO, [f"gear.backlash_mm={quoted}", *PIECES])
+    sc = load_scenario(DEMO, [f"gear.backlash_mm={quoted}", *DEMO_PIECES])
     bm = build_model(sc)
     g = bm.geometry
     j_min = min_backlash_m(g, piece_bulge_m(bm.pieces.piece_error_um))
@@ -115,11 +118,11 @@ def test_pieces_leave_the_requested_play_and_interfere_at_zero_backlash():
     mesh cycle): with j = 0.01 mm the wheel's free play between its flanks is j within 1 um (measured 9.57-10.27 um)
     and nothing touches at the conjugate pose; with j = 0 (check bypassed) the pieces overlap there (measured
     0.21 um): the pieces cannot represent a zero-clearance pair. contact.geometry pieces."""
-    bm = build_model(load_scenario(DEMO, ["gear.backlash_mm=0.01", *PIECES]))
+    bm = build_model(load_scenario(DEMO, ["gear.backlash_mm=0.01", *DEMO_PIECES]))
     p = piece_play(bm)
     assert p["interference_max_m"] == 0.0
     assert abs(p["play_min_m"] - 0.01 * MM) < 1 * UM and abs(p["play_max_m"] - 0.01 * MM) < 1 * UM
-    bm0 = build_model(load_scenario(DEMO, ["gear.backlash_mm=0", *PIECES]), check_backlash_vs_pieces=False)
+    bm0 = build_model(load_scenario(DEMO, ["gear.backlash_mm=0", *DEMO_PIECES]), check_backlash_vs_pieces=False)
     assert piece_play(bm0)["interference_max_m"] > 0.0
 
 
@@ -140,8 +143,8 @@ def test_near_zero_backlash_does_not_change_a_loaded_forward_drive():
     and efficiency 0.6048 for j = 0.05, 0.02, 0.01, 0.005 and 0 mm). contact.geometry pieces, whose check sets j_min;
     with the flank contacts (no j_min) the same runs measured worm torque equal within 1e-3 and efficiency 0.61515
     (j = 0.05 mm) against 0.61578 (j = 0.001 mm), 1.03e-3 apart."""
-    t_nom, eta_nom = _forward(DEMO, ["gear.backlash_mm=0.05", *PIECES], 0.02)
-    t_small, eta_small = _forward(DEMO, ["gear.backlash_mm=0.001", *PIECES], 0.02)
+    t_nom, eta_nom = _forward(DEMO, ["gear.backlash_mm=0.05", *DEMO_PIECES], 0.02)
+    t_small, eta_small = _forward(DEMO, ["gear.backlash_mm=0.001", *DEMO_PIECES], 0.02)
     assert t_small == pytest.approx(t_nom, rel=1e-3)
     assert eta_small == pytest.approx(eta_nom, rel=1e-3)
 
