@@ -3,7 +3,9 @@ left-hand ZA, and a wide-faced gear whose coarse collision pieces interfere, whi
 simulating (wormsim.contact3d.backlash.check_conjugate_interference) with the resolution that works named.
 
 Short runs (0.03 s at 1000 rpm: two mesh periods of a 4-start worm, half a worm turn) at coarse resolution; the ratio
-is checked to the CI tolerance (0.1 %) and torque balance (F_t r2 = load) to 2 %."""
+is checked to the CI tolerance (0.1 %) and torque balance (F_t r2 = load) to 2 %. These pin contact.geometry pieces
+(the convex pieces on other gears, and their interference check); the exact-flank variants (the default geometry)
+follow below."""
 
 from __future__ import annotations
 
@@ -18,6 +20,7 @@ from wormsim.contact3d.runner import simulate
 from wormsim.scenario import ScenarioError, load_scenario
 
 GEAR = Path(__file__).resolve().parent / "assets" / "other_gear.yaml"
+PIECES = ("contact.geometry=pieces",)
 
 
 @pytest.mark.parametrize(
@@ -29,7 +32,7 @@ GEAR = Path(__file__).resolve().parent / "assets" / "other_gear.yaml"
     ids=["4-start", "left-ZA"],
 )
 def test_other_gears_transmit_the_ratio_and_the_load(overrides):
-    sc = load_scenario(GEAR, list(overrides))
+    sc = load_scenario(GEAR, list(overrides + PIECES))
     g = derive(sc.gear)
     s = simulate(sc).summary
     assert abs(s["ratio"] / (g.z2 / g.z1) - 1) < 1e-3, s["ratio"]
@@ -37,6 +40,7 @@ def test_other_gears_transmit_the_ratio_and_the_load(overrides):
 
 
 WIDE = ["gear.wheel_teeth=80", "gear.worm_starts=1", "gear.diameter_quotient=16"]  # b2 50 mm, m_x 4 mm
+WIDE_PIECES = WIDE + list(PIECES)
 
 
 def test_interfering_coarse_pieces_are_refused_before_simulating_with_the_cure(tmp_path, capsys):
@@ -44,14 +48,17 @@ def test_interfering_coarse_pieces_are_refused_before_simulating_with_the_cure(t
     (56 um flank clearance); unrefused, the run jammed (efficiency 0.0006, radial force 241 kN). meshgen's sampled
     bulge (13 um) did not show it, the model's own collision does."""
     with pytest.raises(ScenarioError, match="simulation.resolution medium") as exc:
-        build_model(load_scenario(GEAR, WIDE))
+        build_model(load_scenario(GEAR, WIDE_PIECES))
     assert "interfere" in str(exc.value) and "gear.backlash_mm" in str(exc.value)
     assert (
-        main(["run", str(GEAR), "--out", str(tmp_path / "r"), "--no-progress"] + sum((["--set", o] for o in WIDE), []))
+        main(
+            ["run", str(GEAR), "--out", str(tmp_path / "r"), "--no-progress"]
+            + sum((["--set", o] for o in WIDE_PIECES), [])
+        )
         == 2
     )
     assert "simulation.resolution medium" in capsys.readouterr().err
-    bm = build_model(load_scenario(GEAR, WIDE + ["simulation.resolution=medium"]))
+    bm = build_model(load_scenario(GEAR, WIDE_PIECES + ["simulation.resolution=medium"]))
     assert bm.meta["conjugate_interference_m"] == 0.0
 
 
