@@ -49,6 +49,7 @@ from wormsim.contact3d.flank_pose import N_WORM_PARAMS, static_dir_to_world, to_
 
 N_PROFILE = 64  # points along the profile per slice (the parabola refines between them)
 SLICES = {"coarse": 8, "medium": 16, "fine": 32}  # default slices across the face per simulation.resolution
+TAPER_SHARE = 0.5  # outer share of the candidate margin over which an edge contact's depth fades to zero
 MARGIN_PITCH = 0.10  # candidate points: conjugate angle within this fraction of a pitch (plus the backlash
 # angle and the transmission error, find_contacts' margin) of the wheel angle
 
@@ -261,6 +262,11 @@ def _find_contacts(xy, c, c_range, span, zeta, ks, theta1, theta2, margin, P, ou
             for j in range(S):
                 if hi < c_range[sg, j, 0] or lo > c_range[sg, j, 1]:
                     continue
+                # an edge contact (the line's point past the active profile's end, the wheel's tip edge pressed into
+                # the worm flank) fades to zero at the window's edge instead of being cut there with its load:
+                # the line depth is scaled by the taper over the outer TAPER_SHARE of the margin
+                out = max(c_range[sg, j, 0] - target, target - c_range[sg, j, 1], 0.0)
+                taper = min((margin - out) / (TAPER_SHARE * margin), 1.0)
                 # start at the active point whose conjugate angle is nearest the target (the contact line's point;
                 # bisection, c is monotone along the active profile)
                 a, b = span[sg, j, 0], span[sg, j, 1]
@@ -380,10 +386,22 @@ def _find_contacts(xy, c, c_range, span, zeta, ks, theta1, theta2, margin, P, ou
                 pos[n, 2] = pz + 0.5 * dlt * az
                 nrm[n, 0], nrm[n, 1], nrm[n, 2] = ax, ay, az
                 depth[n] = max(dlt, 0.0)
-                line[n, 0], line[n, 1] = e_x, -gline
+                line[n, 0], line[n, 1] = e_x, -gline * taper
                 meta[n, 0], meta[n, 1], meta[n, 2], meta[n, 3] = k, sg, j, f
                 n += 1
     return n
+
+
+@numba.njit(cache=True, inline="always")
+def _covered_half(e, d):
+    """Length (in slice widths) of t in [0, 1/2] with e + t d <= 0: the half-strip's part inside the threaded
+    region, the excess linear across the face (continuous in e and d; a step only where d = 0)."""
+    if d == 0.0:
+        return 0.5 if e <= 0.0 else 0.0
+    t0 = -e / d  # where the excess crosses zero
+    if d > 0.0:  # inside for t <= t0
+        return min(max(t0, 0.0), 0.5)
+    return 0.5 - min(max(t0, 0.0), 0.5)  # inside for t >= t0
 
 
 @numba.njit(cache=True)
@@ -400,19 +418,23 @@ def slice_weights(meta, line, n, slices, pos, nrm, depth, weight):
     for i in range(n):
         k, sg, j = meta[i, 0], meta[i, 1], meta[i, 2]
         e = line[i, 0]
+        # the neighbours' excess (nan where that slice has no contact)
+        el, er = np.nan, np.nan
+        if i > 0 and meta[i - 1, 0] == k and meta[i - 1, 1] == sg and meta[i - 1, 2] == j - 1:
+            el = line[i - 1, 0]
+        if i + 1 < n and meta[i + 1, 0] == k and meta[i + 1, 1] == sg and meta[i + 1, 2] == j + 1:
+            er = line[i + 1, 0]
         w = 0.0
         for side in (-1, 1):
-            nb = i + side
-            if nb >= 0 and nb < n and meta[nb, 0] == k and meta[nb, 1] == sg and meta[nb, 2] == j + side:
-                en = line[nb, 0]
-                if e <= 0.0 and en <= 0.0:
-                    w += 0.5
-                elif e <= 0.0:
-                    w += min(e / (e - en), 0.5)
-                elif en <= 0.0:
-                    w += max(en / (en - e) - 0.5, 0.0)
-            elif e <= 0.0:
-                w += 0.5
+            en, eo = (el, er) if side < 0 else (er, el)
+            # excess per slice towards this side: from the neighbour there, else extrapolated from the other one
+            if en == en:
+                d = en - e
+            elif eo == eo:
+                d = e - eo
+            else:
+                d = 0.0
+            w += _covered_half(e, d)
         if w <= 0.0 or line[i, 1] <= 0.0:
             continue
         if m != i:
