@@ -28,7 +28,11 @@ contact line is quadratic), giving ONE contact per (tooth, flank, slice): depth 
 n = grad G / |grad G| in the assembly frame (from the worm into the wheel: the force on the wheel is along +n),
 position = the wheel point moved delta / 2 along n (MuJoCo's midpoint). A tooth pair whose contact line spans the face
 thus gives S contacts of stiffness K / S each (wormsim.contact3d.law, n_ref = S): the slice method of gear dynamics;
-slice_weights scales each by the share of its slice the contact line covers (the line's end interpolated).
+slice_weights scales each by the share of its slice the contact line covers (the line's end interpolated). Where the
+line's point lies past the wheel's active profile, the contact is the profile's end (the wheel's tip edge, or the
+end at the worm tip's reach) pressed into the worm flank, its depth the gap there; its depth fades linearly to zero
+over the outer TAPER_SHARE of the candidate window, so that it leaves at zero load also where the flanks are still
+pressed together at the window's edge (seat motor: 30 um deep, 0.1 pitch past the profile's end).
 
 The kernel repeats the worm's H(r) (meshgen.worm.half_thickness, ZI/ZA) in compiled form; tests/test_flank_contact.py
 pins the kernel's distance to meshgen.worm.thread_gap.
@@ -411,9 +415,11 @@ def slice_weights(meta, line, n, slices, pos, nrm, depth, weight):
     past the worm's tip, root or end face: the line point's excess e crosses 0) sweeps across the face, instead of by
     K / S when the end crosses a slice centre. The end lies between slices j and j + 1 where e changes sign, linear
     in e; each half-strip counts as covered up to it (the trapezoidal rule for the line load with its end
-    interpolated). A half-strip towards the face edge or towards a slice without contact counts as covered when the
-    line point is inside. Keeps the contacts with w > 0 (in place: pos, nrm, depth, meta, line), sets depth to the
-    line's depth and weight to w; returns their number."""
+    interpolated). Towards the face edge or a slice without contact, the excess is extrapolated with the slope from
+    the other neighbour (covered where the extrapolation is <= 0; without either neighbour, covered when the line
+    point is inside): counting such a half-strip as covered while e <= 0 dropped it whole, half the slice's load,
+    when e crossed 0 (docs/contact3d.md). Keeps the contacts with w > 0 (in place: pos, nrm, depth, meta, line),
+    sets depth to the line's depth and weight to w; returns their number."""
     m = 0
     for i in range(n):
         k, sg, j = meta[i, 0], meta[i, 1], meta[i, 2]
