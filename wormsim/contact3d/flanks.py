@@ -248,6 +248,7 @@ def _find_contacts(xy, c, c_range, span, zeta, ks, theta1, theta2, margin, P, ou
     pitch = P[11]
     te = theta2 - P[12] * theta1
     te = (te + pitch / 2) % pitch - pitch / 2
+    taper_end = margin  # edge contacts fade to zero at this distance past the profile's conjugate range
     margin = margin + abs(te)
     stamp[:] = -1
     sid = 0
@@ -268,9 +269,10 @@ def _find_contacts(xy, c, c_range, span, zeta, ks, theta1, theta2, margin, P, ou
                     continue
                 # an edge contact (the line's point past the active profile's end, the wheel's tip edge pressed into
                 # the worm flank) fades to zero at the window's edge instead of being cut there with its load:
-                # the line depth is scaled by the taper over the outer TAPER_SHARE of the margin
+                # the line depth is scaled by the taper over the outer TAPER_SHARE of the margin without the TE
+                # term (a property of the slice's position, not of the wheel's lag; zero before the window cuts)
                 out = max(c_range[sg, j, 0] - target, target - c_range[sg, j, 1], 0.0)
-                taper = min((margin - out) / (TAPER_SHARE * margin), 1.0)
+                taper = min(max((taper_end - out) / (TAPER_SHARE * taper_end), 0.0), 1.0)
                 # start at the active point whose conjugate angle is nearest the target (the contact line's point;
                 # bisection, c is monotone along the active profile)
                 a, b = span[sg, j, 0], span[sg, j, 1]
