@@ -84,6 +84,7 @@ from wormsim.geometry import derive, displaced_pair
 from wormsim.metrics import dominant_frequency, drive_summary, mean_speeds_rpm, window_of
 from wormsim.result import Result
 from wormsim.scenario import Scenario
+from wormsim.torsional.loaded_tca import loaded_tca
 from wormsim.torsional.mesh_stiffness import MeshStiffness, mesh_stiffness, per_length_stiffness
 from wormsim.units import rad_s_to_rpm, step
 
@@ -105,10 +106,39 @@ def inertias(scenario: Scenario, g: GearGeometry) -> tuple[float, float]:
     return 0.5 * m1 * g.r1**2 + j1, 0.5 * m2 * g.r2**2 + j2
 
 
+class _TorqueTable:
+    """T_side(theta1, x) of a loaded TCA (wormsim.torsional.loaded_tca): bilinear, periodic in theta1, uniform in x;
+    0 below the grid, extended beyond its end with the last interval's slope. at() returns (T, dT/dx)."""
+
+    def __init__(self, ltca):
+        self.N, self.P = len(ltca.theta1_rad), ltca.period_rad
+        self.x0 = float(ltca.x_rad[0])
+        self.dx = float(ltca.x_rad[1] - ltca.x_rad[0])
+        self.M = len(ltca.x_rad)
+        self.T = {1: ltca.torque_fwd_nm.tolist(), -1: ltca.torque_rev_nm.tolist()}
+
+    def at(self, th1: float, x: float, side: int) -> tuple[float, float]:
+        u = (x - self.x0) / self.dx
+        if u <= 0.0:
+            return 0.0, 0.0
+        j = min(int(u), self.M - 2)
+        f = u - j
+        y = (th1 % self.P) / self.P * self.N
+        i = int(y)
+        a = y - i
+        tab = self.T[side]
+        r0, r1 = tab[i % self.N], tab[(i + 1) % self.N]
+        t0 = r0[j] * (1.0 - a) + r1[j] * a
+        t1 = r0[j + 1] * (1.0 - a) + r1[j + 1] * a
+        return t0 + (t1 - t0) * f, (t1 - t0) / self.dx
+
+
 class _Mesh:
     """The force element (module docstring); scalar call for the ODE, array call for the outputs."""
 
-    def __init__(self, scenario: Scenario, g: GearGeometry, ms: MeshStiffness, I1: float, I2: float, kin=None):
+    def __init__(
+        self, scenario: Scenario, g: GearGeometry, ms: MeshStiffness, I1: float, I2: float, kin=None, ltca=None
+    ):
         c = scenario.contact
         self.g, self.ms = g, ms
         self.hz = g.hand * g.z1 / g.z2
@@ -119,6 +149,10 @@ class _Mesh:
         if kin is not None:
             self.kP, self.kN = kin.period_rad, len(kin.theta1_rad)
             self.gf, self.gr = kin.gap_fwd_rad.tolist(), kin.gap_rev_rad.tolist()
+        # ... and the mesh torque of the displaced flanks from the loaded TCA (wormsim.torsional.loaded_tca)
+        self.ltca = ltca
+        if ltca is not None:
+            self.table = _TorqueTable(ltca)
         self.arm0 = ms.arm0_m
         self.N = ms.samples
         self.period = ms.period_rad
@@ -172,18 +206,40 @@ class _Mesh:
         e < -g_-1; the penetration rate includes the gap's change with the worm angle."""
         gf, dgf = self.gap_at(th1, self.gf)
         gr, dgr = self.gap_at(th1, self.gr)
+        if self.ltca is not None:
+            return self._torque_table(th1, w1, e, de, gf, dgf, gr, dgr)
         if e > gf:
             return self._torque(th1, w1, 1.0, e - gf, de - dgf * w1, self.k_at(th1, self.kf))
         if e < -gr:
             return self._torque(th1, w1, -1.0, -e - gr, -de - dgr * w1, self.k_at(th1, self.kr))
         return 0.0, 0.0
 
+    def _torque_table(self, th1, w1, e, de, gf, dgf, gr, dgr) -> tuple[float, float]:
+        """The loaded TCA's elastic torque T_side(theta1, x), x = side e - g_side (the lag past the first touch),
+        plus the damping of _torque with the table's tangent stiffness dT/dx in place of K_theta."""
+        if e >= 0.0:
+            side, x, dx, g = 1.0, e - gf, de - dgf * w1, 1
+        else:
+            side, x, dx, g = -1.0, -e - gr, -de - dgr * w1, -1
+        Tel, K = self.table.at(th1, x, g)
+        if Tel <= 0.0:
+            return 0.0, 0.0
+        blend = step(self.arm0 * x, 0.0, 0.0, self.d_max, 1.0)
+        T = Tel + self.c_theta_per_k * K * blend * dx
+        if T <= 0.0:
+            return 0.0, 0.0
+        return self._with_friction(side * T, w1)
+
     def _torque(self, th1, w1, side, dlt, ddlt, K) -> tuple[float, float]:
         blend = step(self.arm0 * dlt, 0.0, 0.0, self.d_max, 1.0)  # IMPACT's damping ramp over d_max
         T = K * dlt + self.c_theta_per_k * K * blend * ddlt
         if T <= 0.0:
             return 0.0, 0.0
-        T2m = side * T
+        return self._with_friction(side * T, w1)
+
+    def _with_friction(self, T2m: float, w1: float) -> tuple[float, float]:
+        """(T2m, T1m): the worm's torque through the wedge law (module docstring)."""
+        side = 1.0 if T2m > 0.0 else -1.0
         g = self.g
         vs = w1 * g.r1 / math.cos(g.gamma)
         rho = gt.virtual_friction_angle_rad(self.mu(vs), g.alpha_n)
@@ -207,6 +263,12 @@ class _Mesh:
         kf = np.interp(phase, np.arange(self.N + 1), self.kf + self.kf[:1])
         kr = np.interp(phase, np.arange(self.N + 1), self.kr + self.kr[:1])
         k = np.where(e >= 0, kf, kr) / self.arm0**2
+        if self.ltca is not None:  # the loaded TCA's tangent stiffness at the run's lag past the first touch
+            x = np.mod(th1, self.kP) / self.kP * self.kN
+            gf = np.interp(x, np.arange(self.kN + 1), self.gf + self.gf[:1])
+            gr = np.interp(x, np.arange(self.kN + 1), self.gr + self.gr[:1])
+            lag = np.where(e >= 0, e - gf, -e - gr)
+            k = np.array([self.table.at(a, b, 1 if c >= 0 else -1)[1] for a, b, c in zip(th1, lag, e)]) / self.arm0**2
         if self.kin is None:
             deflection = self.arm0 * np.maximum(np.abs(e) - self.gap, 0.0)
         else:
@@ -353,7 +415,13 @@ def simulate(scenario: Scenario, progress=None, method: str = "implicit") -> Res
     I1, I2 = inertias(scenario, g)
     pair = displaced_pair(scenario.errors, g)
     kin = pair[1] if pair is not None else None
-    mesh = _Mesh(scenario, g, ms, I1, I2, kin)
+    ltca, t_lt = None, 0.0
+    if pair is not None:
+        t_lt = time.perf_counter()
+        t2w = gt.working_wheel_torque_nm(scenario, g.ratio)
+        ltca = loaded_tca(g, pair[0], kin, kp * g.face_width, t2w, float(np.mean(ms.k_theta_fwd_nm_per_rad)))
+        t_lt = time.perf_counter() - t_lt
+    mesh = _Mesh(scenario, g, ms, I1, I2, kin, ltca)
     drv = scenario.drive
     cmds = gt.commands(scenario, g.hand)
     speed_driven = drv.speed_rpm is not None
@@ -446,6 +514,9 @@ def simulate(scenario: Scenario, progress=None, method: str = "implicit") -> Res
     if kin is not None:
         side = gt.working_flank(scenario, g.hand)
         summary.update(kin.summary(g, side))
+        k_lt = ltca.secant_stiffness_nm_per_rad(side, t2w) / ms.arm0_m**2
+        summary["mesh_stiffness_loaded_tca_mean_n_per_m"] = float(np.nanmean(k_lt)) if np.isfinite(k_lt).any() else None
+        summary["loaded_tca_wall_s"] = t_lt
         te = kin.te_rad(side)
         S["transmission_error_kinematic_rad"] = np.interp(
             np.mod(th1, kin.period_rad), np.append(kin.theta1_rad, kin.period_rad), np.append(te, te[0])
