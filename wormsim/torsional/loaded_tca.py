@@ -79,8 +79,9 @@ def _poses(g: GearGeometry, dev: displaced.Deviations, th1: float, th2: float, P
     return M[:3, 3], M[:3, 2]
 
 
-class _Evaluator:
-    """(1) at (theta1, theta2): the kernel's buffers and parameters for one pair."""
+class Evaluator:
+    """(1) at (theta1, theta2): the kernel's buffers and parameters for one pair (dev None or zero: the perfect
+    pair through the nominal kernel path)."""
 
     def __init__(self, g: GearGeometry, dev: displaced.Deviations | None, k_pair_n_per_m: float, slices: int):
         self.g, self.dev = g, dev
@@ -93,6 +94,7 @@ class _Evaluator:
         self.weight = np.zeros(cap)
         self.margin = MARGIN_PITCH * 2 * math.pi / g.z2 + g.backlash / (2 * g.r2)
         self.slices = slices
+        self.n = 0
         if dev is None or dev.is_zero():
             self.P = grid.params  # the nominal kernel path
             self.o, self.a = np.zeros(3), np.array([0.0, 0.0, 1.0])
@@ -110,11 +112,18 @@ class _Evaluator:
             gr.xy, gr.c, gr.c_range, gr.span, gr.zeta, self.ks, th1, th2, self.margin, self.P,
             self.pos, self.nrm, self.depth, self.meta, self.line,
         )  # fmt: skip
-        n = slice_weights(self.meta, self.line, n, self.slices, self.pos, self.nrm, self.depth, self.weight)
+        self.n = n = slice_weights(self.meta, self.line, n, self.slices, self.pos, self.nrm, self.depth, self.weight)
         if n == 0:
             return 0.0
         arm = np.cross(self.pos[:n] - self.o, self.nrm[:n]) @ self.a
         return float(self.kc * np.sum(self.weight[:n] * self.depth[:n] * arm))
+
+    def band_extent_m(self) -> float:
+        """Extent across the face of the last torque()'s contacts, all teeth together: the slices with a loaded
+        contact times b2 / S."""
+        n = self.n
+        loaded = self.depth[:n] * self.weight[:n] > 0
+        return len(np.unique(self.meta[:n, 2][loaded])) * self.g.face_width / self.slices
 
 
 def _gap(kin, th1: float, side: int, g: GearGeometry) -> float:
@@ -140,7 +149,7 @@ def compute(
 ) -> LoadedTCA:
     """The tables (module docstring). kin: the kinematic TCA of dev (None: the perfect pair, gap j / (2 r2), one mesh
     cycle); the x range starts at X_MAX_FACTOR working_torque / k_theta_guess and doubles (module docstring)."""
-    ev = _Evaluator(g, dev, k_pair_n_per_m, slices)
+    ev = Evaluator(g, dev, k_pair_n_per_m, slices)
     mesh = 2 * math.pi / g.z1
     period = kin.period_rad if kin is not None else mesh
     n = max(4, int(round(period / mesh * samples_per_mesh)))
