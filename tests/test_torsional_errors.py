@@ -29,9 +29,9 @@ def _pair(name: str, sets=()):
 @pytest.mark.parametrize("name", ["screw_jack", "seat_motor"])
 def test_perfect_pair_slope_is_the_mesh_stiffness(name):
     """At a small lag (1 urad) past the first touch the table's torque per lag is k(theta) of the contact-line TCA
-    (measured, 32 slices, 16 worm angles: mean ratio 1.003 screw jack, 0.996 seat motor; per worm angle within 3.7 %
-    and 5.6 %). The secant grows with the lag (more of the flanks comes into reach): +1.7 / +3.6 % at 10 urad,
-    +3.6 / +6.6 % at 100 urad (docs/errors.md section 5a)."""
+    (measured, 32 slices, 16 worm angles: mean ratio 0.997 screw jack, 0.994 seat motor; per worm angle within 3.2 %
+    and 5.6 %). The secant grows with the lag (more of the flanks comes into reach): +1.1 / +2.9 % at 10 urad,
+    +3.1 / +4.6 % at 100 urad (docs/errors.md section 5a)."""
     sc, g, kp, _ = _pair(name)
     ev = lt.Evaluator(g, None, kp * g.face_width, lt.SLICES)
     th = np.arange(16) * (2 * math.pi / g.z1) / 16
@@ -71,19 +71,19 @@ def test_shaft_angle_narrows_the_loaded_band_as_contact3d_shows():
             for t1 in tab.theta1_rad[::4]
         ]
     )
-    # measured: 5.08 mm (contact3d 5.2 mm), perfect pair 21.2 mm (contact3d 20.3 mm; slice centres: steps of b2 / 32)
+    # measured: 5.10 mm (contact3d 5.2 mm), perfect pair 21.2 mm (contact3d 20.3 mm; slice centres: steps of b2 / 32)
     assert band_mm == pytest.approx(5.2, rel=0.15)
     assert perfect_mm == pytest.approx(20.3, rel=0.1)
     # secant stiffness at the working torque: a wedge-shaped gap across the face, F = k' s L^2 / 2, lowers it far
-    # below the perfect pair's (measured 0.083 of it); the line's share L / b2 alone would give 0.26
+    # below the perfect pair's (measured 0.082 of it); the band's share, 5.1 of 21.2 mm, alone would give 0.24
     k_err = np.nanmean(tab.secant_stiffness_nm_per_rad(side, t2))
     assert k_err < 0.15 * np.mean(ms.k_theta_fwd_nm_per_rad)
 
 
 def test_shaft_angle_lowers_the_torsional_mesh_stiffness_and_raises_the_loaded_te():
     """Torsional runs of the screw jack: 0.1 deg shaft angle against the perfect pair (docs/errors.md section 5a).
-    Measured: loaded TE p2p 9.7 -> 201 urad (kinematic 210; contact3d 11 -> 240 urad), mesh deflection 0.68 ->
-    8.2 um, mesh stiffness 634 -> 52.8 N/um."""
+    Measured: loaded TE p2p 9.7 -> 207 urad (kinematic 210; contact3d 11 -> 240 urad), mesh deflection 0.68 ->
+    8.2 um, mesh stiffness 634 -> 52.2 N/um."""
     from wormsim.run import simulate
 
     r0 = simulate(load_scenario(SCEN / "screw_jack.yaml", ["model=torsional"])).summary

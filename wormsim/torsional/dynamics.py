@@ -11,7 +11,9 @@ Mesh deflection. The wheel lag angle (transmission error with the opposite sign 
 measures how far the worm leads the wheel. Conjugate flanks with circumferential backlash j (taken from the
 wheel tooth, j / 2 per side, meshgen.wheel) leave an angular gap g = j / (2 r2) each side, so the flank the
 worm pushes in forward drive (side +1) touches for e > g and the opposite flank (side -1) for e < -g;
-in between, no force. The penetration along the line of action is delta = arm0 (|e| - g), arm0 = r2 cos(alpha_n)
+in between, no force. (With assembly errors, `errors:`, the gaps are the kinematic TCA's g_side(theta1) and the
+elastic torque is the loaded TCA's table of the displaced flanks, wormsim.torsional.loaded_tca; docs/errors.md 5a.)
+The penetration along the line of action is delta = arm0 (|e| - g), arm0 = r2 cos(alpha_n)
 cos(gamma) (wormsim.torsional.mesh_stiffness: k(theta1) is computed there, once, from the generated flanks).
 
 Mesh torque on the wheel (ADAMS IMPACT form with e = 1, damping blended in over the penetration depth d_max

@@ -28,6 +28,8 @@ method); docs/errors.md, section 5a, has the measured ratio.
 
 from __future__ import annotations
 
+import hashlib
+import inspect
 import math
 from dataclasses import asdict, dataclass
 
@@ -36,14 +38,14 @@ import numpy as np
 from meshgen import assembly, displaced
 from meshgen.cache import cached
 from meshgen.geometry import GearGeometry
-from wormsim.contact3d import flank_pose
+from wormsim.contact3d import flank_pose, flanks
 from wormsim.contact3d.flanks import MARGIN_PITCH, find_contacts, flank_grid, slice_weights
 
 CODE_VERSION = "ltca-2"
 SLICES = 32  # slices across the face (contact3d's "fine")
 SAMPLES_PER_MESH = 32  # worm angles per mesh cycle
 X_POINTS = 17  # wheel lag grid points from 0 to the range's end
-X_BELOW = 4  # and below 0 (the flank kernel touches up to ~30 urad before the kinematic TCA's g: screw jack)
+X_BELOW = 4  # and below 0 (the flank kernel touches up to ~35 urad before the kinematic TCA's g: screw jack)
 MAX_DOUBLINGS = 8
 X_MAX_FACTOR = 1.5  # the grid reaches this multiple of the working torque's deflection on every worm angle
 
@@ -189,7 +191,7 @@ def compute(
 
 def loaded_tca(g, dev, kin, k_pair_n_per_m, working_torque_nm, k_theta_guess_nm_per_rad) -> LoadedTCA:
     """compute(), cached on disk (meshgen.cache) by the geometry, the errors, the kinematic TCA's gaps, the law and the
-    code's version."""
+    code's version (with the source of the flank kernel and its poses, which change on their own)."""
     parts = {
         "g": asdict(g),
         "dev": asdict(dev),
@@ -199,6 +201,7 @@ def loaded_tca(g, dev, kin, k_pair_n_per_m, working_torque_nm, k_theta_guess_nm_
         "kg": k_theta_guess_nm_per_rad,
         "grid": (SLICES, SAMPLES_PER_MESH, X_POINTS, X_BELOW, X_MAX_FACTOR),
         "v": CODE_VERSION,
+        "kernel": hashlib.sha256((inspect.getsource(flanks) + inspect.getsource(flank_pose)).encode()).hexdigest(),
     }
     return cached(
         "ltca",
