@@ -86,7 +86,6 @@ from wormsim.geometry import derive, displaced_pair
 from wormsim.metrics import dominant_frequency, drive_summary, mean_speeds_rpm, window_of
 from wormsim.result import Result
 from wormsim.scenario import Scenario
-from wormsim.torsional.loaded_tca import loaded_tca
 from wormsim.torsional.mesh_stiffness import MeshStiffness, mesh_stiffness, per_length_stiffness
 from wormsim.units import rad_s_to_rpm, step
 
@@ -419,6 +418,8 @@ def simulate(scenario: Scenario, progress=None, method: str = "implicit") -> Res
     kin = pair[1] if pair is not None else None
     ltca, t_lt = None, 0.0
     if pair is not None:
+        from wormsim.torsional.loaded_tca import loaded_tca  # imports contact3d's kernel: only with errors
+
         t_lt = time.perf_counter()
         t2w = gt.working_wheel_torque_nm(scenario, g.ratio)
         ltca = loaded_tca(g, pair[0], kin, kp * g.face_width, t2w, float(np.mean(ms.k_theta_fwd_nm_per_rad)))

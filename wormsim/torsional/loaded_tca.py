@@ -18,8 +18,8 @@ dynamics with contact3d's law). Tabulated per side s = +1 (the worm leads), -1 a
 theta2 = hand theta1 z1 / z2 - s (g_s(theta1) + x), g_s the kinematic TCA's first touch (meshgen.kinematic_tca,
 the same gap table the force element uses, linear between its samples), for x on a uniform grid from X_BELOW intervals
 below 0 up to X_MAX_FACTOR times the working deflection (doubled until the working torque is reached on every worm
-angle and the first column is free of contact), and SAMPLES_PER_MESH worm angles per mesh cycle over the kinematic
-TCA's period. T is reported as s T >= 0.
+angle and the first column is free of contact; at least the perfect pair's torque at MIN_APPROACH_M), and
+SAMPLES_PER_MESH worm angles per mesh cycle over the kinematic TCA's period. T is reported as s T >= 0.
 
 Check on the perfect pair (tests/test_torsional_errors.py): the slope dT/dx against mesh_stiffness's K_theta (4),
 which integrates k' arm^2 along the contact LINE, while (1) sums per slice of the face width (contact3d's slice
@@ -40,13 +40,15 @@ from meshgen.cache import cached
 from meshgen.geometry import GearGeometry
 from wormsim.contact3d import flank_pose, flanks
 from wormsim.contact3d.flanks import MARGIN_PITCH, find_contacts, flank_grid, slice_weights
+from wormsim.errors import SimulationError
 
-CODE_VERSION = "ltca-2"
+CODE_VERSION = "ltca-3"
 SLICES = 32  # slices across the face (contact3d's "fine")
 SAMPLES_PER_MESH = 32  # worm angles per mesh cycle
 X_POINTS = 17  # wheel lag grid points from 0 to the range's end
 X_BELOW = 4  # and below 0 (the flank kernel touches up to ~35 urad before the kinematic TCA's g: screw jack)
 MAX_DOUBLINGS = 8
+MIN_APPROACH_M = 1e-6  # the range covers at least the perfect pair's torque at this approach (an unloaded run)
 X_MAX_FACTOR = 1.5  # the grid reaches this multiple of the working torque's deflection on every worm angle
 
 
@@ -157,7 +159,7 @@ def compute(
     n = max(4, int(round(period / mesh * samples_per_mesh)))
     th1s = np.arange(n) * period / n
     hz = g.hand * g.z1 / g.z2
-    t_need = X_MAX_FACTOR * max(working_torque_nm, 1e-9)
+    t_need = X_MAX_FACTOR * max(working_torque_nm, k_theta_guess_nm_per_rad * MIN_APPROACH_M / g.r2)
 
     def tables(rows, xs):
         out = {}
@@ -183,7 +185,7 @@ def compute(
                 break
             x_max *= 2.0
         else:
-            raise ValueError(f"loaded TCA: no lag range up to {x_max * 1e6:.0f} urad reaches {t_need:.3g} N m")
+            raise SimulationError(f"loaded TCA: no lag range up to {x_max * 1e6:.0f} urad reaches {t_need:.3g} N m")
     return LoadedTCA(
         theta1_rad=th1s, period_rad=period, x_rad=xs, torque_fwd_nm=tabs[1], torque_rev_nm=tabs[-1], slices=slices
     )
