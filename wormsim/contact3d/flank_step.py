@@ -30,7 +30,14 @@ import numba
 import numpy as np
 
 from wormsim.contact3d.flank_handoff import ContactBuffer
-from wormsim.contact3d.flanks import MARGIN_PITCH, contact_frames, find_contacts, flank_grid, slice_weights
+from wormsim.contact3d.flanks import (
+    MARGIN_PITCH,
+    TAPER_SHARE,
+    contact_frames,
+    find_contacts,
+    flank_grid,
+    slice_weights,
+)
 
 
 class FlankContacts:
@@ -43,6 +50,7 @@ class FlankContacts:
         self.grid = flank_grid(g, slices)
         self.pitch = 2 * math.pi / g.z2
         self.margin0 = MARGIN_PITCH * self.pitch + g.backlash / (2 * g.r2)
+        self.taper_rad = TAPER_SHARE * self.margin0  # of the error-free window (flanks.find_contacts)
         W = bm.window_teeth
         cap = 2 * W * slices
         self.pos = np.zeros((cap, 3))
@@ -135,6 +143,7 @@ class FlankContacts:
             self.depth,
             self.meta,
             self.line,
+            self.taper_rad,
         )
         self.n = n = slice_weights(self.meta, self.line, n, self.slices, self.pos, self.nrm, self.depth, self.weight)
         contact_frames(self.nrm, n, self.frame)

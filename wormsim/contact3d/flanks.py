@@ -222,23 +222,29 @@ def _gap_at(xy, sg, j, i, zeta, ca, sa, theta1, P, tmp, gaps, exc, pts, nrs, sta
 
 
 @numba.njit(cache=True)
-def find_contacts(xy, c, c_range, span, zeta, ks, theta1, theta2, margin, P, pos, nrm, depth, meta, line):
+def find_contacts(
+    xy, c, c_range, span, zeta, ks, theta1, theta2, margin, P, pos, nrm, depth, meta, line, taper_rad=0.0
+):
     """Contacts of the window teeth ks at worm angle theta1, wheel angle theta2 (module docstring). Writes per contact
     the assembly position pos (n, 3), unit normal nrm (n, 3) (worm -> wheel), depth (n,) > 0 and meta (n, 4) =
     (tooth k, flank sigma, slice j, fractional profile index), and line (n, 2) = (excess of the contact line's point,
     its depth: the extended gap's minimum, m) for slice_weights; returns n. A contact is written where the depth at
     the worm's edge or the line's depth is positive (depth may then be 0). The candidate window is margin plus the
     transmission error |theta2 - hand z1 / z2 theta1| (wrapped to a pitch), so a wheel pushed far into the
-    worm keeps its contacts."""
+    worm keeps its contacts. Edge contacts fade to zero over the last taper_rad of the margin (default TAPER_SHARE x
+    margin; with assembly errors the caller passes TAPER_SHARE x the error-free margin, so contacts that the errors
+    move past the nominal conjugate range keep their full depth)."""
     N = c.shape[2]
+    if taper_rad <= 0.0:
+        taper_rad = TAPER_SHARE * margin
     work = (np.empty(6), np.empty(N), np.empty(N), np.empty((N, 3)), np.empty((N, 3)), np.empty(N, dtype=np.int64))
     return _find_contacts(
-        xy, c, c_range, span, zeta, ks, theta1, theta2, margin, P, (pos, nrm, depth, meta, line), work
+        xy, c, c_range, span, zeta, ks, theta1, theta2, margin, taper_rad, P, (pos, nrm, depth, meta, line), work
     )
 
 
 @numba.njit(cache=True, _nrt=False)
-def _find_contacts(xy, c, c_range, span, zeta, ks, theta1, theta2, margin, P, out, work):
+def _find_contacts(xy, c, c_range, span, zeta, ks, theta1, theta2, margin, taper_rad, P, out, work):
     """find_contacts with its work arrays passed in, compiled without numba's reference counting (_nrt=False): the
     inlined helpers take arrays, and with it every helper call cost an atomic incref/decref pair per array (about
     60 % of the kernel's time; docs/contact3d.md, "Exact flanks: cost")."""
@@ -269,10 +275,10 @@ def _find_contacts(xy, c, c_range, span, zeta, ks, theta1, theta2, margin, P, ou
                     continue
                 # an edge contact (the line's point past the active profile's end, the wheel's tip edge pressed into
                 # the worm flank) fades to zero at the window's edge instead of being cut there with its load:
-                # the line depth is scaled by the taper over the outer TAPER_SHARE of the margin without the TE
-                # term (a property of the slice's position, not of the wheel's lag; zero before the window cuts)
+                # the line depth is scaled by the taper over the last taper_rad of the margin without the TE term
+                # (a property of the slice's position, not of the wheel's lag; zero before the window cuts)
                 out = max(c_range[sg, j, 0] - target, target - c_range[sg, j, 1], 0.0)
-                taper = min(max((taper_end - out) / (TAPER_SHARE * taper_end), 0.0), 1.0)
+                taper = min(max((taper_end - out) / taper_rad, 0.0), 1.0)
                 # start at the active point whose conjugate angle is nearest the target (the contact line's point;
                 # bisection, c is monotone along the active profile)
                 a, b = span[sg, j, 0], span[sg, j, 1]

@@ -39,7 +39,7 @@ from meshgen import assembly, displaced
 from meshgen.cache import cached
 from meshgen.geometry import GearGeometry
 from wormsim.contact3d import flank_pose, flanks
-from wormsim.contact3d.flanks import MARGIN_PITCH, find_contacts, flank_grid, slice_weights
+from wormsim.contact3d.flanks import MARGIN_PITCH, TAPER_SHARE, find_contacts, flank_grid, slice_weights
 from wormsim.errors import SimulationError
 
 CODE_VERSION = "ltca-3"
@@ -97,6 +97,7 @@ class Evaluator:
         self.depth, self.meta, self.line = np.zeros(cap), np.zeros((cap, 4)), np.zeros((cap, 2))
         self.weight = np.zeros(cap)
         self.margin = MARGIN_PITCH * 2 * math.pi / g.z2 + g.backlash / (2 * g.r2)
+        self.taper_rad = TAPER_SHARE * self.margin  # of the error-free window (flanks.find_contacts)
         self.slices = slices
         self.n = 0
         if dev is None or dev.is_zero():
@@ -114,7 +115,7 @@ class Evaluator:
         gr = self.grid
         n = find_contacts(
             gr.xy, gr.c, gr.c_range, gr.span, gr.zeta, self.ks, th1, th2, self.margin, self.P,
-            self.pos, self.nrm, self.depth, self.meta, self.line,
+            self.pos, self.nrm, self.depth, self.meta, self.line, self.taper_rad,
         )  # fmt: skip
         self.n = n = slice_weights(self.meta, self.line, n, self.slices, self.pos, self.nrm, self.depth, self.weight)
         if n == 0:
