@@ -24,12 +24,10 @@ def run(name: str) -> dict:
     return _CACHE[name]
 
 
-# seat motor and screw jack pass since contacts leave at zero load (wormsim.contact3d.flanks, docs/contact3d.md):
-# F_t peaks at 29.97 / 22.14 Hz (before: the 3rd harmonic, 89.9 / 66.4 Hz, from half a slice's load dropped at once)
-MESH_XFAIL = {
-    "involute_41": "F_t peak 1087 Hz against 24.14 Hz: the 41-tooth wheel's mesh mode rings (p2p 55 kN on 13.8 kN), "
-    "as with pieces (tests/test_contact3d_seeds.py); the radial force shows 24.19 Hz",
-}
+# all three pass since contacts leave at zero load (wormsim.contact3d.flanks, docs/contact3d.md): F_t peaks at
+# 29.97 / 22.14 / 24.14 Hz (before: the 3rd harmonic, 89.9 / 66.4 Hz, from half a slice's load dropped at once; and
+# involute_41's mesh mode at 1087 Hz with p2p 55 kN, now 292 N on 13.8 kN)
+MESH_XFAIL: dict[str, str] = {}
 
 
 def _xf(table, n):
