@@ -267,9 +267,14 @@ class _Guards:
         self.speed_driven = scenario.drive.speed_rpm is not None
         self.locked_since: float | None = None
         self.turn_max = 0.0
+        # sliding contacts' friction against their slip (wormsim.contact3d.friction_guard)
+        from wormsim.contact3d.friction_guard import FrictionGuard
+        from wormsim.contact3d.mjcf import nominal_normal_force_n
+
+        self.friction = FrictionGuard(scenario, bm, nominal_normal_force_n(scenario, geo), rec * dt)
 
     def state(self, d: mujoco.MjData, t: float, th1: float, th2: float, w1: float, w2: float) -> float:
-        """Divergence, overspeed, teeth jumped; returns the transmission error (rad)."""
+        """Divergence, overspeed, teeth jumped, friction against the slip; returns the transmission error (rad)."""
         bm, dt = self.bm, self.dt
         if not math.isfinite(th1 + th2 + w1 + w2) or d.warning[mujoco.mjtWarning.mjWARN_BADQACC].number:
             raise diverged_error(t, dt, bm, "non-finite state or huge acceleration (MuJoCo's bad-qacc warning)")
@@ -282,6 +287,7 @@ class _Guards:
         te = th2 - bm.direction * th1 / bm.geometry.ratio
         if abs(te) > JUMP_PITCH * self.pitch_angle:
             raise jump_error(t, te / self.pitch_angle, dt, bm, self.scenario)
+        self.friction.check(d, t, w1, w2)
         return te
 
     def contact(self, t: float, pen: float, w_drive: float, cmd: float) -> None:

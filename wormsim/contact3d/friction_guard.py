@@ -1,0 +1,117 @@
+"""contact3d's friction guard: sliding contacts whose friction does not oppose their slip (docs/contact3d.md,
+"Friction against the slip").
+
+On MuJoCo's elliptic cone a sliding contact's friction force points along -(J_t qacc - a_ref_t), the tangential
+part of the constraint's "jar" (engine_core_constraint.c, the cone's middle zone; wormsim.contact3d.law), with the
+friction rows' reference acceleration a_ref_t = -b_f v_t. Coulomb's friction opposes the slip v_t only while
+|b_f v_t| dominates the contact's tangential acceleration |J_t qacc|. The flank contacts' friction rows have a
+small damping c_f, law (4), sized at the working load's normal force; far above that load (a self-locking pair
+back-driven by a stiff speed servo: mesh force 1e4 x the nominal) |J_t qacc| exceeds |b_f v_t| and the friction
+turns towards the contacts' acceleration. Measured (screw jack, wheel speed-driven at 55 rpm, mu 0.2, coarse
+flanks): |a_ref_t| 120 m/s^2 against |J_t qacc| 130-300 m/s^2, cos(f_t, -v_t) 0.27-0.31 (median over the contacts)
+on contacts on the cone (|f_t| = mu f_n), so the worm's friction torque fell to the normal forces' driving torque
+and the self-locking worm was back-driven at 700-900 rpm; with c_f = c_c (the pieces' value) the cosine is 0.98.
+
+The guard: after the ramps, the friction-weighted mean of cos(f_t, -v_t) over the contacts that slide (on the
+cone, slip faster than contact.transition_velocity_m_s, above which law (3) makes friction Coulomb's) must stay at or
+above ALIGN_MIN; below it for HOLD_S the run stops (SimulationError; LockedError where the wheel drives a pair that
+is self-locking, the cause of the overload). Valid runs measured at 1.000 (screw jack, seat demo, involute_41
+forward; the back-driven screw jack at mu 0.02).
+"""
+
+from __future__ import annotations
+
+import math
+
+import mujoco
+import numpy as np
+
+from wormsim import gear_theory as gt
+from wormsim.errors import SimulationError
+from wormsim.friction import friction_coefficient
+from wormsim.units import rad_s_to_rpm, rpm_to_rad_s
+
+ALIGN_MIN = 0.5  # friction-weighted cos(f_t, -v_t) of the sliding contacts below this ...
+HOLD_S = 0.02  # ... for this long (start-up transients measured: under 6 ms of misalignment, seat demo)
+ON_CONE = 0.99  # |f_t| >= ON_CONE mu f_n: the contact slides (on the friction cone)
+
+
+def friction_alignment(d: mujoco.MjData, v_min: float) -> tuple[float, float, float]:
+    """(friction-weighted mean of cos(f_t, -v_t) over the contacts on the cone that slip faster than v_min, their
+    friction force sum (N), the normal force sum of all contacts (N)); cosine 1 where none slides. Elliptic-cone rows:
+    normal, tangent 1, tangent 2 (efc_force the forces, efc_vel = J qvel the velocities, in the contact frame)."""
+    n = d.ncon
+    if n == 0:
+        return 1.0, 0.0, 0.0
+    con = d.contact
+    adr = np.asarray(con.efc_address[:n])
+    ok = (adr >= 0) & (np.asarray(con.dim[:n]) >= 3)
+    if not ok.any():
+        return 1.0, 0.0, 0.0
+    adr, mu = adr[ok], np.asarray(con.friction[:n, 0])[ok]
+    f, v = d.efc_force, d.efc_vel
+    fn = f[adr]
+    f1, f2, v1, v2 = f[adr + 1], f[adr + 2], v[adr + 1], v[adr + 2]
+    ft, vt = np.hypot(f1, f2), np.hypot(v1, v2)
+    slide = (vt > v_min) & (fn > 0) & (ft >= ON_CONE * mu * fn)
+    if not slide.any():
+        return 1.0, 0.0, float(fn.sum())
+    # |f_t| cos = -(f_t . v_t) / |v_t|, summed and divided by the summed |f_t|
+    proj = -(f1[slide] * v1[slide] + f2[slide] * v2[slide]) / vt[slide]
+    fs = float(ft[slide].sum())
+    return float(proj.sum() / fs), fs, float(fn.sum())
+
+
+class FrictionGuard:
+    """The check of the module docstring, one call per sample."""
+
+    def __init__(self, scenario, bm, nominal_normal_force_n: float, rec_interval_s: float):
+        self.scenario, self.bm = scenario, bm
+        self.start = gt.ramps_end_s(scenario)
+        self.hold = max(HOLD_S, 5 * rec_interval_s)
+        self.v_min = scenario.contact.transition_velocity_m_s
+        self.f_nominal = nominal_normal_force_n
+        self.since: float | None = None
+        self.worst = 1.0
+
+    def check(self, d: mujoco.MjData, t: float, w1: float, w2: float) -> None:
+        if t <= self.start:
+            return
+        cos, _, fn = friction_alignment(d, self.v_min)
+        if cos >= ALIGN_MIN:
+            self.since, self.worst = None, 1.0
+            return
+        self.since = t if self.since is None else self.since
+        self.worst = min(self.worst, cos)
+        if t - self.since > self.hold:
+            raise friction_error(t, cos, fn, w1, w2, self.f_nominal, self.bm, self.scenario)
+
+
+def friction_error(
+    t: float, cos: float, fn: float, w1: float, w2: float, f_nominal: float, bm, scenario
+) -> SimulationError:
+    """Friction against the slip: where the wheel drives a pair that is self-locking at standstill, the drive is
+    locked (wormsim.contact3d.runner.locked_error's diagnosis, with what was measured); otherwise the load is
+    beyond what the friction rows were sized for."""
+    from wormsim.contact3d.runner import locked_error
+
+    geo = bm.geometry
+    law = bm.law
+    ratio = fn / f_nominal if f_nominal > 0 else math.inf
+    what = (
+        f"the sliding flank contacts' friction no longer opposes the slip (friction-weighted cos(f_t, -v_t) = "
+        f"{cos:.2f} < {ALIGN_MIN} for {HOLD_S * 1e3:.0f} ms) at a mesh normal force of {fn / 1e3:.4g} kN, "
+        f"{ratio:.3g} x the {f_nominal:.4g} N of the working load that the friction rows' damping "
+        f"c_f = {law.friction_damping:.3g} N s/m was sized for (wormsim.contact3d.law (4)); the worm turns at "
+        f"{rad_s_to_rpm(w1):.4g} rpm, the wheel at {rad_s_to_rpm(w2):.4g} rpm"
+    )
+    drv = scenario.drive
+    if drv.on == "wheel" and drv.speed_rpm is not None:
+        mu0 = float(friction_coefficient(scenario.contact, 0.0))
+        if gt.virtual_friction_angle_rad(mu0, geo.alpha_n) >= geo.gamma:
+            err = locked_error(t, w2, rpm_to_rad_s(drv.speed_rpm), bm, scenario)
+            return type(err)(f"{err} (caught by the friction guard: {what}; the back-driving is not physical)")
+    return SimulationError(
+        f"friction out of range at t = {t:.4g} s: {what}; set load.torque_nm to the working load, or run "
+        f"contact.geometry=pieces (friction rows with c_f = c_c)"
+    )
