@@ -23,6 +23,7 @@ from conftest import SCENARIOS as SCEN
 
 from wormsim import cli
 from wormsim.bench.stability import FAILURE_CLASSES, classify_failure, stability_edge
+from wormsim.contact3d.friction_guard import ALIGN_MIN, friction_error
 from wormsim.contact3d.mjcf import build_model
 from wormsim.contact3d.runner import JUMP_PITCH, simulate
 from wormsim.contact3d.timestep import default_timestep
@@ -56,19 +57,7 @@ def _rho_deg(mu: float, alpha_n_deg: float) -> float:
     return math.degrees(math.atan(mu / math.cos(math.radians(alpha_n_deg))))
 
 
-LOCK_FLANKS_XFAIL = (
-    "contact.geometry flanks (the default), mu 0.2 (rho' 12.0 deg > gamma 5.71 deg): the speed-driven wheel slows from "
-    "55 to 28.6 rpm over the 0.085 s but still turns the worm at 725 rpm (ratio 23.2) with efficiency 1.1e-4, through "
-    "a mesh force rising to 736 kN (1840 x the jack's 400 N) and a penetration rising to 983 um (guard 1000 um, "
-    "0.4 m_x); the lock guard (drive below half its command for 0.05 s) does not fire and the run exits 0. The "
-    "flank contacts' friction rows have the same viscous slope impratio c_f (17 100 N s/m per contact) as the "
-    "pieces', so the cause is not the friction hardness (3)/(4); not found in the time available"
-)
-
-
-@pytest.mark.parametrize(
-    "geometry", ["flanks", "pieces"]
-)
+@pytest.mark.parametrize("geometry", ["flanks", "pieces"])
 def test_self_locking_pair_with_speed_driven_wheel_stops_locked_through_the_cli(tmp_path, capsys, geometry):
     """mu = 0.2: rho' = 12.0 deg > gamma = 5.71 deg, the wheel cannot turn the worm. Exit 3, a failed summary.json
     naming the self-locking and what to change, and nothing else left in DIR. For each contact.geometry."""
@@ -95,6 +84,32 @@ def test_self_locking_pair_with_speed_driven_wheel_stops_locked_through_the_cli(
     mu_max = float(re.search(r"below mu = tan\(gamma\) cos\(alpha_n\) = ([0-9.]+)", msg).group(1))
     assert mu_max == pytest.approx(math.tan(math.radians(5.7106)) * math.cos(math.radians(20)), rel=2e-3)
     assert [p.name for p in out.iterdir()] == ["summary.json"]
+    if geometry == "flanks":
+        # caught by the friction guard (wormsim.contact3d.friction_guard): before it, the flank contacts' friction
+        # turned from the slip towards the contacts' acceleration (cos 0.27-0.31 at 1e4 x the working load) and the
+        # worm was back-driven at 700-900 rpm
+        cos = float(re.search(r"cos\(f_t, -v_t\) = (-?[0-9.]+)", msg).group(1))
+        over = float(re.search(r"kN, ([0-9.e+]+) x the", msg).group(1))
+        assert cos < ALIGN_MIN and over > 100, msg
+    else:
+        assert "friction guard" not in msg, msg  # the lock guard itself: the wheel held below half its command
+
+
+def test_friction_guard_names_the_lock_only_where_the_wheel_drives_a_self_locking_pair():
+    """friction_error's diagnosis: LockedError naming the self-locking where the speed-driven wheel meets rho' >=
+    gamma (mu 0.2); otherwise (mu 0.02, rho' < gamma) a SimulationError saying the load is beyond what the friction
+    rows were sized for, with the measured cosine and force ratio."""
+    for mu, locked in ((0.2, True), (0.02, False)):
+        sc = load_scenario(JACK, WHEEL_DRIVEN + [f"contact.friction={mu}", LOCK_DURATION])
+        bm = build_model(sc)
+        err = friction_error(0.03, 0.3, 2e5, 90.0, 5.0, 100.0, bm, sc)
+        assert isinstance(err, LockedError) == locked, str(err)
+        msg = str(err)
+        assert "cos(f_t, -v_t) = 0.30" in msg and "2e+03 x the 100 N" in msg, msg
+        if locked:
+            assert msg.startswith("the drive locked") and "self-locking" in msg, msg
+        else:
+            assert msg.startswith("friction out of range") and "load.torque_nm" in msg, msg
 
 
 def test_valid_back_driven_run_trips_no_guard():
