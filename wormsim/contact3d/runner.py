@@ -19,7 +19,8 @@ rate cancel exactly what would fold onto 0 Hz), and whose angles and speeds are 
   `penetration_limit_m`, the transmission error passing half a pitch (teeth jumped; divergence when the
   timestep is above the contact's stable limit), a speed-driven drive stuck below half its command (locked;
   self-locking named when the wheel drives), the worm turning more than 1.25 x MAX_WORM_TURN_PER_STEP_RAD per
-  step (overspeed: its pieces would tunnel through the wheel's). Each raises its subclass of SimulationError
+  step (overspeed: its pieces would tunnel through the wheel's), the sliding contacts' friction turned away from
+  their slip (wormsim.contact3d.friction_guard). Each raises its subclass of SimulationError
   (wormsim.errors) with what to change (diverged_error, jump_error, locked_error, overspeed_error, penetration_error;
   docs/contact3d.md "Failure modes and guards").
 
