@@ -34,6 +34,7 @@ from wormsim.units import rad_s_to_rpm, rpm_to_rad_s
 ALIGN_MIN = 0.5  # friction-weighted cos(f_t, -v_t) of the sliding contacts below this ...
 HOLD_S = 0.02  # ... for this long (start-up transients measured: under 6 ms of misalignment, seat demo)
 ON_CONE = 0.99  # |f_t| >= ON_CONE mu f_n: the contact slides (on the friction cone)
+CHECK_EVERY_S = HOLD_S / 40  # the contacts are read at most this often (a sample can be a single step)
 
 
 def friction_alignment(d: mujoco.MjData, v_min: float) -> tuple[float, float, float]:
@@ -72,23 +73,23 @@ class FrictionGuard:
         self.v_min = scenario.contact.transition_velocity_m_s
         self.f_nominal = nominal_normal_force_n
         self.since: float | None = None
-        self.worst = 1.0
+        self.next_check = self.start
 
     def check(self, d: mujoco.MjData, t: float, w1: float, w2: float) -> None:
-        if t <= self.start:
+        if t <= self.next_check:
             return
+        self.next_check = t + CHECK_EVERY_S
         cos, _, fn = friction_alignment(d, self.v_min)
         if cos >= ALIGN_MIN:
-            self.since, self.worst = None, 1.0
+            self.since = None
             return
         self.since = t if self.since is None else self.since
-        self.worst = min(self.worst, cos)
         if t - self.since > self.hold:
-            raise friction_error(t, cos, fn, w1, w2, self.f_nominal, self.bm, self.scenario)
+            raise friction_error(t, cos, fn, w1, w2, self.f_nominal, self.bm, self.scenario, self.hold)
 
 
 def friction_error(
-    t: float, cos: float, fn: float, w1: float, w2: float, f_nominal: float, bm, scenario
+    t: float, cos: float, fn: float, w1: float, w2: float, f_nominal: float, bm, scenario, hold_s: float = HOLD_S
 ) -> SimulationError:
     """Friction against the slip: where the wheel drives a pair that is self-locking at standstill, the drive is
     locked (wormsim.contact3d.runner.locked_error's diagnosis, with what was measured); otherwise the load is
@@ -100,7 +101,7 @@ def friction_error(
     ratio = fn / f_nominal if f_nominal > 0 else math.inf
     what = (
         f"the sliding flank contacts' friction no longer opposes the slip (friction-weighted cos(f_t, -v_t) = "
-        f"{cos:.2f} < {ALIGN_MIN} for {HOLD_S * 1e3:.0f} ms) at a mesh normal force of {fn / 1e3:.4g} kN, "
+        f"{cos:.2f} < {ALIGN_MIN} for {hold_s * 1e3:.3g} ms) at a mesh normal force of {fn / 1e3:.4g} kN, "
         f"{ratio:.3g} x the {f_nominal:.4g} N of the working load that the friction rows' damping "
         f"c_f = {law.friction_damping:.3g} N s/m was sized for (wormsim.contact3d.law (4)); the worm turns at "
         f"{rad_s_to_rpm(w1):.4g} rpm, the wheel at {rad_s_to_rpm(w2):.4g} rpm"
