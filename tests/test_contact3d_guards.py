@@ -270,3 +270,28 @@ def test_bench_writes_the_stability_record_into_bench_meta(tmp_path, monkeypatch
     assert rec["last_stable_timestep_s"] is None and rec["failure"] == "diverged"
     assert len(rec["runs"]) == 1 and rec["runs"][0]["status"] == "failed"
     assert "stable limit" in rec["failure_message"]
+
+
+def test_friction_alignment_reads_one_for_a_box_sliding_on_a_plane():
+    """friction_guard.friction_alignment's signs (efc_force against efc_vel in the contact frame): a 1 kg box sliding
+    at 1 m/s on a plane (elliptic cone, mu 0.5) has its friction on the cone and against the slip (cos 1), |f_t| =
+    mu f_n = mu m g; at rest nothing slides (cos 1 by definition, friction sum 0)."""
+    import mujoco
+
+    from wormsim.contact3d.friction_guard import friction_alignment
+
+    xml = """<mujoco><option cone="elliptic" timestep="1e-4"/><worldbody>
+    <geom type="plane" size="1 1 0.1" friction="0.5 0 0"/>
+    <body pos="0 0 0.05"><freejoint/><geom type="box" size="0.05 0.05 0.05" mass="1" friction="0.5 0 0"/></body>
+    </worldbody></mujoco>"""
+    m = mujoco.MjModel.from_xml_string(xml)
+    d = mujoco.MjData(m)
+    for _ in range(200):  # settle onto the plane
+        mujoco.mj_step(m, d)
+    cos, ft, fn = friction_alignment(d, 1e-3)
+    assert cos == 1.0 and ft == 0.0 and fn == pytest.approx(9.81, rel=0.02)
+    d.qvel[0] = 1.0
+    for _ in range(5):
+        mujoco.mj_step(m, d)
+    cos, ft, fn = friction_alignment(d, 1e-3)
+    assert cos == pytest.approx(1.0, abs=1e-3) and ft == pytest.approx(0.5 * fn, rel=0.01), (cos, ft, fn)
