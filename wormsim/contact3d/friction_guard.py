@@ -100,7 +100,7 @@ def friction_error(
     law = bm.law
     ratio = fn / f_nominal if f_nominal > 0 else math.inf
     what = (
-        f"the sliding flank contacts' friction no longer opposes the slip (friction-weighted cos(f_t, -v_t) = "
+        f"the sliding contacts' friction no longer opposes the slip (friction-weighted cos(f_t, -v_t) = "
         f"{cos:.2f} < {ALIGN_MIN} for {hold_s * 1e3:.3g} ms) at a mesh normal force of {fn / 1e3:.4g} kN, "
         f"{ratio:.3g} x the {f_nominal:.4g} N of the working load that the friction rows' damping "
         f"c_f = {law.friction_damping:.3g} N s/m was sized for (wormsim.contact3d.law (4)); the worm turns at "
@@ -112,7 +112,7 @@ def friction_error(
         if gt.virtual_friction_angle_rad(mu0, geo.alpha_n) >= geo.gamma:
             err = locked_error(t, w2, rpm_to_rad_s(drv.speed_rpm), bm, scenario)
             return type(err)(f"{err} (caught by the friction guard: {what}; the back-driving is not physical)")
+    pieces = " or run contact.geometry=pieces (friction rows with c_f = c_c)" if law.friction_damping_n_s_per_m else ""
     return SimulationError(
-        f"friction out of range at t = {t:.4g} s: {what}; set load.torque_nm to the working load, or run "
-        f"contact.geometry=pieces (friction rows with c_f = c_c)"
+        f"friction out of range at t = {t:.4g} s: {what}; set load.torque_nm to the working load{pieces}"
     )
