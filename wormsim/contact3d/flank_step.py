@@ -36,6 +36,7 @@ from wormsim.contact3d.flanks import (
     contact_frames,
     find_contacts,
     flank_grid,
+    flank_memo,
     slice_weights,
 )
 
@@ -48,6 +49,7 @@ class FlankContacts:
         m = bm.model
         self.bm = bm
         self.grid = flank_grid(g, slices)
+        self.memo = flank_memo(self.grid, g.z2)  # find_contacts' open-slice memo
         self.pitch = 2 * math.pi / g.z2
         self.margin0 = MARGIN_PITCH * self.pitch + g.backlash / (2 * g.r2)
         self.taper_rad = TAPER_SHARE * self.margin0  # of the error-free window (flanks.find_contacts)
@@ -144,6 +146,7 @@ class FlankContacts:
             self.meta,
             self.line,
             self.taper_rad,
+            self.memo,
         )
         self.n = n = slice_weights(self.meta, self.line, n, self.slices, self.pos, self.nrm, self.depth, self.weight)
         contact_frames(self.nrm, n, self.frame)

@@ -56,6 +56,9 @@ SLICES = {"coarse": 8, "medium": 16, "fine": 32}  # default slices across the fa
 TAPER_SHARE = 0.5  # outer share of the candidate margin over which an edge contact's depth fades to zero
 MARGIN_PITCH = 0.10  # candidate points: conjugate angle within this fraction of a pitch (plus the backlash
 # angle and the transmission error, find_contacts' margin) of the wheel angle
+MEMO_GAP_SHARE = 0.5  # a memorised open slice is skipped while its bound keeps this share of the gap it had
+MEMO_JITTER_MODULE = 1e-3  # allowance (x m_x) for the slice minimum's change at constant TE (measured <= 1.5e-5)
+MEMO_AGE_CYCLE = 1.0 / 8  # a memorised slice is evaluated again after this share of a mesh cycle of worm rotation
 
 
 @dataclass(frozen=True)
@@ -223,7 +226,7 @@ def _gap_at(xy, sg, j, i, zeta, ca, sa, theta1, P, tmp, gaps, exc, pts, nrs, sta
 
 @numba.njit(cache=True)
 def find_contacts(
-    xy, c, c_range, span, zeta, ks, theta1, theta2, margin, P, pos, nrm, depth, meta, line, taper_rad=0.0
+    xy, c, c_range, span, zeta, ks, theta1, theta2, margin, P, pos, nrm, depth, meta, line, taper_rad=0.0, memo=None
 ):
     """Contacts of the window teeth ks at worm angle theta1, wheel angle theta2 (module docstring). Writes per contact
     the assembly position pos (n, 3), unit normal nrm (n, 3) (worm -> wheel), depth (n,) > 0 and meta (n, 4) =
@@ -233,23 +236,48 @@ def find_contacts(
     transmission error |theta2 - hand z1 / z2 theta1| (wrapped to a pitch), so a wheel pushed far into the
     worm keeps its contacts. Edge contacts fade to zero over the last taper_rad of the margin (default TAPER_SHARE x
     margin; with assembly errors the caller passes TAPER_SHARE x the error-free margin, so contacts that the errors
-    move past the nominal conjugate range keep their full depth)."""
+    move past the nominal conjugate range keep their full depth). memo (`flank_memo`, optional): the open-slice memo
+    that skips slices whose flanks are clearly apart (`_find_contacts`); the contacts are the same with and without."""
     N = c.shape[2]
     if taper_rad <= 0.0:
         taper_rad = TAPER_SHARE * margin
     work = (np.empty(6), np.empty(N), np.empty(N), np.empty((N, 3)), np.empty((N, 3)), np.empty(N, dtype=np.int64))
+    if memo is None:
+        memo = (np.zeros((0, 2, 1, 3)), np.zeros(3))
     return _find_contacts(
-        xy, c, c_range, span, zeta, ks, theta1, theta2, margin, taper_rad, P, (pos, nrm, depth, meta, line), work
+        xy, c, c_range, span, zeta, ks, theta1, theta2, margin, taper_rad, P, (pos, nrm, depth, meta, line), work, memo
     )
 
 
+def flank_memo(grid: FlankGrid, z2: int) -> tuple[np.ndarray, np.ndarray]:
+    """Preallocated state of find_contacts' open-slice memo for one grid: table (z2, 2, S, 3) = per (tooth mod z2,
+    flank, slice) the line depth's gap gline (> 0; 0 = nothing memorised), TE and theta1 when it was evaluated, and
+    consts = (largest radius of a grid point, jitter allowance, largest worm-angle age) (`_find_contacts`)."""
+    P = grid.params
+    z1 = abs(P[12]) * 2 * math.pi / P[11]
+    rho = float(np.nanmax(np.where(np.isfinite(grid.c), grid.rho[None], np.nan)))
+    consts = np.array([rho, MEMO_JITTER_MODULE * P[1] / math.pi, MEMO_AGE_CYCLE * 2 * math.pi / z1])
+    return np.zeros((z2, 2, grid.slices, 3)), consts
+
+
 @numba.njit(cache=True, _nrt=False)
-def _find_contacts(xy, c, c_range, span, zeta, ks, theta1, theta2, margin, taper_rad, P, out, work):
+def _find_contacts(xy, c, c_range, span, zeta, ks, theta1, theta2, margin, taper_rad, P, out, work, memo):
     """find_contacts with its work arrays passed in, compiled without numba's reference counting (_nrt=False): the
     inlined helpers take arrays, and with it every helper call cost an atomic incref/decref pair per array (about
-    60 % of the kernel's time; docs/contact3d.md, "Exact flanks: cost")."""
+    60 % of the kernel's time; docs/contact3d.md, "Exact flanks: cost").
+
+    The open-slice memo (memo = flank_memo(...); an empty table turns it off, as do displaced poses): a slice whose
+    flanks were apart at its last evaluation, with the gap's minimum gline_e > 0 inside the profile (not at its ends,
+    the parabola through three points, the line's point inside the threaded region), is skipped while
+        gline_e - 2 rho_max |TE - TE_e| - J > MEMO_GAP_SHARE gline_e   and   |theta1 - theta1_e| <= age.
+    Along the conjugate motion the minimum of such a slice depends on the TE alone (the flanks are conjugate): over
+    recorded mesh cycles of the three seeds it moved by <= 1.5e-5 m_x at constant TE (J = 1e-3 m_x), and a point of the
+    wheel moves by rho |dTE| relative to the conjugate pose (factor 2 for the gap's gradient). A skipped slice gives no
+    contact, as its evaluation would: tests/test_flank_kernel_memo.py compares with and without over mesh cycles."""
     pos, nrm, depth, meta, line = out
     tmp, gaps, exc, pts, nrs, stamp = work
+    mtab, mc = memo
+    use_memo = mtab.shape[0] > 0 and P.shape[0] <= N_WORM_PARAMS
     S, N = c.shape[1], c.shape[2]
     pitch = P[11]
     te = theta2 - P[12] * theta1
@@ -279,6 +307,16 @@ def _find_contacts(xy, c, c_range, span, zeta, ks, theta1, theta2, margin, taper
                 # (a property of the slice's position, not of the wheel's lag; zero before the window cuts)
                 out = max(c_range[sg, j, 0] - target, target - c_range[sg, j, 1], 0.0)
                 taper = min(max((taper_end - out) / taper_rad, 0.0), 1.0)
+                if use_memo:
+                    km = k % mtab.shape[0]
+                    ge = mtab[km, sg, j, 0]
+                    if ge > 0.0:
+                        if (
+                            abs(theta1 - mtab[km, sg, j, 2]) <= mc[2]
+                            and ge - 2.0 * mc[0] * abs(te - mtab[km, sg, j, 1]) - mc[1] > MEMO_GAP_SHARE * ge
+                        ):
+                            continue
+                        mtab[km, sg, j, 0] = 0.0
                 # start at the active point whose conjugate angle is nearest the target (the contact line's point;
                 # bisection, c is monotone along the active profile)
                 a, b = span[sg, j, 0], span[sg, j, 1]
@@ -367,6 +405,9 @@ def _find_contacts(xy, c, c_range, span, zeta, ks, theta1, theta2, margin, taper
                             break  # past the parabola's reach: the linear crossings from here on are >= 0
                 gline = best + qa * x_l + qb * x_l * x_l
                 if gmin >= 0.0 and gline >= 0.0:
+                    if use_memo and par and e_x <= 0.0 and gline > 0.0 and span[sg, j, 0] < ib < span[sg, j, 1]:
+                        km = k % mtab.shape[0]
+                        mtab[km, sg, j, 0], mtab[km, sg, j, 1], mtab[km, sg, j, 2] = gline, te, theta1
                     continue
                 if gmin == np.inf:
                     x = x_l  # no edge inside reach: the line's point (only its weight can make it carry)
