@@ -160,6 +160,14 @@ def _half_thickness(r, P):
 
 
 @numba.njit(cache=True, inline="always")
+def _wrap(x, period):
+    """x wrapped to [-period / 2, period / 2): Python's (x + period / 2) % period - period / 2 with floor, inlined
+    (numba's float % calls a helper around fmod: 15 % of the kernel's time); equal to it within an ulp of x."""
+    w = x + 0.5 * period
+    return w - period * math.floor(w / period) - 0.5 * period
+
+
+@numba.njit(cache=True, inline="always")
 def worm_gap_ext(xs, ys, zs, theta1, P, out):
     """Signed normal distance (1) of a static-worm-frame point from the thread flank extended past the worm's tip,
     root and end faces, the unit gradient (static worm frame) in out[0:3], and the excess (m) by which the point is
@@ -168,18 +176,18 @@ def worm_gap_ext(xs, ys, zs, theta1, P, out):
     ex = max(r - P[3], P[2] - r, abs(zs) - P[4])
     p, p_x = P[0], P[1]
     phi = math.atan2(ys, xs)
-    u = zs - p * (phi - theta1)
-    u = (u + p_x / 2) % p_x - p_x / 2
+    u = _wrap(zs - p * (phi - theta1), p_x)
     H, dH = _half_thickness(r, P)
     sg = 1.0 if u >= 0.0 else -1.0
-    cp, sp = xs / r, ys / r
+    ir = 1.0 / r
+    cp, sp = xs * ir, ys * ir
     # grad G = sg (e_z - p/r e_phi) - H' e_r, e_r = (c, s, 0), e_phi = (-s, c, 0)
-    gx = sg * (p / r) * sp - dH * cp
-    gy = -sg * (p / r) * cp - dH * sp
+    gx = sg * (p * ir) * sp - dH * cp
+    gy = -sg * (p * ir) * cp - dH * sp
     gz = sg
-    nrm = math.sqrt(gx * gx + gy * gy + gz * gz)
-    out[0], out[1], out[2] = gx / nrm, gy / nrm, gz / nrm
-    return (abs(u) - H) / nrm, ex
+    inrm = 1.0 / math.sqrt(gx * gx + gy * gy + gz * gz)
+    out[0], out[1], out[2] = gx * inrm, gy * inrm, gz * inrm
+    return (abs(u) - H) * inrm, ex
 
 
 @numba.njit(cache=True)
@@ -280,8 +288,7 @@ def _find_contacts(xy, c, c_range, span, zeta, ks, theta1, theta2, margin, taper
     use_memo = mtab.shape[0] > 0 and P.shape[0] <= N_WORM_PARAMS
     S, N = c.shape[1], c.shape[2]
     pitch = P[11]
-    te = theta2 - P[12] * theta1
-    te = (te + pitch / 2) % pitch - pitch / 2
+    te = _wrap(theta2 - P[12] * theta1, pitch)
     taper_end = margin  # edge contacts fade to zero at this distance past the profile's conjugate range
     margin = margin + abs(te)
     stamp[:] = -1
@@ -295,8 +302,7 @@ def _find_contacts(xy, c, c_range, span, zeta, ks, theta1, theta2, margin, taper
             ang, dk = tooth_angle(k, P)  # wheel body frame, pitch deviation dk (flank_pose)
         ca, sa = math.cos(ang), math.sin(ang)
         for sg in range(2):
-            target = theta2 + pitch * (k + sg) + dk
-            target = (target + math.pi) % (2 * math.pi) - math.pi
+            target = _wrap(theta2 + pitch * (k + sg) + dk, 2 * math.pi)
             lo, hi = target - margin, target + margin
             for j in range(S):
                 if hi < c_range[sg, j, 0] or lo > c_range[sg, j, 1]:
