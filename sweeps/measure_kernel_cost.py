@@ -111,7 +111,7 @@ def main(ref: str | None, repeats: int) -> dict:
         bm, loaded, unloaded = record_states(name)
         fcs = {"this": FlankContacts(bm, bm.law.contacts_per_pair)}
         off = FlankContacts(bm, bm.law.contacts_per_pair)
-        off.memo = (np.zeros((0, 2, 1, 3)), np.zeros(3))  # the memo turned off
+        off.kernel.memo_consts[2] = -1.0  # the memo turned off (no memorised slice is young enough)
         fcs["nomemo"] = off
         if refmod is not None:  # the same FlankContacts with the other kernel (its grid, main's find)
             orig_grid = flank_step.flank_grid

@@ -30,6 +30,8 @@ def _states(g, steps: int) -> np.ndarray:
 
 @pytest.mark.parametrize("name", ["screw_jack", "seat_motor"])
 def test_memo_gives_the_same_contacts(name):
+    """find_contacts with and without its memo, and find_packed (memo, slice_weights and frames in one call on
+    PackedKernel's buffers) against find_contacts without memo + slice_weights + contact_frames."""
     g = derive(load_scenario(SCENARIOS / f"{name}.yaml").gear)
     S = 16
     fg = F.flank_grid(g, S)
@@ -39,23 +41,32 @@ def test_memo_gives_the_same_contacts(name):
     margin = F.MARGIN_PITCH * pitch + g.backlash / (2 * g.r2)
     cap = 2 * W * S
     memo = F.flank_memo(fg, g.z2)
-    runs = []
-    for use in (memo, None):
+    pk = F.PackedKernel(fg, fg.params, cap, W, g.z2)
+    runs: dict = {"memo": [], "none": [], "packed": []}
+    for use in ("memo", "none"):
         bufs = [np.zeros((cap, 3)), np.zeros((cap, 3)), np.zeros(cap), np.zeros((cap, 4)), np.zeros((cap, 2))]
-        out = []
+        wf = [np.zeros(cap), np.zeros((cap, 9))]
         for th1, th2 in _states(g, 600):
             ks = window_teeth_at(th2, g.z2, W, tooth0).astype(np.int64)
-            n = F.find_contacts(
-                fg.xy, fg.c, fg.c_range, fg.span, fg.zeta, ks, th1, th2, margin, fg.params, *bufs, 0.0, use
-            )
-            out.append([b[:n].copy() for b in bufs])
-        runs.append(out)
-    with_memo, without = runs
-    loaded = sum(len(a[2]) > 0 for a in without)
+            args = (fg.xy, fg.c, fg.c_range, fg.span, fg.zeta, ks, th1, th2, margin, fg.params, *bufs, 0.0)
+            n = F.find_contacts(*args, memo if use == "memo" else None)
+            runs[use].append([b[:n].copy() for b in bufs])
+            if use == "none":
+                pos, nrm, dep, meta, line = bufs
+                n = F.slice_weights(meta, line, n, S, pos, nrm, dep, wf[0])
+                F.contact_frames(nrm, n, wf[1])
+                runs["weights"] = runs.get("weights", []) + [[b[:n].copy() for b in bufs + wf]]
+                pk.ks[:] = ks
+                m = F.find_packed(pk.fb, pk.ib, th1, th2, margin, 0.0)
+                runs["packed"].append([b[:m].copy() for b in (pk.pos, pk.nrm, pk.depth, pk.meta, pk.line)])
+                runs["packed"][-1] += [pk.weight[:m].copy(), pk.frame[:m].copy()]
+    loaded = sum(len(a[2]) > 0 for a in runs["none"])
     assert loaded > 250  # the loaded half and the jumps touch
-    for a, b in zip(with_memo, without):
-        assert len(a[2]) == len(b[2])
-        for x, y in zip(a, b):
-            assert np.array_equal(x, y)
+    for x, y in ((runs["memo"], runs["none"]), (runs["packed"], runs["weights"])):
+        for a, b in zip(x, y):
+            assert len(a[2]) == len(b[2])
+            for u, v in zip(a, b):
+                assert np.array_equal(u, v)
     # the memo was used: open slices remembered at the end of the sequence (mid-backlash stretch and jumps)
-    assert np.count_nonzero(memo[0][..., 0] > 0) > 10
+    for table in (memo[0], pk.memo):
+        assert np.count_nonzero(table[..., 0] > 0) > 10

@@ -33,11 +33,9 @@ from wormsim.contact3d.flank_handoff import ContactBuffer
 from wormsim.contact3d.flanks import (
     MARGIN_PITCH,
     TAPER_SHARE,
-    contact_frames,
-    find_contacts,
+    PackedKernel,
+    find_packed,
     flank_grid,
-    flank_memo,
-    slice_weights,
 )
 
 
@@ -49,7 +47,6 @@ class FlankContacts:
         m = bm.model
         self.bm = bm
         self.grid = flank_grid(g, slices)
-        self.memo = flank_memo(self.grid, g.z2)  # find_contacts' open-slice memo
         self.pitch = 2 * math.pi / g.z2
         self.margin0 = MARGIN_PITCH * self.pitch + g.backlash / (2 * g.r2)
         self.taper_rad = TAPER_SHARE * self.margin0  # of the error-free window (flanks.find_contacts)
@@ -103,6 +100,11 @@ class FlankContacts:
             self.params = flank_pose.displaced_params(self.grid.params, np.asarray(shift, dtype=float))
             self.margin0 += flank_pose.error_margin_rad(g, self.grid, dev)
             self._set_pose = flank_pose.set_pose
+        # the kernel's arrays, memo included, in two buffers: one compiled call per step (flanks.find_packed)
+        k = self.kernel = PackedKernel(self.grid, self.params, cap, W, g.z2)
+        self.pos, self.nrm, self.depth, self.meta, self.line = k.pos, k.nrm, k.depth, k.meta, k.line
+        self.weight, self.frame, self.ks, self.params = k.weight, k.frame, k.ks, k.P
+        self.memo = (k.memo, k.memo_consts)  # find_contacts' open-slice memo
 
     def set_friction(self, mu: float) -> None:
         if mu != self.mu:
@@ -124,32 +126,14 @@ class FlankContacts:
         return self.ks
 
     def find(self, d: mujoco.MjData) -> int:
-        """Run the kernel at the current positions; returns the number of contacts."""
+        """Run the kernel at the current positions (flanks.find_packed: find_contacts with its memo, slice_weights,
+        contact_frames); returns the number of contacts."""
         th1, th2 = d.qpos[self.qa1], d.qpos[self.qa2]
-        g = self.grid
         if self.displaced:
             self._set_pose(self.params, d.xpos, d.xmat, self.bm.worm_body, self.bm.wheel_body, th1)
-        n = find_contacts(
-            g.xy,
-            g.c,
-            g.c_range,
-            g.span,
-            g.zeta,
-            self.window(th2),
-            th1,
-            th2,
-            self.margin0,
-            self.params,
-            self.pos,
-            self.nrm,
-            self.depth,
-            self.meta,
-            self.line,
-            self.taper_rad,
-            self.memo,
-        )
-        self.n = n = slice_weights(self.meta, self.line, n, self.slices, self.pos, self.nrm, self.depth, self.weight)
-        contact_frames(self.nrm, n, self.frame)
+        self.window(th2)
+        k = self.kernel
+        self.n = n = find_packed(k.fb, k.ib, th1, th2, self.margin0, self.taper_rad)
         return n
 
     def add(self, m: mujoco.MjModel, d: mujoco.MjData) -> None:

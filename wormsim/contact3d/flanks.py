@@ -531,6 +531,120 @@ def contact_frames(nrm, n, frame):
         f[6], f[7], f[8] = b0, b1, b2
 
 
+_F_FIELDS = ("xy", "c", "c_range", "zeta", "P", "pos", "nrm", "depth", "meta", "line", "weight", "frame", "memo")
+_F_FIELDS += ("memo_consts", "tmp", "gaps", "exc", "pts", "nrs")
+_I_HEADER = 8  # S, N, cap, len(P), W, z2, 0, 0
+
+
+def _shapes(S: int, N: int, cap: int, nP: int, W: int, z2: int) -> tuple[list, list]:
+    """Shapes of the packed buffers' fields, in order (PackedKernel; find_packed unpacks the same order)."""
+    f = [(2, S, N, 2), (2, S, N), (2, S, 2), (S,), (nP,), (cap, 3), (cap, 3), (cap,), (cap, 4), (cap, 2), (cap,)]
+    f += [(cap, 9), (z2, 2, S, 3), (3,), (6,), (N,), (N,), (N, 3), (N, 3)]
+    return f, [(2, S, 2), (W,), (N,)]
+
+
+class PackedKernel:
+    """The kernel's inputs, outputs, memo and work arrays in one float and one int buffer, so that one compiled call,
+    find_packed(fb, ib, theta1, theta2, margin, taper_rad), runs find_contacts, slice_weights and contact_frames:
+    numba's dispatch costs ~0.25 us per array argument (the three calls with their 28 arrays and find_contacts' work
+    allocation cost ~9 us of Python per step). The fields are numpy views of the buffers (pos, nrm, depth, meta, line,
+    weight, frame, P, memo, span, ks: write ks and P in place)."""
+
+    def __init__(self, grid: FlankGrid, P: np.ndarray, cap: int, W: int, z2: int):
+        S, N = grid.slices, grid.c.shape[2]
+        fs, is_ = _shapes(S, N, cap, len(P), W, z2)
+        self.fb = np.zeros(sum(int(np.prod(sh)) for sh in fs))
+        self.ib = np.zeros(_I_HEADER + sum(int(np.prod(sh)) for sh in is_), dtype=np.int64)
+        self.ib[:6] = (S, N, cap, len(P), W, z2)
+        o = 0
+        for name, sh in zip(_F_FIELDS, fs):
+            k = int(np.prod(sh))
+            setattr(self, name, self.fb[o : o + k].reshape(sh))
+            o += k
+        o = _I_HEADER
+        for name, sh in zip(("span", "ks", "stamp"), is_):
+            k = int(np.prod(sh))
+            setattr(self, name, self.ib[o : o + k].reshape(sh))
+            o += k
+        self.xy[:], self.c[:], self.c_range[:], self.zeta[:] = grid.xy, grid.c, grid.c_range, grid.zeta
+        self.span[:] = grid.span
+        self.P[:] = P
+        self.memo_consts[:] = flank_memo(grid, z2)[1]
+
+
+@numba.njit(cache=True)
+def find_packed(fb, ib, theta1, theta2, margin, taper_rad):
+    """find_contacts (with its memo), slice_weights and contact_frames on a PackedKernel's buffers at worm angle
+    theta1, wheel angle theta2 for the window teeth in its ks; returns the number of contacts (their fields in
+    pos, nrm, depth, weight, frame, meta, line)."""
+    S, N, cap, nP, W, z2 = ib[0], ib[1], ib[2], ib[3], ib[4], ib[5]
+    o = 0
+    xy = fb[o : o + 4 * S * N].reshape((2, S, N, 2))
+    o += 4 * S * N
+    c = fb[o : o + 2 * S * N].reshape((2, S, N))
+    o += 2 * S * N
+    c_range = fb[o : o + 4 * S].reshape((2, S, 2))
+    o += 4 * S
+    zeta = fb[o : o + S]
+    o += S
+    P = fb[o : o + nP]
+    o += nP
+    pos = fb[o : o + 3 * cap].reshape((cap, 3))
+    o += 3 * cap
+    nrm = fb[o : o + 3 * cap].reshape((cap, 3))
+    o += 3 * cap
+    depth = fb[o : o + cap]
+    o += cap
+    meta = fb[o : o + 4 * cap].reshape((cap, 4))
+    o += 4 * cap
+    line = fb[o : o + 2 * cap].reshape((cap, 2))
+    o += 2 * cap
+    weight = fb[o : o + cap]
+    o += cap
+    frame = fb[o : o + 9 * cap].reshape((cap, 9))
+    o += 9 * cap
+    mtab = fb[o : o + 6 * z2 * S].reshape((z2, 2, S, 3))
+    o += 6 * z2 * S
+    mc = fb[o : o + 3]
+    o += 3
+    tmp = fb[o : o + 6]
+    o += 6
+    gaps = fb[o : o + N]
+    o += N
+    exc = fb[o : o + N]
+    o += N
+    pts = fb[o : o + 3 * N].reshape((N, 3))
+    o += 3 * N
+    nrs = fb[o : o + 3 * N].reshape((N, 3))
+    o = 8
+    span = ib[o : o + 4 * S].reshape((2, S, 2))
+    o += 4 * S
+    ks = ib[o : o + W]
+    o += W
+    stamp = ib[o : o + N]
+    if taper_rad <= 0.0:
+        taper_rad = TAPER_SHARE * margin
+    n = _find_contacts(
+        xy,
+        c,
+        c_range,
+        span,
+        zeta,
+        ks,
+        theta1,
+        theta2,
+        margin,
+        taper_rad,
+        P,
+        (pos, nrm, depth, meta, line),
+        (tmp, gaps, exc, pts, nrs, stamp),
+        (mtab, mc),
+    )
+    n = slice_weights(meta, line, n, S, pos, nrm, depth, weight)
+    contact_frames(nrm, n, frame)
+    return n
+
+
 def gap_reference(g: GearGeometry, pts_static: np.ndarray, theta1: float) -> np.ndarray:
     """meshgen.worm.thread_gap on static-worm-frame points (the reference the kernel is tested against)."""
     return worm.thread_gap(g, pts_static, theta1)
