@@ -100,8 +100,13 @@ class FlankContacts:
             self.params = flank_pose.displaced_params(self.grid.params, np.asarray(shift, dtype=float))
             self.margin0 += flank_pose.error_margin_rad(g, self.grid, dev)
             self._set_pose = flank_pose.set_pose
-        # the kernel's arrays, memo included, in two buffers: one compiled call per step (flanks.find_packed)
-        k = self.kernel = PackedKernel(self.grid, self.params, cap, W, g.z2)
+        self._pack()
+
+    def _pack(self) -> None:
+        """The kernel's arrays, memo included, in two buffers: one compiled call per step (flanks.find_packed);
+        again when self.params was replaced."""
+        k = self.kernel = PackedKernel(self.grid, self.params, len(self.depth), len(self.ks), self.bm.geometry.z2)
+        k.ks[:] = self.ks
         self.pos, self.nrm, self.depth, self.meta, self.line = k.pos, k.nrm, k.depth, k.meta, k.line
         self.weight, self.frame, self.ks, self.params = k.weight, k.frame, k.ks, k.P
         self.memo = (k.memo, k.memo_consts)  # find_contacts' open-slice memo
@@ -129,6 +134,8 @@ class FlankContacts:
         """Run the kernel at the current positions (flanks.find_packed: find_contacts with its memo, slice_weights,
         contact_frames); returns the number of contacts."""
         th1, th2 = d.qpos[self.qa1], d.qpos[self.qa2]
+        if self.params is not self.kernel.P:
+            self._pack()
         if self.displaced:
             self._set_pose(self.params, d.xpos, d.xmat, self.bm.worm_body, self.bm.wheel_body, th1)
         self.window(th2)
