@@ -377,6 +377,14 @@ def _find_contacts(xy, c, c_range, span, zeta, ks, theta1, theta2, margin, taper
                 if par:
                     qa, qb = 0.5 * (gp - gm), 0.5 * (gm - 2.0 * best + gp)
                     x = -qa / (2.0 * qb)
+                elif (gm == np.inf) != (gp == np.inf):
+                    # the deepest point is the active profile's end: the parabola through it and its two inner
+                    # neighbours (the one the central fit uses once the next point is deeper), its vertex clamped
+                    # to the profile, so the line point moves continuously onto the end instead of jumping to it
+                    s1 = 1 if gm == np.inf else -1
+                    g1 = gp if s1 > 0 else gm
+                    g2 = _gap_at(xy, sg, j, ib + 2 * s1, zj, ca, sa, theta1, P, tmp, gaps, exc, pts, nrs, stamp, sid)
+                    qa, qb, x, par = _end_parabola(best, g1, g2, s1)
                 nb = ib + 1 if x > 0.0 else ib - 1
                 e_x = exc[ib] if x == 0.0 else exc[ib] + abs(x) * (exc[nb] - exc[ib])
                 x_l = x
@@ -445,57 +453,71 @@ def _find_contacts(xy, c, c_range, span, zeta, ks, theta1, theta2, margin, taper
                 pos[n, 2] = pz + 0.5 * dlt * az
                 nrm[n, 0], nrm[n, 1], nrm[n, 2] = ax, ay, az
                 depth[n] = max(dlt, 0.0)
-                line[n, 0], line[n, 1] = e_x, -gline * taper
+                sl = _face_slope(xy, sg, j, ib + x_l, zj, zeta[1] - zeta[0], ca, sa, theta1, P, tmp)
+                line[n, 0], line[n, 1] = _excess_in_slices(e_x, sl), -gline * taper
                 meta[n, 0], meta[n, 1], meta[n, 2], meta[n, 3] = k, sg, j, f
                 n += 1
     return n
 
 
 @numba.njit(cache=True, inline="always")
-def _covered_half(e, d):
-    """Length (in slice widths) of t in [0, 1/2] with e + t d <= 0: the half-strip's part inside the threaded
-    region, the excess linear across the face (continuous in e and d; a step only where d = 0)."""
-    if d == 0.0:
-        return 0.5 if e <= 0.0 else 0.0
-    t0 = -e / d  # where the excess crosses zero
-    if d > 0.0:  # inside for t <= t0
-        return min(max(t0, 0.0), 0.5)
-    return 0.5 - min(max(t0, 0.0), 0.5)  # inside for t >= t0
+def _face_slope(xy, sg, j, f, zj, dz, ca, sa, theta1, P, tmp):
+    """Change of the excess (worm_gap_ext) across one slice width at the line's point: the wheel point at fractional
+    profile index f of (flank sg, slice j), its (x, y) linear between the grid points, moved by -dz/2 and +dz/2
+    along the wheel axis. A property of the point alone, so each slice's weight is continuous in the mesh angle
+    (slice_weights)."""
+    i0 = int(math.floor(f))
+    t = f - i0
+    x0, y0 = xy[sg, j, i0, 0], xy[sg, j, i0, 1]
+    if t > 0.0:
+        x0 += t * (xy[sg, j, i0 + 1, 0] - x0)
+        y0 += t * (xy[sg, j, i0 + 1, 1] - y0)
+    _, e_lo = _eval(x0, y0, zj - 0.5 * dz, ca, sa, theta1, P, tmp)
+    _, e_hi = _eval(x0, y0, zj + 0.5 * dz, ca, sa, theta1, P, tmp)
+    return e_hi - e_lo
+
+
+@numba.njit(cache=True, inline="always")
+def _excess_in_slices(e, sl):
+    """The line point's excess e in slice widths along the face, e / |sl| (sl: its change across one slice width,
+    _face_slope): how far past the contact line's end the slice centre lies. +-inf where sl is 0 or undefined."""
+    a = abs(sl)
+    if a > 0.0:
+        return e / a
+    return -np.inf if e <= 0.0 else np.inf
+
+
+@numba.njit(cache=True, inline="always")
+def _end_parabola(g0, g1, g2, s1):
+    """Parabola q(x) = g0 + qa x + qb x^2 through the gaps g0, g1, g2 at x = 0, s1, 2 s1 (s1 = +-1 towards the
+    profile's inside), and its vertex clamped to the inside (s1 x >= 0). Returns (qa, qb, x, ok); ok is False (x = 0)
+    where the three points are not convex or g2 is missing."""
+    if g2 == np.inf or g2 - 2.0 * g1 + g0 <= 0.0:
+        return 0.0, 0.0, 0.0, False
+    qb = 0.5 * (g2 - 2.0 * g1 + g0)
+    qa = s1 * (g1 - g0 - qb)
+    x = -qa / (2.0 * qb)
+    if s1 * x < 0.0:
+        x = 0.0
+    return qa, qb, x, True
 
 
 @numba.njit(cache=True)
 def slice_weights(meta, line, n, slices, pos, nrm, depth, weight):
     """Line-end interpolation of the slice method: each contact's share w in [0, 1] of its slice's strip (width b2 / S)
     that the contact line covers, so that the mesh stiffness changes continuously as the line's end (where it runs
-    past the worm's tip, root or end face: the line point's excess e crosses 0) sweeps across the face, instead of by
-    K / S when the end crosses a slice centre. The end lies between slices j and j + 1 where e changes sign, linear
-    in e; each half-strip counts as covered up to it (the trapezoidal rule for the line load with its end
-    interpolated). Towards the face edge or a slice without contact, the excess is extrapolated with the slope from
-    the other neighbour (covered where the extrapolation is <= 0; without either neighbour, covered when the line
-    point is inside): counting such a half-strip as covered while e <= 0 dropped it whole, half the slice's load,
-    when e crossed 0 (docs/contact3d.md). Keeps the contacts with w > 0 (in place: pos, nrm, depth, meta, line),
-    sets depth to the line's depth and weight to w; returns their number."""
+    past the worm's tip, root or end face: the line point's excess crosses 0) sweeps across the face, instead of by
+    K / S when the end crosses a slice centre. line[:, 0] is the line point's excess in slice widths, e / |de|
+    (find_contacts: de is the excess's change across one slice width at that point, _face_slope); with the excess
+    linear across the strip, the covered share is w = clip(1/2 - e / |de|, 0, 1) (the trapezoidal rule for the line
+    load with its end interpolated). The slope is the contact's own, not the neighbours' difference: with the
+    neighbours' excess, a neighbour leaving the list (its slice leaving the candidate window, or a slice without
+    one) switched the slope and stepped the weight at full depth (docs/contact3d.md). Keeps the contacts with w > 0
+    (in place: pos, nrm, depth, meta, line), sets depth to the line's depth and weight to w; returns their number.
+    meta and slices are kept in the signature for the callers."""
     m = 0
     for i in range(n):
-        k, sg, j = meta[i, 0], meta[i, 1], meta[i, 2]
-        e = line[i, 0]
-        # the neighbours' excess (nan where that slice has no contact)
-        el, er = np.nan, np.nan
-        if i > 0 and meta[i - 1, 0] == k and meta[i - 1, 1] == sg and meta[i - 1, 2] == j - 1:
-            el = line[i - 1, 0]
-        if i + 1 < n and meta[i + 1, 0] == k and meta[i + 1, 1] == sg and meta[i + 1, 2] == j + 1:
-            er = line[i + 1, 0]
-        w = 0.0
-        for side in (-1, 1):
-            en, eo = (el, er) if side < 0 else (er, el)
-            # excess per slice towards this side: from the neighbour there, else extrapolated from the other one
-            if en == en:
-                d = en - e
-            elif eo == eo:
-                d = e - eo
-            else:
-                d = 0.0
-            w += _covered_half(e, d)
+        w = min(max(0.5 - line[i, 0], 0.0), 1.0)
         if w <= 0.0 or line[i, 1] <= 0.0:
             continue
         if m != i:
