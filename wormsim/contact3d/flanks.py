@@ -377,6 +377,16 @@ def _find_contacts(xy, c, c_range, span, zeta, ks, theta1, theta2, margin, taper
                 if par:
                     qa, qb = 0.5 * (gp - gm), 0.5 * (gm - 2.0 * best + gp)
                     x = -qa / (2.0 * qb)
+                    # blended with the parabola through the next three points towards the vertex, by lam = |x| (0 at
+                    # the grid point, 1/2 where the deepest point passes to the neighbour: there both sides blend the
+                    # same two parabolas), so the line's depth and point do not step when the deepest point moves on
+                    s1 = 1 if x > 0.0 else -1
+                    g2 = _gap_at(xy, sg, j, ib + 2 * s1, zj, ca, sa, theta1, P, tmp, gaps, exc, pts, nrs, stamp, sid)
+                    qa2, qb2, _, ok2 = _end_parabola(best, gp if s1 > 0 else gm, g2, s1)
+                    if ok2 and x != 0.0:
+                        lam = min(abs(x), 0.5)
+                        qa, qb = (1.0 - lam) * qa + lam * qa2, (1.0 - lam) * qb + lam * qb2
+                        x = -qa / (2.0 * qb)
                 elif (gm == np.inf) != (gp == np.inf):
                     # the deepest point is the active profile's end: the parabola through it and its two inner
                     # neighbours (the one the central fit uses once the next point is deeper), its vertex clamped
@@ -385,6 +395,7 @@ def _find_contacts(xy, c, c_range, span, zeta, ks, theta1, theta2, margin, taper
                     g1 = gp if s1 > 0 else gm
                     g2 = _gap_at(xy, sg, j, ib + 2 * s1, zj, ca, sa, theta1, P, tmp, gaps, exc, pts, nrs, stamp, sid)
                     qa, qb, x, par = _end_parabola(best, g1, g2, s1)
+                x = min(max(x, -1.0), 1.0)
                 nb = ib + 1 if x > 0.0 else ib - 1
                 e_x = exc[ib] if x == 0.0 else exc[ib] + abs(x) * (exc[nb] - exc[ib])
                 x_l = x
@@ -490,7 +501,7 @@ def _excess_in_slices(e, sl):
 @numba.njit(cache=True, inline="always")
 def _end_parabola(g0, g1, g2, s1):
     """Parabola q(x) = g0 + qa x + qb x^2 through the gaps g0, g1, g2 at x = 0, s1, 2 s1 (s1 = +-1 towards the
-    profile's inside), and its vertex clamped to the inside (s1 x >= 0). Returns (qa, qb, x, ok); ok is False (x = 0)
+    profile's inside, or towards the vertex), and its vertex clamped to that side (s1 x >= 0). Returns (qa, qb, x, ok); ok is False (x = 0)
     where the three points are not convex or g2 is missing."""
     if g2 == np.inf or g2 - 2.0 * g1 + g0 <= 0.0:
         return 0.0, 0.0, 0.0, False
