@@ -24,11 +24,14 @@ negative inside the thread, valid for r_f1 <= r <= r_a1 and |z_s| <= b1 / 2; the
 bounds too (the flank extended, worm_gap_ext) and, where the minimum lies outside, takes the worm's edge on the wheel
 flank (where the excess crosses zero), so contacts enter and leave at zero depth (docs/contact3d.md). In each slice
 the deepest point along the profile is refined by the parabola through it and its two neighbours (the gap across a
-contact line is quadratic), giving ONE contact per (tooth, flank, slice): depth delta = -G_min, normal
+contact line is quadratic; blended with the next parabola towards its vertex, and at the active profile's end the one
+through the end and its two inner neighbours, so the line's depth and point are continuous in the mesh angle),
+giving ONE contact per (tooth, flank, slice): depth delta = -G_min, normal
 n = grad G / |grad G| in the assembly frame (from the worm into the wheel: the force on the wheel is along +n),
 position = the wheel point moved delta / 2 along n (MuJoCo's midpoint). A tooth pair whose contact line spans the face
 thus gives S contacts of stiffness K / S each (wormsim.contact3d.law, n_ref = S): the slice method of gear dynamics;
-slice_weights scales each by the share of its slice the contact line covers (the line's end interpolated). Where the
+slice_weights scales each by the share of its slice the contact line covers (the line's end interpolated with the
+excess's own slope across the face at the line's point, _face_slope). Where the
 line's point lies past the wheel's active profile, the contact is the profile's end (the wheel's tip edge, or the
 end at the worm tip's reach) pressed into the worm flank, its depth the gap there; its depth fades linearly to zero
 over the outer TAPER_SHARE of the candidate window, so that it leaves at zero load also where the flanks are still
@@ -501,8 +504,8 @@ def _excess_in_slices(e, sl):
 @numba.njit(cache=True, inline="always")
 def _end_parabola(g0, g1, g2, s1):
     """Parabola q(x) = g0 + qa x + qb x^2 through the gaps g0, g1, g2 at x = 0, s1, 2 s1 (s1 = +-1 towards the
-    profile's inside, or towards the vertex), and its vertex clamped to that side (s1 x >= 0). Returns (qa, qb, x, ok); ok is False (x = 0)
-    where the three points are not convex or g2 is missing."""
+    profile's inside, or towards the vertex), and its vertex clamped to that side (s1 x >= 0). Returns
+    (qa, qb, x, ok); ok is False (x = 0) where the three points are not convex or g2 is missing."""
     if g2 == np.inf or g2 - 2.0 * g1 + g0 <= 0.0:
         return 0.0, 0.0, 0.0, False
     qb = 0.5 * (g2 - 2.0 * g1 + g0)
