@@ -92,8 +92,8 @@ FLANK_GEARS = {
     "narrow-b8": ["gear.face_width_mm=8", "simulation.duration_s=0.08"],  # 11.3
 }
 HARMONIC = (
-    "F_t's largest peak is a meshing harmonic at 8 slices, the one nearest the mesh mode (450-600 Hz; a geometric "
-    "excitation: the kernel's quasi-static force has it, no load steps are left; no rattle since "
+    "F_t's largest peak is a meshing harmonic at 8 slices (all three at 450-600 Hz, far below the contact mode's "
+    "2-7 kHz; the kernel's quasi-static force has it, no load steps are left; no rattle since "
     "the flank contacts' friction rows have their own damping, wormsim.contact3d.law (4)): "
 )
 # left-ZA passes since contacts leave at zero load (docs/contact3d.md): 99.9 Hz, p2p 55.7 N on 833 N (before 499.5 Hz,
