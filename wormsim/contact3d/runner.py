@@ -323,7 +323,7 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
     pts_world = np.full((n_rec, MAX_POINTS, 3), np.nan, dtype=np.float32)
     forces = np.full((n_rec, MAX_POINTS, 3), np.nan, dtype=np.float32)
 
-    fc = pattern = None
+    fc = pattern = loop = None
     if bm.meta.get("contact_geometry") == "flanks":
         # contacts found on the exact flanks and added between collision and constraints (wormsim.contact3d.flank_step)
         from wormsim.contact3d.flank_outputs import PatternLog
@@ -347,16 +347,23 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
     a1, a2 = (ia_drv, ia_load) if worm_is_drive else (ia_load, ia_drv)
     mu_of = friction_coefficient_scalar(scenario.contact)
     mu_set = None
+    if fc is not None:  # the record interval's steps compiled (wormsim.contact3d.flank_loop)
+        from wormsim.contact3d.flank_loop import FlankLoop
+
+        loop = FlankLoop(fc, d, ia_drv, ia_load, a1, a2, s0)
     # the commands at each step's midpoint, evaluated for blocks of about 4096 steps at once
     cmds = gt.commands(scenario, bm.direction)
     block = max(1, 4096 // rec)
     for i in range(n_rec):
         if i % block == 0:
             t_blk = (i * rec + np.arange(min(block, n_rec - i) * rec) + 0.5) * dt
-            cmd_blk, load_blk = cmds.drive(t_blk).tolist(), cmds.load(t_blk).tolist()
+            cmd_arr, load_arr = cmds.drive(t_blk), cmds.load(t_blk)
+            cmd_blk, load_blk = cmd_arr.tolist(), load_arr.tolist()
         o = (i % block) * rec
         fx = fy = fz = mz = nc = t1 = t2 = p1 = p2 = fpk = 0.0
-        for j in range(o, o + rec):
+        if loop is not None:
+            t1, t2, p1, p2, nc, fx, fy, fz, mz, fpk = loop.run(cmd_arr, load_arr, o, o + rec).tolist()
+        for j in range(o, o + rec) if loop is None else ():
             ctrl[ia_drv] = cmd_blk[j]
             ctrl[ia_load] = load_blk[j]
             w1j, w2j = qv[dof1], qv[dof2]

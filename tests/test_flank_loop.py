@@ -1,0 +1,84 @@
+"""The compiled step loop (wormsim.contact3d.flank_loop) steps the model exactly as the Python split step
+(FlankContacts.step) with the runner's per-step sums: same qpos, qvel, efc_force and sums, bit for bit."""
+
+import math
+from pathlib import Path
+
+import mujoco
+import numpy as np
+import pytest
+
+from wormsim.contact3d.flank_loop import FlankLoop
+from wormsim.contact3d.flank_step import FlankContacts, split_forward
+from wormsim.contact3d.mjcf import build_model
+from wormsim.scenario import load_scenario
+
+SCEN = Path(__file__).resolve().parents[1] / "scenarios"
+N_STEPS = 400
+BASE = ["contact.geometry=flanks", "simulation.resolution=coarse", "drive.ramp_s=0.002", "load.ramp_s=0.002"]
+
+
+def _python_sums(m, d, fc, bm, cmd, load, a1, a2, s0):
+    """The runner's former per-step loop (wormsim.contact3d.runner.run_model before flank_loop)."""
+    sd, act, qv, ctrl = d.sensordata, d.actuator_force, d.qvel, d.ctrl
+    t1 = t2 = p1 = p2 = nc = fx = fy = fz = mz = fpk = 0.0
+    for j in range(len(cmd)):
+        ctrl[bm.drive_actuator] = cmd[j]
+        ctrl[bm.load_actuator] = load[j]
+        w1j, w2j = qv[bm.worm_dof], qv[bm.wheel_dof]
+        fc.step(m, d)
+        q1, q2 = act[a1], act[a2]
+        t1 += q1
+        t2 += q2
+        p1 += q1 * w1j
+        p2 += q2 * w2j
+        nc += sd[s0]
+        f0, f1, f2 = sd[s0 + 1], sd[s0 + 2], sd[s0 + 3]
+        fx += f0
+        fpk = max(fpk, abs(f0))
+        fy += f1
+        fz += f2
+        mz += sd[s0 + 6] + sd[s0 + 7] * f1 - sd[s0 + 8] * f0
+    return np.array([t1, t2, p1, p2, nc, fx, fy, fz, mz, fpk])
+
+
+@pytest.mark.parametrize("sets", [[], ["errors.shaft_angle_deg=0.1", "errors.worm_runout_mm=0.01"]])
+def test_compiled_loop_equals_python_split_step(sets):
+    sc = load_scenario(SCEN / "screw_jack.yaml", BASE + sets)
+    bm = build_model(sc)
+    m = bm.model
+    from wormsim import gear_theory as gt
+
+    dt = m.opt.timestep
+    cmds = gt.commands(sc, bm.direction)
+    t = (np.arange(N_STEPS) + 0.5) * dt
+    cmd, load = cmds.drive(t), cmds.load(t)
+    a1, a2 = (bm.drive_actuator, bm.load_actuator)  # the screw jack's worm drives
+    s0 = int(m.sensor_adr[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SENSOR, "mesh_force")])
+
+    d_py, d_nb = mujoco.MjData(m), mujoco.MjData(m)
+    fc_py = FlankContacts(bm, bm.law.contacts_per_pair)
+    fc_nb = FlankContacts(bm, bm.law.contacts_per_pair)
+    assert fc_nb.displaced == bool(sets)
+    split_forward(m, d_py, fc_py.add)
+    split_forward(m, d_nb, fc_nb.add)
+    loop = FlankLoop(fc_nb, d_nb, bm.drive_actuator, bm.load_actuator, a1, a2, s0)
+
+    rec = 7  # record intervals of 7 steps; the sums compared per interval
+    most = 0
+    for j0 in range(0, N_STEPS - rec + 1, rec):
+        ref = _python_sums(m, d_py, fc_py, bm, cmd[j0 : j0 + rec], load[j0 : j0 + rec], a1, a2, s0)
+        got = loop.run(cmd, load, j0, j0 + rec).copy()
+        assert np.array_equal(got, ref), (j0, got - ref)
+        assert fc_nb.n == fc_py.n
+        most = max(most, fc_nb.n)
+        mu = 0.05 + 0.04 * math.sin(j0)  # the runner changes friction between intervals
+        fc_py.set_friction(mu)
+        fc_nb.set_friction(mu)
+    assert most > 1 and d_nb.ncon == d_py.ncon > 0
+    assert np.array_equal(d_nb.qpos, d_py.qpos)
+    assert np.array_equal(d_nb.qvel, d_py.qvel)
+    assert d_nb.nefc == d_py.nefc
+    assert np.array_equal(d_nb.efc_force, d_py.efc_force)
+    assert np.array_equal(fc_nb.ks, fc_py.ks) and fc_nb._c == fc_py._c
+    assert loop.dropped == 0
