@@ -82,3 +82,40 @@ def test_compiled_loop_equals_python_split_step(sets):
     assert np.array_equal(d_nb.efc_force, d_py.efc_force)
     assert np.array_equal(fc_nb.ks, fc_py.ks) and fc_nb._c == fc_py._c
     assert loop.dropped == 0
+
+
+def test_compiled_sample_equals_numpy_path():
+    """FlankLoop.sample against flank_contact_details, PatternLog.record and the numpy sums the runner used."""
+    from wormsim import gear_theory as gt
+    from wormsim.contact3d.flank_outputs import PatternLog
+    from wormsim.contact3d.flank_step import flank_contact_details
+
+    sc = load_scenario(SCEN / "screw_jack.yaml", BASE)
+    bm = build_model(sc)
+    m, geo = bm.model, bm.geometry
+    d = mujoco.MjData(m)
+    fc = FlankContacts(bm, bm.law.contacts_per_pair)
+    split_forward(m, d, fc.add)
+    loop = FlankLoop(fc, d, bm.drive_actuator, bm.load_actuator, bm.drive_actuator, bm.load_actuator, 0)
+    t = (np.arange(N_STEPS) + 0.5) * m.opt.timestep
+    cmds = gt.commands(sc, bm.direction)
+    loop.run(cmds.drive(t), cmds.load(t), 0, N_STEPS)
+    assert fc.n > 4
+    mu = 0.05
+    ref_log, log = PatternLog(fc, 2.2e11), PatternLog(fc, 2.2e11)
+    nteeth, pen, p0, F, pw = flank_contact_details(fc, d)
+    ref_log.record(3, d)
+    store = tuple(np.full((5, 4, 3), np.nan, dtype=np.float32) for _ in range(3))
+    got = loop.sample(3, log, store, mu, True)
+    assert got[:2] == (nteeth, pen)
+    for a, b in zip(store, (p0, F, pw)):
+        assert np.array_equal(a[3], b[:4].astype(np.float32))
+        assert np.isnan(a[:3]).all() and np.isnan(a[4]).all()
+    assert log.m == ref_log.m > 0 and np.array_equal(log.buf[: log.m], ref_log.buf[: ref_log.m])
+    phi = np.arctan2(pw[:, 2], pw[:, 1] + geo.a)
+    fr_lc = float(-(F[:, 1] * np.cos(phi) + F[:, 2] * np.sin(phi)).sum())
+    w = np.linalg.norm(F, axis=1)
+    r = np.hypot(pw[:, 1] + geo.a, pw[:, 2])
+    eta = gt.efficiency_at_radius(geo.gamma, geo.r1, r, mu, geo.alpha_n)
+    ref = (fr_lc, (w * r).sum() / w.sum(), (w * eta).sum() / w.sum())
+    assert np.allclose(got[2:], ref, rtol=1e-12, atol=0)

@@ -16,6 +16,10 @@ the Python binding is its error interception: an mju_error inside a stage (MuJoC
 exhausted) is not turned into a Python exception here. MuJoCo's warnings (d.warning) are counted as before, and the
 runner's guards read them after each interval.
 
+`sample` is the runner's per-sample work on the flank contacts in one compiled call: flank_step.flank_contact_details
+(forces, points, teeth touching, largest penetration), flank_outputs.PatternLog.record (the contact pattern's rows),
+contact_sums.radial_and_radius, and the points stored into the run's arrays.
+
 Cost (docs/contact3d.md, "Exact flanks: cost"): the Python loop spent about 1.3-3.5 us per stage call on the binding
 and 10-20 us per step on the runner's per-step reads and sums.
 """
@@ -31,8 +35,11 @@ from llvmlite import ir
 from numba import types
 from numba.extending import intrinsic
 
+from wormsim.contact3d.contact_sums import radial_and_radius, radius_efficiency
 from wormsim.contact3d.flank_handoff import _MJ_ADD_CONTACT, _fill_add, _library
+from wormsim.contact3d.flank_outputs import _rows
 from wormsim.contact3d.flank_pose import set_pose
+from wormsim.contact3d.flank_step import _contact_forces
 from wormsim.contact3d.flanks import contact_frames, find_contacts, slice_weights
 
 STAGES_BEFORE = ("mj_checkPos", "mj_checkVel", "mj_fwdKinematics", "mj_makeM", "mj_factorM", "mj_collision")
@@ -158,6 +165,34 @@ def run_interval(fns, m_addr, d_addr, cmd, load, j0, j1, mjd, iv, fv, state, gri
     return dropped
 
 
+@numba.njit(cache=True)
+def sample_flanks(adr, frame, pos, efc_force, ncon, n_fc, cone3, meta, weight, depth, th2, z2, a, i, store, work, pat):
+    """FlankLoop.sample's compiled part (module docstring): store = (points in tooth 0's frame, forces, points; the
+    run's float32 arrays, row i); work = (3, cap, 3) and the radii and weights (cap each); pat = PatternLog's
+    (inv_rho, line_len, E*, buffer, rows used). Returns (contacts with a row, teeth touching, largest penetration,
+    F_r,lc, sum w, sum w r, the pattern's rows used)."""
+    pts, forces, pts_world = store
+    out, r, w = work
+    inv_rho, line_len, e_star, buf, pm = pat
+    n = min(n_fc, ncon)
+    if n == 0:
+        return 0, 0, 0.0, -0.0, 0.0, 0.0, pm
+    k0 = ncon - n
+    m, nteeth = _contact_forces(adr[k0:], frame[k0:], pos[k0:], efc_force, cone3, meta, th2, z2, out)
+    pen = depth[0]
+    for c in range(1, n):
+        if depth[c] > pen:
+            pen = depth[c]
+    pm = _rows(i, adr[k0:ncon], efc_force, meta, weight, inv_rho, line_len, e_star, buf, pm)
+    fr, W, wr = radial_and_radius(out[1], out[2], m, a, r, w)
+    for c in range(min(m, pts.shape[1])):
+        for x in range(3):
+            pts[i, c, x] = out[0, c, x]
+            forces[i, c, x] = out[1, c, x]
+            pts_world[i, c, x] = out[2, c, x]
+    return m, nteeth, pen, fr, W, wr, pm
+
+
 class FlankLoop:
     """run_interval's arguments for one FlankContacts and its MjData (module docstring); `run` steps an interval."""
 
@@ -194,6 +229,10 @@ class FlankLoop:
         self.hand = (buf.rec, buf.off, fc.solref, fc.solreffriction)
         self.acc = np.zeros(N_ACC)
         self.dropped = 0
+        cap = fc.pos.shape[0]
+        self.work = (np.empty((3, cap, 3)), np.empty(cap), np.empty(cap))
+        self.z2 = bm.geometry.z2
+        self.a = bm.geometry.a
 
     def run(self, cmd: np.ndarray, load: np.ndarray, j0: int, j1: int) -> np.ndarray:
         """Steps j0..j1-1 of the commands; returns the sums (run_interval's acc); fc.n and fc's window follow."""
@@ -223,3 +262,34 @@ class FlankLoop:
         fc.n = int(self.state[1])
         fc._c = int(self.state[0])
         return self.acc
+
+    def sample(self, i: int, pattern, store: tuple, mu: float, worm_drives: bool):
+        """The runner's per-sample contact outputs at sample i (module docstring): writes row i of store = (points in
+        tooth 0's frame, forces on the wheel, points; float32, up to their second dimension) and the pattern's rows;
+        returns (teeth touching, largest penetration, F_r,lc, contact radius, efficiency at the contact radius)."""
+        fc, d = self.fc, self.d
+        pattern.reserve(fc.n)
+        con = d.contact
+        cv = pattern.cv
+        m, nteeth, pen, fr, W, wr, pattern.m = sample_flanks(
+            con.efc_address,
+            con.frame,
+            con.pos,
+            d.efc_force,
+            d.ncon,
+            fc.n,
+            fc.template.dim == 3,
+            fc.meta,
+            fc.weight,
+            fc.depth,
+            float(d.qpos[fc.qa2]),
+            self.z2,
+            self.a,
+            i,
+            store,
+            self.work,
+            (cv.inv_rho, cv.line_len, pattern.e_star, pattern.buf, pattern.m),
+        )
+        _, r, w = self.work
+        r_c, eta_c = radius_efficiency(r[:m], w[:m], W, wr, self.fc.bm.geometry, mu, worm_drives)
+        return nteeth, float(pen), fr, r_c, eta_c

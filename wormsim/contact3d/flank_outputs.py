@@ -210,11 +210,15 @@ class PatternLog:
         n = min(fc.n, d.ncon)
         if n == 0:
             return
-        if self.m + n > len(self.buf):
-            self.buf = np.concatenate([self.buf, np.zeros_like(self.buf)])
+        self.reserve(n)
         adr = d.contact.efc_address[d.ncon - n : d.ncon]
         cv = self.cv
         self.m = _rows(i, adr, d.efc_force, fc.meta, fc.weight, cv.inv_rho, cv.line_len, self.e_star, self.buf, self.m)
+
+    def reserve(self, n: int) -> None:
+        """Room for n more rows."""
+        while self.m + n > len(self.buf):
+            self.buf = np.concatenate([self.buf, np.zeros_like(self.buf)])
 
     def table(self) -> np.ndarray:
         """The log as float64 rows (i, sigma, j, f, F_n, p_H, zeta, rho): zeta the slice centre, rho the flank radius

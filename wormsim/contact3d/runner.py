@@ -37,6 +37,7 @@ import numpy as np
 
 from wormsim import gear_theory as gt
 from wormsim.contact3d import mass_scaling
+from wormsim.contact3d.contact_sums import contact_sums
 from wormsim.contact3d.metrics import contact3d_summary
 from wormsim.contact3d.mjcf import BuiltModel, build_model
 from wormsim.contact3d.timestep import (
@@ -107,18 +108,6 @@ def contact_details(bm: BuiltModel, d: mujoco.MjData, window_ks: np.ndarray):
     p0 = np.stack([c * pos[:, 0] - s * pos[:, 1], s * pos[:, 0] + c * pos[:, 1], pos[:, 2]], axis=1)
     pen = float(max(0.0, -dist.min())) if len(dist) else 0.0
     return int(np.unique(ks).size), pen, p0, F, pos
-
-
-def _contact_radius_efficiency(F: np.ndarray, pw: np.ndarray, geo, mu: float, worm_drives: bool):
-    """Force-weighted worm radius of the contacts and the wedge efficiency at each contact's own radius
-    (gear_theory.efficiency_at_radius), averaged with the contact forces as weights. (nan, nan) without contacts."""
-    w = np.linalg.norm(F, axis=1)
-    W = float(w.sum())
-    if W <= 0:
-        return float("nan"), float("nan")
-    r = np.hypot(pw[:, 1] + geo.a, pw[:, 2])
-    eta = gt.efficiency_at_radius(geo.gamma, geo.r1, r, mu, geo.alpha_n, backdriving=not worm_drives)
-    return float((w * r).sum() / W), float((w * eta).sum() / W)
 
 
 def diverged_error(t: float, dt: float, bm: BuiltModel, what: str) -> SimulationError:
@@ -322,6 +311,7 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
     pts = np.full((n_rec, MAX_POINTS, 3), np.nan, dtype=np.float32)
     pts_world = np.full((n_rec, MAX_POINTS, 3), np.nan, dtype=np.float32)
     forces = np.full((n_rec, MAX_POINTS, 3), np.nan, dtype=np.float32)
+    store = (pts, forces, pts_world)
 
     fc = pattern = loop = None
     if bm.meta.get("contact_geometry") == "flanks":
@@ -390,20 +380,24 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
         te = guards.state(d, t, th1, th2, w1, w2)
         vs = abs(w1) * geo.r1 / math.cos(geo.gamma)
         mu = mu_of(vs)
-        if fc is None:
-            window = repose_window(bm, th2, window)
-            if mu != mu_set:
-                m.geom_friction[coll, 0] = mu_set = mu
-            nteeth, pen, p0, F, pw = contact_details(bm, d, window)
-        else:
+        # each contact's force turned about the worm axis onto the line of centres: the radial force DIN 3975's
+        # single pitch-point contact means; the force-weighted contact radius and efficiency there (contact_sums)
+        if fc is None or fc.displaced:
+            if fc is None:
+                window = repose_window(bm, th2, window)
+                if mu != mu_set:
+                    m.geom_friction[coll, 0] = mu_set = mu
+                nteeth, pen, p0, F, pw = contact_details(bm, d, window)
+            else:
+                fc.set_friction(mu)
+                nteeth, pen, p0, F, pw = flank_contact_details(fc, d)
+                pattern.record(i, d)
+            k = min(len(p0), MAX_POINTS)
+            pts[i, :k], forces[i, :k], pts_world[i, :k] = p0[:k], F[:k], pw[:k]
+            fr_lc, r_c, eta_c = contact_sums(F, pw, geo, mu, worm_is_drive)
+        else:  # compiled (wormsim.contact3d.flank_loop)
             fc.set_friction(mu)
-            nteeth, pen, p0, F, pw = flank_contact_details(fc, d)
-            pattern.record(i, d)
-        # each contact's force turned about the worm axis onto the line of centres (phi = its angle about the
-        # worm axis from the line of centres): the radial force DIN 3975's single pitch-point contact means
-        phi = np.arctan2(pw[:, 2], pw[:, 1] + geo.a)
-        fr_lc = float(-(F[:, 1] * np.cos(phi) + F[:, 2] * np.sin(phi)).sum())
-        r_c, eta_c = _contact_radius_efficiency(F, pw, geo, mu, worm_is_drive)
+            nteeth, pen, fr_lc, r_c, eta_c = loop.sample(i, pattern, store, mu, worm_is_drive)
         guards.contact(t, pen, w1 if worm_is_drive else w2, cmd)
         S["t_s"][i] = t
         S["worm_angle_rad"][i], S["wheel_angle_rad"][i] = th1, th2
@@ -425,8 +419,6 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
         S["max_penetration_m"][i] = pen
         S["friction_coefficient"][i] = mu
         S["transmission_error_rad"][i] = te
-        k = min(len(p0), MAX_POINTS)
-        pts[i, :k], forces[i, :k], pts_world[i, :k] = p0[:k], F[:k], pw[:k]
         if progress is not None:
             progress.update(t)
     wall = time.perf_counter() - t_wall
