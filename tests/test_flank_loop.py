@@ -8,6 +8,7 @@ import mujoco
 import numpy as np
 import pytest
 
+from wormsim.contact3d.contact_sums import RadiusLog
 from wormsim.contact3d.flank_loop import FlankLoop
 from wormsim.contact3d.flank_step import FlankContacts, split_forward
 from wormsim.contact3d.mjcf import build_model
@@ -106,16 +107,20 @@ def test_compiled_sample_equals_numpy_path():
     nteeth, pen, p0, F, pw = flank_contact_details(fc, d)
     ref_log.record(3, d)
     store = tuple(np.full((5, 4, 3), np.nan, dtype=np.float32) for _ in range(3))
-    got = loop.sample(3, log, store, mu, True)
+    rlog = RadiusLog()
+    got = loop.sample(3, log, rlog, store)
     assert got[:2] == (nteeth, pen)
     for a, b in zip(store, (p0, F, pw)):
         assert np.array_equal(a[3], b[:4].astype(np.float32))
         assert np.isnan(a[:3]).all() and np.isnan(a[4]).all()
     assert log.m == ref_log.m > 0 and np.array_equal(log.buf[: log.m], ref_log.buf[: ref_log.m])
+    # the numpy sums the runner used per sample
     phi = np.arctan2(pw[:, 2], pw[:, 1] + geo.a)
     fr_lc = float(-(F[:, 1] * np.cos(phi) + F[:, 2] * np.sin(phi)).sum())
     w = np.linalg.norm(F, axis=1)
     r = np.hypot(pw[:, 1] + geo.a, pw[:, 2])
     eta = gt.efficiency_at_radius(geo.gamma, geo.r1, r, mu, geo.alpha_n)
-    ref = (fr_lc, (w * r).sum() / w.sum(), (w * eta).sum() / w.sum())
-    assert np.allclose(got[2:], ref, rtol=1e-12, atol=0)
+    assert np.allclose(got[2:], (fr_lc, (w * r).sum() / w.sum()), rtol=1e-12, atol=0)
+    eta_c = rlog.efficiency(np.full(5, mu), geo, True)
+    assert np.isnan(eta_c[[0, 1, 2, 4]]).all()
+    assert eta_c[3] == pytest.approx((w * eta).sum() / w.sum(), rel=1e-12)

@@ -35,7 +35,7 @@ from llvmlite import ir
 from numba import types
 from numba.extending import intrinsic
 
-from wormsim.contact3d.contact_sums import radial_and_radius, radius_efficiency
+from wormsim.contact3d.contact_sums import radial_and_radius, radius_mean
 from wormsim.contact3d.flank_handoff import _MJ_ADD_CONTACT, _fill_add, _library
 from wormsim.contact3d.flank_outputs import _rows
 from wormsim.contact3d.flank_pose import set_pose
@@ -166,31 +166,33 @@ def run_interval(fns, m_addr, d_addr, cmd, load, j0, j1, mjd, iv, fv, state, gri
 
 
 @numba.njit(cache=True)
-def sample_flanks(adr, frame, pos, efc_force, ncon, n_fc, cone3, meta, weight, depth, th2, z2, a, i, store, work, pat):
+def sample_flanks(
+    adr, frame, pos, efc_force, ncon, n_fc, cone3, meta, weight, depth, th2, z2, a, i, store, work, pat, rlog
+):
     """FlankLoop.sample's compiled part (module docstring): store = (points in tooth 0's frame, forces, points; the
-    run's float32 arrays, row i); work = (3, cap, 3) and the radii and weights (cap each); pat = PatternLog's
-    (inv_rho, line_len, E*, buffer, rows used). Returns (contacts with a row, teeth touching, largest penetration,
-    F_r,lc, sum w, sum w r, the pattern's rows used)."""
+    run's float32 arrays, row i); work (3, cap, 3); pat = PatternLog's (inv_rho, line_len, E*, buffer, rows used);
+    rlog = contact_sums.RadiusLog's (buffer, rows used). Returns (teeth touching, largest penetration, F_r,lc,
+    sum w, sum w r, the pattern's rows used, the radius log's rows used)."""
     pts, forces, pts_world = store
-    out, r, w = work
     inv_rho, line_len, e_star, buf, pm = pat
+    rbuf, rm = rlog
     n = min(n_fc, ncon)
     if n == 0:
-        return 0, 0, 0.0, -0.0, 0.0, 0.0, pm
+        return 0, 0.0, -0.0, 0.0, 0.0, pm, rm
     k0 = ncon - n
-    m, nteeth = _contact_forces(adr[k0:], frame[k0:], pos[k0:], efc_force, cone3, meta, th2, z2, out)
+    m, nteeth = _contact_forces(adr[k0:], frame[k0:], pos[k0:], efc_force, cone3, meta, th2, z2, work)
     pen = depth[0]
     for c in range(1, n):
         if depth[c] > pen:
             pen = depth[c]
     pm = _rows(i, adr[k0:ncon], efc_force, meta, weight, inv_rho, line_len, e_star, buf, pm)
-    fr, W, wr = radial_and_radius(out[1], out[2], m, a, r, w)
+    fr, W, wr = radial_and_radius(work[1], work[2], m, a, i, rbuf, rm)
     for c in range(min(m, pts.shape[1])):
         for x in range(3):
-            pts[i, c, x] = out[0, c, x]
-            forces[i, c, x] = out[1, c, x]
-            pts_world[i, c, x] = out[2, c, x]
-    return m, nteeth, pen, fr, W, wr, pm
+            pts[i, c, x] = work[0, c, x]
+            forces[i, c, x] = work[1, c, x]
+            pts_world[i, c, x] = work[2, c, x]
+    return nteeth, pen, fr, W, wr, pm, rm + m
 
 
 class FlankLoop:
@@ -230,7 +232,7 @@ class FlankLoop:
         self.acc = np.zeros(N_ACC)
         self.dropped = 0
         cap = fc.pos.shape[0]
-        self.work = (np.empty((3, cap, 3)), np.empty(cap), np.empty(cap))
+        self.work = np.empty((3, cap, 3))
         self.z2 = bm.geometry.z2
         self.a = bm.geometry.a
 
@@ -263,22 +265,24 @@ class FlankLoop:
         fc._c = int(self.state[0])
         return self.acc
 
-    def sample(self, i: int, pattern, store: tuple, mu: float, worm_drives: bool):
+    def sample(self, i: int, pattern, rlog, store: tuple):
         """The runner's per-sample contact outputs at sample i (module docstring): writes row i of store = (points in
-        tooth 0's frame, forces on the wheel, points; float32, up to their second dimension) and the pattern's rows;
-        returns (teeth touching, largest penetration, F_r,lc, contact radius, efficiency at the contact radius)."""
+        tooth 0's frame, forces on the wheel, points; float32, up to their second dimension), the pattern's rows and
+        the radius log's (contact_sums.RadiusLog); returns (teeth touching, largest penetration, F_r,lc, contact
+        radius)."""
         fc, d = self.fc, self.d
-        pattern.reserve(fc.n)
+        n = fc.n
+        pattern.reserve(n)
+        rlog.reserve(n)
         con = d.contact
-        cv = pattern.cv
-        m, nteeth, pen, fr, W, wr, pattern.m = sample_flanks(
+        nteeth, pen, fr, W, wr, pattern.m, rlog.m = sample_flanks(
             con.efc_address,
             con.frame,
             con.pos,
             d.efc_force,
             d.ncon,
-            fc.n,
-            fc.template.dim == 3,
+            n,
+            fc.mu > 0,  # the template's dim 3 (FlankContacts.set_friction)
             fc.meta,
             fc.weight,
             fc.depth,
@@ -288,8 +292,7 @@ class FlankLoop:
             i,
             store,
             self.work,
-            (cv.inv_rho, cv.line_len, pattern.e_star, pattern.buf, pattern.m),
+            (pattern.cv.inv_rho, pattern.cv.line_len, pattern.e_star, pattern.buf, pattern.m),
+            (rlog.buf, rlog.m),
         )
-        _, r, w = self.work
-        r_c, eta_c = radius_efficiency(r[:m], w[:m], W, wr, self.fc.bm.geometry, mu, worm_drives)
-        return nteeth, float(pen), fr, r_c, eta_c
+        return nteeth, float(pen), fr, radius_mean(W, wr)

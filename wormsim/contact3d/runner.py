@@ -37,7 +37,7 @@ import numpy as np
 
 from wormsim import gear_theory as gt
 from wormsim.contact3d import mass_scaling
-from wormsim.contact3d.contact_sums import contact_sums
+from wormsim.contact3d.contact_sums import RadiusLog
 from wormsim.contact3d.metrics import contact3d_summary
 from wormsim.contact3d.mjcf import BuiltModel, build_model
 from wormsim.contact3d.timestep import (
@@ -312,6 +312,7 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
     pts_world = np.full((n_rec, MAX_POINTS, 3), np.nan, dtype=np.float32)
     forces = np.full((n_rec, MAX_POINTS, 3), np.nan, dtype=np.float32)
     store = (pts, forces, pts_world)
+    rlog = RadiusLog()  # the contacts' radii and weights: the efficiency at the contact radius (contact_sums)
 
     fc = pattern = loop = None
     if bm.meta.get("contact_geometry") == "flanks":
@@ -394,10 +395,10 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
                 pattern.record(i, d)
             k = min(len(p0), MAX_POINTS)
             pts[i, :k], forces[i, :k], pts_world[i, :k] = p0[:k], F[:k], pw[:k]
-            fr_lc, r_c, eta_c = contact_sums(F, pw, geo, mu, worm_is_drive)
+            fr_lc, r_c = rlog.add(i, F, pw, geo.a)
         else:  # compiled (wormsim.contact3d.flank_loop)
             fc.set_friction(mu)
-            nteeth, pen, fr_lc, r_c, eta_c = loop.sample(i, pattern, store, mu, worm_is_drive)
+            nteeth, pen, fr_lc, r_c = loop.sample(i, pattern, rlog, store)
         guards.contact(t, pen, w1 if worm_is_drive else w2, cmd)
         S["t_s"][i] = t
         S["worm_angle_rad"][i], S["wheel_angle_rad"][i] = th1, th2
@@ -413,7 +414,7 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
         S["tangential_force_n"][i], S["radial_force_n"][i], S["axial_force_n"][i] = fx / rec, -fy / rec, fz / rec
         S["wheel_contact_torque_nm"][i] = mz / rec
         S["radial_force_line_of_centres_n"][i] = fr_lc
-        S["worm_contact_radius_m"][i], S["efficiency_theory_at_contact_radius"][i] = r_c, eta_c
+        S["worm_contact_radius_m"][i] = r_c
         S["tangential_force_abs_max_n"][i] = fpk
         S["contacts"][i], S["teeth_in_contact"][i] = nc / rec, nteeth
         S["max_penetration_m"][i] = pen
@@ -421,6 +422,7 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
         S["transmission_error_rad"][i] = te
         if progress is not None:
             progress.update(t)
+    S["efficiency_theory_at_contact_radius"][:] = rlog.efficiency(S["friction_coefficient"], geo, worm_is_drive)
     wall = time.perf_counter() - t_wall
     summary = _run_summary(
         S, scenario, bm, rec, guards.turn_max, len(coll), 1e6 * wall / max(n_rec * rec, 1), flanks=fc is not None
