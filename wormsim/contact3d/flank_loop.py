@@ -29,6 +29,7 @@ from __future__ import annotations
 import ctypes
 import math
 
+import mujoco
 import numba
 import numpy as np
 from llvmlite import ir
@@ -167,12 +168,13 @@ def run_interval(fns, m_addr, d_addr, cmd, load, j0, j1, mjd, iv, fv, state, gri
 
 @numba.njit(cache=True)
 def sample_flanks(
-    adr, frame, pos, efc_force, ncon, n_fc, cone3, meta, weight, depth, th2, z2, a, i, store, work, pat, rlog
+    adr, frame, pos, own, efc_force, ncon, n_fc, cone3, meta, weight, depth, th2, z2, a, i, store, work, pat, rlog
 ):
-    """FlankLoop.sample's compiled part (module docstring): store = (points in tooth 0's frame, forces, points; the
-    run's float32 arrays, row i); work (3, cap, 3); pat = PatternLog's (inv_rho, line_len, E*, buffer, rows used);
-    rlog = contact_sums.RadiusLog's (buffer, rows used). Returns (teeth touching, largest penetration, F_r,lc,
-    sum w, sum w r, the pattern's rows used, the radius log's rows used)."""
+    """FlankLoop.sample's compiled part (module docstring): adr the contacts' efc_address; frame, pos theirs or,
+    where own, the kernel's (the same values: flank_handoff copies them into the contacts); store = (points in tooth
+    0's frame, forces, points; the run's float32 arrays, row i); work (3, cap, 3); pat = PatternLog's (inv_rho,
+    line_len, E*, buffer, rows used); rlog = contact_sums.RadiusLog's (buffer, rows used). Returns (teeth touching,
+    largest penetration, F_r,lc, sum w, sum w r, the pattern's rows used, the radius log's rows used)."""
     pts, forces, pts_world = store
     inv_rho, line_len, e_star, buf, pm = pat
     rbuf, rm = rlog
@@ -180,7 +182,8 @@ def sample_flanks(
     if n == 0:
         return 0, 0.0, -0.0, 0.0, 0.0, pm, rm
     k0 = ncon - n
-    m, nteeth = _contact_forces(adr[k0:], frame[k0:], pos[k0:], efc_force, cone3, meta, th2, z2, work)
+    f0 = 0 if own else k0
+    m, nteeth = _contact_forces(adr[k0:], frame[f0:], pos[f0:], efc_force, cone3, meta, th2, z2, work)
     pen = depth[0]
     for c in range(1, n):
         if depth[c] > pen:
@@ -201,6 +204,10 @@ class FlankLoop:
     def __init__(self, fc, d, drive_actuator: int, load_actuator: int, a1: int, a2: int, sensor_adr: int):
         bm, m = fc.bm, fc.bm.model
         self.fc, self.m, self.d = fc, m, d
+        # one island: the worm and the wheel are the model's only dofs and the flank contacts couple them, so
+        # MuJoCo's island decomposition (mj_island, ~3.5 us per step) only repartitions the same solve (measured
+        # bit-identical: docs/contact3d.md, "Exact flanks: cost")
+        m.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_ISLAND)
         self.fns = np.concatenate([STAGE_ADDRESSES, [_MJ_ADD_CONTACT]]).astype(np.int64)
         self.mjd = (d.ctrl, d.qvel, d.qpos, d.actuator_force, d.sensordata, d.xpos, d.xmat)
         buf = fc.buffer
@@ -275,10 +282,12 @@ class FlankLoop:
         pattern.reserve(n)
         rlog.reserve(n)
         con = d.contact
+        own = self.dropped == 0  # d.contact's last fc.n entries are the kernel's contacts, in order
         nteeth, pen, fr, W, wr, pattern.m, rlog.m = sample_flanks(
             con.efc_address,
-            con.frame,
-            con.pos,
+            fc.frame if own else con.frame,
+            fc.pos if own else con.pos,
+            own,
             d.efc_force,
             d.ncon,
             n,
