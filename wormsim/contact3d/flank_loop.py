@@ -178,6 +178,17 @@ def _f64_at(typingctx, addr):
 
 
 @intrinsic
+def _f32_at(typingctx, addr):
+    """The float32 pointer at an address (int64)."""
+    sig = types.CPointer(types.float32)(types.int64)
+
+    def codegen(context, builder, signature, args):
+        return builder.inttoptr(args[0], context.get_value_type(types.CPointer(types.float32)))
+
+    return sig, codegen
+
+
+@intrinsic
 def _i64_at(typingctx, addr):
     """The int64 pointer at an address (int64)."""
     sig = types.CPointer(types.int64)(types.int64)
@@ -271,12 +282,13 @@ def run_table(T, m_addr, d_addr, cmd, load, j0, j1):
     )
 
 
-def address_table(arrays) -> np.ndarray:
-    """T for run_table: each array checked against TABLE (dtype, dimensions, C order) and kept by the caller."""
-    if len(arrays) != len(TABLE):
-        raise RuntimeError("flank_loop: the address table and TABLE disagree")
+def address_table(arrays, table=TABLE) -> np.ndarray:
+    """T for run_table (sample_table with SAMPLE_TABLE): each array checked against the table (dtype, dimensions, C
+    order) and kept by the caller."""
+    if len(arrays) != len(table):
+        raise RuntimeError("flank_loop: the address table and its layout disagree")
     T = np.zeros((len(arrays), 5), dtype=np.int64)
-    for k, (a, (dt, nd)) in enumerate(zip(arrays, TABLE)):
+    for k, (a, (dt, nd)) in enumerate(zip(arrays, table)):
         if a.dtype != np.dtype(dt) or a.ndim != nd or not a.flags.c_contiguous:
             raise RuntimeError(
                 f"flank_loop: array {k} is {a.dtype} {a.shape}, expected {dt} with {nd} dimensions, C order"
@@ -316,6 +328,51 @@ def sample_flanks(
             forces[i, c, x] = work[1, c, x]
             pts_world[i, c, x] = work[2, c, x]
     return nteeth, pen, fr, W, wr, pm, rm + m
+
+
+# the per-run arrays of sample_flanks in FlankLoop's sample table, in this order
+SAMPLE_TABLE = (
+    ("f8", 2),  # 0 meta
+    ("f8", 1),  # 1 weight
+    ("f8", 1),  # 2 depth
+    ("f8", 3),  # 3 work
+    ("f8", 3),  # 4 PatternLog's inv_rho
+    ("f8", 3),  # 5 PatternLog's line_len
+    ("f4", 3),  # 6 points in tooth 0's frame (the run's)
+    ("f4", 3),  # 7 forces
+    ("f4", 3),  # 8 points
+)
+
+
+@numba.njit(cache=True)
+def sample_table(T, adr, frame, pos, own, efc_force, buf, rbuf, ncon, n_fc, cone3, th2, z2, a, i, e_star, pm, rm):
+    """sample_flanks with its per-run arrays given by address and shape (T: one row per SAMPLE_TABLE entry)."""
+    f32 = (
+        numba.carray(_f32_at(T[6, 0]), (T[6, 1], T[6, 2], T[6, 3])),
+        numba.carray(_f32_at(T[7, 0]), (T[7, 1], T[7, 2], T[7, 3])),
+        numba.carray(_f32_at(T[8, 0]), (T[8, 1], T[8, 2], T[8, 3])),
+    )
+    return sample_flanks(
+        adr,
+        frame,
+        pos,
+        own,
+        efc_force,
+        ncon,
+        n_fc,
+        cone3,
+        _f2(T, 0),
+        _f1(T, 1),
+        _f1(T, 2),
+        th2,
+        z2,
+        a,
+        i,
+        f32,
+        _f3(T, 3),
+        (_f3(T, 4), _f3(T, 5), e_star, buf, pm),
+        (rbuf, rm),
+    )
 
 
 class FlankLoop:
@@ -391,6 +448,7 @@ class FlankLoop:
         self.dropped = 0
         cap = fc.pos.shape[0]
         self.work = np.empty((3, cap, 3))
+        self._store = self._pattern = None
         self.z2 = bm.geometry.z2
         self.a = bm.geometry.a
 
@@ -412,27 +470,31 @@ class FlankLoop:
         n = fc.n
         pattern.reserve(n)
         rlog.reserve(n)
+        if self._store is not store or self._pattern is not pattern:
+            cv = pattern.cv
+            self._sample_arrays = (fc.meta, fc.weight, fc.depth, self.work, cv.inv_rho, cv.line_len) + tuple(store)
+            self._sample_T = address_table(self._sample_arrays, SAMPLE_TABLE)
+            self._store, self._pattern = store, pattern
         con = d.contact
         own = self.dropped == 0  # d.contact's last fc.n entries are the kernel's contacts, in order
-        nteeth, pen, fr, W, wr, pattern.m, rlog.m = sample_flanks(
+        nteeth, pen, fr, W, wr, pattern.m, rlog.m = sample_table(
+            self._sample_T,
             con.efc_address,
             fc.frame if own else con.frame,
             fc.pos if own else con.pos,
             own,
             d.efc_force,
+            pattern.buf,
+            rlog.buf,
             d.ncon,
             n,
             fc.mu > 0,  # the template's dim 3 (FlankContacts.set_friction)
-            fc.meta,
-            fc.weight,
-            fc.depth,
             float(d.qpos[fc.qa2]),
             self.z2,
             self.a,
             i,
-            store,
-            self.work,
-            (pattern.cv.inv_rho, pattern.cv.line_len, pattern.e_star, pattern.buf, pattern.m),
-            (rlog.buf, rlog.m),
+            pattern.e_star,
+            pattern.m,
+            rlog.m,
         )
         return nteeth, float(pen), fr, radius_mean(W, wr)
