@@ -307,7 +307,8 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
     coll = np.concatenate([bm.worm_geoms, bm.wheel_slot_geoms.ravel()])
     guards = _Guards(bm, scenario, dt, rec)
 
-    S = {k: np.zeros(n_rec) for k in SERIES}
+    S_all = np.zeros((len(SERIES), n_rec))  # one column per sample, written at once
+    S = dict(zip(SERIES, S_all))
     pts = np.full((n_rec, MAX_POINTS, 3), np.nan, dtype=np.float32)
     pts_world = np.full((n_rec, MAX_POINTS, 3), np.nan, dtype=np.float32)
     forces = np.full((n_rec, MAX_POINTS, 3), np.nan, dtype=np.float32)
@@ -331,7 +332,7 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
         step_fn = mujoco.mj_step
     t_wall = time.perf_counter()
     worm_is_drive = scenario.drive.on == "worm"
-    sd, act, qv, ctrl = d.sensordata, d.actuator_force, d.qvel, d.ctrl
+    sd, act, qv, qp, ctrl = d.sensordata, d.actuator_force, d.qvel, d.qpos, d.ctrl
     s0 = int(m.sensor_adr[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SENSOR, "mesh_force")])
     ia_drv, ia_load, dof1, dof2 = bm.drive_actuator, bm.load_actuator, bm.worm_dof, bm.wheel_dof
     # worm / wheel actuator on each shaft: (drive, load) or (load, drive)
@@ -375,7 +376,7 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
             fz += f2
             mz += sd[s0 + 6] + sd[s0 + 7] * f1 - sd[s0 + 8] * f0
         cmd = cmd_blk[o + rec - 1]
-        th1, th2 = float(d.qpos[qa_worm]), float(d.qpos[qa_wheel])
+        th1, th2 = float(qp[qa_worm]), float(qp[qa_wheel])
         w1, w2 = float(qv[dof1]), float(qv[dof2])
         t = float(d.time)
         te = guards.state(d, t, th1, th2, w1, w2)
@@ -400,26 +401,36 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
             fc.set_friction(mu)
             nteeth, pen, fr_lc, r_c = loop.sample(i, pattern, rlog, store)
         guards.contact(t, pen, w1 if worm_is_drive else w2, cmd)
-        S["t_s"][i] = t
-        S["worm_angle_rad"][i], S["wheel_angle_rad"][i] = th1, th2
-        S["worm_speed_rpm"][i], S["wheel_speed_rpm"][i] = rad_s_to_rpm(w1), rad_s_to_rpm(w2)
-        S["worm_torque_nm"][i], S["wheel_torque_nm"][i] = t1 / rec, t2 / rec
-        S["worm_power_w"][i], S["wheel_power_w"][i] = p1 / rec, p2 / rec
-        S["drive_command"][i] = cmd
         # the mean resultant on the wheel resolved at the pitch point P = (0, -r2, 0) on the line of centres, in the
         # wheel's directions there (DIN 3975 F_t2, F_r2, F_a2; seed 001 resolves ADAMS's contact force the same
         # way): tangential e_t = +x, radial e_r = -y (outward, towards the worm), axial e_z. The contact torque M_z
         # is kept apart: M_z / r2 equals the mean F_t, but by the wheel's torque balance it varies only through
         # I2 alpha2 and hides the mesh
-        S["tangential_force_n"][i], S["radial_force_n"][i], S["axial_force_n"][i] = fx / rec, -fy / rec, fz / rec
-        S["wheel_contact_torque_nm"][i] = mz / rec
-        S["radial_force_line_of_centres_n"][i] = fr_lc
-        S["worm_contact_radius_m"][i] = r_c
-        S["tangential_force_abs_max_n"][i] = fpk
-        S["contacts"][i], S["teeth_in_contact"][i] = nc / rec, nteeth
-        S["max_penetration_m"][i] = pen
-        S["friction_coefficient"][i] = mu
-        S["transmission_error_rad"][i] = te
+        S_all[:, i] = (  # in SERIES order
+            t,  # t_s
+            th1,  # worm_angle_rad
+            th2,  # wheel_angle_rad
+            rad_s_to_rpm(w1),  # worm_speed_rpm
+            rad_s_to_rpm(w2),  # wheel_speed_rpm
+            t1 / rec,  # worm_torque_nm
+            t2 / rec,  # wheel_torque_nm
+            cmd,  # drive_command
+            fx / rec,  # tangential_force_n
+            -fy / rec,  # radial_force_n
+            fz / rec,  # axial_force_n
+            nc / rec,  # contacts
+            nteeth,  # teeth_in_contact
+            pen,  # max_penetration_m
+            mu,  # friction_coefficient
+            te,  # transmission_error_rad
+            mz / rec,  # wheel_contact_torque_nm
+            p1 / rec,  # worm_power_w
+            p2 / rec,  # wheel_power_w
+            fpk,  # tangential_force_abs_max_n
+            fr_lc,  # radial_force_line_of_centres_n
+            r_c,  # worm_contact_radius_m
+            0.0,  # efficiency_theory_at_contact_radius: after the loop, from rlog
+        )
         if progress is not None:
             progress.update(t)
     S["efficiency_theory_at_contact_radius"][:] = rlog.efficiency(S["friction_coefficient"], geo, worm_is_drive)
