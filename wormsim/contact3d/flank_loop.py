@@ -20,8 +20,10 @@ runner's guards read them after each interval.
 (forces, points, teeth touching, largest penetration), flank_outputs.PatternLog.record (the contact pattern's rows),
 contact_sums.radial_and_radius, and the points stored into the run's arrays.
 
-Cost (docs/contact3d.md, "Exact flanks: cost"): the Python loop spent about 1.3-3.5 us per stage call on the binding
-and 10-20 us per step on the runner's per-step reads and sums.
+Both take their per-run arrays as one table of addresses and shapes (`run_table`, `sample_table`: numba's unboxing of
+~30 arrays cost 10-20 us per call). Flank runs turn MuJoCo's islands off (`FlankLoop`: two dofs, one island; measured
+bit-identical). Cost and checks: docs/contact3d.md, "Exact flanks: the step loop compiled" (the Python loop spent
+about 1.3-3.5 us per stage call on the binding and 10-20 us per step on the runner's per-step reads and sums).
 """
 
 from __future__ import annotations
@@ -383,8 +385,9 @@ class FlankLoop:
         self.fc, self.m, self.d = fc, m, d
         # one island: the worm and the wheel are the model's only dofs and the flank contacts couple them, so
         # MuJoCo's island decomposition (mj_island, ~3.5 us per step) only repartitions the same solve (measured
-        # bit-identical: docs/contact3d.md, "Exact flanks: cost")
-        m.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_ISLAND)
+        # bit-identical: docs/contact3d.md, "Exact flanks: the step loop compiled")
+        if m.nv == 2:
+            m.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_ISLAND)
         buf = fc.buffer
         self.iv = np.array(
             [
