@@ -5,10 +5,10 @@ Each step does what the runner's Python loop did with `FlankContacts.step` (worm
 same order and with the same floating-point operations, so the results are bit-identical
 (tests/test_flank_loop.py): the drive and load commands into d.ctrl, the shaft speeds read, then `split_step`'s stages
 (mj_checkPos, mj_checkVel, mj_fwdKinematics, mj_makeM, mj_factorM, mj_collision; the flank contacts: the window
-update of FlankContacts.window, with assembly errors flank_pose.set_pose, flanks.find_contacts, slice_weights,
-contact_frames, flank_handoff._fill_add; mj_makeConstraint, mj_island, mj_transmission, mj_projectConstraint,
-mj_sensorPos, mj_fwdVelocity, mj_sensorVel, mj_step2), then the runner's per-step sums (actuator torques, shaft
-powers T w, the contact sensor's count, force and moment, the peak |F_x|).
+update of FlankContacts.window, with assembly errors flank_pose.set_pose, flanks.find_packed (find_contacts with
+its memo, slice_weights, contact_frames), flank_handoff._fill_add; mj_makeConstraint, mj_island, mj_transmission,
+mj_projectConstraint, mj_sensorPos, mj_fwdVelocity, mj_sensorVel, mj_step2), then the runner's per-step sums
+(actuator torques, shaft powers T w, the contact sensor's count, force and moment, the peak |F_x|).
 
 The stages are the functions of the shared library the mujoco package loaded (flank_handoff._library), called through
 their addresses as flank_handoff calls mj_addContact; all are `void f(const mjModel*, mjData*)`. What this skips of
@@ -43,7 +43,7 @@ from wormsim.contact3d.flank_handoff import _MJ_ADD_CONTACT, _fill_add, _library
 from wormsim.contact3d.flank_outputs import _rows
 from wormsim.contact3d.flank_pose import set_pose
 from wormsim.contact3d.flank_step import _contact_forces
-from wormsim.contact3d.flanks import contact_frames, find_contacts, slice_weights
+from wormsim.contact3d.flanks import find_packed
 
 STAGES_BEFORE = ("mj_checkPos", "mj_checkVel", "mj_fwdKinematics", "mj_makeM", "mj_factorM", "mj_collision")
 STAGES_AFTER = (
@@ -85,7 +85,7 @@ def _call_stage(typingctx, fn, m_addr, d_addr):
 
 
 @numba.njit(cache=True)
-def run_interval(fns, m_addr, d_addr, cmd, load, j0, j1, mjd, iv, fv, state, grid, params, out, hand, acc):
+def run_interval(fns, m_addr, d_addr, cmd, load, j0, j1, mjd, iv, fv, state, kern, params, out, hand, acc):
     """Steps j0..j1-1 of the command arrays cmd (drive) and load (module docstring).
 
     mjd = (ctrl, qvel, qpos, actuator_force, sensordata, xpos, xmat): d's own arrays;
@@ -93,16 +93,17 @@ def run_interval(fns, m_addr, d_addr, cmd, load, j0, j1, mjd, iv, fv, state, gri
     address, worm qpos address, wheel qpos address, worm body, wheel body, displaced, window teeth, slices,
     mjContact record size, record buffer address, solreffriction written);
     fv = (tooth 0's angle, pitch angle, margin, taper); state = (the window's centre tooth, the last step's contact
-    count); grid = FlankContacts.grid's (xy, c, c_range, span, zeta) and ks (the window's teeth); out = the kernel's
-    (pos, nrm, depth, meta, line, weight, frame); hand = (records, field offsets, solref, solreffriction).
+    count); kern = FlankContacts.kernel's buffers (fb, ib; flanks.PackedKernel) and ks (the window's teeth, a view
+    of ib); params = the kernel's P (a view of fb); out = the kernel's (pos, depth, weight, frame); hand = (records,
+    field offsets, solref, solreffriction).
     acc (N_ACC) receives the sums over the steps: worm and wheel actuator torque, worm and wheel power, contact count,
     F_x, F_y, F_z, M_z about the wheel axis, the peak |F_x|. Returns the number of contacts MuJoCo did not take
     (arena full) summed over the steps."""
     ctrl, qvel, qpos, act, sd, xpos, xmat = mjd
     ia_drv, ia_load, dof1, dof2, a1, a2, s0, qa1, qa2, worm_body, wheel_body, displaced, W, slices, size, base, fr = iv
     tooth0, pitch, margin0, taper = fv
-    xy, c, c_range, span, zeta, ks = grid
-    pos, nrm, depth, meta, line, weight, frame = out
+    fb, ib, ks = kern
+    pos, depth, weight, frame = out
     rec, off, solref, solreffriction = hand
     nb = N_BEFORE
     t1 = t2 = p1 = p2 = nc = fx = fy = fz = mz = fpk = 0.0
@@ -123,9 +124,7 @@ def run_interval(fns, m_addr, d_addr, cmd, load, j0, j1, mjd, iv, fv, state, gri
             for i in range(W):
                 ks[i] = cw - h + 1 + i
             state[0] = cw
-        n = find_contacts(xy, c, c_range, span, zeta, ks, th1, th2, margin0, params, pos, nrm, depth, meta, line, taper)
-        n = slice_weights(meta, line, n, slices, pos, nrm, depth, weight)
-        contact_frames(nrm, n, frame)
+        n = find_packed(fb, ib, th1, th2, margin0, taper)
         state[1] = n
         if n:
             k = min(n, rec.shape[0])
@@ -210,29 +209,23 @@ TABLE = (
     ("f8", 1),  # 4 d.sensordata
     ("f8", 2),  # 5 d.xpos
     ("f8", 2),  # 6 d.xmat
-    ("f8", 4),  # 7 grid.xy
-    ("f8", 3),  # 8 grid.c
-    ("f8", 3),  # 9 grid.c_range
-    ("i8", 3),  # 10 grid.span
-    ("f8", 1),  # 11 grid.zeta
-    ("i8", 1),  # 12 ks
-    ("f8", 1),  # 13 params
-    ("f8", 2),  # 14 pos
-    ("f8", 2),  # 15 nrm
-    ("f8", 1),  # 16 depth
-    ("f8", 2),  # 17 meta
-    ("f8", 2),  # 18 line
-    ("f8", 1),  # 19 weight
-    ("f8", 2),  # 20 frame
-    ("i8", 2),  # 21 the hand-off's records (as int64 rows; run_interval views them as float64)
-    ("i8", 1),  # 22 the records' field offsets
-    ("f8", 1),  # 23 solref
-    ("f8", 1),  # 24 solreffriction
-    ("i8", 1),  # 25 state
-    ("f8", 1),  # 26 acc
-    ("i8", 1),  # 27 the stage addresses
-    ("i8", 1),  # 28 iv
-    ("f8", 1),  # 29 fv
+    ("f8", 1),  # 7 the kernel's float buffer (flanks.PackedKernel.fb)
+    ("i8", 1),  # 8 its int buffer (ib)
+    ("i8", 1),  # 9 ks (a view of ib)
+    ("f8", 1),  # 10 params (P, a view of fb)
+    ("f8", 2),  # 11 pos
+    ("f8", 1),  # 12 depth
+    ("f8", 1),  # 13 weight
+    ("f8", 2),  # 14 frame
+    ("i8", 2),  # 15 the hand-off's records (as int64 rows; run_interval views them as float64)
+    ("i8", 1),  # 16 the records' field offsets
+    ("f8", 1),  # 17 solref
+    ("f8", 1),  # 18 solreffriction
+    ("i8", 1),  # 19 state
+    ("f8", 1),  # 20 acc
+    ("i8", 1),  # 21 the stage addresses
+    ("i8", 1),  # 22 iv
+    ("f8", 1),  # 23 fv
 )
 
 
@@ -271,16 +264,16 @@ def run_table(T, m_addr, d_addr, cmd, load, j0, j1):
     """run_interval with its arrays given by address and shape (T: one row per TABLE entry, (address, shape));
     numba unboxes one array instead of 30 per call (about 10-20 us per call saved, docs/contact3d.md)."""
     mjd = (_f1(T, 0), _f1(T, 1), _f1(T, 2), _f1(T, 3), _f1(T, 4), _f2(T, 5), _f2(T, 6))
-    grid = (_f4(T, 7), _f3(T, 8), _f3(T, 9), _i3(T, 10), _f1(T, 11), _i1(T, 12))
-    out = (_f2(T, 14), _f2(T, 15), _f1(T, 16), _f2(T, 17), _f2(T, 18), _f1(T, 19), _f2(T, 20))
-    rec = numba.carray(_f64_at(T[21, 0]), (T[21, 1], T[21, 2]))  # int64 rows of the same bytes as float64
-    hand = (rec, _i1(T, 22), _f1(T, 23), _f1(T, 24))
-    v = _i1(T, 28)
+    kern = (_f1(T, 7), _i1(T, 8), _i1(T, 9))
+    out = (_f2(T, 11), _f1(T, 12), _f1(T, 13), _f2(T, 14))
+    rec = numba.carray(_f64_at(T[15, 0]), (T[15, 1], T[15, 2]))  # int64 rows of the same bytes as float64
+    hand = (rec, _i1(T, 16), _f1(T, 17), _f1(T, 18))
+    v = _i1(T, 22)
     iv = (v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7], v[8], v[9], v[10], v[11], v[12], v[13], v[14], v[15], v[16])
-    fw = _f1(T, 29)
+    fw = _f1(T, 23)
     fv = (fw[0], fw[1], fw[2], fw[3])
     return run_interval(
-        _i1(T, 27), m_addr, d_addr, cmd, load, j0, j1, mjd, iv, fv, _i1(T, 25), grid, _f1(T, 13), out, hand, _f1(T, 26)
+        _i1(T, 21), m_addr, d_addr, cmd, load, j0, j1, mjd, iv, fv, _i1(T, 19), kern, _f1(T, 10), out, hand, _f1(T, 20)
     )
 
 
@@ -414,7 +407,19 @@ class FlankLoop:
         self.fv = np.array([float(bm.tooth0_angle_rad), fc.pitch, fc.margin0, fc.taper_rad])
         self.state = np.array([NO_WINDOW if fc._c is None else fc._c, fc.n], dtype=np.int64)
         self.acc = np.zeros(N_ACC)
-        g = fc.grid
+        self._tables(d, buf)
+        self.dropped = 0
+        cap = fc.pos.shape[0]
+        self.work = np.empty((3, cap, 3))
+        self._store = self._pattern = self._sample_kernel = None
+        self.z2 = bm.geometry.z2
+        self.a = bm.geometry.a
+
+    def _tables(self, d, buf) -> None:
+        """run_table's address table over the kernel's current buffers (FlankContacts repacks them when its params
+        array is replaced)."""
+        fc = self.fc
+        k = fc.kernel
         self.arrays = (  # kept alive here: run_table reads them by address
             d.ctrl,
             d.qvel,
@@ -423,18 +428,12 @@ class FlankLoop:
             d.sensordata,
             d.xpos,
             d.xmat,
-            g.xy,
-            g.c,
-            g.c_range,
-            g.span,
-            g.zeta,
+            k.fb,
+            k.ib,
             fc.ks,
             fc.params,
             fc.pos,
-            fc.nrm,
             fc.depth,
-            fc.meta,
-            fc.line,
             fc.weight,
             fc.frame,
             buf.bytes.view(np.int64),
@@ -448,16 +447,15 @@ class FlankLoop:
             self.fv,
         )
         self.table = address_table(self.arrays)
-        self.dropped = 0
-        cap = fc.pos.shape[0]
-        self.work = np.empty((3, cap, 3))
-        self._store = self._pattern = None
-        self.z2 = bm.geometry.z2
-        self.a = bm.geometry.a
+        self._kernel = k
 
     def run(self, cmd: np.ndarray, load: np.ndarray, j0: int, j1: int) -> np.ndarray:
         """Steps j0..j1-1 of the commands; returns the sums (run_interval's acc); fc.n and fc's window follow."""
         fc = self.fc
+        if fc.params is not fc.kernel.P:  # replaced: FlankContacts.find would repack (flank_step)
+            fc._pack()
+        if fc.kernel is not self._kernel:
+            self._tables(self.d, fc.buffer)
         self.iv[-1] = fc.solreffriction[1] != 0.0
         self.dropped += run_table(self.table, self.m._address, self.d._address, cmd, load, j0, j1)
         fc.n = int(self.state[1])
@@ -473,11 +471,11 @@ class FlankLoop:
         n = fc.n
         pattern.reserve(n)
         rlog.reserve(n)
-        if self._store is not store or self._pattern is not pattern:
+        if self._store is not store or self._pattern is not pattern or self._sample_kernel is not fc.kernel:
             cv = pattern.cv
             self._sample_arrays = (fc.meta, fc.weight, fc.depth, self.work, cv.inv_rho, cv.line_len) + tuple(store)
             self._sample_T = address_table(self._sample_arrays, SAMPLE_TABLE)
-            self._store, self._pattern = store, pattern
+            self._store, self._pattern, self._sample_kernel = store, pattern, fc.kernel
         con = d.contact
         own = self.dropped == 0  # d.contact's last fc.n entries are the kernel's contacts, in order
         nteeth, pen, fr, W, wr, pattern.m, rlog.m = sample_table(
