@@ -248,7 +248,7 @@ def test_resume_after_ctrl_c_skips_finished_points(tmp_path, capsys):
     sweep = _write(
         tmp_path / "resume.yaml",
         (
-            f"name: resume\nbase: {SCREW_JACK}\nset: {{model: torsional, simulation.duration_s: 0.12}}\n"
+            f"name: resume\nbase: {SCREW_JACK}\nset: {{model: torsional, simulation.duration_s: 0.4}}\n"
             "grid: {drive.speed_rpm: {linspace: [1000, 1500, 6]}}\n"
         ),
     )
