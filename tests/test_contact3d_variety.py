@@ -92,21 +92,24 @@ FLANK_GEARS = {
     "narrow-b8": ["gear.face_width_mm=8", "simulation.duration_s=0.08"],  # 11.3
 }
 HARMONIC = (
-    "F_t's largest peak is a meshing harmonic at 8 slices (all three at 450-600 Hz, far below the contact mode's "
-    "2-7 kHz; the kernel's quasi-static force has it, no load steps are left; no rattle since "
-    "the flank contacts' friction rows have their own damping, wormsim.contact3d.law (4)): "
+    "F_t's largest line below the search cap (599.4 Hz) is a meshing harmonic, not the 1st, at 8, 16 and 32 slices: "
+    "F_t's mesh lines are 0.02-1.6 N, rising towards the contact mode's band (2-7 kHz, lines 0.9-2.9 N); at constant "
+    "load torque the mesh stiffness's fluctuation goes into the TE, not into F_t. Not a slicing artefact "
+    "(docs/contact3d.md, 'Variants against slice count'; sweeps/variant_harmonics.py): "
 )
 # left-ZA passes since contacts leave at zero load (docs/contact3d.md): 99.9 Hz, p2p 55.7 N on 833 N (before 499.5 Hz,
 # the 5th harmonic, p2p 77 N)
 FLANK_MESH_XFAIL = {
-    "wide-z80-q16": HARMONIC + "499.5 Hz (10th) against 49.9 Hz, p2p 23.6 N on 312 N, 12.7 contacts (before contacts "
-    "left at zero load at the profile's and the line's end: 33.2 N; the kernel's quasi-static 10th harmonic 0.0135 of "
-    "the mean, the TCA's 0.0077)",
-    "ZA-a25-z60-3start": HARMONIC + "449.6 Hz (3rd) against 149.8 Hz, p2p 32.3 N on 417 N, 12.5 contacts (before: "
-    "37.7 N; quasi-static 3rd harmonic 0.038 of the mean, the TCA's 0.013)",
-    "narrow-b8": HARMONIC + "599.4 Hz (6th) against 99.9 Hz, p2p 75.0 N on 833 N, 14.9 contacts (before: 88.6 N; "
-    "quasi-static 6th harmonic 0.020 of the mean, the TCA's 0.006; with c_f = c_c it passed at 100.2 Hz only through "
-    "a half rattle at the mesh frequency: 7.3 contacts, p2p 2.5 kN)",
+    "wide-z80-q16": HARMONIC + "499.5 Hz (10th) against 49.9 Hz, p2p 23.6 N on 312 N at 8 slices; 549.5 Hz (11th, "
+    "24.0 N) at 16, 349.7 Hz (7th, 26.8 N) at 32, where the kernel's quasi-static harmonics match the TCA's k (10th "
+    "0.0076 / 0.0077 of the mean, the 1st the largest, 0.087 / 0.078); F_t's 1st line 0.015 N, 10th 0.19 N; the TE "
+    "peaks at the 1st",
+    "ZA-a25-z60-3start": HARMONIC + "449.6 Hz (3rd) against 149.8 Hz, p2p 32.3 N on 417 N at 8 slices; 299.7 Hz (2nd; "
+    "26.0 / 30.5 N) at 16 / 32: the quasi-static 3rd harmonic falls from 0.038 to 0.007 / 0.009 of the mean (TCA "
+    "0.013), the largest is then the 2nd (0.038 / 0.040) as in the TCA's k (2nd 0.038, 1st 0.036)",
+    "narrow-b8": HARMONIC + "599.4 Hz (6th, at the cap) against 99.9 Hz, p2p 75.0 N on 833 N at 8 slices, 599.4 Hz "
+    "(72.6 N) at 16: on the 8 mm face the kernel's quasi-static harmonics do not change with the slices (6th 0.020 of "
+    "the mean at 8 / 16 / 32, TCA 0.006); F_t's lines 1-6 0.15-0.23 N; the TE peaks at the 1st (4.0 urad)",
 }
 _FLANK_RUNS: dict[str, tuple] = {}
 
