@@ -202,3 +202,28 @@ def test_extent_is_the_face_span_holding_95_percent_of_the_load():
     assert log.extent_face_m(rows([5], [3.0])) == pytest.approx(0.95 * w, rel=1e-12)
     # half the load in slice 0, half in slice 15: 2.5 % lies 0.05 w into slice 0, 97.5 % 0.95 w into slice 15
     assert log.extent_face_m(rows([0, 15], [1.0, 1.0])) == pytest.approx(g.face_width - 0.1 * w, rel=1e-12)
+
+
+def test_pressure_maximum_skips_contacts_entering_or_leaving_the_line():
+    """A contact carrying a vanishing share of its slice divides a vanishing force by a vanishing line length (the
+    screw jack CI run: 2069 MPa from < 0.005 N): the maximum counts contacts with at least
+    PRESSURE_MIN_FORCE_SHARE of the mean contact F_n; the F_n-weighted mean counts every contact."""
+    g = derive(load_scenario(SCENARIOS / "screw_jack.yaml").gear)
+    log = FO.PatternLog.__new__(FO.PatternLog)
+    log.cv = FO.flank_curvature(g, 16)
+    # (i, sigma, j, f, F_n, p_H, zeta, rho)
+    T = np.array(
+        [
+            [0, 0, 7, 10.4, 10.0, 300e6, -0.7e-3, 28.3e-3],
+            [0, 0, 11, 2.5, 1e-4, 2.0e9, 4.9e-3, 28.5e-3],
+            [1, 0, 8, 10.0, 12.0, 320e6, 0.7e-3, 28.9e-3],
+        ]
+    )
+    log.table = lambda: T
+    s = log.summary(np.array([0.0, 1.0]), (0.0, 1.0))
+    assert s["contact_pressure_max_mpa"] == pytest.approx(320.0)
+    assert s["contact_pressure_max_face_mm"] == pytest.approx(0.7) and s["contact_pressure_max_radius_mm"] == pytest.approx(28.9)
+    fn, p = T[:, 4], T[:, 5]
+    assert s["contact_pressure_mean_mpa"] == pytest.approx((fn * p).sum() / fn.sum() * 1e-6, rel=1e-12)
+    T[1, 4] = 0.5  # 2.3 % of the mean: counted
+    assert log.summary(np.array([0.0, 1.0]), (0.0, 1.0))["contact_pressure_max_mpa"] == pytest.approx(2000.0)
