@@ -222,7 +222,9 @@ def test_pressure_maximum_skips_contacts_entering_or_leaving_the_line():
     log.table = lambda: T
     s = log.summary(np.array([0.0, 1.0]), (0.0, 1.0))
     assert s["contact_pressure_max_mpa"] == pytest.approx(320.0)
-    assert s["contact_pressure_max_face_mm"] == pytest.approx(0.7) and s["contact_pressure_max_radius_mm"] == pytest.approx(28.9)
+    assert s["contact_pressure_max_face_mm"] == pytest.approx(0.7) and s[
+        "contact_pressure_max_radius_mm"
+    ] == pytest.approx(28.9)
     fn, p = T[:, 4], T[:, 5]
     assert s["contact_pressure_mean_mpa"] == pytest.approx((fn * p).sum() / fn.sum() * 1e-6, rel=1e-12)
     T[1, 4] = 0.5  # 2.3 % of the mean: counted
