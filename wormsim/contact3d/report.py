@@ -169,12 +169,28 @@ def write_recording(result: Result, path) -> None:
         P, F = result.extra["points_world"], result.extra["forces_world"]
         fmean = np.nanmean(np.linalg.norm(F.reshape(-1, 3), axis=1)) if np.isfinite(F).any() else 1.0
         scale = 5e-3 / max(fmean, 1e-9)  # mean contact force -> 5 mm arrow
-        for i in idx:
-            ok = np.isfinite(P[i, :, 0])
-            rr.set_time("sim_time", duration=float(t[i]), recording=rec)
-            rr.log("assembly/contacts/points", rr.Points3D(P[i, ok], radii=2e-4, colors=(230, 40, 40)), recording=rec)
-            rr.log(
-                "assembly/contacts/forces",
-                rr.Arrows3D(origins=P[i, ok], vectors=F[i, ok] * scale, colors=(40, 200, 40)),
-                recording=rec,
-            )
+        # one send_columns per entity (rows of varying length: partition), not one archetype per instant
+        Pi, Fi = P[idx], F[idx]
+        ok = np.isfinite(Pi[:, :, 0])
+        lengths = ok.sum(axis=1)
+        # nanoseconds rounded as rr.set_time rounds them (TimeColumn of float seconds truncates)
+        times = [rr.TimeColumn("sim_time", duration=np.round(1e9 * t[idx]).astype(np.int64).astype("timedelta64[ns]"))]
+        n = len(idx)
+        rr.send_columns(
+            "assembly/contacts/points",
+            indexes=times,
+            columns=[
+                *rr.Points3D.columns(positions=Pi[ok]).partition(lengths),
+                *rr.Points3D.columns(radii=np.full(n, 2e-4), colors=np.tile((230, 40, 40), (n, 1))),
+            ],
+            recording=rec,
+        )
+        rr.send_columns(
+            "assembly/contacts/forces",
+            indexes=times,
+            columns=[
+                *rr.Arrows3D.columns(origins=Pi[ok], vectors=Fi[ok] * scale).partition(lengths),
+                *rr.Arrows3D.columns(colors=np.tile((40, 200, 40), (n, 1))),
+            ],
+            recording=rec,
+        )
