@@ -44,13 +44,16 @@ pins the kernel's distance to meshgen.worm.thread_gap.
 from __future__ import annotations
 
 import functools
+import hashlib
 import math
-from dataclasses import dataclass
+import sys
+from dataclasses import asdict, dataclass
 
 import numba
 import numpy as np
 
 from meshgen import wheel, worm
+from meshgen.cache import cached
 from meshgen.geometry import GearGeometry
 from wormsim.contact3d.flank_pose import N_WORM_PARAMS, static_dir_to_world, to_static, tooth_angle
 
@@ -106,7 +109,26 @@ def worm_params(g: GearGeometry) -> np.ndarray:
 
 @functools.lru_cache(maxsize=16)
 def flank_grid(g: GearGeometry, slices: int, n_profile: int = N_PROFILE) -> FlankGrid:
-    """The grids of the module docstring (meshgen.wheel's envelope, both flanks of tooth 0)."""
+    """The grids of the module docstring (meshgen.wheel's envelope, both flanks of tooth 0); in process and on disk
+    (meshgen.cache, keyed by the geometry, the grid size and the source of the modules that compute the grid)."""
+    parts = {"g": asdict(g), "slices": slices, "n_profile": n_profile, "code": _grid_code_hash()}
+    return cached("flankgrid", parts, lambda: _flank_grid(g, slices, n_profile))
+
+
+@functools.cache
+def _grid_code_hash() -> str:
+    """SHA-256 of the source that determines flank_grid's result (this module, the trim, the pose, the window and
+    meshgen's geometry, worm and wheel)."""
+    import inspect
+
+    from meshgen import geometry as mg
+    from wormsim.contact3d import flank_pose, flank_trim, window
+
+    mods = (sys.modules[__name__], flank_trim, flank_pose, window, mg, worm, wheel)
+    return hashlib.sha256("".join(inspect.getsource(m) for m in mods).encode()).hexdigest()
+
+
+def _flank_grid(g: GearGeometry, slices: int, n_profile: int) -> FlankGrid:
     bw = g.face_width
     zeta = -bw / 2 + (np.arange(slices) + 0.5) * bw / slices
     lo = np.maximum(g.a - np.sqrt(np.maximum(g.r_a1**2 - zeta**2, 0.0)), wheel.root_rho(g, zeta))
