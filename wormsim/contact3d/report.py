@@ -143,6 +143,7 @@ def write_report(result: Result, path) -> None:
         color="C3" if scaled else "k",
     )
     fig.tight_layout()
+    fig.set_layout_engine(None)  # tight_layout leaves a placeholder engine: savefig would draw twice
     fig.savefig(path, dpi=110)
     plt.close(fig)
 
