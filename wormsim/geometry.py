@@ -5,16 +5,18 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 from contextlib import contextmanager
+from typing import TYPE_CHECKING
 
 from meshgen import displaced as _displaced
 from meshgen import geometry as _geometry
 from meshgen import kinematic_tca as _kinematic_tca
-from meshgen import pieces as _pieces
 from meshgen.displaced import Deviations, ErrorsData
 from meshgen.geometry import GearData, GearGeometry, GeometryError
 from meshgen.kinematic_tca import KinematicTCA
-from meshgen.pieces import GearSet
 from wormsim.scenario import Scenario, ScenarioError
+
+if TYPE_CHECKING:  # meshgen.pieces (trimesh, scipy.spatial: ~1 s) is imported only where pieces are built
+    from meshgen.pieces import GearSet
 
 
 @contextmanager
@@ -36,6 +38,8 @@ def gear_set(scenario: Scenario, resolution: str | None = None) -> tuple[GearGeo
     """(geometry, collision pieces) of the scenario's gear at `resolution` (default: simulation.resolution)."""
     if scenario.gear is None:
         raise ScenarioError("gear: this needs a gear: block (model contact3d or torsional)")
+    from meshgen import pieces as _pieces
+
     geo = derive(scenario.gear)
     with geometry_errors():
         return geo, _pieces.build_gear_set(geo, resolution=resolution or scenario.simulation.resolution)
