@@ -244,11 +244,15 @@ def test_external_scheduler_gives_the_same_table(local_run, tmp_path, capsys):
     assert failed["status"] == "failed" and not (runs[2] / "report.png").exists()
 
 
+def _default_sigint():
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def test_resume_after_ctrl_c_skips_finished_points(tmp_path, capsys):
     sweep = _write(
         tmp_path / "resume.yaml",
         (
-            f"name: resume\nbase: {SCREW_JACK}\nset: {{model: torsional, simulation.duration_s: 0.4}}\n"
+            f"name: resume\nbase: {SCREW_JACK}\nset: {{model: torsional, simulation.duration_s: 0.12}}\n"
             "grid: {drive.speed_rpm: {linspace: [1000, 1500, 6]}}\n"
         ),
     )
@@ -260,6 +264,7 @@ def test_resume_after_ctrl_c_skips_finished_points(tmp_path, capsys):
         stderr=subprocess.PIPE,
         text=True,
         env=env,
+        preexec_fn=_default_sigint,  # as on a terminal (a background job's child inherits SIGINT ignored)
     )
     try:
         t0 = time.monotonic()
