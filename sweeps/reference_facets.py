@@ -2,10 +2,10 @@
 400 N mean) against our exact flanks (~4 N): how much of it the STL's triangle facets can give. docs/contact3d.md,
 "The reference simulator's 40-50 N".
 
-(a) chordal deviation of the exported meshes (meshgen.meshes, what worm.stl / wheel.stl hold) from the exact flanks on
-    the working flanks: wheel, exact flank points of tooth 0 (the flank grid) against the wheel mesh (circumferential ray
-    -> the facet's polar angle, trimesh.proximity for the normal distance); worm, points sampled on the worm mesh's
-    flank facets against the closed-form thread (meshgen.worm.thread_gap).
+(a) chordal deviation of the exported meshes (meshgen.meshes, what worm.stl / wheel.stl hold) from the exact flanks
+    on the working flanks: wheel, exact flank points of tooth 0 (the flank grid) against the wheel mesh (a ray along
+    the circle through each point -> the facet's polar angle, times the flank normal's share); worm, points sampled
+    on the worm mesh's flank facets against the closed-form thread (meshgen.worm.thread_gap).
 (b) the mesh stiffness k_mesh = dF_t / d(r2 lag) of the exact-flank kernel at the CI load (quasi-static, the worm set
     over a mesh cycle, the wheel at the conjugate angle minus a fixed lag, as sweeps/variant_harmonics.py), and
     k_mesh x deviation at 1x and 0.66x.
@@ -83,7 +83,7 @@ def facet_psi(sub: trimesh.Trimesh, rho, psi, zeta) -> np.ndarray:
 def wheel_deviation(g, wheel_mesh, slices: int, n_profile: int = 64):
     """Normal deviation (m) of the wheel mesh from the exact flank at tooth 0's grid points, and the facetted psi.
     The facet's polar angle along the circle through the point, rho (psi_facet - psi) (n . e_psi) with the flank
-    normal n from the grid's tangents. Sign: + where the facet lies inside the tooth (material removed: the gap grows)."""
+    normal n from the grid's tangents. Sign: + where the facet lies inside the tooth (material removed: gap grows)."""
     gr = flank_grid(g, slices, n_profile)
     sub = tooth0_faces(wheel_mesh, g)
     psi_f = np.full_like(gr.psi, np.nan)
@@ -212,6 +212,53 @@ class patched_grid:
         flank_step.flank_grid = self.old
 
 
+class worm_facet_kernel:
+    """The flank kernel (flanks.find_packed) and the compiled step loop (flank_loop) rebuilt from their source with the
+    worm's facets in worm_gap_ext: the gap grows by the facet's recess of worm_facet_recess (the same closed form), so
+    a dynamic run sees the STL's worm. The modified copies are written to `folder` and imported from there."""
+
+    HOOK = "    return (abs(u) - H) * inrm, ex\n"
+
+    def __init__(self, folder: Path, segments_per_turn: int = WORM_SEGMENTS_PER_TURN):
+        self.folder = Path(folder)
+        self.segments = segments_per_turn
+
+    def __enter__(self):
+        import importlib
+
+        from wormsim.contact3d import flank_loop, flanks
+
+        self.folder.mkdir(parents=True, exist_ok=True)
+        src = Path(flanks.__file__).read_text()
+        assert src.count(self.HOOK) == 1, "flanks.worm_gap_ext changed: update worm_facet_kernel.HOOK"
+        dphi = 2 * math.pi / self.segments
+        src = src.replace(
+            self.HOOK,
+            f"    t = (phi - theta1) / {dphi!r}\n"
+            "    t -= math.floor(t)\n"
+            f"    return (abs(u) - H + r * t * (1.0 - t) * {dphi**2 / 2!r} * abs(dH)) * inrm, ex\n",
+        )
+        name = f"facet_flanks_{self.segments}"
+        (self.folder / f"{name}.py").write_text(src)
+        lsrc = Path(flank_loop.__file__).read_text()
+        old = "from wormsim.contact3d.flanks import find_packed"
+        assert old in lsrc
+        (self.folder / f"{name}_loop.py").write_text(lsrc.replace(old, f"from {name} import find_packed"))
+        sys.path.insert(0, str(self.folder))
+        self.names = (name, f"{name}_loop")
+        ff, fl = (importlib.import_module(n) for n in self.names)
+        self.saved = (flank_step.find_packed, sys.modules["wormsim.contact3d.flank_loop"])
+        flank_step.find_packed = ff.find_packed
+        sys.modules["wormsim.contact3d.flank_loop"] = fl
+        return self
+
+    def __exit__(self, *exc):
+        flank_step.find_packed, sys.modules["wormsim.contact3d.flank_loop"] = self.saved
+        sys.path.remove(str(self.folder))
+        for n in self.names:
+            sys.modules.pop(n, None)
+
+
 def facetted_grid(gr, psi_f):
     """The exact grid with the wheel flank's polar angles taken from the facets (c unchanged: the conjugate angle
     only orders the candidates; the gap is evaluated at the facetted point)."""
@@ -221,14 +268,53 @@ def facetted_grid(gr, psi_f):
     return dataclasses.replace(gr, psi=psi, xy=xy)
 
 
-def dynamic(slices: int, grid=None, *extra: str) -> dict:
+def dynamic(slices: int, grid=None, worm_facets: int = 0, *extra: str) -> dict:
+    """The screw jack's CI run with flanks at `slices`; grid: the wheel's flank grid replaced; worm_facets: the worm's
+    facets at that many segments per turn (0: exact worm); extra: scenario overrides."""
+    import contextlib
+    import tempfile
+
     from wormsim.contact3d.runner import simulate
 
     sc = scenario(slices, *extra)
-    if grid is None:
+    with contextlib.ExitStack() as st:
+        if grid is not None:
+            st.enter_context(patched_grid(grid))
+        if worm_facets:
+            folder = Path(st.enter_context(tempfile.TemporaryDirectory()))
+            st.enter_context(worm_facet_kernel(folder, worm_facets))
         return simulate(sc).summary
-    with patched_grid(grid):
-        return simulate(sc).summary
+
+
+def worm_study(slices: int) -> None:
+    """F_t p2p of CI runs with the facetted worm against its segments per turn (the recess ~ 1 / segments^2) and
+    the contact stiffness (1x, and the reference's 0.66x)."""
+    g = build_model(scenario(slices)).geometry
+    K = scenario(slices).contact.stiffness_n_per_m
+    hp = float(worm_geo.half_thickness_dr(g, g.r_a1))
+    n_r = abs(hp) / math.sqrt(1 + (g.p / g.r_a1) ** 2 + hp**2)
+    for seg, share in ((96, REFERENCE_STIFFNESS_SHARE), (192, 1.0), (384, 1.0), (192, REFERENCE_STIFFNESS_SHARE)):
+        sm = dynamic(slices, None, seg, f"contact.stiffness_n_per_m={K * share}")
+        rec = g.r_a1 * (2 * math.pi / seg) ** 2 / 8 * n_r
+        print(
+            f"worm facets {seg}/turn (recess max ~{rec * 1e6:.2f} um at r_a1), stiffness {share}x: F_t mean "
+            f"{sm['tangential_force_mean_n']:.1f} N, p2p {sm['tangential_force_p2p_n']:.2f} N, TE p2p "
+            f"{sm['transmission_error_p2p_urad']:.2f} urad, F_t peak {sm['mesh_frequency_hz']:.2f} Hz",
+            flush=True,
+        )
+
+
+def load_study(slices: int) -> None:
+    """Exact flanks, the wheel's load with a driven-machine inertia (load.inertia_kg_m2; the bare wheel's J2 is
+    about 2.4e-4 kg m^2): a heavier wheel side lowers the mesh mode towards the meshing harmonics."""
+    for inertia in (0.0, 2.4e-3, 2.4e-2):
+        sm = dynamic(slices, None, 0, f"load.inertia_kg_m2={inertia}")
+        print(
+            f"exact flanks, load inertia {inertia} kg m^2: F_t mean {sm['tangential_force_mean_n']:.1f} N, p2p "
+            f"{sm['tangential_force_p2p_n']:.2f} N, TE p2p {sm['transmission_error_p2p_urad']:.2f} urad, F_t peak "
+            f"{sm['mesh_frequency_hz']:.2f} Hz, steady window {sm['steady_window_s']}",
+            flush=True,
+        )
 
 
 def main() -> None:
@@ -236,7 +322,17 @@ def main() -> None:
     ap.add_argument("--slices", type=int, nargs="+", default=[16, 64])
     ap.add_argument("--samples", type=int, default=1000)
     ap.add_argument("--no-dynamic", action="store_true")
+    ap.add_argument("--worm-study", action="store_true", help="only the facetted worm against segments and stiffness")
+    ap.add_argument("--load-study", action="store_true", help="only exact flanks against the load's inertia")
     a = ap.parse_args()
+    if a.load_study:
+        for s in a.slices:
+            load_study(s)
+        return
+    if a.worm_study:
+        for s in a.slices:
+            worm_study(s)
+        return
     g = build_model(scenario(16)).geometry
     wm, gm = meshes.wheel_mesh(g), meshes.worm_mesh(g)
     print(f"wheel mesh {len(wm.faces)} faces, worm mesh {len(gm.faces)} faces")
@@ -293,12 +389,16 @@ def main() -> None:
             f"{np.ptp(te_e) * g.r2 * 1e6:.3f} / {np.ptp(te_f) * g.r2 * 1e6:.3f} / {np.ptp(te_w) * g.r2 * 1e6:.3f} um)"
         )
         if not a.no_dynamic:
-            for name, grid in (("exact", None), ("facetted wheel", facetted_grid(gr, psi_f))):
-                sm = dynamic(s, grid)
+            fg = facetted_grid(gr, psi_f)
+            W = WORM_SEGMENTS_PER_TURN
+            cases = (("exact", None, 0), ("facetted wheel", fg, 0), ("facetted worm", None, W))
+            cases += (("facetted worm and wheel", fg, W),)
+            for name, grid, wfac in cases:
+                sm = dynamic(s, grid, wfac)
                 print(
                     f"(c) {s} slices CI run, {name}: F_t mean {sm['tangential_force_mean_n']:.1f} N, p2p "
                     f"{sm['tangential_force_p2p_n']:.2f} N, TE p2p {sm['transmission_error_p2p_urad']:.2f} urad, "
-                    f"F_t peak {sm.get('tangential_force_peak_hz', float('nan'))} Hz"
+                    f"F_t peak {sm['mesh_frequency_hz']:.2f} Hz"
                 )
 
 
