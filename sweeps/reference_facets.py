@@ -286,18 +286,19 @@ def dynamic(slices: int, grid=None, worm_facets: int = 0, *extra: str) -> dict:
         return simulate(sc).summary
 
 
-def worm_study(slices: int) -> None:
+def worm_study(slices: int, cases, *extra: str) -> None:
     """F_t p2p of CI runs with the facetted worm against its segments per turn (the recess ~ 1 / segments^2) and
     the contact stiffness (1x, and the reference's 0.66x)."""
     g = build_model(scenario(slices)).geometry
     K = scenario(slices).contact.stiffness_n_per_m
     hp = float(worm_geo.half_thickness_dr(g, g.r_a1))
     n_r = abs(hp) / math.sqrt(1 + (g.p / g.r_a1) ** 2 + hp**2)
-    for seg, share in ((96, REFERENCE_STIFFNESS_SHARE), (192, 1.0), (384, 1.0), (192, REFERENCE_STIFFNESS_SHARE)):
-        sm = dynamic(slices, None, seg, f"contact.stiffness_n_per_m={K * share}")
+    for seg, share in cases:
+        sm = dynamic(slices, None, seg, f"contact.stiffness_n_per_m={K * share}", *extra)
         rec = g.r_a1 * (2 * math.pi / seg) ** 2 / 8 * n_r
         print(
-            f"worm facets {seg}/turn (recess max ~{rec * 1e6:.2f} um at r_a1), stiffness {share}x: F_t mean "
+            f"{slices} slices, h {sm['timestep_s']} s: worm facets {seg}/turn (recess max ~{rec * 1e6:.2f} um at r_a1), "
+            f"stiffness {share}x: F_t mean "
             f"{sm['tangential_force_mean_n']:.1f} N, p2p {sm['tangential_force_p2p_n']:.2f} N, TE p2p "
             f"{sm['transmission_error_p2p_urad']:.2f} urad, F_t peak {sm['mesh_frequency_hz']:.2f} Hz",
             flush=True,
@@ -324,14 +325,17 @@ def main() -> None:
     ap.add_argument("--no-dynamic", action="store_true")
     ap.add_argument("--worm-study", action="store_true", help="only the facetted worm against segments and stiffness")
     ap.add_argument("--load-study", action="store_true", help="only exact flanks against the load's inertia")
+    ap.add_argument("--worm", nargs="+", default=["96:1", "96:0.66", "192:1", "384:1"], help="SEGMENTS:STIFFNESS")
+    ap.add_argument("--set", nargs="*", default=[], help="scenario overrides for --worm-study")
     a = ap.parse_args()
     if a.load_study:
         for s in a.slices:
             load_study(s)
         return
     if a.worm_study:
+        cases = [(int(c.split(":")[0]), float(c.split(":")[1])) for c in a.worm]
         for s in a.slices:
-            worm_study(s)
+            worm_study(s, cases, *a.set)
         return
     g = build_model(scenario(16)).geometry
     wm, gm = meshes.wheel_mesh(g), meshes.worm_mesh(g)
