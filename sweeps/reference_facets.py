@@ -297,8 +297,8 @@ def worm_study(slices: int, cases, *extra: str) -> None:
         sm = dynamic(slices, None, seg, f"contact.stiffness_n_per_m={K * share}", *extra)
         rec = g.r_a1 * (2 * math.pi / seg) ** 2 / 8 * n_r
         print(
-            f"{slices} slices, h {sm['timestep_s']} s: worm facets {seg}/turn (recess max ~{rec * 1e6:.2f} um at r_a1), "
-            f"stiffness {share}x: F_t mean "
+            f"{slices} slices, h {sm['timestep_s']} s: worm facets {seg}/turn (recess max ~{rec * 1e6:.2f} um at "
+            f"r_a1), stiffness {share}x: F_t mean "
             f"{sm['tangential_force_mean_n']:.1f} N, p2p {sm['tangential_force_p2p_n']:.2f} N, TE p2p "
             f"{sm['transmission_error_p2p_urad']:.2f} urad, F_t peak {sm['mesh_frequency_hz']:.2f} Hz",
             flush=True,
