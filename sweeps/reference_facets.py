@@ -1,5 +1,5 @@
 """Issue 13's reference figure (an exact-surface simulator fed `wormsim mesh`'s STL: screw jack F_t p2p 40-50 N at
-400 N mean) against our exact flanks (~4 N): how much of it the STL's triangle facets can give. docs/contact3d.md,
+400 N mean) against our exact flanks (1.64 N): how much of it the STL's triangle facets can give. docs/contact3d.md,
 "The reference simulator's 40-50 N".
 
 (a) chordal deviation of the exported meshes (meshgen.meshes, what worm.stl / wheel.stl hold) from the exact flanks
@@ -11,9 +11,15 @@
     k_mesh x deviation at 1x and 0.66x.
 (c) the wheel flank replaced by its facetted version (the grid's polar angles taken from the wheel mesh's facets:
     linear between the STL's vertices): quasi-static F p2p at the fixed lag and the TE p2p at constant load, and the
-    screw jack's CI run (tests/test_contact3d_seeds.py) with that grid, F_t and TE p2p.
+    screw jack's CI run (tests/test_contact3d_seeds.py) with that grid, F_t and TE p2p; the same with the worm's
+    facets (worm_facet_recess; in the kernel for the runs, worm_facet_kernel) and with both.
 
-    .venv/bin/python sweeps/reference_facets.py [--slices 16 64] [--samples 1000] [--no-dynamic]
+Studies: --worm-study, CI runs with the facetted worm at SEGMENTS per turn and a STIFFNESS share (the reference's
+mesh 0.66x as stiff); --load-study, exact flanks with a driven machine's inertia on the wheel.
+
+    .venv/bin/python sweeps/reference_facets.py [--slices 16 32] [--samples 400] [--no-dynamic]
+    .venv/bin/python sweeps/reference_facets.py --slices 64 --worm-study --worm 96:1 96:0.66 [--set KEY=VALUE ...]
+    .venv/bin/python sweeps/reference_facets.py --slices 16 --load-study
 """
 
 from __future__ import annotations
