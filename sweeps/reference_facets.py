@@ -292,23 +292,43 @@ def dynamic(slices: int, grid=None, worm_facets: int = 0, *extra: str) -> dict:
         return simulate(sc).summary
 
 
-def worm_study(slices: int, cases, *extra: str) -> None:
+def worm_study(slices: int, cases, with_wheel: bool = False, *extra: str) -> None:
     """F_t p2p of CI runs with the facetted worm against its segments per turn (the recess ~ 1 / segments^2) and
-    the contact stiffness (1x, and the reference's 0.66x)."""
+    the contact stiffness (1x, and the reference's 0.66x); SEGMENTS 0: the exact worm; with_wheel: the wheel's
+    facets too (facetted_grid)."""
     g = build_model(scenario(slices)).geometry
     K = scenario(slices).contact.stiffness_n_per_m
     hp = float(worm_geo.half_thickness_dr(g, g.r_a1))
     n_r = abs(hp) / math.sqrt(1 + (g.p / g.r_a1) ** 2 + hp**2)
+    grid = None
+    if with_wheel:
+        gr, psi_f, _ = wheel_deviation(g, meshes.wheel_mesh(g), slices)
+        grid = facetted_grid(gr, psi_f)
     for seg, share in cases:
-        sm = dynamic(slices, None, seg, f"contact.stiffness_n_per_m={K * share}", *extra)
-        rec = g.r_a1 * (2 * math.pi / seg) ** 2 / 8 * n_r
+        sm = dynamic(slices, grid, seg, f"contact.stiffness_n_per_m={K * share}", *extra)
+        rec = g.r_a1 * (2 * math.pi / seg) ** 2 / 8 * n_r if seg else 0.0
         print(
-            f"{slices} slices, h {sm['timestep_s']} s: worm facets {seg}/turn (recess max ~{rec * 1e6:.2f} um at "
-            f"r_a1), stiffness {share}x: F_t mean "
+            f"{slices} slices, h {sm['timestep_s']} s, wheel facets {with_wheel}: worm facets {seg}/turn (recess "
+            f"max ~{rec * 1e6:.2f} um at r_a1), stiffness {share}x: F_t mean "
             f"{sm['tangential_force_mean_n']:.1f} N, p2p {sm['tangential_force_p2p_n']:.2f} N, TE p2p "
             f"{sm['transmission_error_p2p_urad']:.2f} urad, F_t peak {sm['mesh_frequency_hz']:.2f} Hz",
             flush=True,
         )
+
+
+def held_study(slices: int, n: int = 240) -> None:
+    """The facetted worm (first order, quasi-static) with the wheel held at the lag that carries the load on the cycle's
+    mean: F_t over two worm facets (7.5 deg of worm turn, where the wheel cannot follow: 2128 Hz against the mesh
+    mode) at three places in the mesh cycle. The p2p within such a window is the facets' ripple for a held wheel;
+    its change with the slices shows the slices' sampling of the pattern along the contact line."""
+    wf = QuasiStatic(slices, worm_facets=True)
+    lag = wf.lag_for_mean()
+    dphi = 2 * math.pi / WORM_SEGMENTS_PER_TURN
+    out = []
+    for th0 in (0.0, 2.1, 4.2):
+        F = np.array([wf.f_t(th0 + 2 * dphi * i / n, lag) for i in range(n)])
+        out.append(f"{np.ptp(F):.1f}")
+    print(f"held wheel, {slices} slices: F_t p2p over two worm facets {' / '.join(out)} N", flush=True)
 
 
 def load_study(slices: int) -> None:
@@ -333,7 +353,13 @@ def main() -> None:
     ap.add_argument("--load-study", action="store_true", help="only exact flanks against the load's inertia")
     ap.add_argument("--worm", nargs="+", default=["96:1", "96:0.66", "192:1", "384:1"], help="SEGMENTS:STIFFNESS")
     ap.add_argument("--set", nargs="*", default=[], help="scenario overrides for --worm-study")
+    ap.add_argument("--with-wheel", action="store_true", help="--worm-study with the wheel's facets too")
+    ap.add_argument("--held-study", action="store_true", help="only the facetted worm with the wheel held")
     a = ap.parse_args()
+    if a.held_study:
+        for s in a.slices:
+            held_study(s)
+        return
     if a.load_study:
         for s in a.slices:
             load_study(s)
@@ -341,7 +367,7 @@ def main() -> None:
     if a.worm_study:
         cases = [(int(c.split(":")[0]), float(c.split(":")[1])) for c in a.worm]
         for s in a.slices:
-            worm_study(s, cases, *a.set)
+            worm_study(s, cases, a.with_wheel, *a.set)
         return
     g = build_model(scenario(16)).geometry
     wm, gm = meshes.wheel_mesh(g), meshes.worm_mesh(g)
