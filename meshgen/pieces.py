@@ -22,14 +22,17 @@ from __future__ import annotations
 import functools
 import math
 from dataclasses import asdict, dataclass, field
-from typing import Callable
+from typing import TYPE_CHECKING, Callable
 
 import numpy as np
-import trimesh
 
-from meshgen import meshes, wheel, worm
+from meshgen import wheel, worm
 from meshgen.cache import cache_key, cached
 from meshgen.geometry import GearGeometry
+from meshgen.lazymesh import LazyMesh
+
+if TYPE_CHECKING:  # trimesh (scipy.spatial, ~1 s) only where pieces or meshes are built: meshgen.lazymesh
+    import trimesh
 
 CODE_VERSION = "meshgen-14"
 
@@ -52,11 +55,11 @@ RESOLUTIONS: dict[str, Resolution] = {
 class GearSet:
     geometry: GearGeometry
     resolution: Resolution
-    worm_pieces: list[trimesh.Trimesh]
-    wheel_tooth_pieces: list[trimesh.Trimesh]
+    worm_pieces: list[LazyMesh]  # each a trimesh.Trimesh on first use of anything but vertices and faces
+    wheel_tooth_pieces: list[LazyMesh]
     tooth_angle_rad: Callable[[int], float]
-    worm_visual: trimesh.Trimesh
-    wheel_visual: trimesh.Trimesh
+    worm_visual: LazyMesh
+    wheel_visual: LazyMesh
     worm_core_radius_m: float
     piece_error_um: dict
     undercut_fraction: float = 0.0
@@ -68,6 +71,7 @@ class GearSet:
 
 def _hull(points: np.ndarray) -> trimesh.Trimesh:
     """Convex hull as a watertight, outward-oriented mesh (scipy/qhull; trimesh's hull may drop sliver faces)."""
+    import trimesh
     from scipy.spatial import ConvexHull
 
     pts = np.asarray(points, float)
@@ -436,11 +440,14 @@ def _pack(m: trimesh.Trimesh):
     return (np.asarray(m.vertices, float), np.asarray(m.faces, np.int64))
 
 
-def _unpack(t) -> trimesh.Trimesh:
-    return trimesh.Trimesh(t[0], t[1], process=False)
+def _unpack(t) -> LazyMesh:
+    """The stored arrays as a mesh: a LazyMesh, which builds its trimesh.Trimesh(process=False) on first use."""
+    return LazyMesh(t[0], t[1])
 
 
 def _generate(g: GearGeometry, res: Resolution) -> dict:
+    from meshgen import meshes
+
     worm.check_worm(g, wheel.hob_radius(g))
     wheel.check_wheel(g)
     wp = build_worm_pieces(g, res)

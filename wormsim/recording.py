@@ -64,17 +64,20 @@ def log_mesh(
     faces: np.ndarray,
     color=(180, 180, 190),
     static: bool = True,
+    vertex_normals: np.ndarray | None = None,
 ) -> None:
-    """A triangle mesh (metres) with vertex normals, logged once (static) under `path`."""
-    import trimesh
+    """A triangle mesh (metres) with vertex normals (trimesh's, unless given), logged once (static) under `path`."""
+    if vertex_normals is None:
+        import trimesh
 
-    mesh = trimesh.Trimesh(vertices=vertices, faces=faces, process=False)
+        mesh = trimesh.Trimesh(vertices=vertices, faces=faces, process=False)
+        vertices, faces, vertex_normals = mesh.vertices, mesh.faces, mesh.vertex_normals
     rr.log(
         path,
         rr.Mesh3D(
-            vertex_positions=mesh.vertices,
-            triangle_indices=mesh.faces,
-            vertex_normals=mesh.vertex_normals,
+            vertex_positions=vertices,
+            triangle_indices=faces,
+            vertex_normals=vertex_normals,
             albedo_factor=list(color),
         ),
         static=static,

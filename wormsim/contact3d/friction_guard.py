@@ -24,7 +24,7 @@ from __future__ import annotations
 import math
 
 import mujoco
-import numpy as np
+import numba
 
 from wormsim import gear_theory as gt
 from wormsim.errors import SimulationError
@@ -45,22 +45,32 @@ def friction_alignment(d: mujoco.MjData, v_min: float) -> tuple[float, float, fl
     if n == 0:
         return 1.0, 0.0, 0.0
     con = d.contact
-    adr = np.asarray(con.efc_address[:n])
-    ok = (adr >= 0) & (np.asarray(con.dim[:n]) >= 3)
-    if not ok.any():
+    return _alignment(con.efc_address, con.dim, con.friction, d.efc_force, d.efc_vel, v_min)
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _alignment(adr, dim, friction, f, v, v_min):
+    """friction_alignment over the contacts' rows, compiled (a numpy version cost ~150 us per call, 0.3 s per
+    seat-motor 20 s run). |f_t| cos = -(f_t . v_t) / |v_t|, summed and divided by the summed |f_t|."""
+    proj = fs = fn_sum = 0.0
+    rows = sliding = 0
+    for k in range(adr.size):
+        a = adr[k]
+        if a < 0 or dim[k] < 3:
+            continue
+        rows += 1
+        fn, f1, f2, v1, v2 = f[a], f[a + 1], f[a + 2], v[a + 1], v[a + 2]
+        fn_sum += fn
+        ft, vt = math.hypot(f1, f2), math.hypot(v1, v2)
+        if vt > v_min and fn > 0 and ft >= ON_CONE * friction[k, 0] * fn:
+            sliding += 1
+            proj -= (f1 * v1 + f2 * v2) / vt
+            fs += ft
+    if rows == 0:
         return 1.0, 0.0, 0.0
-    adr, mu = adr[ok], np.asarray(con.friction[:n, 0])[ok]
-    f, v = d.efc_force, d.efc_vel
-    fn = f[adr]
-    f1, f2, v1, v2 = f[adr + 1], f[adr + 2], v[adr + 1], v[adr + 2]
-    ft, vt = np.hypot(f1, f2), np.hypot(v1, v2)
-    slide = (vt > v_min) & (fn > 0) & (ft >= ON_CONE * mu * fn)
-    if not slide.any():
-        return 1.0, 0.0, float(fn.sum())
-    # |f_t| cos = -(f_t . v_t) / |v_t|, summed and divided by the summed |f_t|
-    proj = -(f1[slide] * v1[slide] + f2[slide] * v2[slide]) / vt[slide]
-    fs = float(ft[slide].sum())
-    return float(proj.sum() / fs), fs, float(fn.sum())
+    if sliding == 0:
+        return 1.0, 0.0, fn_sum
+    return proj / fs, fs, fn_sum
 
 
 class FrictionGuard:

@@ -24,6 +24,7 @@ Built with mujoco.MjSpec from the template `models/worm_pair.xml` (see models/RE
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import astuple, dataclass, field, replace
 from importlib.resources import files
@@ -31,9 +32,9 @@ from pathlib import Path
 
 import mujoco
 import numpy as np
-import trimesh
 
 from meshgen import assembly
+from meshgen.cache import cached
 from meshgen.displaced import Deviations, wheel_mount, worm_mount
 from meshgen.geometry import GearGeometry
 from meshgen.kinematic_tca import KinematicTCA
@@ -137,6 +138,43 @@ def _axial_inertia(mesh, density: float, r_in: float, r_out: float, length: floa
     return mass, 0.5 * mass * (r_out**2 + r_in**2)
 
 
+def _on_gear_set(gs: GearSet, what: str, fn, *args):
+    """fn(*args) of gs's meshes, on disk (meshgen.cache) under the gear set's cache key (geometry, resolution,
+    meshgen's code version), `what`, the arguments, fn's source and trimesh's version: trimesh's mass properties
+    cost 0.6-0.8 s per run, and reading them from the cache keeps trimesh unimported (meshgen.lazymesh). A gear set
+    without a key (built elsewhere) is computed directly."""
+    key = gs.info.get("cache_key")
+    compute = functools.partial(fn, *args)
+    if key is None:
+        return compute()
+    parts = {"gearset": key, "what": what, "args": [a for a in args if isinstance(a, (int, float))], "code": _code(fn)}
+    return cached("gearsetprops", parts, compute)
+
+
+@functools.cache
+def _code(fn) -> str:
+    import inspect
+    from importlib.metadata import version
+
+    return inspect.getsource(fn) + version("trimesh")
+
+
+def _visual_inertia(gs: GearSet, part: str, density: float, r_in: float, r_out: float, length: float):
+    """_axial_inertia of gs.<part> (worm_visual / wheel_visual), cached (_on_gear_set)."""
+    return _on_gear_set(gs, part, _axial_inertia, getattr(gs, part), density, r_in, r_out, length)
+
+
+def visual_vertex_normals(gs: GearSet, part: str) -> np.ndarray:
+    """trimesh's vertex normals of gs.<part> (worm_visual / wheel_visual) for the recording, cached (_on_gear_set)."""
+    return _on_gear_set(gs, f"{part}_normals", _vertex_normals, getattr(gs, part))
+
+
+def _vertex_normals(mesh) -> np.ndarray:
+    import trimesh
+
+    return np.asarray(trimesh.Trimesh(vertices=mesh.vertices, faces=mesh.faces, process=False).vertex_normals)
+
+
 def nominal_normal_force_n(scenario: Scenario, geo: GearGeometry) -> float:
     """Whole-mesh normal force at the working load (gear_theory.normal_force_n of working_wheel_torque_nm). Sets
     the friction rows' hardness (wormsim.contact3d.law (3)); with T2 = 0 impratio fell to 1 and a self-locking pair
@@ -177,8 +215,12 @@ def _slabs_per_flank(gs: GearSet) -> int:
 
 
 def _tooth0_angle(gs: GearSet) -> float:
-    """Angle of tooth 0's centre (mean of its pieces' centroids) in the wheel frame."""
-    c = np.mean([p.centroid for p in gs.wheel_tooth_pieces], axis=0)
+    """Angle of tooth 0's centre (mean of its pieces' centroids) in the wheel frame (cached: _on_gear_set)."""
+    return _on_gear_set(gs, "tooth0_angle", _pieces_angle, gs.wheel_tooth_pieces)
+
+
+def _pieces_angle(pieces) -> float:
+    c = np.mean([p.centroid for p in pieces], axis=0)
     return math.atan2(c[1], c[0])
 
 
@@ -187,8 +229,8 @@ def _tooth0_angle(gs: GearSet) -> float:
 
 def shaft_inertias(scenario: Scenario, geo: GearGeometry, gs: GearSet) -> Inertias:
     mats = scenario.materials
-    m1, I1 = _axial_inertia(gs.worm_visual, mats.worm.density_kg_m3, 0.0, geo.r1, geo.worm_length)
-    m2, I2 = _axial_inertia(gs.wheel_visual, mats.wheel.density_kg_m3, 0.0, geo.r2, geo.face_width)
+    m1, I1 = _visual_inertia(gs, "worm_visual", mats.worm.density_kg_m3, 0.0, geo.r1, geo.worm_length)
+    m2, I2 = _visual_inertia(gs, "wheel_visual", mats.wheel.density_kg_m3, 0.0, geo.r2, geo.face_width)
     j_load = scenario.load.inertia_kg_m2
     J1, J2 = (j_load, 0.0) if scenario.load.on == "worm" else (0.0, j_load)
     return Inertias(m1, I1, m2, I2, J1, J2)
@@ -390,7 +432,7 @@ def _place_displaced(spec: mujoco.MjSpec, geo: GearGeometry, dev: Deviations) ->
         spec.joint(f"{part}_hinge").pos = -E[:3, 3]
 
 
-def _add_mesh(spec: mujoco.MjSpec, name: str, mesh: trimesh.Trimesh) -> None:
+def _add_mesh(spec: mujoco.MjSpec, name: str, mesh) -> None:
     me = spec.add_mesh()
     me.name = name
     me.uservert = np.asarray(mesh.vertices, dtype=np.float32).ravel()
@@ -548,6 +590,8 @@ def write_model(scenario: Scenario, out_dir: str | Path) -> Path:
             bias[0] = drive_final if act.name == "drive" else load_final
         act.biastype = mujoco.mjtBias.mjBIAS_AFFINE
         act.biasprm = bias
+    import trimesh
+
     for me in spec.meshes:
         v = np.asarray(me.uservert, dtype=float).reshape(-1, 3)
         f = np.asarray(me.userface, dtype=int).reshape(-1, 3)

@@ -19,6 +19,7 @@ import numpy as np
 import rerun as rr
 
 from meshgen import assembly
+from wormsim.contact3d.mjcf import visual_vertex_normals
 from wormsim.metrics import dominant_frequency
 from wormsim.recording import log_mesh, log_series, log_transforms, recording
 from wormsim.result import Result
@@ -156,8 +157,10 @@ def write_recording(result: Result, path) -> None:
     with recording(path, f"contact3d-{result.summary.get('scenario', 'run')}") as rec:
         log_series(rec, t, {k: v for k, v in S.items() if k != "drive_command"})
         gs = bm.pieces
-        log_mesh(rec, "assembly/worm/mesh", gs.worm_visual.vertices, gs.worm_visual.faces, color=(150, 160, 180))
-        log_mesh(rec, "assembly/wheel/mesh", gs.wheel_visual.vertices, gs.wheel_visual.faces, color=(220, 165, 80))
+        for part, color in (("worm", (150, 160, 180)), ("wheel", (220, 165, 80))):
+            mesh = getattr(gs, f"{part}_visual")
+            normals = visual_vertex_normals(gs, f"{part}_visual")  # cached: no trimesh import
+            log_mesh(rec, f"assembly/{part}/mesh", mesh.vertices, mesh.faces, color=color, vertex_normals=normals)
         idx = np.unique(np.linspace(0, len(t) - 1, min(len(t), MAX_FRAMES)).astype(int))
         Tw = np.stack([assembly.worm_to_assembly(float(a), geo) for a in S["worm_angle_rad"][idx]])
         Tg = np.stack([assembly.wheel_to_assembly(float(a)) for a in S["wheel_angle_rad"][idx]])
