@@ -130,6 +130,30 @@ def test_speedup_of_flanks_over_pieces_pairs_equal_level_and_step_factor():
     assert "speedup_vs_pieces" not in recs[4]  # no pieces run of that level: no speed-up claimed
 
 
+def test_loop_speedup_uses_the_stepping_loop_wall_time_of_the_same_records():
+    from wormsim.bench.run import speedups
+
+    def rec(geo, whole, loop):
+        return {
+            "scenario": "s",
+            "model": "contact3d",
+            "status": "ok",
+            "resolution": {"level": "medium", "geometry": geo},
+            "timestep_factor": 1.0,
+            "wall_s_per_sim_s": whole,
+            "loop_wall_s_per_sim_s": loop,
+        }
+
+    recs = [rec("pieces", 120.0, 110.0), rec("flanks", 15.0, 5.0)]
+    assert speedups(recs) == {"s": {"medium": 8.0}}
+    assert speedups(recs, "loop_wall_s_per_sim_s", "loop_speedup_vs_pieces") == {"s": {"medium": 22.0}}
+    assert recs[1]["speedup_vs_pieces"] == 8.0 and recs[1]["loop_speedup_vs_pieces"] == 22.0
+    recs[0]["loop_wall_s_per_sim_s"] = None  # a level without a loop time (torsional): no loop speed-up claimed
+    del recs[1]["loop_speedup_vs_pieces"]
+    assert speedups(recs, "loop_wall_s_per_sim_s", "loop_speedup_vs_pieces") == {}
+    assert "loop_speedup_vs_pieces" not in recs[1]
+
+
 def test_json_results_are_readable_by_others(tmp_path):
     import os
     import stat

@@ -3,8 +3,12 @@
 For each seed scenario, each fidelity level runs across its resolutions and timesteps. Per run:
 
     wall_s            median wall time of `repeats` runs in this process, after a short warm-up run
-                      that builds the geometry and k(theta) caches
+                      that builds the geometry and k(theta) caches: the whole `simulate()` call (model build,
+                      stepping loop, summary; no files written)
     realtime_factor   sim_s / wall_s
+    loop_wall_s       contact3d only: median of the runner's stepping loop alone (summary `step_wall_us` x steps:
+                      from the first step to the last sample, per-sample guards and bookkeeping included; model
+                      build, first forward and summary excluded), over the same runs
     error[key]        |value - reference| / |reference| for key in ERROR_KEYS, against the converged
                       reference: the finest contact3d run of that scenario. The reference itself is checked
                       against a finer run (`reference_check` in bench_meta.json).
@@ -61,7 +65,7 @@ def machine_info() -> dict:
     }
 
 
-def _run_case(case: BenchCase, repeats: int) -> tuple[dict, float, float]:
+def _run_case(case: BenchCase, repeats: int) -> tuple[dict, float, float, float | None]:
     sc = load_scenario(SCENARIOS / f"{case.scenario}.yaml", list(case.overrides))
     # warm-up: a run of a few steps builds the geometry / k(theta) caches, so the timed runs measure
     # simulation, not one-off generation (which `wormsim mesh` reports on its own)
@@ -71,18 +75,22 @@ def _run_case(case: BenchCase, repeats: int) -> tuple[dict, float, float]:
         simulate(warm)
     except Exception:  # a too-short run may fail its own checks (or its metrics); the timed runs report real failures
         pass
-    walls, res = [], None
+    walls, loops, res = [], [], None
     for _ in range(repeats):
         t0 = time.perf_counter()
         res = simulate(sc)
         walls.append(time.perf_counter() - t0)
-    return res.summary, statistics.median(walls), res.sim_time_s
+        if res.summary.get("step_wall_us") is not None:
+            loops.append(1e-6 * res.summary["step_wall_us"] * res.steps)
+    loop = statistics.median(loops) if loops else None
+    return res.summary, statistics.median(walls), res.sim_time_s, loop
 
 
-def speedups(records: list[dict]) -> dict:
-    """Wall time per simulated second of pieces over flanks, per scenario and resolution level, both at their own
-    default timestep (timestep_factor 1) in the same bench run; also written into each flanks record
-    (`speedup_vs_pieces`, at every timestep factor both ran)."""
+def speedups(records: list[dict], key: str = "wall_s_per_sim_s", name: str = "speedup_vs_pieces") -> dict:
+    """Wall time per simulated second of pieces over flanks (`key`: the whole simulate() call, or
+    loop_wall_s_per_sim_s: the stepping loop alone), per scenario and resolution level, both at their own default
+    timestep (timestep_factor 1) in the same bench run; also written into each flanks record (`name`, at every
+    timestep factor both ran)."""
     out: dict = {}
     for r in records:
         res = r.get("resolution") or {}
@@ -100,11 +108,11 @@ def speedups(records: list[dict]) -> dict:
             ),
             None,
         )
-        if p is None or not r.get("wall_s_per_sim_s"):
+        if p is None or not r.get(key) or not p.get(key):
             continue
-        r["speedup_vs_pieces"] = p["wall_s_per_sim_s"] / r["wall_s_per_sim_s"]
+        r[name] = p[key] / r[key]
         if r.get("timestep_factor") == 1.0:
-            out.setdefault(r["scenario"], {})[res["level"]] = r["speedup_vs_pieces"]
+            out.setdefault(r["scenario"], {})[res["level"]] = r[name]
     return out
 
 
@@ -126,7 +134,7 @@ def run_bench(
     machine_start = machine_info()
     for case in bench_cases(quick, models, scenarios, geometries, resolutions):
         try:
-            summary, wall, sim_s = _run_case(case, repeats)
+            summary, wall, sim_s, loop = _run_case(case, repeats)
         except SimulationError as exc:
             notes.append(f"{case.scenario} {case.model} {case.resolution} dt={case.timestep_s}: failed: {exc}")
             records.append(
@@ -155,6 +163,8 @@ def run_bench(
             "sim_s": sim_s,
             "realtime_factor": sim_s / wall if wall > 0 else None,
             "wall_s_per_sim_s": wall / sim_s if sim_s else None,
+            "loop_wall_s": loop,
+            "loop_wall_s_per_sim_s": loop / sim_s if loop is not None and sim_s else None,
             "status": "ok",
             "reference": case.reference,
             "finer": case.finer,
@@ -169,7 +179,8 @@ def run_bench(
         "repeats": repeats,
         "scenarios": sorted({r["scenario"] for r in records}),
         "reference_check": {},
-        "speedup_flanks_vs_pieces": speedups(records),
+        "speedup_flanks_vs_pieces": speedups(records),  # whole simulate() calls (wall_s)
+        "speedup_flanks_vs_pieces_loop": speedups(records, "loop_wall_s_per_sim_s", "loop_speedup_vs_pieces"),
         "notes": notes,
     }
     for scen in {r["scenario"] for r in records}:
