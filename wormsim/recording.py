@@ -136,4 +136,5 @@ def recorded_data(path: str | Path) -> dict[str, list]:
         out.setdefault(chunk.entity_path, []).append(cols)
     for chunks in out.values():
         chunks.sort(key=lambda c: repr(sorted(c.items()))[:10000])
-    return out
+    # entities by path: the store streams chunks in the order the batcher flushed them, which depends on timing
+    return dict(sorted(out.items()))

@@ -154,13 +154,13 @@ def write_recording(result: Result, path) -> None:
     geo = bm.geometry
     S = result.series
     t = S["t_s"]
+    gs = bm.pieces
+    normals = {part: visual_vertex_normals(gs, f"{part}_visual") for part in ("worm", "wheel")}  # cached (mjcf)
     with recording(path, f"contact3d-{result.summary.get('scenario', 'run')}") as rec:
         log_series(rec, t, {k: v for k, v in S.items() if k != "drive_command"})
-        gs = bm.pieces
         for part, color in (("worm", (150, 160, 180)), ("wheel", (220, 165, 80))):
             mesh = getattr(gs, f"{part}_visual")
-            normals = visual_vertex_normals(gs, f"{part}_visual")  # cached: no trimesh import
-            log_mesh(rec, f"assembly/{part}/mesh", mesh.vertices, mesh.faces, color=color, vertex_normals=normals)
+            log_mesh(rec, f"assembly/{part}/mesh", mesh.vertices, mesh.faces, color, vertex_normals=normals[part])
         idx = np.unique(np.linspace(0, len(t) - 1, min(len(t), MAX_FRAMES)).astype(int))
         Tw = np.stack([assembly.worm_to_assembly(float(a), geo) for a in S["worm_angle_rad"][idx]])
         Tg = np.stack([assembly.wheel_to_assembly(float(a)) for a in S["wheel_angle_rad"][idx]])
