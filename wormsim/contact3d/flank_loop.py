@@ -259,10 +259,11 @@ def _i3(T, k):
     return numba.carray(_i64_at(T[k, 0]), (T[k, 1], T[k, 2], T[k, 3]))
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def run_table(T, m_addr, d_addr, cmd, load, j0, j1):
     """run_interval with its arrays given by address and shape (T: one row per TABLE entry, (address, shape));
-    numba unboxes one array instead of 30 per call (about 10-20 us per call saved, docs/contact3d.md)."""
+    numba unboxes one array instead of 30 per call (about 10-20 us per call saved, docs/contact3d.md). Releases the
+    GIL, as MuJoCo's bindings do around mj_step: wormsim.run imports the report's libraries meanwhile."""
     mjd = (_f1(T, 0), _f1(T, 1), _f1(T, 2), _f1(T, 3), _f1(T, 4), _f2(T, 5), _f2(T, 6))
     kern = (_f1(T, 7), _i1(T, 8), _i1(T, 9))
     out = (_f2(T, 11), _f1(T, 12), _f1(T, 13), _f2(T, 14))
