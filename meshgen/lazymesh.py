@@ -42,7 +42,7 @@ class LazyMesh:
         return self._f if self._mesh is None else self._mesh.faces
 
     def __getattr__(self, name: str) -> Any:  # only names not found above: trimesh's
-        if name.startswith("__"):
+        if name.startswith("__") or name in LazyMesh.__slots__:  # unset slot (copy / unpickling): no recursion
             raise AttributeError(name)
         return getattr(self.mesh, name)
 
