@@ -14,9 +14,12 @@ from __future__ import annotations
 import os
 from contextlib import contextmanager
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
-import rerun as rr
+
+if TYPE_CHECKING:  # rerun (~0.6 s) is imported where a recording is written: wormsim.run imports it meanwhile
+    import rerun as rr
 
 TIMELINE = "sim_time"
 APP_ID = "wormsim"
@@ -25,6 +28,8 @@ APP_ID = "wormsim"
 @contextmanager
 def recording(path: str | Path, name: str):
     """A RecordingStream that saves to `path` (written to a temp file, renamed on success)."""
+    import rerun as rr
+
     path = Path(path)
     tmp = path.with_name(f".{path.name}.tmp{os.getpid()}")
     rec = rr.RecordingStream(APP_ID, recording_id=name, send_properties=False)
@@ -45,6 +50,8 @@ def log_series(rec: rr.RecordingStream, t_s: np.ndarray, series: dict[str, np.nd
     Multi-column arrays (N, k) become k plots named `<name>/<i>`. Non-numeric or mismatched arrays
     are skipped (they belong elsewhere).
     """
+    import rerun as rr
+
     t_s = np.asarray(t_s, dtype=float)
     times = rr.TimeColumn(TIMELINE, duration=t_s)
     for name, values in series.items():
@@ -67,6 +74,8 @@ def log_mesh(
     vertex_normals: np.ndarray | None = None,
 ) -> None:
     """A triangle mesh (metres) with vertex normals (trimesh's, unless given), logged once (static) under `path`."""
+    import rerun as rr
+
     if vertex_normals is None:
         import trimesh
 
@@ -87,6 +96,8 @@ def log_mesh(
 
 def log_transforms(rec: rr.RecordingStream, path: str, t_s: np.ndarray, matrices: np.ndarray) -> None:
     """A moving frame: 4x4 homogeneous transforms (N, 4, 4) of `path` on the sim-time timeline."""
+    import rerun as rr
+
     t_s = np.asarray(t_s, dtype=float)
     mats = np.asarray(matrices, dtype=float)
     rr.send_columns(

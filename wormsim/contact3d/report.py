@@ -16,7 +16,6 @@ and in report.png the pattern as a band on the wheel flank coloured by pressure 
 from __future__ import annotations
 
 import numpy as np
-import rerun as rr
 
 from meshgen import assembly
 from wormsim.contact3d.mjcf import visual_vertex_normals
@@ -150,6 +149,8 @@ def write_report(result: Result, path) -> None:
 
 
 def write_recording(result: Result, path) -> None:
+    import rerun as rr
+
     bm = result.extra["built"]
     geo = bm.geometry
     S = result.series
