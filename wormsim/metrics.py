@@ -179,3 +179,17 @@ def drive_summary(
         "wheel_speed_fluctuation": float(np.ptp(w2[sl]) / n2) if n2 > 0 else float("nan"),
         "wheel_speed_std_rpm": float(np.std(w2[sl])),
     }
+
+
+def p2p_below(t: np.ndarray, x: np.ndarray, f_max_hz: float) -> float:
+    """Peak-to-peak of x(t) (uniform grid) below f_max_hz: linear trend removed, the FFT's lines at and above
+    f_max_hz zeroed (a brick-wall low-pass). Separates F_t's meshing band from the contact mode's ringing
+    (docs/contact3d.md, "Default slice count")."""
+    n = len(x)
+    if n < 8:
+        return float("nan")
+    tt = t - t[0]
+    y = x - np.polyval(np.polyfit(tt, x, 1), tt)
+    X = np.fft.rfft(y)
+    X[np.fft.rfftfreq(n, tt[-1] / (n - 1)) >= f_max_hz] = 0
+    return float(np.ptp(np.fft.irfft(X, n)))

@@ -122,7 +122,8 @@ class Contact(_Strict):
         ge=2,
         le=256,
         description=(
-            "flanks: slices across the face width (default by simulation.resolution: coarse 8, medium 16, fine 32)"
+            "flanks: slices across the face width (default by simulation.resolution: coarse 8, a quick look; medium and "
+            "fine 32, converged; docs/contact3d.md)"
         ),
     )
 
