@@ -58,16 +58,35 @@ from meshgen.geometry import GearGeometry
 from wormsim.contact3d.flank_pose import N_WORM_PARAMS, static_dir_to_world, to_static, tooth_angle
 
 N_PROFILE = 64  # points along the profile per slice (the parabola refines between them)
-# default slices across the face per simulation.resolution: 32 at medium and fine, where F_t's meshing band and the TE
-# p2p are within 10 % of 64 slices on every seed and variant measured, and the seat motor's whole F_t p2p too; coarse
-# is a quick look (docs/contact3d.md, "Default slice count")
-SLICES = {"coarse": 8, "medium": 32, "fine": 32}
+SLICES_COARSE = 8  # simulation.resolution coarse: a quick look (not converged; docs/contact3d.md)
+SLICE_SHARE = 0.2  # medium and fine: a slice's stiffness K / S at most this share of the mesh stiffness's p2p
+SLICES_STEP = 8  # the count rounded up to a multiple of this
+SLICES_TCA_SAMPLES = 128  # worm angles per mesh cycle of the TCA that gives the fluctuation
 TAPER_SHARE = 0.5  # outer share of the candidate margin over which an edge contact's depth fades to zero
 MARGIN_PITCH = 0.10  # candidate points: conjugate angle within this fraction of a pitch (plus the backlash
 # angle and the transmission error, find_contacts' margin) of the wheel angle
 MEMO_GAP_SHARE = 0.5  # a memorised open slice is skipped while its bound keeps this share of the gap it had
 MEMO_JITTER_MODULE = 1e-3  # allowance (x m_x) for the slice minimum's change at constant TE (measured <= 1.5e-5)
 MEMO_AGE_CYCLE = 1.0 / 8  # a memorised slice is evaluated again after this share of a mesh cycle of worm rotation
+
+
+def default_slices(g: GearGeometry, resolution: str) -> int:
+    """Slices across the face when contact.slices is not given. Each slice switches a stiffness of up to K / S as the
+    contact line's end crosses it, and rings the contact mode; the slicing resolves the mesh stiffness's own change
+    over a mesh cycle once K / S is small against it:
+
+        S = SLICES_STEP ceil(k_mean / (SLICE_SHARE k_p2p) / SLICES_STEP),
+
+    k_p2p / k_mean the fluctuation of the zero-load TCA's k(theta) (wormsim.torsional.mesh_stiffness, both flank
+    sides, the smaller). Measured (docs/contact3d.md, "Default slice count"): seat motor 0.177 -> 32 slices (16 were
+    not converged), screw jack 0.376 -> 16, involute_41 0.267 -> 24. Coarse: SLICES_COARSE."""
+    if resolution == "coarse":
+        return SLICES_COARSE
+    from wormsim.torsional.mesh_stiffness import mesh_stiffness
+
+    ms = mesh_stiffness(g, 1.0, "slices", SLICES_TCA_SAMPLES)
+    share = min(float(np.ptp(k) / np.mean(k)) for k in (ms.k_mesh_fwd_n_per_m, ms.k_mesh_rev_n_per_m))
+    return int(SLICES_STEP * math.ceil(1.0 / (SLICE_SHARE * max(share, 1e-3)) / SLICES_STEP))
 
 
 @dataclass(frozen=True)

@@ -199,10 +199,13 @@ def expected_direction(scenario: Scenario, geo: GearGeometry) -> int:
 
 
 def flank_slices(scenario: Scenario) -> int:
-    """contact.geometry flanks: slices across the face (contact.slices, else by simulation.resolution)."""
-    from wormsim.contact3d.flanks import SLICES
+    """contact.geometry flanks: slices across the face (contact.slices, else flanks.default_slices)."""
+    from meshgen.geometry import derive
+    from wormsim.contact3d.flanks import default_slices
 
-    return int(scenario.contact.slices or SLICES[scenario.simulation.resolution])
+    if scenario.contact.slices:
+        return int(scenario.contact.slices)
+    return default_slices(derive(scenario.gear), scenario.simulation.resolution)
 
 
 def _slabs_per_flank(gs: GearSet) -> int:
