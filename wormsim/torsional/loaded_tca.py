@@ -43,7 +43,7 @@ from wormsim.contact3d.flanks import MARGIN_PITCH, TAPER_SHARE, find_contacts, f
 from wormsim.errors import SimulationError
 
 CODE_VERSION = "ltca-3"
-SLICES = 32  # slices across the face (contact3d's "fine")
+SLICES = 32  # slices across the face (contact3d's default for the seat motor; flanks.default_slices)
 SAMPLES_PER_MESH = 32  # worm angles per mesh cycle
 X_POINTS = 17  # wheel lag grid points from 0 to the range's end
 X_BELOW = 4  # and below 0 (the flank kernel touches up to ~35 urad before the kinematic TCA's g: screw jack)
