@@ -124,7 +124,7 @@ class Contact(_Strict):
         description=(
             "flanks: slices across the face width (default: coarse 8, a quick look; medium and fine from the gear, a "
             "slice's stiffness at most 1/5 of the mesh stiffness's fluctuation, a multiple of 8: seat motor 32, screw "
-            "jack 16, involute_41 24; docs/contact3d.md)"
+            "jack 16, involute_41 24; at most 16 with simulation.mass_scaling, which keeps means only; docs/contact3d.md)"
         ),
     )
 

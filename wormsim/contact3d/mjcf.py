@@ -269,6 +269,10 @@ def prepare(scenario: Scenario, gs: GearSet | None = None) -> Prepared:
     S = scaling.factor
     if S != 1:
         ine = Inertias(*(S * v for v in astuple(ine)))
+        if scenario.contact.geometry == "flanks" and not scenario.contact.slices:
+            from wormsim.contact3d.flanks import SLICES_MASS_SCALED
+
+            slabs = min(slabs, SLICES_MASS_SCALED)  # a scaled run keeps means only (flanks.SLICES_MASS_SCALED)
     a1, a2 = arm1**2 / (S * I1), arm2**2 / (S * I2)
     law = contact_law(scenario.contact, scenario.materials, geo.face_width, slabs, a1 + a2)
     mu0 = float(friction_coefficient(scenario.contact, 0.0))
