@@ -157,7 +157,7 @@ def static_flanks():
 def test_flank_contact_stiffness_is_k_over_slices(static_flanks):
     bm, out = static_flanks
     C = out[-1][2]
-    assert bm.law.contacts_per_pair == 16
+    assert bm.law.contacts_per_pair == 32  # the seat motor's default slices (flanks.default_slices)
     assert len(C) >= 8
     assert np.all((C[:, 3] > 0) & (C[:, 3] <= 1)) and np.sum(C[:, 3] == 1) >= 8
     ratio = C[:, 0] / C[:, 1] / (C[:, 3] * bm.law.contact_stiffness_n_per_m)
