@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
 import time
 from pathlib import Path
@@ -71,6 +72,11 @@ def limit_s(name: str) -> float:
     return prepare(load_scenario(path, ov)).law.stable_limit_s
 
 
+def _finite(v):
+    """None for a non-finite float (strict JSON: a ringing run's efficiency can be NaN)."""
+    return None if isinstance(v, float) and not math.isfinite(v) else v
+
+
 def one(name: str, h: float, h0: float) -> dict:
     path, ov = overrides(name)
     sc = load_scenario(path, [*ov, f"simulation.timestep_s={h!r}", "simulation.record_every=1"])
@@ -84,7 +90,7 @@ def one(name: str, h: float, h0: float) -> dict:
     s = res.summary
     t = res.series["t_s"]
     m = (t >= s["steady_window_s"][0]) & (t <= s["steady_window_s"][1])
-    rec.update({k: s.get(k) for k in KEYS})
+    rec.update({k: _finite(s.get(k)) for k in KEYS})
     rec.update(
         status="ok",
         tangential_force_p2p_mesh_band_n=p2p_below(t[m], res.series["tangential_force_n"][m], BAND_HZ),
