@@ -4,14 +4,13 @@ report.png, recording.rrd and summary.json atomically (wormsim.output)."""
 from __future__ import annotations
 
 import importlib
-import threading
 import time
 from pathlib import Path
 from types import ModuleType
 
 import numpy as np
 
-from wormsim import interrupt
+from wormsim import interrupt, prewarm
 from wormsim.errors import ScenarioError, SimulationError
 from wormsim.output import ResultDir
 from wormsim.progress import Progress
@@ -37,20 +36,6 @@ def simulate(scenario: Scenario, progress: Progress | None = None) -> Result:
     return model_module(scenario.model).simulate(scenario, progress=progress)
 
 
-def _import_writers() -> None:
-    """Import what write_report and write_recording use (matplotlib ~0.7 s, rerun ~0.6 s), in a thread started before
-    the simulation: contact3d's compiled stepping loop releases the GIL (wormsim.contact3d.flank_loop.run_table), so on
-    a second core the imports cost no wall time. Failures are left to the writers' own imports."""
-    try:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        importlib.import_module("matplotlib.pyplot")
-        importlib.import_module("rerun")
-    except Exception:
-        pass
-
-
 def run_scenario(scenario: Scenario, out_dir: str | Path, progress: bool | None = None) -> dict:
     """Simulate and write DIR/{summary.json, timeseries.npz, report.png, recording.rrd}.
 
@@ -63,21 +48,26 @@ def run_scenario(scenario: Scenario, out_dir: str | Path, progress: bool | None 
     rd = ResultDir(out_dir)
     base = {"model": scenario.model, "scenario": scenario.name}
     t0 = time.perf_counter()
-    threading.Thread(target=_import_writers, name="wormsim-import-writers", daemon=True).start()
+    # the writers' imports and matplotlib's text warm-up, in a thread while the simulation runs (wormsim.prewarm)
+    warm = prewarm.Writers(gated=getattr(mod, "GIL_FREE_LOOP", False))
     try:
         with Progress(
             scenario.simulation.duration_s, label=f"{scenario.name} ({scenario.model})", enabled=progress
         ) as bar:
             res = mod.simulate(scenario, progress=bar)
         wall = time.perf_counter() - t0
+        warm.release()
         np.savez_compressed(rd.path("timeseries.npz"), **res.series)
+        warm.join()
         mod.write_report(res, rd.path("report.png"))
         mod.write_recording(res, rd.path("recording.rrd"))
         interrupt.check()  # an interrupt swallowed on the way (a library's `except BaseException`)
     except KeyboardInterrupt:  # Ctrl-C / SIGTERM: not a failure of the run; an earlier result stays
+        warm.cancel()
         rd.abandon()
         raise
     except (SimulationError, ScenarioError) as exc:  # a diagnosis (exit 3) or input found invalid (exit 2)
+        warm.cancel()
         if (sig := interrupt.pending()) is not None:
             rd.abandon()
             raise interrupt.Interrupted(sig) from exc
@@ -93,6 +83,7 @@ def run_scenario(scenario: Scenario, out_dir: str | Path, progress: bool | None 
         )
         raise
     except BaseException as exc:  # never leave a result that looks complete
+        warm.cancel()
         if (sig := interrupt.pending()) is not None:  # the interrupt came back as another exception
             rd.abandon()
             raise interrupt.Interrupted(sig) from exc

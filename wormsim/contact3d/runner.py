@@ -36,7 +36,8 @@ import mujoco
 import numpy as np
 
 from wormsim import gear_theory as gt
-from wormsim.contact3d import mass_scaling
+from wormsim import prewarm
+from wormsim.contact3d import jit_warmup, mass_scaling
 from wormsim.contact3d.contact_sums import RadiusLog
 from wormsim.contact3d.metrics import contact3d_summary
 from wormsim.contact3d.mjcf import BuiltModel, build_model
@@ -346,6 +347,7 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
     # the commands at each step's midpoint, evaluated for blocks of about 4096 steps at once
     cmds = gt.commands(scenario, bm.direction)
     block = max(1, 4096 // rec)
+    prewarm.loop_started()  # the writers' warm-up thread goes now, beside the GIL-free loop (wormsim.prewarm)
     for i in range(n_rec):
         if i % block == 0:
             t_blk = (i * rec + np.arange(min(block, n_rec - i) * rec) + 0.5) * dt
@@ -495,6 +497,7 @@ def _run_summary(
 
 def simulate(scenario: Scenario, progress=None) -> Result:
     """Build the model (its timestep chosen before the build) and run it."""
+    jit_warmup.start()  # numba's start-up beside MuJoCo's model compilation (wormsim.contact3d.jit_warmup)
     bm = build_model(scenario)
     if progress is not None and scenario.simulation.mass_scaling != 1:
         progress.note(mass_scaling.note(bm.meta["mass_scaling_check"], scenario.simulation.mass_scaling, bm.timestep_s))

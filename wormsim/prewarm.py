@@ -1,0 +1,100 @@
+"""Work done in a background thread while a simulation runs, so that it costs no wall time on a second core.
+
+`Writers` imports what the writers use (matplotlib ~0.7 s, rerun ~0.6 s) and warms matplotlib's text machinery (the
+font lookup and the mathtext parser that the log axis's tick labels need, ~0.3-0.4 s the first time in a process) by
+drawing a throwaway figure to an in-memory Agg canvas, made with matplotlib.figure.Figure, not pyplot, so no figure
+is registered and no rcParam is set. Python code only gains from a thread while the main thread has released the GIL:
+contact3d's compiled stepping loop does (wormsim.contact3d.flank_loop.run_table), the model build before it mostly
+does not, so a package that sets GIL_FREE_LOOP holds the thread until its runner calls `loop_started()` (else the
+imports would slow the build). run_scenario joins the thread before writing (matplotlib is not thread-safe). A
+failure in the thread is dropped: the writers import and draw for themselves.
+"""
+
+from __future__ import annotations
+
+import importlib
+import threading
+
+JOIN_TIMEOUT_S = 60.0  # a warm-up that hangs must not hang the run
+
+_gate: threading.Event | None = None  # the running Writers' gate (one run at a time per process)
+_text_warmed = False  # the throwaway figure is drawn once per process
+
+
+def loop_started() -> None:
+    """Called by a runner when its GIL-free loop starts: lets the waiting warm-up go."""
+    if _gate is not None:
+        _gate.set()
+
+
+def _import_writers() -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    importlib.import_module("matplotlib.pyplot")
+    importlib.import_module("rerun")
+
+
+def warm_text() -> None:
+    """Draw a small throwaway figure with what report.png has (titles, labels, a legend, a boxed text, a log axis
+    whose tick labels are mathtext, a suptitle, tight_layout) to an Agg canvas in memory."""
+    import numpy as np
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(4, 3))
+    FigureCanvasAgg(fig)
+    a, b = fig.subplots(1, 2)
+    x = np.linspace(0.0, 1.0, 50)
+    a.plot(x, x + 1.0, label="a")
+    a.legend(fontsize=8)
+    a.set(xlabel="x", ylabel="y", title="t")
+    a.text(0.5, 1.5, "r", fontsize=9, bbox=dict(facecolor="white", edgecolor="0.6", pad=1.5))
+    b.semilogy(x, np.exp(8.0 * x) * 1e-3)
+    fig.suptitle("s")
+    fig.tight_layout()
+    fig.canvas.draw()
+
+
+class Writers:
+    """The writers' warm-up thread of one run (module docstring). gated: wait for loop_started() (or release())."""
+
+    def __init__(self, gated: bool = False):
+        global _gate
+        self.gate = threading.Event()
+        if not gated:
+            self.gate.set()
+        _gate = self.gate
+        self.error: BaseException | None = None
+        self.cancelled = False
+        self.thread = threading.Thread(target=self._run, name="wormsim-prewarm-writers", daemon=True)
+        self.thread.start()
+
+    def _run(self) -> None:
+        global _text_warmed
+        self.gate.wait()
+        if self.cancelled:
+            return
+        try:
+            _import_writers()
+            if not _text_warmed:
+                warm_text()
+                _text_warmed = True
+        except Exception as exc:  # the writers import and draw for themselves
+            self.error = exc
+
+    def release(self) -> None:
+        self.gate.set()
+
+    def cancel(self) -> None:
+        """The run failed: the thread ends without work (it must not draw while a later run's writers do)."""
+        self.cancelled = True
+        self.join()
+
+    def join(self) -> None:
+        """Let the thread go if it still waits, and wait for it (before anything uses matplotlib)."""
+        global _gate
+        self.gate.set()
+        self.thread.join(JOIN_TIMEOUT_S)
+        if _gate is self.gate:
+            _gate = None
