@@ -1,4 +1,4 @@
-"""The background warm-ups (wormsim.prewarm, wormsim.contact3d.jit_warmup): no figure leaked, no rcParam changed, the
+"""The background warm-ups (wormsim.prewarm, wormsim.contact3d.jit_warmup): no figure made, no rcParam changed, the
 gate holds, a failure does not fail the run, a failed run's thread does no work."""
 
 from __future__ import annotations

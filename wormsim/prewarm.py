@@ -1,13 +1,13 @@
 """Work done in a background thread while a simulation runs, so that it costs no wall time on a second core.
 
 `Writers` imports what the writers use (matplotlib ~0.7 s, rerun ~0.6 s) and warms matplotlib's text machinery (the
-font lookup and the mathtext parser that the log axis's tick labels need, ~0.3-0.4 s the first time in a process) by
-drawing a throwaway figure to an in-memory Agg canvas, made with matplotlib.figure.Figure, not pyplot, so no figure
-is registered and no rcParam is set. Python code only gains from a thread while the main thread has released the GIL:
-contact3d's compiled stepping loop does (wormsim.contact3d.flank_loop.run_table), the model build before it mostly
-does not, so a package that sets GIL_FREE_LOOP holds the thread until its runner calls `loop_started()` (else the
-imports would slow the build). run_scenario joins the thread before writing (matplotlib is not thread-safe). A
-failure in the thread is dropped: the writers import and draw for themselves.
+default font and the mathtext parser that the log axis's tick labels need: ~0.1 s of report.png's ~1.4 s; the rest,
+tight_layout's text layout and the draw, costs as much again on a second report in one process). Python code only
+gains from a thread while the main thread has released the GIL: contact3d's compiled stepping loop does
+(wormsim.contact3d.flank_loop.run_table), the model build before it mostly does not, so a package that sets
+GIL_FREE_LOOP holds the thread until its runner calls `loop_started()` (else the imports would slow the build).
+run_scenario joins the thread before writing (matplotlib is not thread-safe); a failed run cancels it. A failure in
+the thread is dropped: the writers import and draw for themselves.
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ import threading
 JOIN_TIMEOUT_S = 60.0  # a warm-up that hangs must not hang the run
 
 _gate: threading.Event | None = None  # the running Writers' gate (one run at a time per process)
-_text_warmed = False  # the throwaway figure is drawn once per process
+_text_warmed = False  # warm_text runs once per process
 
 
 def loop_started() -> None:
@@ -36,24 +36,16 @@ def _import_writers() -> None:
 
 
 def warm_text() -> None:
-    """Draw a small throwaway figure with what report.png has (titles, labels, a legend, a boxed text, a log axis
-    whose tick labels are mathtext, a suptitle, tight_layout) to an Agg canvas in memory."""
-    import numpy as np
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
+    """Load the default font and build matplotlib's mathtext parser (the log axis's tick labels are mathtext): the
+    first-use costs report.png pays (~0.1 s; a whole throwaway figure, tight_layout and draw, saved no more and cost
+    0.4 s). No figure is made, no rcParam set."""
+    from matplotlib import font_manager
+    from matplotlib.font_manager import FontProperties
+    from matplotlib.mathtext import MathTextParser
 
-    fig = Figure(figsize=(4, 3))
-    FigureCanvasAgg(fig)
-    a, b = fig.subplots(1, 2)
-    x = np.linspace(0.0, 1.0, 50)
-    a.plot(x, x + 1.0, label="a")
-    a.legend(fontsize=8)
-    a.set(xlabel="x", ylabel="y", title="t")
-    a.text(0.5, 1.5, "r", fontsize=9, bbox=dict(facecolor="white", edgecolor="0.6", pad=1.5))
-    b.semilogy(x, np.exp(8.0 * x) * 1e-3)
-    fig.suptitle("s")
-    fig.tight_layout()
-    fig.canvas.draw()
+    prop = FontProperties(size=10.0)
+    font_manager.get_font(font_manager.findfont(prop))
+    MathTextParser("agg").parse(r"$\mathdefault{10^{-2}}$", dpi=100, prop=prop)
 
 
 class Writers:
