@@ -1,8 +1,10 @@
 """The background warm-ups (wormsim.prewarm, wormsim.contact3d.jit_warmup): no figure made, no rcParam changed, the
-gate holds, a failure does not fail the run, a failed run's thread does no work."""
+gate holds, a failure does not fail the run (and leaves the GIL switch interval as it was), a failed run's thread does
+no work."""
 
 from __future__ import annotations
 
+import sys
 import threading
 import types
 from pathlib import Path
@@ -70,11 +72,14 @@ def test_warm_up_runs_before_the_writers_and_its_failure_does_not_fail_the_run(t
 
     def boom():
         calls.append(("warm", threading.current_thread().name))
+        assert sys.getswitchinterval() <= prewarm.SWITCH_INTERVAL_S  # short while the warm-up holds the GIL
         raise RuntimeError("no fonts")
 
     monkeypatch.setattr(prewarm, "_import_writers", boom)
     monkeypatch.setattr(run, "model_module", lambda name: _level(True, calls))
+    interval = sys.getswitchinterval()
     s = run.run_scenario(load_scenario(MINIMAL), tmp_path, progress=False)
+    assert sys.getswitchinterval() == interval  # the GIL switch interval is the process's again
     assert s["status"] == "ok" and (tmp_path / "report.png").read_bytes() == b"png"
     names = [c[0] for c in calls]
     assert names == ["simulate", "warm", "report"]  # joined before the report is drawn
