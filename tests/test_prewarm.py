@@ -10,6 +10,7 @@ import types
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from wormsim import prewarm, run
 from wormsim.contact3d import jit_warmup
@@ -79,7 +80,7 @@ def test_warm_up_runs_before_the_writers_and_its_failure_does_not_fail_the_run(t
     monkeypatch.setattr(run, "model_module", lambda name: _level(True, calls))
     interval = sys.getswitchinterval()
     s = run.run_scenario(load_scenario(MINIMAL), tmp_path, progress=False)
-    assert seen == [min(interval, prewarm.SWITCH_INTERVAL_S)]  # short while the warm-up holds the GIL
+    assert seen == [pytest.approx(min(interval, prewarm.SWITCH_INTERVAL_S), rel=1e-6)]  # short while it holds the GIL
     assert sys.getswitchinterval() == interval  # the process's again
     assert s["status"] == "ok" and (tmp_path / "report.png").read_bytes() == b"png"
     names = [c[0] for c in calls]
