@@ -43,9 +43,13 @@ def _python_sums(m, d, fc, bm, cmd, load, a1, a2, s0):
     return np.array([t1, t2, p1, p2, nc, fx, fy, fz, mz, fpk])
 
 
+MODES = ["slice", "tooth"]  # contact.flank_contacts: one MuJoCo contact per slice, or per tooth flank (flank_merge)
+
+
+@pytest.mark.parametrize("mode", MODES)
 @pytest.mark.parametrize("sets", [[], ["errors.shaft_angle_deg=0.1", "errors.worm_runout_mm=0.01"]])
-def test_compiled_loop_equals_python_split_step(sets):
-    sc = load_scenario(SCEN / "screw_jack.yaml", BASE + sets)
+def test_compiled_loop_equals_python_split_step(sets, mode):
+    sc = load_scenario(SCEN / "screw_jack.yaml", BASE + sets + [f"contact.flank_contacts={mode}"])
     bm = build_model(sc)
     m = bm.model
     from wormsim import gear_theory as gt
@@ -61,6 +65,7 @@ def test_compiled_loop_equals_python_split_step(sets):
     fc_py = FlankContacts(bm, bm.law.contacts_per_pair)
     fc_nb = FlankContacts(bm, bm.law.contacts_per_pair)
     assert fc_nb.displaced == bool(sets)
+    assert fc_nb.merge == (mode == "tooth")
     split_forward(m, d_py, fc_py.add)
     split_forward(m, d_nb, fc_nb.add)
     loop = FlankLoop(fc_nb, d_nb, bm.drive_actuator, bm.load_actuator, a1, a2, s0)
@@ -77,6 +82,7 @@ def test_compiled_loop_equals_python_split_step(sets):
         fc_py.set_friction(mu)
         fc_nb.set_friction(mu)
     assert most > 1 and d_nb.ncon == d_py.ncon > 0
+    assert (d_nb.ncon < fc_nb.n) == (mode == "tooth")  # merged: fewer MuJoCo contacts than slice contacts
     assert np.array_equal(d_nb.qpos, d_py.qpos)
     assert np.array_equal(d_nb.qvel, d_py.qvel)
     assert d_nb.nefc == d_py.nefc
@@ -85,13 +91,14 @@ def test_compiled_loop_equals_python_split_step(sets):
     assert loop.dropped == 0
 
 
-def test_compiled_sample_equals_numpy_path():
+@pytest.mark.parametrize("mode", MODES)
+def test_compiled_sample_equals_numpy_path(mode):
     """FlankLoop.sample against flank_contact_details, PatternLog.record and the numpy sums the runner used."""
     from wormsim import gear_theory as gt
     from wormsim.contact3d.flank_outputs import PatternLog
     from wormsim.contact3d.flank_step import flank_contact_details
 
-    sc = load_scenario(SCEN / "screw_jack.yaml", BASE)
+    sc = load_scenario(SCEN / "screw_jack.yaml", BASE + [f"contact.flank_contacts={mode}"])
     bm = build_model(sc)
     m, geo = bm.model, bm.geometry
     d = mujoco.MjData(m)

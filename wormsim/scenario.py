@@ -128,6 +128,14 @@ class Contact(_Strict):
         ),
     )
 
+    flank_contacts: Literal["tooth", "slice"] = Field(
+        "slice",
+        description=(
+            "flanks: the MuJoCo contacts: tooth (the slice contacts of one tooth flank merged into one with the same "
+            "total spring force: fewer constraint rows, faster) | slice (one per face slice); docs/contact3d.md"
+        ),
+    )
+
     @model_validator(mode="after")
     def _friction(self) -> "Contact":
         given = [

@@ -126,8 +126,9 @@ def run_interval(fns, m_addr, d_addr, cmd, load, j0, j1, mjd, iv, fv, state, ker
             state[0] = cw
         n = find_packed(fb, ib, th1, th2, margin0, taper)
         state[1] = n
-        if n:
-            k = min(n, rec.shape[0])
+        nh = ib[7] if ib[6] != 0 else n  # one contact per tooth flank (flank_merge): out holds the merged ones
+        if nh:
+            k = min(nh, rec.shape[0])
             added = _fill_add(
                 fns[fns.shape[0] - 1],
                 m_addr,
@@ -433,10 +434,10 @@ class FlankLoop:
             k.ib,
             fc.ks,
             fc.params,
-            fc.pos,
-            fc.depth,
-            fc.weight,
-            fc.frame,
+            fc.handed[1],  # pos, depth, weight, frame: what is handed to MuJoCo (FlankContacts.handed)
+            fc.handed[0],
+            fc.handed[3],
+            fc.handed[2],
             buf.bytes.view(np.int64),
             buf.off,
             fc.solref,
@@ -479,18 +480,23 @@ class FlankLoop:
             self._store, self._pattern, self._sample_kernel = store, pattern, fc.kernel
         con = d.contact
         own = self.dropped == 0  # d.contact's last fc.n entries are the kernel's contacts, in order
+        adr, efc, ncon, cone3 = con.efc_address, d.efc_force, d.ncon, fc.mu > 0  # the template's dim 3 (set_friction)
+        if fc.merge:  # the merged contacts' forces split over the slices (FlankContacts.slice_rows)
+            adr, efc, _, _, cone3 = fc.slice_rows(d)
+            ncon = n = len(adr)
+            own = True
         nteeth, pen, fr, W, wr, pattern.m, rlog.m = sample_table(
             self._sample_T,
-            con.efc_address,
+            adr,
             fc.frame if own else con.frame,
             fc.pos if own else con.pos,
             own,
-            d.efc_force,
+            efc,
             pattern.buf,
             rlog.buf,
-            d.ncon,
+            ncon,
             n,
-            fc.mu > 0,  # the template's dim 3 (FlankContacts.set_friction)
+            cone3,
             float(d.qpos[fc.qa2]),
             self.z2,
             self.a,

@@ -213,13 +213,13 @@ class PatternLog:
         """The kernel's contacts (d.contact's last fc.n entries) at sample i: (i, sigma, j, f, F_n, p_H);
         p_H by (3) (in `_rows`, compiled: the same formula as hertz_line_pressure_pa)."""
         fc = self.fc
-        n = min(fc.n, d.ncon)
+        n = fc.n if fc.merge else min(fc.n, d.ncon)
         if n == 0:
             return
         self.reserve(n)
-        adr = d.contact.efc_address[d.ncon - n : d.ncon]
+        adr, efc = fc.slice_rows(d)[:2]  # per slice contact (with one contact per tooth flank: its force split)
         cv = self.cv
-        self.m = _rows(i, adr, d.efc_force, fc.meta, fc.weight, cv.inv_rho, cv.line_len, self.e_star, self.buf, self.m)
+        self.m = _rows(i, adr, efc, fc.meta, fc.weight, cv.inv_rho, cv.line_len, self.e_star, self.buf, self.m)
 
     def reserve(self, n: int) -> None:
         """Room for n more rows."""

@@ -30,6 +30,7 @@ import numba
 import numpy as np
 
 from wormsim.contact3d.flank_handoff import ContactBuffer
+from wormsim.contact3d.flank_merge import split_forces
 from wormsim.contact3d.flanks import (
     MARGIN_PITCH,
     TAPER_SHARE,
@@ -42,8 +43,11 @@ from wormsim.contact3d.flanks import (
 class FlankContacts:
     """The flank contacts of one model: the grid, the window, the template contact and the step."""
 
-    def __init__(self, bm, slices: int):
+    def __init__(self, bm, slices: int, merge: bool | None = None):
+        """merge: one MuJoCo contact per tooth flank (wormsim.contact3d.flank_merge; contact.flank_contacts tooth);
+        None: from the model's scenario (bm.meta's flank_contacts)."""
         g = bm.geometry
+        self.merge = bm.meta.get("flank_contacts", "slice") == "tooth" if merge is None else bool(merge)
         m = bm.model
         self.bm = bm
         self.grid = flank_grid(g, slices)
@@ -105,11 +109,40 @@ class FlankContacts:
     def _pack(self) -> None:
         """The kernel's arrays, memo included, in two buffers: one compiled call per step (flanks.find_packed);
         again when self.params was replaced."""
-        k = self.kernel = PackedKernel(self.grid, self.params, len(self.depth), len(self.ks), self.bm.geometry.z2)
+        k = self.kernel = PackedKernel(
+            self.grid, self.params, len(self.depth), len(self.ks), self.bm.geometry.z2, self.merge
+        )
         k.ks[:] = self.ks
         self.pos, self.nrm, self.depth, self.meta, self.line = k.pos, k.nrm, k.depth, k.meta, k.line
         self.weight, self.frame, self.ks, self.params = k.weight, k.frame, k.ks, k.P
         self.memo = (k.memo, k.memo_consts)  # find_contacts' open-slice memo
+        # what is handed to MuJoCo: the slice contacts, or one per tooth flank (flank_merge)
+        self.handed = (k.mdepth, k.mpos, k.mframe, k.mweight) if self.merge else (k.depth, k.pos, k.frame, k.weight)
+        self._adr = np.zeros(len(k.depth), dtype=np.int64)  # slice_rows' per-slice rows (merge)
+        self._efc = np.zeros(3 * len(k.depth))
+
+    def n_handed(self) -> int:
+        """The number of contacts handed to MuJoCo at the last find (the merged ones with merge)."""
+        return int(self.kernel.ib[7]) if self.merge else self.n
+
+    def slice_rows(self, d: mujoco.MjData):
+        """Per slice contact (the kernel's last fc.n): (efc_address, efc_force, frame, pos, cone3) to read its
+        constraint force from, as d.contact's last fc.n entries give it; with merge, the merged contacts' forces split
+        over their slices (flank_merge.split_forces: efc_address into the returned efc_force, three rows each)."""
+        dim3 = self.template.dim == 3
+        if not self.merge:
+            n = min(self.n, d.ncon)
+            k0 = d.ncon - n
+            con = d.contact
+            return con.efc_address[k0:], d.efc_force, con.frame[k0:], con.pos[k0:], dim3
+        k = self.kernel
+        n = self.n
+        nh = min(int(k.ib[7]), d.ncon)
+        split_forces(
+            d.contact.efc_address, d.efc_force, d.ncon - nh, dim3, k.grp, k.share, k.mframe, k.frame, n, self._adr,
+            self._efc,
+        )
+        return self._adr[:n], self._efc, self.frame[:n], self.pos[:n], True
 
     def set_friction(self, mu: float) -> None:
         if mu != self.mu:
@@ -147,15 +180,18 @@ class FlankContacts:
     def add(self, m: mujoco.MjModel, d: mujoco.MjData) -> None:
         """Find the flank contacts and append them to d.contact (after mj_collision), in bulk from compiled code
         (wormsim.contact3d.flank_handoff; `add_loop` is the same from Python, one mj_addContact per contact)."""
-        n = self.find(d)
+        self.find(d)
+        n = self.n_handed()
         if n:
-            self.buffer.add(m, d, n, self.depth, self.pos, self.frame, self.weight, self.solref, self.solreffriction)
+            self.buffer.add(m, d, n, *self.handed, self.solref, self.solreffriction)
 
     def add_loop(self, m: mujoco.MjModel, d: mujoco.MjData) -> None:
         """`add` from Python: the template added once per contact, then its fields written through d.contact's views."""
-        n = self.find(d)
+        self.find(d)
+        n = self.n_handed()
         if n == 0:
             return
+        depth, pos, frame, weight = self.handed
         k0 = d.ncon
         t = self.template
         for _ in range(n):
@@ -163,13 +199,13 @@ class FlankContacts:
                 break  # arena full: MuJoCo warns (mjWARN_CONTACTFULL)
         k1 = d.ncon
         c = d.contact
-        c.dist[k0:k1] = -self.depth[: k1 - k0]
-        c.pos[k0:k1] = self.pos[: k1 - k0]
-        c.frame[k0:k1] = self.frame[: k1 - k0]
+        c.dist[k0:k1] = -depth[: k1 - k0]
+        c.pos[k0:k1] = pos[: k1 - k0]
+        c.frame[k0:k1] = frame[: k1 - k0]
         # each contact's stiffness and damping scaled by its share of its slice (direct solref: -k, -b)
-        c.solref[k0:k1] = np.multiply.outer(self.weight[: k1 - k0], self.solref)
+        c.solref[k0:k1] = np.multiply.outer(weight[: k1 - k0], self.solref)
         if self.solreffriction[1] != 0.0:
-            c.solreffriction[k0:k1] = np.multiply.outer(self.weight[: k1 - k0], self.solreffriction)
+            c.solreffriction[k0:k1] = np.multiply.outer(weight[: k1 - k0], self.solreffriction)
 
     def step(self, m: mujoco.MjModel, d: mujoco.MjData) -> None:
         split_step(m, d, self.add)
@@ -215,19 +251,18 @@ def flank_contact_details(fc: FlankContacts, d: mujoco.MjData):
     last fc.n entries; the force on the wheel (geom 2) is the elliptic-cone rows turned into the world frame
     (`_contact_forces`, compiled: this runs at every sample)."""
     bm = fc.bm
-    n = min(fc.n, d.ncon)
+    n = fc.n if fc.merge else min(fc.n, d.ncon)
     if n == 0:
         z = np.zeros((0, 3))
         return 0, 0.0, z, z, z
-    k0 = d.ncon - n
-    con = d.contact
+    adr_all, efc, frame, pos, cone3 = fc.slice_rows(d)
     out = np.empty((3, n, 3))
     m, nteeth = _contact_forces(
-        con.efc_address[k0:],
-        con.frame[k0:],
-        con.pos[k0:],
-        d.efc_force,
-        fc.template.dim == 3,
+        adr_all,
+        frame,
+        pos,
+        efc,
+        cone3,
         fc.meta,
         float(d.qpos[fc.qa2]),
         bm.geometry.z2,
@@ -237,7 +272,7 @@ def flank_contact_details(fc: FlankContacts, d: mujoco.MjData):
     if fc.displaced:  # via the displaced wheel body's frame (wormsim.contact3d.flank_pose)
         from wormsim.contact3d.flank_pose import tooth_shift_of, wheel_body_points
 
-        adr = np.asarray(con.efc_address[k0:])
+        adr = np.asarray(adr_all)
         ks = fc.meta[:n, 0][adr >= 0]
         pos = wheel_body_points(fc.params, pw)
         ang = -(2 * math.pi * ks / bm.geometry.z2 + tooth_shift_of(fc.params, ks))

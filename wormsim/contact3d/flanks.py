@@ -55,6 +55,7 @@ import numpy as np
 from meshgen import wheel, worm
 from meshgen.cache import cached
 from meshgen.geometry import GearGeometry
+from wormsim.contact3d.flank_merge import merge_flanks
 from wormsim.contact3d.flank_pose import N_WORM_PARAMS, static_dir_to_world, to_static, tooth_angle
 
 N_PROFILE = 64  # points along the profile per slice (the parabola refines between them)
@@ -619,13 +620,15 @@ def contact_frames(nrm, n, frame):
 
 _F_FIELDS = ("xy", "c", "c_range", "zeta", "P", "pos", "nrm", "depth", "meta", "line", "weight", "frame", "memo")
 _F_FIELDS += ("memo_consts", "tmp", "gaps", "exc", "pts", "nrs")
-_I_HEADER = 8  # S, N, cap, len(P), W, z2, 0, 0
+_F_FIELDS += ("mpos", "mnrm", "mdepth", "mweight", "mframe", "grp", "share")  # flank_merge
+_I_HEADER = 8  # S, N, cap, len(P), W, z2, merge (one contact per tooth flank), merged contacts
 
 
 def _shapes(S: int, N: int, cap: int, nP: int, W: int, z2: int) -> tuple[list, list]:
     """Shapes of the packed buffers' fields, in order (PackedKernel; find_packed unpacks the same order)."""
     f = [(2, S, N, 2), (2, S, N), (2, S, 2), (S,), (nP,), (cap, 3), (cap, 3), (cap,), (cap, 4), (cap, 2), (cap,)]
     f += [(cap, 9), (z2, 2, S, 3), (3,), (6,), (N,), (N,), (N, 3), (N, 3)]
+    f += [(cap, 3), (cap, 3), (cap,), (cap,), (cap, 9), (cap,), (cap,)]
     return f, [(2, S, 2), (W,), (N,)]
 
 
@@ -634,14 +637,15 @@ class PackedKernel:
     find_packed(fb, ib, theta1, theta2, margin, taper_rad), runs find_contacts, slice_weights and contact_frames:
     numba's dispatch costs ~0.25 us per array argument (the three calls with their 28 arrays and find_contacts' work
     allocation cost ~9 us of Python per step). The fields are numpy views of the buffers (pos, nrm, depth, meta, line,
-    weight, frame, P, memo, span, ks: write ks and P in place)."""
+    weight, frame, P, memo, span, ks: write ks and P in place). merge: also one contact per tooth flank
+    (wormsim.contact3d.flank_merge: mpos, mnrm, mdepth, mweight, mframe, their number in ib[7]; grp, share)."""
 
-    def __init__(self, grid: FlankGrid, P: np.ndarray, cap: int, W: int, z2: int):
+    def __init__(self, grid: FlankGrid, P: np.ndarray, cap: int, W: int, z2: int, merge: bool = False):
         S, N = grid.slices, grid.c.shape[2]
         fs, is_ = _shapes(S, N, cap, len(P), W, z2)
         self.fb = np.zeros(sum(int(np.prod(sh)) for sh in fs))
         self.ib = np.zeros(_I_HEADER + sum(int(np.prod(sh)) for sh in is_), dtype=np.int64)
-        self.ib[:6] = (S, N, cap, len(P), W, z2)
+        self.ib[:7] = (S, N, cap, len(P), W, z2, int(merge))
         o = 0
         for name, sh in zip(_F_FIELDS, fs):
             k = int(np.prod(sh))
@@ -662,7 +666,7 @@ class PackedKernel:
 def find_packed(fb, ib, theta1, theta2, margin, taper_rad):
     """find_contacts (with its memo), slice_weights and contact_frames on a PackedKernel's buffers at worm angle
     theta1, wheel angle theta2 for the window teeth in its ks; returns the number of contacts (their fields in
-    pos, nrm, depth, weight, frame, meta, line)."""
+    pos, nrm, depth, weight, frame, meta, line; with ib[6], the merged contacts as well, PackedKernel)."""
     S, N, cap, nP, W, z2 = ib[0], ib[1], ib[2], ib[3], ib[4], ib[5]
     o = 0
     xy = fb[o : o + 4 * S * N].reshape((2, S, N, 2))
@@ -702,6 +706,20 @@ def find_packed(fb, ib, theta1, theta2, margin, taper_rad):
     pts = fb[o : o + 3 * N].reshape((N, 3))
     o += 3 * N
     nrs = fb[o : o + 3 * N].reshape((N, 3))
+    o += 3 * N
+    mpos = fb[o : o + 3 * cap].reshape((cap, 3))
+    o += 3 * cap
+    mnrm = fb[o : o + 3 * cap].reshape((cap, 3))
+    o += 3 * cap
+    mdepth = fb[o : o + cap]
+    o += cap
+    mweight = fb[o : o + cap]
+    o += cap
+    mframe = fb[o : o + 9 * cap].reshape((cap, 9))
+    o += 9 * cap
+    grp = fb[o : o + cap]
+    o += cap
+    share = fb[o : o + cap]
     o = 8
     span = ib[o : o + 4 * S].reshape((2, S, 2))
     o += 4 * S
@@ -728,6 +746,10 @@ def find_packed(fb, ib, theta1, theta2, margin, taper_rad):
     )
     n = slice_weights(meta, line, n, S, pos, nrm, depth, weight)
     contact_frames(nrm, n, frame)
+    if ib[6]:  # one contact per tooth flank (flank_merge)
+        nm = merge_flanks(meta, n, pos, nrm, depth, weight, grp, share, mpos, mnrm, mdepth, mweight)
+        ib[7] = nm
+        contact_frames(mnrm, nm, mframe)
     return n
 
 

@@ -341,6 +341,7 @@ def build_model(
     ine = p.inertias
     meta = {
         "contact_geometry": scenario.contact.geometry,
+        "flank_contacts": scenario.contact.flank_contacts,
         "worm_mass_kg": ine.worm_mass_kg,
         "wheel_mass_kg": ine.wheel_mass_kg,
         "worm_inertia_kg_m2": ine.worm_inertia_kg_m2,

@@ -490,6 +490,7 @@ def _run_summary(
         "collision_geoms": collision_geoms,
         "contact_geometry": bm.meta.get("contact_geometry", "pieces"),
         "flank_slices": law.contacts_per_pair if flanks else None,
+        "flank_contacts": bm.meta.get("flank_contacts") if flanks else None,
         "step_wall_us": step_wall_us,
         "piece_error_um": bm.pieces.piece_error_um,
     }
