@@ -27,7 +27,7 @@ from llvmlite import ir
 from numba import types
 from numba.extending import intrinsic
 
-FIELDS = ("pos", "frame", "solref", "solreffriction")  # per-contact fields written besides dist
+FIELDS = ("pos", "frame", "solref", "solreffriction", "friction")  # per-contact fields written besides dist
 
 
 def _library() -> ctypes.CDLL:
@@ -59,14 +59,32 @@ def _call_add(typingctx, fn, m_addr, d_addr, c_addr):
 
 @numba.njit(cache=True)
 def _fill_add(
-    fn, m_addr, d_addr, rec, base, size, off, n, depth, pos, frame, weight, solref, solreffriction, friction_ref
+    fn,
+    m_addr,
+    d_addr,
+    rec,
+    base,
+    size,
+    off,
+    n,
+    depth,
+    pos,
+    frame,
+    weight,
+    solref,
+    solreffriction,
+    friction_ref,
+    fscale,
+    mu,
+    scale_friction,
 ):
     """Writes the per-contact fields of records 0..n-1 (rec: the buffer as float64 rows, at address base, size bytes
-    each; off: the offsets of dist, pos, frame, solref, solreffriction in float64 units): dist = -depth, solref (and,
-    where friction_ref, solreffriction) scaled by the contact's share of its slice (direct solref: -k, -b); then
-    mj_addContact (at address fn) on each. Returns how many were added (it stops when the arena is full, where MuJoCo
-    has warned with mjWARN_CONTACTFULL)."""
-    o0, o1, o2, o3, o4 = off[0], off[1], off[2], off[3], off[4]
+    each; off: the offsets of dist, pos, frame, solref, solreffriction, friction in float64 units): dist = -depth,
+    solref (and, where friction_ref, solreffriction) scaled by the contact's share of its slice (direct solref: -k,
+    -b); where scale_friction (one contact per tooth flank, wormsim.contact3d.flank_merge), the sliding friction
+    mu fscale[i] and solreffriction scaled by weight fscale; then mj_addContact (at address fn) on each. Returns how
+    many were added (it stops when the arena is full, where MuJoCo has warned with mjWARN_CONTACTFULL)."""
+    o0, o1, o2, o3, o4, o5 = off[0], off[1], off[2], off[3], off[4], off[5]
     for i in range(n):
         r = rec[i]
         r[o0] = -depth[i]
@@ -76,8 +94,11 @@ def _fill_add(
             r[o2 + a] = frame[i, a]
         w = weight[i]
         r[o3], r[o3 + 1] = w * solref[0], w * solref[1]
+        wf = w * fscale[i] if scale_friction else w
         if friction_ref:
-            r[o4], r[o4 + 1] = w * solreffriction[0], w * solreffriction[1]
+            r[o4], r[o4 + 1] = wf * solreffriction[0], wf * solreffriction[1]
+        if scale_friction:
+            r[o5] = r[o5 + 1] = mu * fscale[i]
     for i in range(n):
         if _call_add(fn, m_addr, d_addr, base + i * size) != 0:
             return i
@@ -118,7 +139,7 @@ class ContactBuffer:
         else:
             self.bytes[:] = raw
 
-    def add(self, m, d, n, depth, pos, frame, weight, solref, solreffriction) -> int:
+    def add(self, m, d, n, depth, pos, frame, weight, solref, solreffriction, fscale, mu, scale_friction) -> int:
         """Writes n contacts' fields and appends them to d.contact; returns how many MuJoCo took."""
         n = min(n, self.cap)
         fr = solreffriction[1] != 0.0
@@ -139,4 +160,7 @@ class ContactBuffer:
             solref,
             solreffriction,
             fr,
+            fscale,
+            mu,
+            scale_friction,
         )

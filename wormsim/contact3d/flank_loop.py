@@ -92,18 +92,19 @@ def run_interval(fns, m_addr, d_addr, cmd, load, j0, j1, mjd, iv, fv, state, ker
     iv = (drive actuator, load actuator, worm dof, wheel dof, worm-shaft actuator, wheel-shaft actuator, contact sensor
     address, worm qpos address, wheel qpos address, worm body, wheel body, displaced, window teeth, slices,
     mjContact record size, record buffer address, solreffriction written);
-    fv = (tooth 0's angle, pitch angle, margin, taper); state = (the window's centre tooth, the last step's contact
+    fv = (tooth 0's angle, pitch angle, margin, taper, friction coefficient); state = (the window's centre tooth, the last step's contact
     count); kern = FlankContacts.kernel's buffers (fb, ib; flanks.PackedKernel) and ks (the window's teeth, a view
-    of ib); params = the kernel's P (a view of fb); out = the kernel's (pos, depth, weight, frame); hand = (records,
+    of ib); params = the kernel's P (a view of fb); out = the kernel's (pos, depth, weight, frame, mfric), the merged ones
+    with one contact per tooth flank (FlankContacts.handed, wormsim.contact3d.flank_merge); hand = (records,
     field offsets, solref, solreffriction).
     acc (N_ACC) receives the sums over the steps: worm and wheel actuator torque, worm and wheel power, contact count,
     F_x, F_y, F_z, M_z about the wheel axis, the peak |F_x|. Returns the number of contacts MuJoCo did not take
     (arena full) summed over the steps."""
     ctrl, qvel, qpos, act, sd, xpos, xmat = mjd
     ia_drv, ia_load, dof1, dof2, a1, a2, s0, qa1, qa2, worm_body, wheel_body, displaced, W, slices, size, base, fr = iv
-    tooth0, pitch, margin0, taper = fv
+    tooth0, pitch, margin0, taper, mu = fv
     fb, ib, ks = kern
-    pos, depth, weight, frame = out
+    pos, depth, weight, frame, fscale = out
     rec, off, solref, solreffriction = hand
     nb = N_BEFORE
     t1 = t2 = p1 = p2 = nc = fx = fy = fz = mz = fpk = 0.0
@@ -145,6 +146,9 @@ def run_interval(fns, m_addr, d_addr, cmd, load, j0, j1, mjd, iv, fv, state, ker
                 solref,
                 solreffriction,
                 fr != 0,
+                fscale,
+                mu,
+                ib[6] != 0,
             )
             dropped += k - added
         for s in range(nb, fns.shape[0] - 1):
@@ -227,6 +231,7 @@ TABLE = (
     ("i8", 1),  # 21 the stage addresses
     ("i8", 1),  # 22 iv
     ("f8", 1),  # 23 fv
+    ("f8", 1),  # 24 the merged contacts' friction scale (flank_merge: mfric)
 )
 
 
@@ -267,13 +272,13 @@ def run_table(T, m_addr, d_addr, cmd, load, j0, j1):
     GIL, as MuJoCo's bindings do around mj_step: wormsim.run imports the report's libraries meanwhile."""
     mjd = (_f1(T, 0), _f1(T, 1), _f1(T, 2), _f1(T, 3), _f1(T, 4), _f2(T, 5), _f2(T, 6))
     kern = (_f1(T, 7), _i1(T, 8), _i1(T, 9))
-    out = (_f2(T, 11), _f1(T, 12), _f1(T, 13), _f2(T, 14))
+    out = (_f2(T, 11), _f1(T, 12), _f1(T, 13), _f2(T, 14), _f1(T, 24))
     rec = numba.carray(_f64_at(T[15, 0]), (T[15, 1], T[15, 2]))  # int64 rows of the same bytes as float64
     hand = (rec, _i1(T, 16), _f1(T, 17), _f1(T, 18))
     v = _i1(T, 22)
     iv = (v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7], v[8], v[9], v[10], v[11], v[12], v[13], v[14], v[15], v[16])
     fw = _f1(T, 23)
-    fv = (fw[0], fw[1], fw[2], fw[3])
+    fv = (fw[0], fw[1], fw[2], fw[3], fw[4])
     return run_interval(
         _i1(T, 21), m_addr, d_addr, cmd, load, j0, j1, mjd, iv, fv, _i1(T, 19), kern, _f1(T, 10), out, hand, _f1(T, 20)
     )
@@ -406,7 +411,7 @@ class FlankLoop:
             ],
             dtype=np.int64,
         )
-        self.fv = np.array([float(bm.tooth0_angle_rad), fc.pitch, fc.margin0, fc.taper_rad])
+        self.fv = np.array([float(bm.tooth0_angle_rad), fc.pitch, fc.margin0, fc.taper_rad, 0.0])  # mu: `run`
         self.state = np.array([NO_WINDOW if fc._c is None else fc._c, fc.n], dtype=np.int64)
         self.acc = np.zeros(N_ACC)
         self._tables(d, buf)
@@ -447,6 +452,7 @@ class FlankLoop:
             np.concatenate([STAGE_ADDRESSES, [_MJ_ADD_CONTACT]]).astype(np.int64),
             self.iv,
             self.fv,
+            k.mfric,
         )
         self.table = address_table(self.arrays)
         self._kernel = k
@@ -459,6 +465,7 @@ class FlankLoop:
         if fc.kernel is not self._kernel:
             self._tables(self.d, fc.buffer)
         self.iv[-1] = fc.solreffriction[1] != 0.0
+        self.fv[4] = fc.mu
         self.dropped += run_table(self.table, self.m._address, self.d._address, cmd, load, j0, j1)
         fc.n = int(self.state[1])
         fc._c = int(self.state[0])

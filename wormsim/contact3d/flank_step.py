@@ -138,10 +138,7 @@ class FlankContacts:
         k = self.kernel
         n = self.n
         nh = min(int(k.ib[7]), d.ncon)
-        split_forces(
-            d.contact.efc_address, d.efc_force, d.ncon - nh, dim3, k.grp, k.share, k.mframe, k.frame, n, self._adr,
-            self._efc,
-        )
+        split_forces(d.contact.efc_address, d.efc_force, d.ncon - nh, dim3, k.grp, k.share, k.mfric, n, self._adr, self._efc)
         return self._adr[:n], self._efc, self.frame[:n], self.pos[:n], True
 
     def set_friction(self, mu: float) -> None:
@@ -183,7 +180,8 @@ class FlankContacts:
         self.find(d)
         n = self.n_handed()
         if n:
-            self.buffer.add(m, d, n, *self.handed, self.solref, self.solreffriction)
+            k = self.kernel
+            self.buffer.add(m, d, n, *self.handed, self.solref, self.solreffriction, k.mfric, self.mu, self.merge)
 
     def add_loop(self, m: mujoco.MjModel, d: mujoco.MjData) -> None:
         """`add` from Python: the template added once per contact, then its fields written through d.contact's views."""
@@ -204,8 +202,13 @@ class FlankContacts:
         c.frame[k0:k1] = frame[: k1 - k0]
         # each contact's stiffness and damping scaled by its share of its slice (direct solref: -k, -b)
         c.solref[k0:k1] = np.multiply.outer(weight[: k1 - k0], self.solref)
+        wf = weight[: k1 - k0]
+        if self.merge:  # friction mu / c_w and its damping by W (wormsim.contact3d.flank_merge)
+            fs = self.kernel.mfric[: k1 - k0]
+            wf = wf * fs
+            c.friction[k0:k1, 0] = c.friction[k0:k1, 1] = self.mu * fs
         if self.solreffriction[1] != 0.0:
-            c.solreffriction[k0:k1] = np.multiply.outer(weight[: k1 - k0], self.solreffriction)
+            c.solreffriction[k0:k1] = np.multiply.outer(wf, self.solreffriction)
 
     def step(self, m: mujoco.MjModel, d: mujoco.MjData) -> None:
         split_step(m, d, self.add)
