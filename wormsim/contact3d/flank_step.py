@@ -116,10 +116,21 @@ class FlankContacts:
         self.pos, self.nrm, self.depth, self.meta, self.line = k.pos, k.nrm, k.depth, k.meta, k.line
         self.weight, self.frame, self.ks, self.params = k.weight, k.frame, k.ks, k.P
         self.memo = (k.memo, k.memo_consts)  # find_contacts' open-slice memo
+        k.axes[:] = self._hinges()  # the merge's moment arms (flank_merge)
         # what is handed to MuJoCo: the slice contacts, or one per tooth flank (flank_merge)
         self.handed = (k.mdepth, k.mpos, k.mframe, k.mweight) if self.merge else (k.depth, k.pos, k.frame, k.weight)
         self._adr = np.zeros(len(k.depth), dtype=np.int64)  # slice_rows' per-slice rows (merge)
         self._efc = np.zeros(3 * len(k.depth))
+
+    def _hinges(self) -> np.ndarray:
+        """(point, direction) of the worm's and the wheel's hinge and the wheel's speed per worm speed in the world at qpos0 (the nominal axes: assembly
+        errors move them by their small offsets, not followed here)."""
+        m, bm = self.bm.model, self.bm
+        d = mujoco.MjData(m)
+        mujoco.mj_kinematics(m, d)
+        j1, j2 = m.dof_jntid[bm.worm_dof], m.dof_jntid[bm.wheel_dof]
+        ratio = float(self.grid.params[12])  # the conjugate motion: theta2 = ratio theta1 (flanks._find_contacts)
+        return np.concatenate([d.xanchor[j1], d.xaxis[j1], d.xanchor[j2], d.xaxis[j2], [ratio]])
 
     def n_handed(self) -> int:
         """The number of contacts handed to MuJoCo at the last find (the merged ones with merge)."""
@@ -138,7 +149,9 @@ class FlankContacts:
         k = self.kernel
         n = self.n
         nh = min(int(k.ib[7]), d.ncon)
-        split_forces(d.contact.efc_address, d.efc_force, d.ncon - nh, dim3, k.grp, k.share, k.mfric, n, self._adr, self._efc)
+        split_forces(
+            d.contact.efc_address, d.efc_force, d.ncon - nh, dim3, k.grp, k.share, k.mfric, k.mwrap, n, self._adr, self._efc
+        )
         return self._adr[:n], self._efc, self.frame[:n], self.pos[:n], True
 
     def set_friction(self, mu: float) -> None:

@@ -620,7 +620,7 @@ def contact_frames(nrm, n, frame):
 
 _F_FIELDS = ("xy", "c", "c_range", "zeta", "P", "pos", "nrm", "depth", "meta", "line", "weight", "frame", "memo")
 _F_FIELDS += ("memo_consts", "tmp", "gaps", "exc", "pts", "nrs")
-_F_FIELDS += ("mpos", "mnrm", "mdepth", "mweight", "mframe", "grp", "share", "mfric")  # flank_merge
+_F_FIELDS += ("mpos", "mnrm", "mdepth", "mweight", "mframe", "grp", "share", "mfric", "mwrap", "axes")  # flank_merge
 _I_HEADER = 8  # S, N, cap, len(P), W, z2, merge (one contact per tooth flank), merged contacts
 
 
@@ -628,7 +628,7 @@ def _shapes(S: int, N: int, cap: int, nP: int, W: int, z2: int) -> tuple[list, l
     """Shapes of the packed buffers' fields, in order (PackedKernel; find_packed unpacks the same order)."""
     f = [(2, S, N, 2), (2, S, N), (2, S, 2), (S,), (nP,), (cap, 3), (cap, 3), (cap,), (cap, 4), (cap, 2), (cap,)]
     f += [(cap, 9), (z2, 2, S, 3), (3,), (6,), (N,), (N,), (N, 3), (N, 3)]
-    f += [(cap, 3), (cap, 3), (cap,), (cap,), (cap, 9), (cap,), (cap,), (cap,)]
+    f += [(cap, 3), (cap, 3), (cap,), (cap,), (cap, 9), (cap,), (cap,), (cap,), (cap,), (13,)]
     return f, [(2, S, 2), (W,), (N,)]
 
 
@@ -638,7 +638,7 @@ class PackedKernel:
     numba's dispatch costs ~0.25 us per array argument (the three calls with their 28 arrays and find_contacts' work
     allocation cost ~9 us of Python per step). The fields are numpy views of the buffers (pos, nrm, depth, meta, line,
     weight, frame, P, memo, span, ks: write ks and P in place). merge: also one contact per tooth flank
-    (wormsim.contact3d.flank_merge: mpos, mnrm, mdepth, mweight, mframe, mfric, their number in ib[7]; grp, share)."""
+    (wormsim.contact3d.flank_merge: mpos, mnrm, mdepth, mweight, mframe, mfric, their number in ib[7]; grp, share; axes: the hinges, set by the caller)."""
 
     def __init__(self, grid: FlankGrid, P: np.ndarray, cap: int, W: int, z2: int, merge: bool = False):
         S, N = grid.slices, grid.c.shape[2]
@@ -722,6 +722,10 @@ def find_packed(fb, ib, theta1, theta2, margin, taper_rad):
     share = fb[o : o + cap]
     o += cap
     mfric = fb[o : o + cap]
+    o += cap
+    mwrap = fb[o : o + cap]
+    o += cap
+    axes = fb[o : o + 13]
     o = 8
     span = ib[o : o + 4 * S].reshape((2, S, 2))
     o += 4 * S
@@ -749,7 +753,7 @@ def find_packed(fb, ib, theta1, theta2, margin, taper_rad):
     n = slice_weights(meta, line, n, S, pos, nrm, depth, weight)
     contact_frames(nrm, n, frame)
     if ib[6]:  # one contact per tooth flank (flank_merge)
-        nm = merge_flanks(meta, n, pos, nrm, depth, weight, grp, share, mpos, mnrm, mdepth, mweight, mfric)
+        nm = merge_flanks(meta, n, pos, nrm, depth, weight, grp, share, mpos, mnrm, mdepth, mweight, mfric, mwrap, axes)
         ib[7] = nm
         contact_frames(mnrm, nm, mframe)
     return n
