@@ -118,7 +118,11 @@ def test_merged_means_agree_with_slices_within_0p2_percent(key):
 def test_merged_te_and_pattern_agree_with_slices():
     s, t = run_slice("screw_jack")["summary"], run_tooth("screw_jack")
     assert abs(t["transmission_error_p2p_urad"] / s["transmission_error_p2p_urad"] - 1) < 0.10
-    for k in ("contact_pattern_centroid_face_mm", "contact_pattern_centroid_radius_mm", "contact_pattern_extent_face_mm"):
+    for k in (
+        "contact_pattern_centroid_face_mm",
+        "contact_pattern_centroid_radius_mm",
+        "contact_pattern_extent_face_mm",
+    ):
         assert abs(t[k] - s[k]) < 0.01, (k, s[k], t[k])  # mm
 
 

@@ -92,11 +92,11 @@ def run_interval(fns, m_addr, d_addr, cmd, load, j0, j1, mjd, iv, fv, state, ker
     iv = (drive actuator, load actuator, worm dof, wheel dof, worm-shaft actuator, wheel-shaft actuator, contact sensor
     address, worm qpos address, wheel qpos address, worm body, wheel body, displaced, window teeth, slices,
     mjContact record size, record buffer address, solreffriction written);
-    fv = (tooth 0's angle, pitch angle, margin, taper, friction coefficient); state = (the window's centre tooth, the last step's contact
-    count); kern = FlankContacts.kernel's buffers (fb, ib; flanks.PackedKernel) and ks (the window's teeth, a view
-    of ib); params = the kernel's P (a view of fb); out = the kernel's (pos, depth, weight, frame, mfric), the merged ones
-    with one contact per tooth flank (FlankContacts.handed, wormsim.contact3d.flank_merge); hand = (records,
-    field offsets, solref, solreffriction).
+    fv = (tooth 0's angle, pitch angle, margin, taper, friction coefficient); state = (the window's centre tooth, the
+    last step's contact count); kern = FlankContacts.kernel's buffers (fb, ib; flanks.PackedKernel) and ks (the
+    window's teeth, a view of ib); params = the kernel's P (a view of fb); out = the kernel's (pos, depth, weight,
+    frame, mfric), the merged ones with one contact per tooth flank (FlankContacts.handed, flank_merge); hand =
+    (records, field offsets, solref, solreffriction).
     acc (N_ACC) receives the sums over the steps: worm and wheel actuator torque, worm and wheel power, contact count,
     F_x, F_y, F_z, M_z about the wheel axis, the peak |F_x|. Returns the number of contacts MuJoCo did not take
     (arena full) summed over the steps."""

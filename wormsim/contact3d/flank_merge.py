@@ -30,9 +30,10 @@ import numba
 @numba.njit(cache=True)
 def merge_flanks(meta, n, pos, nrm, depth, weight, grp, share, mpos, mnrm, mdepth, mweight, mfric, mwrap, axes):
     """The merged contacts of the n slice contacts (module docstring): mpos, mnrm, mdepth, mweight, mfric (the
-    friction coefficient's factor), mwrap (1 / c_w) per tooth flank; grp[c] the merged contact of slice contact c, share[c] = a_c / sum a (its share of the slices' spring
-    forces); axes = (a point on the worm axis, its direction, a point on the wheel axis, its direction), the
-    hinges for the moment-arm correction (module docstring). Returns the number of merged contacts."""
+    friction coefficient's factor), mwrap (1 / c_w) per tooth flank; grp[c] the merged contact of slice contact c,
+    share[c] = a_c / sum a (its share of the slices' spring forces); axes = (a point on the worm axis, its
+    direction, a point on the wheel axis, its direction, the wheel's speed per worm speed): the hinges for the
+    moment-arm and friction corrections (module docstring). Returns the number of merged contacts."""
     g = 0
     i = 0
     while i < n:

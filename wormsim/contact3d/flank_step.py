@@ -123,8 +123,8 @@ class FlankContacts:
         self._efc = np.zeros(3 * len(k.depth))
 
     def _hinges(self) -> np.ndarray:
-        """(point, direction) of the worm's and the wheel's hinge and the wheel's speed per worm speed in the world at qpos0 (the nominal axes: assembly
-        errors move them by their small offsets, not followed here)."""
+        """(point, direction) of the worm's and the wheel's hinge in the world at qpos0 and the wheel's speed per worm
+        speed (the nominal axes: assembly errors move them by their small offsets, not followed here)."""
         m, bm = self.bm.model, self.bm
         d = mujoco.MjData(m)
         mujoco.mj_kinematics(m, d)
@@ -149,9 +149,8 @@ class FlankContacts:
         k = self.kernel
         n = self.n
         nh = min(int(k.ib[7]), d.ncon)
-        split_forces(
-            d.contact.efc_address, d.efc_force, d.ncon - nh, dim3, k.grp, k.share, k.mfric, k.mwrap, n, self._adr, self._efc
-        )
+        adr, efc, k0 = self._adr, self._efc, d.ncon - nh
+        split_forces(d.contact.efc_address, d.efc_force, k0, dim3, k.grp, k.share, k.mfric, k.mwrap, n, adr, efc)
         return self._adr[:n], self._efc, self.frame[:n], self.pos[:n], True
 
     def set_friction(self, mu: float) -> None:

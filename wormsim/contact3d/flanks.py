@@ -638,7 +638,8 @@ class PackedKernel:
     numba's dispatch costs ~0.25 us per array argument (the three calls with their 28 arrays and find_contacts' work
     allocation cost ~9 us of Python per step). The fields are numpy views of the buffers (pos, nrm, depth, meta, line,
     weight, frame, P, memo, span, ks: write ks and P in place). merge: also one contact per tooth flank
-    (wormsim.contact3d.flank_merge: mpos, mnrm, mdepth, mweight, mframe, mfric, their number in ib[7]; grp, share; axes: the hinges, set by the caller)."""
+    (wormsim.contact3d.flank_merge: mpos, mnrm, mdepth, mweight, mframe, mfric, mwrap, their number in ib[7];
+    grp, share; axes: the hinges, set by the caller)."""
 
     def __init__(self, grid: FlankGrid, P: np.ndarray, cap: int, W: int, z2: int, merge: bool = False):
         S, N = grid.slices, grid.c.shape[2]
