@@ -20,7 +20,8 @@ rate cancel exactly what would fold onto 0 Hz), and whose angles and speeds are 
   timestep is above the contact's stable limit), a speed-driven drive stuck below half its command (locked;
   self-locking named when the wheel drives), the worm turning more than 1.25 x MAX_WORM_TURN_PER_STEP_RAD per
   step (overspeed: its pieces would tunnel through the wheel's), the sliding contacts' friction turned away from
-  their slip (wormsim.contact3d.friction_guard). Each raises its subclass of SimulationError
+  their slip (wormsim.contact3d.friction_guard); after the loop, above the stable limit, a mesh that rang to the end
+  (wormsim.contact3d.ringing_check). Each raises its subclass of SimulationError
   (wormsim.errors) with what to change (diverged_error, jump_error, locked_error, overspeed_error, penetration_error;
   docs/contact3d.md "Failure modes and guards").
 
@@ -41,6 +42,7 @@ from wormsim.contact3d import jit_warmup, mass_scaling
 from wormsim.contact3d.contact_sums import RadiusLog
 from wormsim.contact3d.metrics import contact3d_summary
 from wormsim.contact3d.mjcf import BuiltModel, build_model
+from wormsim.contact3d.ringing_check import ringing
 from wormsim.contact3d.timestep import (
     MAX_WORM_TURN_PER_STEP_RAD,
     OVERSPEED_GUARD,
@@ -440,6 +442,9 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
     summary = _run_summary(
         S, scenario, bm, rec, guards.turn_max, len(coll), 1e6 * wall / max(n_rec * rec, 1), flanks=fc is not None
     )
+    rang = ringing(S, summary, dt, bm.law.stable_limit_s)  # rang to the end above the limit (ringing_check)
+    if rang is not None:
+        raise diverged_error(rang[0], dt, bm, rang[1])
     extra = {"points_tooth0": pts, "points_world": pts_world, "forces_world": forces, "built": bm}
     if pattern is not None:  # the loaded contact pattern and Hertz stress (flank_outputs)
         summary.update(pattern.summary(S["t_s"], summary["steady_window_s"]))
