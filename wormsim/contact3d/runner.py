@@ -442,14 +442,14 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
     summary = _run_summary(
         S, scenario, bm, rec, guards.turn_max, len(coll), 1e6 * wall / max(n_rec * rec, 1), flanks=fc is not None
     )
-    rang = ringing(S, summary, dt, bm.law.stable_limit_s)  # rang to the end above the limit (ringing_check)
-    if rang is not None:
-        raise diverged_error(rang[0], dt, bm, rang[1])
     extra = {"points_tooth0": pts, "points_world": pts_world, "forces_world": forces, "built": bm}
     if pattern is not None:  # the loaded contact pattern and Hertz stress (flank_outputs)
         summary.update(pattern.summary(S["t_s"], summary["steady_window_s"]))
         extra["flank_pattern"] = pattern.grid(S["t_s"], summary["steady_window_s"])
     summary.update(mass_scaling.run_summary(S, scenario, bm.meta, summary))  # and the ringing guard (exit 3)
+    rang = ringing(S, summary, dt, bm.law.stable_limit_s)  # rang to the end above the limit (ringing_check)
+    if rang is not None:
+        raise diverged_error(rang[0], dt, bm, rang[1])
     if bm.kinematic_tca is not None:  # errors: the displaced exact flanks' kinematic TE and play (issue 12)
         kin = bm.kinematic_tca.summary(bm.geometry, gt.working_flank(scenario, bm.geometry.hand))
         summary.update({k: v for k, v in kin.items() if not k.startswith("contact_pattern")})
