@@ -82,18 +82,12 @@ def test_stable_runs_above_the_limit_pass(name, h, lim_factor):
     assert s["ratio"] == pytest.approx(s["ratio_theory"], rel=1e-5)
 
 
-def test_pieces_ring_above_the_limit_too():
-    """contact.geometry pieces, screw jack (coarse, 0.1 s) at 40 us, 1.58 x its limit: the facets' impacts ring, F_t
-    peak 4.75 x the mean (measured; medium 0.35 s: 2.37 x, F_t p2p 872 N against 260 N at the default 10 us)."""
-    sc = load_scenario(
-        SCEN / "screw_jack.yaml",
-        [
-            *CI["screw_jack"],
-            "contact.geometry=pieces",
-            "simulation.resolution=coarse",
-            "simulation.duration_s=0.1",
-            "simulation.timestep_s=4e-05",
-        ],
-    )
-    with pytest.raises(DivergedError, match="the mesh rang"):
-        simulate(sc)
+def test_pieces_are_not_checked_their_facet_impacts_peak_as_high_at_the_default_step():
+    """contact.geometry pieces, screw jack (coarse, 0.1 s): the facets' impacts put the steady F_t peak at 3.6 x the
+    mean at the default 10 us (0.39 x the limit; measured) and 4.75 x at 40 us (1.58 x): the signature cannot tell
+    ringing from facets there, so the check is for exact flanks only and the pieces run at 40 us completes."""
+    base = [*CI["screw_jack"], "contact.geometry=pieces", "simulation.resolution=coarse", "simulation.duration_s=0.1"]
+    s = simulate(load_scenario(SCEN / "screw_jack.yaml", [*base, "simulation.timestep_s=4e-05"])).summary
+    assert 4e-5 > 1.5 * s["timestep_stable_limit_s"]
+    assert s["tangential_force_max_n"] > RING_PEAK_OVER_MEAN * s["tangential_force_mean_n"]
+    assert s["ratio"] == pytest.approx(24.0, rel=1e-3)

@@ -20,8 +20,8 @@ rate cancel exactly what would fold onto 0 Hz), and whose angles and speeds are 
   timestep is above the contact's stable limit), a speed-driven drive stuck below half its command (locked;
   self-locking named when the wheel drives), the worm turning more than 1.25 x MAX_WORM_TURN_PER_STEP_RAD per
   step (overspeed: its pieces would tunnel through the wheel's), the sliding contacts' friction turned away from
-  their slip (wormsim.contact3d.friction_guard); after the loop, above the stable limit, a mesh that rang to the end
-  (wormsim.contact3d.ringing_check). Each raises its subclass of SimulationError
+  their slip (wormsim.contact3d.friction_guard); after the loop, above the stable limit, an exact-flank mesh that rang
+  to the end (wormsim.contact3d.ringing_check). Each raises its subclass of SimulationError
   (wormsim.errors) with what to change (diverged_error, jump_error, locked_error, overspeed_error, penetration_error;
   docs/contact3d.md "Failure modes and guards").
 
@@ -447,7 +447,7 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
         summary.update(pattern.summary(S["t_s"], summary["steady_window_s"]))
         extra["flank_pattern"] = pattern.grid(S["t_s"], summary["steady_window_s"])
     summary.update(mass_scaling.run_summary(S, scenario, bm.meta, summary))  # and the ringing guard (exit 3)
-    rang = ringing(S, summary, dt, bm.law.stable_limit_s)  # rang to the end above the limit (ringing_check)
+    rang = ringing(S, summary, dt, bm.law.stable_limit_s) if fc is not None else None  # flanks (ringing_check)
     if rang is not None:
         raise diverged_error(rang[0], dt, bm, rang[1])
     if bm.kinematic_tca is not None:  # errors: the displaced exact flanks' kinematic TE and play (issue 12)
