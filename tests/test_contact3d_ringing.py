@@ -1,4 +1,4 @@
-"""The ringing guard (wormsim.contact3d.ringing_check): above the contact's stable limit, a mesh whose steady per-step
+"""The ringing guard (wormsim.contact3d.ringing_check): above the contact's stable limit, an exact-flank mesh whose steady per-step
 F_t peak exceeds 1.5 x its mean rang, and the run fails as diverged (exit 3) instead of finishing with a broken result.
 
 Measured (docs/contact3d.md, "Ringing above the stable limit"; sweeps/step_convergence.py's configurations, flanks):
