@@ -1,5 +1,6 @@
-"""The ringing guard (wormsim.contact3d.ringing_check): above the contact's stable limit, an exact-flank mesh whose steady per-step
-F_t peak exceeds 1.5 x its mean rang, and the run fails as diverged (exit 3) instead of finishing with a broken result.
+"""The ringing guard (wormsim.contact3d.ringing_check): above the contact's stable limit, an exact-flank mesh whose
+steady per-step F_t peak exceeds 1.5 x its mean rang, and the run fails as diverged (exit 3) instead of finishing
+with a broken result.
 
 Measured (docs/contact3d.md, "Ringing above the stable limit"; sweeps/step_convergence.py's configurations, flanks):
 the seat motor CI run at 20 us (1.24 x the limit) rang to the end with ratio 52.82 and F_t peak 2.38 x its mean;
