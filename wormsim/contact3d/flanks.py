@@ -266,6 +266,19 @@ def _eval(x0, y0, zeta, ca, sa, theta1, P, out):
 
 
 @numba.njit(cache=True, inline="always")
+def _excess(x0, y0, zeta, ca, sa, P, tmp):
+    """The excess alone (worm_gap_ext's second value, the same operations) of the wheel point of _eval: a square root,
+    no angle (the face slope needs no gap)."""
+    x, y = ca * x0 - sa * y0, sa * x0 + ca * y0
+    if P.shape[0] > N_WORM_PARAMS:
+        xs, ys, zs = to_static(x, y, zeta, P, tmp)
+    else:
+        xs, ys, zs = y + P[10], -zeta, -x
+    r = math.sqrt(xs * xs + ys * ys)
+    return max(r - P[3], P[2] - r, abs(zs) - P[4])
+
+
+@numba.njit(cache=True, inline="always")
 def _gap_at(xy, sg, j, i, zeta, ca, sa, theta1, P, tmp, gaps, exc, pts, nrs, stamp, sid):
     """Extended gap of profile point i of (flank sg, slice j), evaluated once per slice (stamp[i] == sid) and kept in
     gaps, exc (excess), pts, nrs; +inf off the grid and at points that are not active flank points."""
@@ -537,9 +550,7 @@ def _face_slope(xy, sg, j, f, zj, dz, ca, sa, theta1, P, tmp):
     if t > 0.0:
         x0 += t * (xy[sg, j, i0 + 1, 0] - x0)
         y0 += t * (xy[sg, j, i0 + 1, 1] - y0)
-    _, e_lo = _eval(x0, y0, zj - 0.5 * dz, ca, sa, theta1, P, tmp)
-    _, e_hi = _eval(x0, y0, zj + 0.5 * dz, ca, sa, theta1, P, tmp)
-    return e_hi - e_lo
+    return _excess(x0, y0, zj + 0.5 * dz, ca, sa, P, tmp) - _excess(x0, y0, zj - 0.5 * dz, ca, sa, P, tmp)
 
 
 @numba.njit(cache=True, inline="always")
