@@ -22,7 +22,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from measure_kernel_cost import _load_ref, record_states  # noqa: E402
 
-FIELDS = ("pos", "nrm", "depth", "weight", "frame", "meta", "line")
+FIELDS = ("pos", "nrm", "depth", "weight", "frame", "meta", "line")  # line[:, 0] only through the weight
 MFIELDS = ("mpos", "mnrm", "mdepth", "mweight", "mframe", "mfric", "mwrap", "grp", "share")
 
 
@@ -45,7 +45,9 @@ def _run(mod, fc, k, states, keep):
         n = fp(k.fb, k.ib, th1, th2, fc.margin0, fc.taper_rad)
         if keep:
             nm = int(k.ib[7])
-            out.append([getattr(k, f)[:n].copy() for f in FIELDS] + [getattr(k, f)[:nm].copy() for f in MFIELDS])
+            a = [getattr(k, f)[:n].copy() for f in FIELDS] + [getattr(k, f)[:nm].copy() for f in MFIELDS]
+            a[FIELDS.index("line")] = a[FIELDS.index("line")][:, 1]  # its [:, 0] matters through the weight alone
+            out.append(a)
     return (time.perf_counter_ns() - t0) / len(states) / 1e3, out
 
 

@@ -74,6 +74,8 @@ MARGIN_PITCH = 0.10  # candidate points: conjugate angle within this fraction of
 MEMO_GAP_SHARE = 0.5  # a memorised open slice is skipped while its bound keeps this share of the gap it had
 MEMO_JITTER_MODULE = 1e-3  # allowance (x m_x) for the slice minimum's change at constant TE (measured <= 1.5e-5)
 MEMO_AGE_CYCLE = 1.0 / 8  # a memorised slice is evaluated again after this share of a mesh cycle of worm rotation
+INSIDE_SHARE = 0.5 * (1.0 + 1e-3)  # line points deeper inside than this x the slice width: weight 1 without the face
+# slope (its |change| across a slice is at most the slice width; 1e-3 is far above the slope's round-off)
 
 
 def default_slices(g: GearGeometry, resolution: str) -> int:
@@ -531,8 +533,17 @@ def _find_contacts(xy, c, c_range, span, zeta, ks, theta1, theta2, margin, taper
                 pos[n, 2] = pz + 0.5 * dlt * az
                 nrm[n, 0], nrm[n, 1], nrm[n, 2] = ax, ay, az
                 depth[n] = max(dlt, 0.0)
-                sl = _face_slope(xy, sg, j, ib + x_l, zj, zeta[1] - zeta[0], ca, sa, theta1, P, tmp)
-                line[n, 0], line[n, 1] = _excess_in_slices(e_x, sl), -gline * taper
+                dz = zeta[1] - zeta[0]
+                if e_x < -INSIDE_SHARE * dz:
+                    # the slice's strip lies wholly inside the threaded region: the excess changes by at most the
+                    # distance moved (a max of distances), so |sl| <= dz, e / |sl| < -1/2 and the weight is 1
+                    # either way (slice_weights); e / dz is kept instead of the slope's two evaluations
+                    line[n, 0] = e_x / dz
+                else:
+                    line[n, 0] = _excess_in_slices(
+                        e_x, _face_slope(xy, sg, j, ib + x_l, zj, dz, ca, sa, theta1, P, tmp)
+                    )
+                line[n, 1] = -gline * taper
                 meta[n, 0], meta[n, 1], meta[n, 2], meta[n, 3] = k, sg, j, f
                 n += 1
     return n
