@@ -307,7 +307,8 @@ def find_contacts(
     """Contacts of the window teeth ks at worm angle theta1, wheel angle theta2 (module docstring). Writes per contact
     the assembly position pos (n, 3), unit normal nrm (n, 3) (worm -> wheel), depth (n,) > 0 and meta (n, 4) =
     (tooth k, flank sigma, slice j, fractional profile index), and line (n, 2) = (excess of the contact line's point
-    in slice widths, e / |de| with de its change across one slice width (_face_slope); its depth: the extended gap's
+    in slice widths, e / |de| with de its change across one slice width (_face_slope; e / dz, dz the slice width, where
+    the slice's strip lies wholly inside: slice_weights gives weight 1 either way); its depth: the extended gap's
     minimum, m) for slice_weights; returns n. A contact is written where the depth at
     the worm's edge or the line's depth is positive (depth may then be 0). The candidate window is margin plus the
     transmission error |theta2 - hand z1 / z2 theta1| (wrapped to a pitch), so a wheel pushed far into the
