@@ -1,8 +1,9 @@
 """Per-step cost of exact-flank contacts against medium convex pieces (issue 13), measured in one process: the CI
 configurations of tests/test_contact3d_seeds.py shortened to 0.08 s at medium resolution, pieces and flanks
-alternating twice; wall time per step (summary step_wall_us: the step and the runner's per-sample work) and the
-run's CPU time. Writes docs/flank_speed.json; README "Exact flanks (the default) beside the convex pieces" quotes
-the best of two per geometry. Compare ratios from one run only: the machine is shared.
+alternating twice (flanks with one contact per slice, the default, and with one per tooth flank,
+`contact.flank_contacts: tooth`); wall time per step (summary step_wall_us: the step and the runner's per-sample
+work) and the run's CPU time. Writes docs/flank_speed.json; README "Speed of exact flanks against the issue's
+targets" quotes the best of two per geometry. Compare ratios from one run only: the machine is shared.
 
     .venv/bin/python sweeps/measure_flank_speed.py [seat_motor screw_jack involute_41]
 """
@@ -29,8 +30,10 @@ def main(seeds: list[str]) -> dict:
         base = [o for o in CI[name] if not o.startswith(("simulation.duration_s", "simulation.resolution"))]
         base += ["simulation.duration_s=0.08", "simulation.resolution=medium"]
         for rep in range(2):
-            for geo in ("pieces", "flanks"):
-                sc = load_scenario(ROOT / "scenarios" / f"{name}.yaml", base + [f"contact.geometry={geo}"])
+            for geo in ("pieces", "flanks", "flanks-tooth"):
+                over = [f"contact.geometry={geo.split('-')[0]}"]
+                over += ["contact.flank_contacts=tooth"] if geo.endswith("-tooth") else []
+                sc = load_scenario(ROOT / "scenarios" / f"{name}.yaml", base + over)
                 c0 = time.process_time()
                 s = simulate(sc).summary
                 rec = {
@@ -44,7 +47,14 @@ def main(seeds: list[str]) -> dict:
     for name in seeds:
         p = min(r["step_wall_us"] for r in runs[f"{name}/pieces"])
         f = min(r["step_wall_us"] for r in runs[f"{name}/flanks"])
-        best[name] = {"pieces_step_wall_us": p, "flanks_step_wall_us": f, "speedup_flanks_vs_pieces": p / f}
+        t = min(r["step_wall_us"] for r in runs[f"{name}/flanks-tooth"])
+        best[name] = {
+            "pieces_step_wall_us": p,
+            "flanks_step_wall_us": f,
+            "speedup_flanks_vs_pieces": p / f,
+            "flanks_tooth_step_wall_us": t,
+            "speedup_flanks_tooth_vs_pieces": p / t,
+        }
         print(name, best[name], flush=True)
     return {"machine": platform.node(), "cpus": os.cpu_count(), "runs": runs, "best": best}
 
