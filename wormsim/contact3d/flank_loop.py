@@ -457,8 +457,8 @@ class FlankLoop:
         self.table = address_table(self.arrays)
         self._kernel = k
 
-    def run(self, cmd: np.ndarray, load: np.ndarray, j0: int, j1: int) -> np.ndarray:
-        """Steps j0..j1-1 of the commands; returns the sums (run_interval's acc); fc.n and fc's window follow."""
+    def prepare(self) -> np.ndarray:
+        """run_table's address table with the contacts' current friction (before each call)."""
         fc = self.fc
         if fc.params is not fc.kernel.P:  # replaced: FlankContacts.find would repack (flank_step)
             fc._pack()
@@ -466,10 +466,28 @@ class FlankLoop:
             self._tables(self.d, fc.buffer)
         self.iv[-1] = fc.solreffriction[1] != 0.0
         self.fv[4] = fc.mu
-        self.dropped += run_table(self.table, self.m._address, self.d._address, cmd, load, j0, j1)
-        fc.n = int(self.state[1])
-        fc._c = int(self.state[0])
+        return self.table
+
+    def sync(self) -> None:
+        """fc.n and fc's window from the loop's state (after each call)."""
+        self.fc.n = int(self.state[1])
+        self.fc._c = int(self.state[0])
+
+    def run(self, cmd: np.ndarray, load: np.ndarray, j0: int, j1: int) -> np.ndarray:
+        """Steps j0..j1-1 of the commands; returns the sums (run_interval's acc); fc.n and fc's window follow."""
+        self.dropped += run_table(self.prepare(), self.m._address, self.d._address, cmd, load, j0, j1)
+        self.sync()
         return self.acc
+
+    def sample_table_for(self, pattern, store: tuple) -> np.ndarray:
+        """sample_table's address table over the run's arrays (rebuilt when one of them was replaced)."""
+        fc = self.fc
+        if self._store is not store or self._pattern is not pattern or self._sample_kernel is not fc.kernel:
+            cv = pattern.cv
+            self._sample_arrays = (fc.meta, fc.weight, fc.depth, self.work, cv.inv_rho, cv.line_len) + tuple(store)
+            self._sample_T = address_table(self._sample_arrays, SAMPLE_TABLE)
+            self._store, self._pattern, self._sample_kernel = store, pattern, fc.kernel
+        return self._sample_T
 
     def sample(self, i: int, pattern, rlog, store: tuple):
         """The runner's per-sample contact outputs at sample i (module docstring): writes row i of store = (points in
@@ -480,11 +498,7 @@ class FlankLoop:
         n = fc.n
         pattern.reserve(n)
         rlog.reserve(n)
-        if self._store is not store or self._pattern is not pattern or self._sample_kernel is not fc.kernel:
-            cv = pattern.cv
-            self._sample_arrays = (fc.meta, fc.weight, fc.depth, self.work, cv.inv_rho, cv.line_len) + tuple(store)
-            self._sample_T = address_table(self._sample_arrays, SAMPLE_TABLE)
-            self._store, self._pattern, self._sample_kernel = store, pattern, fc.kernel
+        T = self.sample_table_for(pattern, store)
         con = d.contact
         own = self.dropped == 0  # d.contact's last fc.n entries are the kernel's contacts, in order
         adr, efc, ncon, cone3 = con.efc_address, d.efc_force, d.ncon, fc.mu > 0  # the template's dim 3 (set_friction)
@@ -493,7 +507,7 @@ class FlankLoop:
             ncon = n = len(adr)
             own = True
         nteeth, pen, fr, W, wr, pattern.m, rlog.m = sample_table(
-            self._sample_T,
+            T,
             adr,
             fc.frame if own else con.frame,
             fc.pos if own else con.pos,

@@ -349,15 +349,31 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
     # the commands at each step's midpoint, evaluated for blocks of about 4096 steps at once
     cmds = gt.commands(scenario, bm.direction)
     block = max(1, 4096 // rec)
+    fast = None
+    if loop is not None:  # whole stretches of samples in one compiled call (wormsim.contact3d.flank_samples)
+        from wormsim.contact3d.flank_samples import FlankSamples
+
+        fast = FlankSamples(loop, guards, scenario, bm, worm_is_drive, rec, S_all)
+        fast.bind(store)
     prewarm.loop_started()  # the writers' warm-up thread goes now, beside the GIL-free loop (wormsim.prewarm)
-    for i in range(n_rec):
+    i = 0
+    while i < n_rec:
         if i % block == 0:
             t_blk = (i * rec + np.arange(min(block, n_rec - i) * rec) + 0.5) * dt
             cmd_arr, load_arr = cmds.drive(t_blk), cmds.load(t_blk)
             cmd_blk, load_blk = cmd_arr.tolist(), load_arr.tolist()
         o = (i % block) * rec
         fx = fy = fz = mz = nc = t1 = t2 = p1 = p2 = fpk = 0.0
-        if loop is not None:
+        if fast is not None and fast.usable():
+            i_next, pending = fast.run(cmd_arr, load_arr, i, min(n_rec, i - i % block + block), o, pattern, rlog)
+            if progress is not None and i_next > i:
+                progress.update(float(S_all[0, i_next - 1]))
+            i = i_next
+            if not pending:  # samples done up to i_next (the block's end)
+                continue
+            o = (i % block) * rec  # sample i's steps are done; its per-sample work follows in Python
+            t1, t2, p1, p2, nc, fx, fy, fz, mz, fpk = loop.acc.tolist()
+        elif loop is not None:
             t1, t2, p1, p2, nc, fx, fy, fz, mz, fpk = loop.run(cmd_arr, load_arr, o, o + rec).tolist()
         for j in range(o, o + rec) if loop is None else ():
             ctrl[ia_drv] = cmd_blk[j]
@@ -437,6 +453,7 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
         )
         if progress is not None:
             progress.update(t)
+        i += 1
     S["efficiency_theory_at_contact_radius"][:] = rlog.efficiency(S["friction_coefficient"], geo, worm_is_drive)
     wall = time.perf_counter() - t_wall
     summary = _run_summary(

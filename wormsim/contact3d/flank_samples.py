@@ -1,0 +1,407 @@
+"""The exact-flank runner's record intervals compiled together (issue 13): one numba call runs many samples, each
+`flank_loop.run_table` (the interval's steps) and then the runner's per-sample work of wormsim.contact3d.runner, so
+the per-sample Python (~45-60 us a sample: dispatch, guards, the series column) is paid once per call.
+
+Per sample, in the runner's order and with its floating-point operations (bit-identical series, pattern and radius
+logs, contact points: tests/test_flank_samples.py): the steps; the state read from d (shaft angles and speeds,
+d.time); the runner's _Guards.state checks (non-finite state or MuJoCo's bad-qacc warning, overspeed, teeth jumped);
+mu from the friction law (wormsim.friction.friction_coefficient_scalar's three forms); flank_loop.sample_flanks; the
+penetration and lock checks of _Guards.contact; the series column (runner.SERIES order).
+
+Anything else hands the sample back to the runner's Python path, after its steps and before any of its per-sample
+work: a guard that would act (it raises or keeps state: a stuck drive, the friction guard's next check), a friction
+coefficient that starts or stops being zero (FlankContacts.set_friction changes the cone's dimension; other changes
+are written into the hand-off's records here, as set_template leaves them), a contact log that needs room, contacts
+MuJoCo did not take.
+The runner then does that sample as before, so errors and their messages are the Python guards' own.
+
+d's scalar fields (time, ncon, nefc) and arena pointers (contact, efc_force) are read at their byte offsets in
+mjData, found once per process on a small model (`mjdata_offsets`: sentinel values and pointers searched in the
+struct, each match unique, checked against the binding). Where that fails the runner keeps the per-sample path.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import math
+
+import mujoco
+import numba
+import numpy as np
+from numba import types
+from numba.extending import intrinsic
+
+from wormsim.contact3d.flank_loop import _f1, _f64_at, _i1, _i64_at, run_table, sample_table
+
+ENABLED = True  # the runner's switch (tests compare against the per-sample path)
+ADR_CAP = 4096  # contacts per step the compiled sample reads (more: the sample goes to the Python path)
+SCAN_BYTES = 1 << 16  # how far past d.warning the scalar fields and pointers are searched
+
+# io: what run_samples hands back
+IO_NEXT, IO_PENDING, IO_TURN_MAX, IO_PM, IO_RM, IO_DROPPED = range(6)
+# g (float parameters), in this order
+G_NAMES = (
+    "dt",
+    "direction",
+    "ratio",
+    "overspeed_turn",
+    "jump_rad",
+    "pen_lim",
+    "lock_start",
+    "lock_fraction",
+    "next_check",
+    "r1",
+    "cos_gamma",
+    "mu_kind",  # 0 constant, 1 STEP(static, dynamic), 2 friction group
+    "mu_a",
+    "mu_b",
+    "mu_c",
+    "mu_d",
+    "mu",  # the coefficient the contacts carry now (FlankContacts.mu)
+    "rpm",  # (rad/s) per rpm
+    "a",
+    "e_star",
+    "speed_driven",
+    "locked",  # the lock guard holds state (locked_since set)
+    "worm_is_drive",
+    "qa1",
+    "qa2",
+    "dof1",
+    "dof2",
+    "z2",
+    "deg",
+)
+G = {k: n for n, k in enumerate(G_NAMES)}
+
+
+@intrinsic
+def _i32_at(typingctx, addr):
+    """The int32 pointer at an address (int64)."""
+    sig = types.CPointer(types.int32)(types.int64)
+
+    def codegen(context, builder, signature, args):
+        return builder.inttoptr(args[0], context.get_value_type(types.CPointer(types.int32)))
+
+    return sig, codegen
+
+
+_OFFSETS: np.ndarray | None = None
+
+
+def _find(raw: bytes, key: bytes, base: int, last_of_two: bool = False) -> int:
+    """base + where key is in raw, 8-aligned and unique (last_of_two: the second of exactly two)."""
+    k = raw.find(key)
+    if k >= 0 and last_of_two:
+        k2 = raw.find(key, k + 1)
+        k = k2 if k2 >= 0 else k
+    if k < 0 or raw.find(key, k + 1) >= 0 or (base + k) % 8:
+        return -1
+    return base + k
+
+
+def mjdata_offsets() -> np.ndarray | None:
+    """Byte offsets in mjData of (time, ncon, nefc, contact pointer, efc_force pointer, warning[BADQACC].number), then
+    mjContact's size and its efc_address field's offset, found on a box resting on a plane (module docstring); None
+    where a search is not unique or does not check."""
+    global _OFFSETS
+    if _OFFSETS is not None:
+        return _OFFSETS if _OFFSETS[0] >= 0 else None
+    m = mujoco.MjModel.from_xml_string(
+        "<mujoco><worldbody><geom type='plane' size='1 1 .1'/><body pos='0 0 .099'><freejoint/>"
+        "<geom type='box' size='.1 .1 .1'/></body></worldbody></mujoco>"
+    )
+    d = mujoco.MjData(m)
+    mujoco.mj_forward(m, d)
+    out = np.full(8, -1, dtype=np.int64)
+    try:
+        if d.ncon < 1 or d.nefc < 1:
+            raise LookupError
+        wn = np.asarray(d.warning.number)
+        w0 = wn.ctypes.data - d._address  # warning[0].number
+        d.time = 1.2345678901234567e-300
+        raw = ctypes.string_at(d._address + w0, SCAN_BYTES)
+        t_off = _find(raw, np.float64(d.time).tobytes(), w0)
+        con = np.asarray(d.contact.dist).ctypes.data  # dist is mjContact's first field
+        c_off = _find(raw, np.int64(con).tobytes(), w0, last_of_two=True)  # d->arena holds it too, declared first
+        e_off = _find(raw, np.int64(np.asarray(d.efc_force).ctypes.data).tobytes(), w0)
+        # ncon .. nefc are the ints after warning[] and timer[] (mjdata.h): the first int32 pair equal to ncon with
+        # nefc 16 bytes on, before time
+        n_off = -1
+        for k in range(w0 + 8 * len(wn), t_off, 4):
+            if ctypes.c_int.from_address(d._address + k).value == d.ncon and (
+                ctypes.c_int.from_address(d._address + k + 16).value == d.nefc
+            ):
+                n_off = k
+                break
+        b_off = w0 + 8 * int(mujoco.mjtWarning.mjWARN_BADQACC)
+        dist = np.asarray(d.contact.dist)
+        size = dist.strides[0]  # one mjContact record
+        a_off = np.asarray(d.contact.efc_address).ctypes.data - con
+        out[:] = (t_off, n_off, n_off + 16, c_off, e_off, b_off, size, a_off)
+        if min(out) < 0:
+            raise LookupError
+        # check: other values read back through the offsets
+        d.time = 0.25
+        mujoco.mj_step(m, d)
+        a = d._address
+        o = [int(x) for x in out]
+        ok = (
+            ctypes.c_double.from_address(a + o[0]).value == d.time
+            and ctypes.c_int.from_address(a + o[1]).value == d.ncon
+            and ctypes.c_int.from_address(a + o[2]).value == d.nefc
+            and ctypes.c_int64.from_address(a + o[3]).value == np.asarray(d.contact.dist).ctypes.data
+            and ctypes.c_int64.from_address(a + o[4]).value == np.asarray(d.efc_force).ctypes.data
+            and ctypes.c_int.from_address(a + o[5]).value == d.warning[mujoco.mjtWarning.mjWARN_BADQACC].number
+            and ctypes.c_int.from_address(np.asarray(d.contact.dist).ctypes.data + o[6] * (d.ncon - 1) + o[7]).value
+            == d.contact.efc_address[d.ncon - 1]
+        )
+        if not ok:
+            raise LookupError
+    except LookupError:
+        out[:] = -1
+    _OFFSETS = out
+    return out if out[0] >= 0 else None
+
+
+@numba.njit(cache=True, inline="always")
+def _friction(vs, g):
+    """wormsim.friction.friction_coefficient_scalar at the sliding speed vs, with its operations."""
+    kind = g[11]
+    if kind == 0.0:
+        return g[12]
+    if kind == 1.0:  # units.step(abs(vs), 0.0, static, v_t, dynamic)
+        t, h0, t1, h1 = abs(vs), g[12], g[13], g[14]
+        if t1 <= 0.0:
+            return h1 if t >= 0.0 else h0
+        s = (t - 0.0) / (t1 - 0.0)
+        s = 0.0 if s < 0.0 else (1.0 if s > 1.0 else s)
+        return h0 + (h1 - h0) * s * s * (3.0 - 2.0 * s)
+    return math.tan(g[28] / (g[12] * abs(vs) ** g[13] + g[14]))  # tan(DEG / (a |Vs|^b + c))
+
+
+@numba.njit(cache=True, nogil=True)
+def run_samples(T, Ts, m_addr, d_addr, cmd, load, i0, i1, o0, rec, S, g, off, frame, pos, adr, pat_buf, r_buf, io):
+    """Samples i0..i1-1 (module docstring); sample i's steps are o0 + (i - i0) rec .. + rec of cmd and load.
+    T, Ts: flank_loop's run and sample tables; S the series (runner.SERIES rows); g the parameters (G_NAMES); off
+    mjdata_offsets; frame, pos the kernel's contacts; adr (ADR_CAP) work room; pat_buf, r_buf the pattern's and the
+    radius log's rows; io: IO_* (io[IO_PM], io[IO_RM] the logs' rows used on entry)."""
+    acc = _f1(T, 20)
+    state = numba.carray(_i64_at(T[19, 0]), (T[19, 1],))
+    qpos, qvel = _f1(T, 2), _f1(T, 1)
+    depth = _f1(Ts, 2)
+    qa1, qa2, dof1, dof2 = int(g[23]), int(g[24]), int(g[25]), int(g[26])
+    dt, direction, ratio, turn_lim, jump_rad, pen_lim = g[0], g[1], g[2], g[3], g[4], g[5]
+    tptr = _f64_at(d_addr + off[0])
+    nptr = _i32_at(d_addr + off[1])
+    eptr = _i32_at(d_addr + off[2])
+    cptr = _i64_at(d_addr + off[3])
+    fptr = _i64_at(d_addr + off[4])
+    bptr = _i32_at(d_addr + off[5])
+    size, o_adr = off[6], off[7]
+    mu_now = g[16]
+    cone3 = mu_now > 0.0
+    turn_max = io[IO_TURN_MAX]
+    pm, rm = int(io[IO_PM]), int(io[IO_RM])
+    z2 = int(g[27])
+    io[IO_PENDING] = 0.0
+    for i in range(i0, i1):
+        o = o0 + (i - i0) * rec
+        io[IO_NEXT] = i
+        io[IO_TURN_MAX] = turn_max
+        io[IO_PM], io[IO_RM] = pm, rm
+        dropped = run_table(T, m_addr, d_addr, cmd, load, o, o + rec)
+        io[IO_PENDING] = 1.0  # from here on sample i's steps are done
+        io[IO_DROPPED] = dropped
+        if dropped:
+            return
+        t1, t2, p1, p2, nc = acc[0], acc[1], acc[2], acc[3], acc[4]
+        fx, fy, fz, mz, fpk = acc[5], acc[6], acc[7], acc[8], acc[9]
+        cmd_i = cmd[o + rec - 1]
+        th1, th2 = qpos[qa1], qpos[qa2]
+        w1, w2 = qvel[dof1], qvel[dof2]
+        t = tptr[0]
+        # _Guards.state
+        if not math.isfinite(th1 + th2 + w1 + w2) or bptr[0] != 0:
+            return
+        turn = abs(w1) * dt
+        if turn > turn_lim:
+            return
+        te = th2 - direction * th1 / ratio
+        if abs(te) > jump_rad:
+            return
+        if t > g[8]:  # the friction guard's next check
+            return
+        vs = abs(w1) * g[9] / g[10]
+        mu = _friction(vs, g)
+        if mu != mu_now:  # FlankContacts.set_friction: the records' friction, where the cone's dimension stays
+            if (mu > 0.0) != (mu_now > 0.0):
+                return
+            fw = _f1(T, 23)
+            fw[4] = mu
+            recs = numba.carray(_f64_at(T[15, 0]), (T[15, 1], T[15, 2]))
+            o5 = _i1(T, 16)[5]
+            for r in range(recs.shape[0]):
+                recs[r, o5] = mu
+                recs[r, o5 + 1] = mu
+            mu_now = mu
+            g[16] = mu
+        # the sample's contacts: d.contact's efc addresses, the largest penetration (_Guards.contact's first check)
+        ncon = nptr[0]
+        n_fc = state[1]
+        if ncon > adr.shape[0] or pm + n_fc > pat_buf.shape[0] or rm + n_fc > r_buf.shape[0]:
+            return
+        n = min(n_fc, ncon)
+        pen = 0.0
+        if n > 0:
+            pen = depth[0]
+            for c in range(1, n):
+                if depth[c] > pen:
+                    pen = depth[c]
+        if pen > pen_lim:
+            return
+        w_drive = w1 if g[22] != 0.0 else w2
+        if g[20] != 0.0 and t > g[6] and (g[21] != 0.0 or abs(w_drive) < g[7] * abs(cmd_i)):
+            return  # the lock guard acts or keeps state: the Python path
+        cbase = cptr[0]
+        for k in range(ncon):
+            adr[k] = _i32_at(cbase + k * size + o_adr)[0]
+        efc = numba.carray(_f64_at(fptr[0]), (max(eptr[0], 0),))
+        nteeth, pen2, fr, W, wr, pm, rm = sample_table(
+            Ts, adr[:ncon], frame, pos, True, efc, pat_buf, r_buf, ncon, n_fc, cone3, th2, z2, g[18], i, g[19], pm, rm
+        )
+        turn_max = max(turn_max, turn)
+        r_c = wr / W if W > 0 else math.nan
+        rpm = g[17]
+        col = (
+            t,
+            th1,
+            th2,
+            w1 / rpm,
+            w2 / rpm,
+            t1 / rec,
+            t2 / rec,
+            cmd_i,
+            fx / rec,
+            -fy / rec,
+            fz / rec,
+            nc / rec,
+            float(nteeth),
+            pen2,
+            mu,
+            te,
+            mz / rec,
+            p1 / rec,
+            p2 / rec,
+            fpk,
+            fr,
+            r_c,
+            0.0,
+        )
+        for k in range(len(col)):
+            S[k, i] = col[k]
+        io[IO_PENDING] = 0.0
+    io[IO_NEXT] = i1
+    io[IO_TURN_MAX] = turn_max
+    io[IO_PM], io[IO_RM] = pm, rm
+
+
+class FlankSamples:
+    """run_samples' parameters for one run (the runner's FlankLoop, guards, friction law, logs); `run` steps and
+    samples a stretch of one command block."""
+
+    def __init__(self, loop, guards, scenario, bm, worm_is_drive: bool, rec: int, series: np.ndarray):
+        from wormsim import gear_theory as gt
+        from wormsim.contact3d.runner import JUMP_PITCH, MAX_WORM_TURN_PER_STEP_RAD, OVERSPEED_GUARD
+        from wormsim.friction import GROUPS, friction_coefficient
+        from wormsim.units import DEG, RPM
+
+        fc, geo, c = loop.fc, bm.geometry, scenario.contact
+        self.loop, self.fc, self.guards, self.rec, self.S = loop, fc, guards, rec, series
+        offs = mjdata_offsets()
+        self.ok = offs is not None
+        if offs is None:
+            return
+        self.off = offs
+        g = np.zeros(len(G_NAMES))
+        g[G["dt"]] = guards.dt
+        g[G["direction"]] = bm.direction
+        g[G["ratio"]] = geo.ratio
+        g[G["overspeed_turn"]] = OVERSPEED_GUARD * MAX_WORM_TURN_PER_STEP_RAD
+        g[G["jump_rad"]] = JUMP_PITCH * guards.pitch_angle
+        g[G["pen_lim"]] = guards.pen_lim
+        g[G["lock_start"]] = guards.lock_start
+        g[G["lock_fraction"]] = gt.LOCK_SPEED_FRACTION
+        g[G["r1"]] = geo.r1
+        g[G["cos_gamma"]] = math.cos(geo.gamma)
+        if c.friction_group is not None:
+            g[G["mu_kind"]] = 2.0
+            g[G["mu_a"]], g[G["mu_b"]], g[G["mu_c"]] = GROUPS[c.friction_group]
+        elif c.friction is None and c.friction_static is None:
+            g[G["mu_a"]] = float(friction_coefficient(c, 0.0))
+        elif c.friction is not None:
+            g[G["mu_a"]] = float(c.friction)
+        else:
+            g[G["mu_kind"]] = 1.0
+            g[G["mu_a"]], g[G["mu_b"]], g[G["mu_c"]] = c.friction_static, c.transition_velocity_m_s, c.friction_dynamic
+        g[G["deg"]] = DEG
+        g[G["rpm"]] = RPM
+        g[G["a"]] = geo.a
+        g[G["speed_driven"]] = float(guards.speed_driven)
+        g[G["worm_is_drive"]] = float(worm_is_drive)
+        g[G["qa1"]], g[G["qa2"]] = fc.qa1, fc.qa2
+        g[G["dof1"]], g[G["dof2"]] = bm.worm_dof, bm.wheel_dof
+        g[G["z2"]] = geo.z2
+        self.g = g
+        self.adr = np.zeros(ADR_CAP, dtype=np.int32)
+        self.io = np.zeros(6)
+        self._store: tuple = ()
+
+    def usable(self) -> bool:
+        """The compiled samples apply: offsets found, slice contacts, rigid poses, every contact MuJoCo's so far."""
+        fc = self.fc
+        return ENABLED and self.ok and not fc.merge and not fc.displaced and self.loop.dropped == 0
+
+    def run(self, cmd, load, i0: int, i1: int, o0: int, pattern, rlog) -> tuple[int, bool]:
+        """Samples i0..i1-1 (run_samples); returns (the next sample, whether its steps are done and its per-sample
+        work is left to the runner's Python path)."""
+        loop, fc, g, io, guards = self.loop, self.fc, self.g, self.io, self.guards
+        T = loop.prepare()
+        Ts = loop.sample_table_for(pattern, self._store)
+        g[G["next_check"]] = guards.friction.next_check
+        g[G["mu"]] = fc.mu
+        g[G["e_star"]] = pattern.e_star
+        g[G["locked"]] = float(guards.locked_since is not None)
+        io[IO_TURN_MAX], io[IO_PM], io[IO_RM] = guards.turn_max, pattern.m, rlog.m
+        run_samples(
+            T,
+            Ts,
+            loop.m._address,
+            loop.d._address,
+            cmd,
+            load,
+            i0,
+            i1,
+            o0,
+            self.rec,
+            self.S,
+            g,
+            self.off,
+            fc.frame,
+            fc.pos,
+            self.adr,
+            pattern.buf,
+            rlog.buf,
+            io,
+        )
+        loop.sync()
+        if g[G["mu"]] != fc.mu:  # changed in the call (run_samples): as FlankContacts.set_friction leaves it
+            fc.mu = float(g[G["mu"]])
+            fc.template.friction = [fc.mu, fc.mu, 0.0, 0.0, 0.0]
+        loop.dropped += int(io[IO_DROPPED])
+        guards.turn_max = float(io[IO_TURN_MAX])
+        pattern.m, rlog.m = int(io[IO_PM]), int(io[IO_RM])
+        return int(io[IO_NEXT]), bool(io[IO_PENDING])
+
+    def bind(self, store: tuple) -> None:
+        """The run's point, force and world-point arrays (FlankLoop.sample's store)."""
+        self._store = store
