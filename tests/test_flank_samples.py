@@ -22,6 +22,7 @@ CASES = {
     "every step, STEP friction": (JACK, SHORT + ["simulation.record_every=1"]),
     "every 3rd step": (SCEN / "involute_41.yaml", SHORT + ["simulation.record_every=3"]),
     "friction group": (JACK, SHORT + GROUP + ["simulation.record_every=2"]),
+    "one contact per tooth flank": (JACK, SHORT + ["contact.flank_contacts=tooth", "simulation.record_every=1"]),
     "frictionless": (
         JACK,
         SHORT + ["contact.friction_static=null", "contact.friction_dynamic=null", "contact.friction=0"],

@@ -32,6 +32,7 @@ from numba import types
 from numba.extending import intrinsic
 
 from wormsim.contact3d.flank_loop import _f1, _f64_at, _i1, _i64_at, run_table, sample_table
+from wormsim.contact3d.flank_merge import split_forces
 
 ENABLED = True  # the runner's switch (tests compare against the per-sample path)
 ADR_CAP = 4096  # contacts per step the compiled sample reads (more: the sample goes to the Python path)
@@ -180,15 +181,18 @@ def _friction(vs, g):
 
 
 @numba.njit(cache=True, nogil=True)
-def run_samples(T, Ts, m_addr, d_addr, cmd, load, i0, i1, o0, rec, S, g, off, frame, pos, adr, pat_buf, r_buf, io):
+def run_samples(T, Ts, m_addr, d_addr, cmd, load, i0, i1, o0, rec, S, g, off, frame, pos, adr, pat_buf, r_buf, io, mrg):
     """Samples i0..i1-1 (module docstring); sample i's steps are o0 + (i - i0) rec .. + rec of cmd and load.
     T, Ts: flank_loop's run and sample tables; S the series (runner.SERIES rows); g the parameters (G_NAMES); off
     mjdata_offsets; frame, pos the kernel's contacts; adr (ADR_CAP) work room; pat_buf, r_buf the pattern's and the
-    radius log's rows; io: IO_* (io[IO_PM], io[IO_RM] the logs' rows used on entry)."""
+    radius log's rows; io: IO_* (io[IO_PM], io[IO_RM] the logs' rows used on entry); mrg: with one contact per tooth
+    flank (merge) the kernel's (grp, share, mfric, mwrap) and the per-slice rows' room (FlankContacts.slice_rows),
+    else None."""
     acc = _f1(T, 20)
     state = numba.carray(_i64_at(T[19, 0]), (T[19, 1],))
     qpos, qvel = _f1(T, 2), _f1(T, 1)
     depth = _f1(Ts, 2)
+    ib = _i1(T, 8)
     qa1, qa2, dof1, dof2 = int(g[23]), int(g[24]), int(g[25]), int(g[26])
     dt, direction, ratio, turn_lim, jump_rad, pen_lim = g[0], g[1], g[2], g[3], g[4], g[5]
     tptr = _f64_at(d_addr + off[0])
@@ -250,7 +254,7 @@ def run_samples(T, Ts, m_addr, d_addr, cmd, load, i0, i1, o0, rec, S, g, off, fr
         n_fc = state[1]
         if ncon > adr.shape[0] or pm + n_fc > pat_buf.shape[0] or rm + n_fc > r_buf.shape[0]:
             return
-        n = min(n_fc, ncon)
+        n = n_fc if mrg is not None else min(n_fc, ncon)
         pen = 0.0
         if n > 0:
             pen = depth[0]
@@ -266,9 +270,51 @@ def run_samples(T, Ts, m_addr, d_addr, cmd, load, i0, i1, o0, rec, S, g, off, fr
         for k in range(ncon):
             adr[k] = _i32_at(cbase + k * size + o_adr)[0]
         efc = numba.carray(_f64_at(fptr[0]), (max(eptr[0], 0),))
-        nteeth, pen2, fr, W, wr, pm, rm = sample_table(
-            Ts, adr[:ncon], frame, pos, True, efc, pat_buf, r_buf, ncon, n_fc, cone3, th2, z2, g[18], i, g[19], pm, rm
-        )
+        if mrg is not None:  # FlankContacts.slice_rows: the merged contacts' forces split over their slices
+            grp, share, mfric, mwrap, adr_m, efc_m = mrg
+            nh = min(ib[7], ncon)
+            split_forces(adr[:ncon], efc, ncon - nh, cone3, grp, share, mfric, mwrap, n_fc, adr_m, efc_m)
+            nteeth, pen2, fr, W, wr, pm, rm = sample_table(
+                Ts,
+                adr_m[:n_fc],
+                frame,
+                pos,
+                True,
+                efc_m,
+                pat_buf,
+                r_buf,
+                n_fc,
+                n_fc,
+                True,
+                th2,
+                z2,
+                g[18],
+                i,
+                g[19],
+                pm,
+                rm,
+            )
+        else:
+            nteeth, pen2, fr, W, wr, pm, rm = sample_table(
+                Ts,
+                adr[:ncon],
+                frame,
+                pos,
+                True,
+                efc,
+                pat_buf,
+                r_buf,
+                ncon,
+                n_fc,
+                cone3,
+                th2,
+                z2,
+                g[18],
+                i,
+                g[19],
+                pm,
+                rm,
+            )
         turn_max = max(turn_max, turn)
         r_c = wr / W if W > 0 else math.nan
         rpm = g[17]
@@ -357,15 +403,16 @@ class FlankSamples:
         self._store: tuple = ()
 
     def usable(self) -> bool:
-        """The compiled samples apply: offsets found, slice contacts, rigid poses, every contact MuJoCo's so far."""
+        """The compiled samples apply: offsets found, rigid poses, every contact MuJoCo's so far."""
         fc = self.fc
-        return ENABLED and self.ok and not fc.merge and not fc.displaced and self.loop.dropped == 0
+        return ENABLED and self.ok and not fc.displaced and self.loop.dropped == 0
 
     def run(self, cmd, load, i0: int, i1: int, o0: int, pattern, rlog) -> tuple[int, bool]:
         """Samples i0..i1-1 (run_samples); returns (the next sample, whether its steps are done and its per-sample
         work is left to the runner's Python path)."""
         loop, fc, g, io, guards = self.loop, self.fc, self.g, self.io, self.guards
         T = loop.prepare()
+        k = fc.kernel
         Ts = loop.sample_table_for(pattern, self._store)
         g[G["next_check"]] = guards.friction.next_check
         g[G["mu"]] = fc.mu
@@ -392,6 +439,7 @@ class FlankSamples:
             pattern.buf,
             rlog.buf,
             io,
+            (k.grp, k.share, k.mfric, k.mwrap, fc._adr, fc._efc) if fc.merge else None,
         )
         loop.sync()
         if g[G["mu"]] != fc.mu:  # changed in the call (run_samples): as FlankContacts.set_friction leaves it
