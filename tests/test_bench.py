@@ -154,6 +154,56 @@ def test_loop_speedup_uses_the_stepping_loop_wall_time_of_the_same_records():
     assert "loop_speedup_vs_pieces" not in recs[1]
 
 
+def _acc_rec(geo, f, w, p2p, eff=1e-3, **over):
+    err = {"ratio": 1e-6, "tangential_force_mean_n": 1e-4, "tangential_force_p2p_n": p2p, "mesh_frequency_hz": 1e-5}
+    err["efficiency"] = eff
+    r = {
+        "scenario": "s",
+        "model": "contact3d",
+        "status": "ok",
+        "resolution": {"level": "medium", "geometry": geo},
+        "timestep_factor": f,
+        "wall_s_per_sim_s": w,
+        "error": err,
+    }
+    r.update(over)
+    return r
+
+
+def test_speedup_at_equal_or_better_accuracy_takes_the_cheapest_flanks_run_at_least_as_accurate():
+    """Both readings (wormsim.bench.run.speedups_equal_accuracy): against the pieces at their default step, and
+    against the cheapest pieces run; a flanks run worse in one error key does not count."""
+    from wormsim.bench.run import speedups_equal_accuracy
+
+    recs = [
+        _acc_rec("pieces", 2.0, 50.0, 150.0),
+        _acc_rec("pieces", 1.0, 100.0, 160.0),
+        _acc_rec("pieces", 0.5, 200.0, 140.0),
+        _acc_rec("flanks", 4.0, 2.0, 0.5, eff=2e-3),  # cheapest, but its efficiency error is the pieces' x2
+        _acc_rec("flanks", 2.0, 5.0, 0.1),
+        _acc_rec("flanks", 1.0, 10.0, 0.0),
+    ]
+    got = speedups_equal_accuracy(recs)["s"]["medium"]
+    d, c = got["vs_default_pieces"], got["vs_cheapest_pieces"]
+    assert d["speedup"] == 20.0 and d["pieces_timestep_factor"] == 1.0 and d["flanks_timestep_factor"] == 2.0
+    assert c["speedup"] == 10.0 and c["pieces_timestep_factor"] == 2.0 and c["flanks_timestep_factor"] == 2.0
+    recs[3]["error"]["efficiency"] = 1e-3  # now as accurate: it is taken
+    assert speedups_equal_accuracy(recs)["s"]["medium"]["vs_default_pieces"]["speedup"] == 50.0
+
+
+def test_speedup_at_equal_accuracy_needs_every_error_key_on_both_sides():
+    from wormsim.bench.run import speedups_equal_accuracy
+
+    recs = [_acc_rec("pieces", 1.0, 100.0, 160.0), _acc_rec("flanks", 1.0, 10.0, 0.0)]
+    del recs[1]["error"]["ratio"]
+    assert speedups_equal_accuracy(recs)["s"]["medium"] == {"vs_default_pieces": None, "vs_cheapest_pieces": None}
+    recs[1]["error"]["ratio"] = 0.0
+    recs[0]["error"]["mesh_frequency_hz"] = None
+    assert speedups_equal_accuracy(recs)["s"]["medium"]["vs_default_pieces"] is None
+    recs[0]["error"]["mesh_frequency_hz"] = 1e-5
+    assert speedups_equal_accuracy(recs)["s"]["medium"]["vs_default_pieces"]["speedup"] == 10.0
+
+
 def test_json_results_are_readable_by_others(tmp_path):
     import os
     import stat

@@ -116,6 +116,57 @@ def speedups(records: list[dict], key: str = "wall_s_per_sim_s", name: str = "sp
     return out
 
 
+def speedups_equal_accuracy(records: list[dict], key: str = "wall_s_per_sim_s") -> dict:
+    """Flanks against pieces at equal or better accuracy (issue 13), per scenario and resolution level, from one bench
+    run's records (their `error` against the scenario's converged reference, every key of ERROR_LABELS) and cost
+    `key` (whole simulate() or the stepping loop per simulated second). Two readings:
+    vs_default_pieces: the pieces record at its default step (timestep_factor 1) against the cheapest flanks record
+    whose |error| is <= the pieces' in every error key; vs_cheapest_pieces: the cheapest pieces record (any step)
+    against the cheapest flanks record at least as accurate as that one (the Pareto reading). A missing error on
+    either side disqualifies a flanks record; None where none qualifies."""
+
+    def ok(r: dict, geo: str) -> bool:
+        res = r.get("resolution") or {}
+        return r["model"] == "contact3d" and res.get("geometry") == geo and r["status"] == "ok" and bool(r.get(key))
+
+    def as_accurate(f: dict, p: dict) -> bool:
+        ef, ep = f.get("error") or {}, p.get("error") or {}
+        return all(ef.get(k) is not None and ep.get(k) is not None and abs(ef[k]) <= abs(ep[k]) for k in ERROR_LABELS)
+
+    def pick(p: dict, flanks: list[dict]) -> dict | None:
+        good = [f for f in flanks if as_accurate(f, p)]
+        if not good:
+            return None
+        f = min(good, key=lambda r: r[key])
+        return {
+            "speedup": p[key] / f[key],
+            "pieces_timestep_factor": p.get("timestep_factor"),
+            "pieces_" + key: p[key],
+            "flanks_timestep_factor": f.get("timestep_factor"),
+            "flanks_" + key: f[key],
+        }
+
+    out: dict = {}
+    pieces = [r for r in records if ok(r, "pieces")]
+    for p0 in pieces:
+        scen, level = p0["scenario"], (p0.get("resolution") or {}).get("level")
+        if level in out.get(scen, {}):
+            continue
+        same = [q for q in pieces if q["scenario"] == scen and (q.get("resolution") or {}).get("level") == level]
+        flanks = [
+            r
+            for r in records
+            if ok(r, "flanks") and r["scenario"] == scen and (r.get("resolution") or {}).get("level") == level
+        ]
+        default = next((q for q in same if q.get("timestep_factor") == 1.0), None)
+        cheapest = min(same, key=lambda r: r[key])
+        out.setdefault(scen, {})[level] = {
+            "vs_default_pieces": pick(default, flanks) if default is not None else None,
+            "vs_cheapest_pieces": pick(cheapest, flanks),
+        }
+    return out
+
+
 def run_bench(
     quick: bool,
     out_dir: str | Path,
@@ -195,6 +246,9 @@ def run_bench(
         finer = next((r for r in records if r["scenario"] == scen and r.get("finer") and r["status"] == "ok"), None)
         if finer is not None:
             meta["reference_check"][scen] = finer["error"]
+    # flanks against pieces at equal or better accuracy, now that every record has its errors
+    meta["speedup_flanks_vs_pieces_equal_accuracy"] = speedups_equal_accuracy(records)
+    meta["speedup_flanks_vs_pieces_equal_accuracy_loop"] = speedups_equal_accuracy(records, "loop_wall_s_per_sim_s")
     if _level_available("contact3d") and (models is None or "contact3d" in models):
         # the timestep sweep of each seed until a guard fires (stability_edge); quick: the seat motor only
         meta["stability"] = stability_map(
