@@ -23,7 +23,10 @@ LONG_TESTS: dict[str, set[str] | None] = {
     # the convex-piece validation of the seeds (contact.geometry pieces); the default geometry's (flanks) is in
     # test_contact3d_seeds_flanks.py and stays in `make test`
     "test_contact3d_seeds.py": {"seat_motor", "screw_jack", "involute_41"},
-    "test_errors_sidebands.py": None,  # F_t sidebands of a wheel runout over a wheel revolution (~1 min)
+    "test_errors_sidebands.py": None,
+    "test_mass_scaling.py": {
+        "unscaled"
+    },  # the unscaled reference run of the scaled ones (240 000 steps, ~3 min)  # F_t sidebands of a wheel runout over a wheel revolution (~1 min)
 }
 
 

@@ -85,3 +85,103 @@ def test_flanks_efficiency_within_3_percent_at_the_contact_radius(name):
 def test_flanks_radial_force_on_the_line_of_centres_is_din_3975(name):
     s = run(name)["summary"]
     assert abs(s["radial_force_line_of_centres_mean_n"] / s["radial_force_theory_n"] - 1) < 0.03
+
+
+# ----------------------------------------------------------------------------- independent references of the forces
+# The worm torque is the speed servo's reaction to the contacts' moments about the worm axis, the forces are the
+# contact sensor's resultant on the wheel: neither is the load command, so the closed forms below can fail.
+
+
+def _geometry(name: str):
+    from meshgen.geometry import derive
+
+    return derive(run(name)["scenario"].gear)
+
+
+@pytest.mark.parametrize("name", SEEDS)
+def test_flanks_worm_torque_is_t2_over_i_eta_at_the_contact_radius(name):
+    """T1 = T2 / (i eta) (power balance, DIN 3975-2) with eta = tan(g_r) / tan(g_r + rho') at the contacts'
+    force-weighted worm radius r_c (tan g_r = tan g r1 / r_c, DIN 3975-1; wormsim.gear_theory.efficiency_at_radius),
+    rho' = atan(mu / cos alpha_n): within 1 % (measured +0.07 / +0.12 / +0.13 %; at the pitch radius r1 the same
+    formula is 1.2-1.8 % off, so the check tells the radii apart)."""
+    from wormsim import gear_theory as gt
+
+    s, sc, g = run(name)["summary"], run(name)["scenario"], _geometry(name)
+    eta = gt.efficiency_at_radius(
+        g.gamma, g.r1, s["worm_contact_radius_mean_m"], s["friction_coefficient_mean"], g.alpha_n
+    )
+    expected = sc.load.torque_nm / (g.ratio * float(eta))
+    assert abs(s["worm_torque_mean_nm"] / expected - 1) < 0.01, (s["worm_torque_mean_nm"], expected)
+
+
+AXIAL_XFAIL = {
+    "screw_jack": "F_a2 56.93 N against T1 / r_c = 0.7841 N m / 13.155 mm = 59.60 N (-4.5 %); seat motor -2.9 %, "
+    "involute_41 -2.8 %: the contacts sit at angles about the worm axis (force-weighted |phi| about 28 deg), which "
+    "turn part of their worm-tangential force out of the wheel's axial direction",
+}
+
+
+@pytest.mark.parametrize("name", [_xf(AXIAL_XFAIL, n) for n in SEEDS])
+def test_flanks_axial_force_is_worm_torque_over_contact_radius(name):
+    """F_a2 = F_t1 = T1 / r (DIN 3975-2, with the contacts' force-weighted worm radius r_c for r1), within 3 % (the
+    issue's tolerance for the DIN 3975 forces)."""
+    s = run(name)["summary"]
+    expected = s["worm_torque_mean_nm"] / s["worm_contact_radius_mean_m"]
+    assert abs(s["axial_force_mean_n"] / expected - 1) < 0.03, (s["axial_force_mean_n"], expected)
+
+
+# ----------------------------------------------------------------------------- torsional against contact3d
+# Two mechanisms on the same gear and the same CI scenario: torsional (a mesh spring k(theta) from the loaded TCA, the
+# DIN 3975 forces at the pitch point) and contact3d (MuJoCo contacts on the exact flanks).
+_TORSIONAL: dict[str, dict] = {}
+
+
+def torsional_run(name: str) -> dict:
+    if name not in _TORSIONAL:
+        from wormsim.torsional.dynamics import simulate as simulate_torsional
+
+        sc = load_scenario(SCEN / f"{name}.yaml", [*CI[name], "model=torsional"])
+        _TORSIONAL[name] = simulate_torsional(sc).summary
+    return _TORSIONAL[name]
+
+
+# key of contact3d -> key of torsional, relative tolerance (3 %: the issue's tolerance for the DIN 3975 forces and the
+# wedge efficiency; 1 % for the mean F_t, which both must hold to the load by statics; 10 % for the TE p2p, the
+# fluctuation criterion of tests/test_flank_convergence.py)
+CROSS = {
+    "tangential_force_mean_n": ("tangential_force_mean_n", 0.01),
+    "efficiency": ("efficiency", 0.03),
+    "worm_torque_mean_nm": ("worm_torque_mean_nm", 0.03),
+    "radial_force_line_of_centres_mean_n": ("radial_force_mean_n", 0.03),
+    "axial_force_mean_n": ("axial_force_mean_n", 0.03),
+    "transmission_error_p2p_urad": ("transmission_error_p2p_urad", 0.10),
+}
+CROSS_XFAIL = {
+    ("seat_motor", "axial_force_mean_n"): "torsional 174.2 N (F_t2 tan(g + rho') at the pitch radius) against "
+    "contact3d 165.9 N (-4.8 %): the contacts sit above r1 (4.32 against 4.19 mm), where the lead angle is smaller",
+    ("screw_jack", "axial_force_mean_n"): "torsional 61.6 N against contact3d 56.9 N (-7.6 %; contacts at 13.16 "
+    "against r1 12.5 mm)",
+    ("involute_41", "axial_force_mean_n"): "torsional 2285.9 N against contact3d 2149.3 N (-6.0 %; contacts at "
+    "47.3 against r1 45.0 mm)",
+    ("seat_motor", "transmission_error_p2p_urad"): "torsional 325.3 urad against contact3d 219.9 urad (+48 %): the "
+    "torsional k(theta) from 64 TCA samples against the kernel's contacts on the flanks at 32 slices",
+    ("screw_jack", "transmission_error_p2p_urad"): "torsional 9.67 urad against contact3d 8.58 urad (+12.7 %)",
+}
+
+
+@pytest.mark.parametrize(
+    "name,key",
+    [
+        pytest.param(n, k, marks=pytest.mark.xfail(reason=CROSS_XFAIL[(n, k)], strict=True))
+        if (n, k) in CROSS_XFAIL
+        else (n, k)
+        for n in SEEDS
+        for k in CROSS
+    ],
+)
+def test_torsional_agrees_with_contact3d_on_the_same_gear(name, key):
+    """Measured: mean F_t within 0.02 %, efficiency and worm torque 1.2-1.8 % (torsional at the pitch radius), radial
+    force on the line of centres 0.3-0.6 %, TE p2p involute_41 +1.2 %."""
+    c, t = run(name)["summary"], torsional_run(name)
+    tkey, rel = CROSS[key]
+    assert abs(t[tkey] / c[key] - 1) < rel, (key, t[tkey], c[key])

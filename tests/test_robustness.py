@@ -89,10 +89,14 @@ def test_random_gear_runs_or_is_refused(gear, tmp_path_factory, capsys):
     s = json.loads((d / "o" / "summary.json").read_text())
     assert s["status"] == "ok"
     assert abs(s["ratio"] / s["ratio_theory"] - 1) < 1e-3, (gear, s["ratio"], s["ratio_theory"])
-    # torque balance: the wheel carries the load, and worm torque x ratio x efficiency is the wheel torque
-    assert abs(abs(s["wheel_torque_mean_nm"]) / load_nm - 1) < 0.02, (gear, s["wheel_torque_mean_nm"], load_nm)
-    balance = abs(s["worm_torque_mean_nm"]) * s["ratio"] * s["efficiency"] / abs(s["wheel_torque_mean_nm"])
-    assert abs(balance - 1) < 0.02, (gear, balance)
+    # torque balance from the mesh force, not from the load command: the mean tangential force of the mesh spring
+    # times r2 carries the load (statics of the wheel: its mean acceleration over the window is zero), within 2 %;
+    # tangential_force_theory_n = T2 / r2 (DIN 3975-2, wormsim.gear_theory.tangential_force_n)
+    assert abs(s["tangential_force_mean_n"] / s["tangential_force_theory_n"] - 1) < 0.02, (
+        gear,
+        s["tangential_force_mean_n"],
+        s["tangential_force_theory_n"],
+    )
 
 
 CONTACT3D_OUTCOMES: list[int] = []

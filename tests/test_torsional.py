@@ -82,8 +82,8 @@ def test_torque_balance_ft2_r2_equals_load(seed_runs, name):
     s = seed_runs[name][0]
     sc = scen(name)
     g = derive(sc.gear)
+    # the mesh spring's mean force (not the load command) times r2 carries the load: statics of the wheel, 2 %
     assert abs(s["tangential_force_mean_n"] * g.r2 / sc.load.torque_nm - 1) < 0.02
-    assert abs(s["wheel_torque_mean_nm"] / sc.load.torque_nm - 1) < 0.02
 
 
 @pytest.mark.parametrize("name", SEEDS)
@@ -117,8 +117,11 @@ def test_efficiency_is_the_wedge_law(seed_runs, name):
 )
 def test_mesh_frequency_is_z1_n1_over_60(seed_runs, name):
     s = seed_runs[name][0]
-    tol = max(0.01 * s["mesh_frequency_theory_hz"], s["mesh_frequency_resolution_hz"])
-    assert abs(s["mesh_frequency_hz"] - s["mesh_frequency_theory_hz"]) <= tol
+    # 0.5 % of z1 n1 / 60 (seed 001), the peak interpolated between FFT bins (wormsim.metrics.dominant_frequency)
+    assert abs(s["mesh_frequency_hz"] / s["mesh_frequency_theory_hz"] - 1) <= 0.005, (
+        s["mesh_frequency_hz"],
+        s["mesh_frequency_theory_hz"],
+    )
 
 
 def test_backdriving_efficiency_when_not_self_locking():
@@ -266,8 +269,11 @@ def test_variants_hand_profile_starts_direction(overrides):
     assert abs(s["ratio"] / g.ratio - 1) < 1e-3
     assert abs(s["tangential_force_mean_n"] * g.r2 / sc.load.torque_nm - 1) < 0.02
     assert abs(s["efficiency"] / (math.tan(g.gamma) / math.tan(g.gamma + rho_prime(s, g))) - 1) < 0.03
-    tol = max(0.01 * s["mesh_frequency_theory_hz"], s["mesh_frequency_resolution_hz"])
-    assert abs(s["mesh_frequency_hz"] - s["mesh_frequency_theory_hz"]) <= tol
+    # 0.5 % of z1 n1 / 60 (seed 001), the peak interpolated between FFT bins (wormsim.metrics.dominant_frequency)
+    assert abs(s["mesh_frequency_hz"] / s["mesh_frequency_theory_hz"] - 1) <= 0.005, (
+        s["mesh_frequency_hz"],
+        s["mesh_frequency_theory_hz"],
+    )
     w1, w2 = r.series["worm_speed_rpm"][-1], r.series["wheel_speed_rpm"][-1]
     assert np.sign(w1) == np.sign(sc.drive.speed_rpm)
     assert np.sign(w2) == np.sign(w1) * g.hand
