@@ -55,11 +55,30 @@ def _per_step(name: str, half: bool = False) -> dict:
     return run(name, f"simulation.timestep_s={s['timestep_s'] / 2}", "simulation.record_every=1")
 
 
-DEFAULT_SLICES = {"screw_jack": 16, "seat_motor": 32}  # wormsim.contact3d.flanks.default_slices at medium
+DEFAULT_SLICES = {
+    "screw_jack": 16,
+    "seat_motor": 32,
+    "involute_41": 24,
+}  # wormsim.contact3d.flanks.default_slices at medium
 
 
-@pytest.mark.parametrize("key", KEYS)
-@pytest.mark.parametrize("name", ["screw_jack", "seat_motor"])
+SLICES_XFAIL = {
+    ("involute_41", "tangential_force_p2p_n"): "whole-band F_t p2p 147.7 N at 24 slices against 230.5 N at 48 (+56 %): "
+    "the 41-tooth wheel's contact mode (mass_scaling_mesh_mode_hz 1672 Hz) rings above the meshing band; its meshing "
+    "band below 1 kHz converges (test_flank_mesh_band_converged_in_slices), and so does the TE p2p",
+}
+
+
+@pytest.mark.parametrize(
+    "name,key",
+    [
+        pytest.param(n, k, marks=pytest.mark.xfail(reason=SLICES_XFAIL[(n, k)], strict=True))
+        if (n, k) in SLICES_XFAIL
+        else (n, k)
+        for n in DEFAULT_SLICES
+        for k in KEYS
+    ],
+)
 def test_flank_fluctuation_converged_in_slices(name, key):
     """The default slice count (the CI run, medium: flanks.default_slices) against twice it: within 10 %. Seat motor
     (32; F_t p2p 0.07 % of its mean): F_t p2p 0.869 -> 0.851 N (-2.1 %), TE p2p 219.9 -> 203.4 urad (-7.5 %); at 16
@@ -73,7 +92,7 @@ def test_flank_fluctuation_converged_in_slices(name, key):
     assert b[key] == pytest.approx(a[key], rel=0.10), (key, a[key], b[key])
 
 
-@pytest.mark.parametrize("name", ["screw_jack", "seat_motor"])
+@pytest.mark.parametrize("name", list(DEFAULT_SLICES))
 def test_flank_mesh_band_converged_in_slices(name):
     """F_t's meshing band (below 1 kHz, under the contact modes) at the default against twice the slices, within 10 %:
     screw jack 0.359 -> 0.341 N (16 -> 32), seat motor 0.815 -> 0.866 N (32 -> 64; sweeps/slice_convergence.py)."""
@@ -82,7 +101,7 @@ def test_flank_mesh_band_converged_in_slices(name):
     assert b == pytest.approx(a, rel=0.10), (a, b)
 
 
-@pytest.mark.parametrize("name", ["screw_jack", "seat_motor"])
+@pytest.mark.parametrize("name", list(DEFAULT_SLICES))
 def test_flank_fluctuation_converged_in_timestep(name):
     """h against h/2 at the default slices, per-step samples: within 10 % (screw jack, 16: F_t p2p 1.636 -> 1.622 N,
     TE p2p 8.580 -> 8.579 urad; seat motor, 32: F_t p2p 0.871 -> 0.868 N, TE p2p 219.926 -> 219.920 urad; h and h/2
