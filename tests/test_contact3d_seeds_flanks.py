@@ -185,3 +185,32 @@ def test_torsional_agrees_with_contact3d_on_the_same_gear(name, key):
     c, t = run(name)["summary"], torsional_run(name)
     tkey, rel = CROSS[key]
     assert abs(t[tkey] / c[key] - 1) < rel, (key, t[tkey], c[key])
+
+
+# ----------------------------------------------------------------------------- Hertz pressure against a closed form
+HERTZ_XFAIL = {
+    "seat_motor": "contact_pressure_mean_mpa 198.7 MPa against 189.8 MPa from the pitch point's closed form (+4.7 %): "
+    "the 58 % undercut wheel carries its load above the pitch radius (contacts at 4.32 against r1 4.19 mm), where the "
+    "flanks' relative curvature is not the pitch point's; screw jack -0.4 %, involute_41 -1.9 %",
+}
+
+
+@pytest.mark.parametrize("name", [_xf(HERTZ_XFAIL, n) for n in SEEDS])
+def test_flanks_mean_contact_pressure_is_the_line_contact_formula(name):
+    """The F_n-weighted mean Hertz pressure of the run (wormsim.contact3d.flank_outputs: per cell, from the kernel's
+    loads and the flanks' numerical curvature) against the line-contact formula p = sqrt(w E* / (pi rho')) (Johnson,
+    Contact Mechanics, section 4.3: the peak p_0 of two cylinders) with the load per length w = F_n / L, F_n = T2 / (r2 cos alpha_n cos gamma)
+    (DIN 3975-2), L the torsional TCA's mean total contact line length, and rho' the relative radius of curvature at
+    the pitch point in the normal section of the virtual spur gears (Tredgold: r / cos^2 beta; the wheel's helix angle
+    is gamma, the worm's 90 deg - gamma): 1 / rho' = cos^2 g / (r2 sin a_n) + sin^2 g / (r1 sin a_n). Within 3 %."""
+    import math
+
+    from wormsim import gear_theory as gt
+
+    s, sc, g = run(name)["summary"], run(name)["scenario"], _geometry(name)
+    length_m = torsional_run(name)["contact_line_length_mean_mm"] * 1e-3
+    fn = gt.normal_force_n(sc.load.torque_nm, g.r2, g.alpha_n, g.gamma)
+    sa = math.sin(g.alpha_n)
+    inv_rho = math.cos(g.gamma) ** 2 / (g.r2 * sa) + math.sin(g.gamma) ** 2 / (g.r1 * sa)
+    p_mpa = math.sqrt(fn / length_m * gt.effective_modulus_pa(sc.materials) * inv_rho / math.pi) * 1e-6
+    assert abs(s["contact_pressure_mean_mpa"] / p_mpa - 1) < 0.03, (s["contact_pressure_mean_mpa"], p_mpa)
