@@ -1,6 +1,6 @@
 """Charts of issue 12's error studies (docs/errors.md sections 7 and 8).
 
-    .venv/bin/python sweeps/errors_figures.py study                 # section 7: from docs/errors_study.csv
+    .venv/bin/python sweeps/errors_figures.py study                 # section 7: from docs/data/errors_study.json
     .venv/bin/python sweeps/errors_figures.py tolerance [--runs out] # section 8: from RUNS/<gear>_tolerance/sweep.csv
 
 `study` draws docs/img/errors_study.png: each error alone at 0.25 and 0.5 of its limit, one panel per output, the
@@ -54,9 +54,11 @@ def _num(v: str) -> float | None:
         return None
 
 
-def study() -> None:
-    with (ROOT / "docs" / "errors_study.csv").open(newline="") as fh:
-        rows = list(csv.DictReader(fh))
+def study(path: Path = IMG / "errors_study.png") -> None:
+    rows = [
+        {k: "" if v is None else str(v) for k, v in r.items()}
+        for r in json.loads((ROOT / "docs" / "data" / "errors_study.json").read_text())["rows"]
+    ]
     fig, axes = plt.subplots(len(STUDY_OUT), len(GEARS), figsize=(12, 2.6 * len(STUDY_OUT)), squeeze=False)
     x = np.arange(len(ERRS))
     for j, gear in enumerate(GEARS):
@@ -98,7 +100,7 @@ def study() -> None:
     fig.suptitle("docs/errors.md section 7: each error alone at 0.25 and 0.5 of its limit", fontsize=10)
     fig.tight_layout()
     IMG.mkdir(parents=True, exist_ok=True)
-    fig.savefig(IMG / "errors_study.png", dpi=90)
+    fig.savefig(path, dpi=90)
     print(f"wrote {IMG / 'errors_study.png'}")
 
 

@@ -1,13 +1,13 @@
 """Issue 12's study: the screw jack and the seat motor under each assembly error at two sizes, contact3d with exact
 flanks (short, coarse runs at the working load): pattern, TE, F_t p2p, efficiency, peak pressure.
 
-    .venv/bin/python sweeps/errors_study.py [--out docs/errors_study.csv]
+    .venv/bin/python sweeps/errors_study.py [--out rows.csv]   # writes docs/data/errors_study.json
 
 Each error key alone at SIZES of its limit (meshgen.displaced.limits: the closing centre distance and the runouts
 against the radial budget (3), the shaft angle (5), the wheel axial offset against the play it closes at the face
 edges (docs/errors.md section 2), the worm axial offset (7), every other wheel tooth shifted (8)). The runs cover a
 few mesh cycles: a runout shows the phase of the wheel revolution they see (the kinematic TE covers the revolution).
-Prints a markdown table and writes the csv. Results and discussion: docs/errors.md, "Study".
+Prints a markdown table and writes the record docs/data/errors_study.json. Discussion: docs/errors.md, "Study".
 """
 
 from __future__ import annotations
@@ -76,7 +76,7 @@ def error_sets(name: str, f: float) -> dict[str, str]:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--out", type=Path, default=ROOT / "docs" / "errors_study.csv")
+    ap.add_argument("--out", type=Path, default=None, help="also write the rows as csv")
     args = ap.parse_args()
     rows = []
     for name, base in RUNS.items():
@@ -96,10 +96,14 @@ def main() -> None:
             row["wall_s"] = round(time.perf_counter() - t0, 1)
             rows.append(row)
             print(row, flush=True)
-    with args.out.open("w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=list(rows[0]))
-        w.writeheader()
-        w.writerows(rows)
+    from wormsim.provenance import record
+
+    record("errors_study", {"rows": rows})
+    if args.out is not None:
+        with args.out.open("w", newline="") as fh:
+            w = csv.DictWriter(fh, fieldnames=list(rows[0]))
+            w.writeheader()
+            w.writerows(rows)
     head = ["gear", "error", "size", "value", *KEYS]
     print("| " + " | ".join(head) + " |")
     print("|" + " --- |" * len(head))

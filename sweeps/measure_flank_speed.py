@@ -2,7 +2,7 @@
 configurations of tests/test_contact3d_seeds.py shortened to 0.08 s at medium resolution, pieces and flanks
 alternating twice (flanks with one contact per slice, the default, and with one per tooth flank,
 `contact.flank_contacts: tooth`); wall time per step (summary step_wall_us: the step and the runner's per-sample
-work) and the run's CPU time. Writes docs/flank_speed.json; README "Speed of exact flanks against the issue's
+work) and the run's CPU time. Writes docs/data/flank_speed.json; README "Speed of exact flanks against the issue's
 targets" quotes the best of two per geometry. Compare ratios from one run only: the machine is shared.
 
     .venv/bin/python sweeps/measure_flank_speed.py [seat_motor screw_jack involute_41]
@@ -10,7 +10,6 @@ targets" quotes the best of two per geometry. Compare ratios from one run only: 
 
 from __future__ import annotations
 
-import json
 import os
 import platform
 import sys
@@ -69,4 +68,6 @@ def _ci() -> dict:
 
 if __name__ == "__main__":
     out = main(sys.argv[1:] or list(_ci()))
-    (ROOT / "docs" / "flank_speed.json").write_text(json.dumps(out, indent=1) + "\n")
+    from wormsim.provenance import record
+
+    record("flank_speed", out)

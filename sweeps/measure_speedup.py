@@ -1,5 +1,5 @@
 """Speed-up of a sweep of 8 torsional points on 1 and on 2 LocalCluster workers (one after the other, in one
-run), and the overhead per point. Writes docs/sweep_speedup.json; README "Sweeps" quotes it.
+run), and the overhead per point. Writes docs/data/sweep_speedup.json; README "Sweeps" quotes it.
 
     .venv/bin/python sweeps/measure_speedup.py [--out out/speedup]
 
@@ -93,8 +93,9 @@ def main() -> None:
         ),
         "runs": res,
     }
-    (ROOT / "docs").mkdir(exist_ok=True)
-    (ROOT / "docs" / "sweep_speedup.json").write_text(json.dumps(rec, indent=2) + "\n")
+    from wormsim.provenance import record
+
+    record("sweep_speedup", rec)
     print(json.dumps(rec, indent=2))
 
 

@@ -40,6 +40,7 @@ from wormsim.bench.cases import (
 from wormsim.bench.stability import stability_map
 from wormsim.errors import SimulationError
 from wormsim.output import write_json_atomic
+from wormsim.provenance import provenance
 from wormsim.run import simulate
 from wormsim.scenario import ScenarioError, load_scenario
 
@@ -224,6 +225,7 @@ def run_bench(
         summaries[id(rec)] = summary
         records.append(rec)
     meta = {
+        "provenance": provenance(),  # command, commit, date, machine (wormsim.provenance; docs/data records)
         "machine": machine_start,
         "load_average_1min_end": machine_info()["load_average_1min"],
         "quick": quick,

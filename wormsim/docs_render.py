@@ -1,0 +1,397 @@
+"""`make docs`: the tables and figures of README.md and docs/*.md rendered from the records under docs/data/*.json
+(each with its provenance, wormsim.provenance), simulating nothing.
+
+A markdown block to render is marked
+
+    <!-- render: NAME -->
+    ...            (replaced by TABLES[NAME]())
+    <!-- /render -->
+
+and each figure of FIGURES is drawn to docs/img/NAME.png from its record (matplotlib's Agg backend, fixed metadata:
+the same record gives the same bytes). `python -m wormsim.docs_render` renders every block and figure in place;
+`--check` only reports the blocks that differ from their records (exit 1). tests/test_docs_render.py runs the check.
+`python -m wormsim.docs_render record-bench NAME DIR` turns a `wormsim bench --out DIR` into the record
+docs/data/NAME.json (the provenance bench_meta.json carries).
+"""
+
+from __future__ import annotations
+
+import json
+import re
+import sys
+from collections.abc import Callable
+from pathlib import Path
+
+from wormsim.provenance import DATA, KEYS, ROOT, record
+
+MARK = re.compile(r"(<!-- render: (?P<name>[a-z0-9_]+) -->\n)(?P<body>.*?)(<!-- /render -->)", re.S)
+IMG = ROOT / "docs" / "img"
+# deterministic PNGs: no software/date chunks that change between matplotlib builds or runs
+PNG_METADATA = {"Software": None}
+
+
+def load(name: str) -> dict:
+    """docs/data/NAME.json."""
+    return json.loads((DATA / f"{name}.json").read_text())
+
+
+def _fmt(x, digits: int = 3) -> str:
+    """A number for a table: '-' for none, fixed for moderate magnitudes, exponent otherwise."""
+    if x is None:
+        return "-"
+    if isinstance(x, str):
+        return x
+    if x == 0:
+        return "0"
+    a = abs(x)
+    if a < 1e-6:
+        return "< 1e-6"
+    if a < 1e-2 or a >= 1e6:
+        return f"{x:.1e}"
+    if a >= 100:
+        return f"{x:.0f}"
+    return f"{x:.{digits}g}"
+
+
+def _table(head: list[str], rows: list[list[str]]) -> str:
+    lines = ["| " + " | ".join(head) + " |", "|" + " --- |" * len(head)]
+    lines += ["| " + " | ".join(r) + " |" for r in rows]
+    return "\n".join(lines) + "\n"
+
+
+def _source(name: str) -> str:
+    """The line under a table: its record and the record's provenance."""
+    p = load(name)["provenance"]
+    return f"Record: `docs/data/{name}.json` (`{p['command']}`; commit {p['commit']}, {p['date'][:10]}).\n"
+
+
+# ----------------------------------------------------------------------------- tables
+
+
+def bench_full_table(name: str = "bench_full") -> str:
+    """One row per bench record: level, resolution, step, wall s per simulated s, relative errors against the
+    reference (the finest contact3d run of the seed, itself checked against h/2)."""
+    rows = []
+    for r in load(name)["records"]:
+        res = r["resolution"]
+        level = r["model"]
+        if r.get("reference"):
+            level += " (reference)"
+        elif r.get("finer"):
+            level += " (check, h/2)"
+        if "mesh_stiffness_samples" in res:
+            resolution = f"{res['mesh_stiffness_samples']} samples/cycle"
+        else:
+            resolution = res.get("level", "") + (f" {res['geometry']}" if "geometry" in res else "")
+        e = r.get("error") or {}
+        keys = ("ratio", "tangential_force_mean_n", "tangential_force_p2p_n", "mesh_frequency_hz", "efficiency")
+        errs = ["-" if r.get("reference") else _fmt(e.get(k), 2) for k in keys]
+        rows.append(
+            [r["scenario"], level, resolution, f"{r['timestep_s']:g} s", _fmt(r.get("wall_s_per_sim_s"), 3), *errs]
+        )
+    head = ["seed", "level", "resolution", "timestep", "wall s per sim s", "ratio err", "F_t mean err"]
+    head += ["F_t p2p err", "f_mesh err", "efficiency err"]
+    return _table(head, rows) + "\n" + _source(name)
+
+
+def bench_stability_table(name: str = "bench_full") -> str:
+    """The stability edge of each seed (bench_meta.json "stability", wormsim.bench.stability)."""
+    rows = []
+    for seed, s in sorted(load(name)["meta"].get("stability", {}).items()):
+        res = next((o.split("=")[1] for o in s.get("overrides", []) if o.startswith("simulation.resolution=")), "")
+        h0, lim = s["default_timestep_s"], s["stable_limit_s"]
+        last = s.get("last_stable_timestep_s")
+        last_s = f"{last:.3g} s (x{s['last_stable_factor']}, {last / lim:.2f} h_lim)" if last else "-"
+        nxt = s.get("failed_timestep_s")
+        nxt_s = f"{nxt:.3g} s ({nxt / lim:.2f} h_lim)" if nxt else "-"
+        rows.append([f"{seed} ({res})", f"{h0:.3g} s", f"{lim:.3g} s", last_s, nxt_s, s.get("failure") or "-"])
+    head = ["seed (resolution)", "h0", "h_lim", "last stable", "next step", "failed as"]
+    return _table(head, rows) + "\n" + _source(name)
+
+
+def bench_flanks_vs_pieces_table(name: str = "bench_flanks_vs_pieces") -> str:
+    """Speed-up of exact flanks over convex pieces (bench_meta.json): at the same resolution level and step, and at
+    equal or better accuracy (wormsim.bench.run.speedups_equal_accuracy; every error is measured against the
+    reference run of the seed's default geometry, which is the flanks' own finest run)."""
+    m = load(name)["meta"]
+    rows = []
+    for seed in sorted(m.get("speedup_flanks_vs_pieces", {})):
+        for level, whole in sorted(m["speedup_flanks_vs_pieces"][seed].items()):
+            loop = m.get("speedup_flanks_vs_pieces_loop", {}).get(seed, {}).get(level)
+            eq = m.get("speedup_flanks_vs_pieces_equal_accuracy", {}).get(seed, {}).get(level, {})
+            eq_l = m.get("speedup_flanks_vs_pieces_equal_accuracy_loop", {}).get(seed, {}).get(level, {})
+
+            def x(d: dict, k: str) -> str:
+                return _fmt(d.get(k, {}).get("speedup"), 3) + "x"
+
+            rows.append(
+                [
+                    seed,
+                    level,
+                    f"{_fmt(whole)}x / {_fmt(loop)}x",
+                    f"{x(eq, 'vs_default_pieces')} / {x(eq_l, 'vs_default_pieces')}",
+                    f"{x(eq, 'vs_cheapest_pieces')} / {x(eq_l, 'vs_cheapest_pieces')}",
+                ]
+            )
+    head = ["seed", "level", "same step: whole / loop", "equal accuracy, pieces at default step: whole / loop"]
+    head += ["pieces' cheapest run (Pareto): whole / loop"]
+    note = (
+        "Accuracy is each run's relative error against the seed's reference, the finest run of the default "
+        "geometry (exact flanks) at its default step: the flanks are compared with their own reference, the pieces "
+        "with it too.\n"
+    )
+    return _table(head, rows) + "\n" + note + _source(name)
+
+
+def flank_speed_table(name: str = "flank_speed") -> str:
+    """Per step, exact flanks against medium convex pieces (sweeps/measure_flank_speed.py, best of the repeats)."""
+    best = load(name)["best"]
+    rows = []
+    for seed, b in best.items():
+        rows.append(
+            [
+                seed,
+                f"{b['pieces_step_wall_us']:.0f} us",
+                f"{b['flanks_step_wall_us']:.0f} us",
+                f"{b['speedup_flanks_vs_pieces']:.1f}x",
+                f"{b['flanks_tooth_step_wall_us']:.0f} us",
+                f"{b['speedup_flanks_tooth_vs_pieces']:.1f}x",
+            ]
+        )
+    head = ["seed", "pieces (medium)", "flanks, per slice (default)", "speed-up", "flanks, per tooth flank"]
+    head += ["speed-up"]
+    return _table(head, rows) + "\n" + _source(name)
+
+
+def seat_motor_20s_table(name: str = "seat_motor_20s") -> str:
+    """The 20 s seat motor run (pieces, unscaled): its summary recomputed with the fixed steady window."""
+    r = load(name)
+    s = r.get("recomputed_with_the_fixed_steady_window") or r["summary_as_written_by_the_run"]
+    keys = [
+        ("wall_time_s", "wall s", 0),
+        ("steps", "steps", 0),
+        ("efficiency", "efficiency", 4),
+        ("ratio", "ratio", 6),
+        ("tangential_force_mean_n", "F_t mean N", 6),
+        ("tangential_force_p2p_n", "F_t p2p N", 3),
+        ("steady_window_s", "steady window s", 0),
+    ]
+    row = []
+    for k, _, d in keys:
+        v = s.get(k, r.get(k))
+        if isinstance(v, list):
+            row.append(f"{v[0]:.2f}-{v[1]:.2f}")
+        elif isinstance(v, float) and d:
+            row.append(f"{v:.{d}g}")
+        else:
+            row.append(_fmt(v) if not isinstance(v, int) else f"{v}")
+    return _table([h for _, h, _ in keys], [row]) + "\n" + _source(name)
+
+
+def sweep_speedup_table(name: str = "sweep_speedup") -> str:
+    """1 against 2 dask workers on the same sweep (sweeps/measure_speedup.py)."""
+    r = load(name)
+    rows = []
+    for n, x in sorted(r["runs"].items()):
+        rows.append(
+            [
+                n,
+                f"{x['command_wall_s']:.0f}",
+                f"{x['sweep_wall_s']:.0f}",
+                f"{x['cluster_start_s']:.1f}",
+                f"{x['task_wall_median_s']:.1f}",
+                f"{x['simulate_wall_median_s']:.1f}",
+            ]
+        )
+    head = ["workers", "command wall s", "sweep wall s", "cluster start s", "task median s", "simulate median s"]
+    text = _table(head, rows)
+    text += (
+        f"\nSpeed-up 1 -> 2 workers: {r['speedup_command']:.2f}x for the whole command, "
+        f"{r['speedup_excluding_cluster_start']:.2f}x without the cluster's start ({r['what']}).\n"
+    )
+    return text + "\n" + _source(name)
+
+
+def _study_value(v) -> str:
+    """The error's value: a number, or the pitch deviations of every other tooth as one phrase."""
+    if v in (None, ""):
+        return "-"
+    if isinstance(v, list):
+        return f"every other tooth +{max(v):g} um"
+    return str(v)
+
+
+def errors_study_table(name: str = "errors_study") -> str:
+    """sweeps/errors_study.py: each error alone at 0.25 and 0.5 of its limit (docs/errors.md section 7)."""
+
+    def f(x, spec):
+        return "-" if x is None or x == "" else spec.format(x)
+
+    rows = []
+    for r in load(name)["rows"]:
+        te, kin = r.get("transmission_error_p2p_urad"), r.get("transmission_error_kinematic_p2p_urad")
+        te_s = f(te, "{:.0f}") + (f" ({kin:.0f})" if kin not in (None, "") else "")
+        p = f"{f(r.get('contact_pressure_max_mpa'), '{:.0f}')} / {f(r.get('contact_pressure_mean_mpa'), '{:.0f}')}"
+        play = r.get("backlash_measured_mm")
+        rows.append(
+            [
+                r["gear"].replace("_", " "),
+                r["error"],
+                f(r.get("size"), "{:g}") if r.get("size") not in (None, "") else "-",
+                _study_value(r.get("value")),
+                f(r.get("contact_pattern_centroid_face_mm"), "{:.2f}"),
+                f(r.get("contact_pattern_extent_face_mm"), "{:.1f}"),
+                te_s,
+                f(r.get("tangential_force_p2p_n"), "{:.1f}"),
+                f(r.get("efficiency"), "{:.3f}"),
+                p,
+                "j" if play in (None, "") else f"{play:.4f}",
+            ]
+        )
+    head = ["gear", "error", "size", "value", "centroid face mm", "extent mm", "TE p2p urad (kin.)", "F_t p2p N"]
+    head += ["efficiency", "p_H max / mean MPa", "play mm"]
+    return _table(head, rows) + "\n" + _source(name)
+
+
+TABLES: dict[str, Callable[[], str]] = {
+    "bench_full": bench_full_table,
+    "bench_stability": bench_stability_table,
+    "bench_flanks_vs_pieces": bench_flanks_vs_pieces_table,
+    "flank_speed": flank_speed_table,
+    "seat_motor_20s": seat_motor_20s_table,
+    "sweep_speedup": sweep_speedup_table,
+    "errors_study": errors_study_table,
+}
+
+
+# ----------------------------------------------------------------------------- figures
+
+
+def _bench_png(name: str) -> Callable[[Path], None]:
+    def draw(path: Path) -> None:
+        from wormsim.bench.run import plot_bench
+
+        plot_bench(load(name)["records"], path)
+
+    return draw
+
+
+def _errors_study_png(path: Path) -> None:
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("errors_figures", ROOT / "sweeps" / "errors_figures.py")
+    assert spec is not None and spec.loader is not None
+    sys.path.insert(0, str(ROOT / "sweeps"))
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    mod.study(path)
+
+
+FIGURES: dict[str, Callable[[Path], None]] = {
+    "bench_full": _bench_png("bench_full"),
+    "bench_quick": _bench_png("bench_quick"),
+    "errors_study": _errors_study_png,
+}
+
+
+# ----------------------------------------------------------------------------- rendering
+
+
+def render_text(text: str) -> str:
+    """text with every marked block replaced by its table (an unknown NAME raises KeyError naming it)."""
+
+    def sub(m: re.Match) -> str:
+        name = m.group("name")
+        if name not in TABLES:
+            raise KeyError(f"<!-- render: {name} -->: no such table (wormsim.docs_render.TABLES: {sorted(TABLES)})")
+        return m.group(1) + TABLES[name]() + m.group(4)
+
+    return MARK.sub(sub, text)
+
+
+def markdown_files() -> list[Path]:
+    """README.md and docs/*.md."""
+    return [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
+
+
+def blocks(text: str) -> list[str]:
+    """The NAMEs of the marked blocks in text."""
+    return [m.group("name") for m in MARK.finditer(text)]
+
+
+def render_figures(img: Path = IMG, names: list[str] | None = None) -> list[Path]:
+    """Draw every FIGURES entry (or those named) to IMG/NAME.png with fixed PNG metadata."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    saved = plt.savefig
+    out = []
+
+    def savefig(*a, **k):  # the figure functions call plt.savefig / fig.savefig: fix their metadata
+        k.setdefault("metadata", PNG_METADATA)
+        return saved(*a, **k)
+
+    from matplotlib.figure import Figure
+
+    fig_saved = Figure.savefig
+
+    def fig_savefig(self, *a, **k):
+        k.setdefault("metadata", PNG_METADATA)
+        return fig_saved(self, *a, **k)
+
+    plt.savefig, Figure.savefig = savefig, fig_savefig  # type: ignore[method-assign]
+    try:
+        for name, draw in FIGURES.items():
+            if names is not None and name not in names:
+                continue
+            path = img / f"{name}.png"
+            draw(path)
+            plt.close("all")
+            out.append(path)
+    finally:
+        plt.savefig, Figure.savefig = saved, fig_saved  # type: ignore[method-assign]
+    return out
+
+
+def record_bench(name: str, bench_dir: Path) -> Path:
+    """docs/data/NAME.json from a `wormsim bench --out DIR`: its records, its meta, the meta's provenance."""
+    records = json.loads((bench_dir / "bench.json").read_text())
+    meta = json.loads((bench_dir / "bench_meta.json").read_text())
+    prov = meta.pop("provenance", None)
+    if prov is None or any(k not in prov for k in KEYS):
+        raise SystemExit(f"{bench_dir / 'bench_meta.json'}: no provenance (written by an older wormsim bench)")
+    return record(name, {"records": records, "meta": meta}, prov=prov)
+
+
+def main(argv: list[str] | None = None) -> int:
+    argv = sys.argv[1:] if argv is None else argv
+    if argv[:1] == ["record-bench"] and len(argv) == 3:
+        print(record_bench(argv[1], Path(argv[2])))
+        return 0
+    check = argv == ["--check"]
+    if argv and not check:
+        print("usage: python -m wormsim.docs_render [--check | record-bench NAME DIR]", file=sys.stderr)
+        return 2
+    stale = []
+    for path in markdown_files():
+        text = path.read_text()
+        new = render_text(text)
+        if new != text:
+            stale.append(path.relative_to(ROOT))
+            if not check:
+                path.write_text(new)
+    if check:
+        for p in stale:
+            print(f"{p}: a rendered block differs from its record (run `make docs`)")
+        return 1 if stale else 0
+    for p in render_figures():
+        print(p.relative_to(ROOT))
+    for p in stale:
+        print(f"rendered {p}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
