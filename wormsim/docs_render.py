@@ -253,7 +253,31 @@ def errors_study_table(name: str = "errors_study") -> str:
     return _table(head, rows) + "\n" + _source(name)
 
 
+def errors_shaft_angle_table(name: str = "errors_shaft_angle") -> str:
+    """sweeps/errors_shaft_angle.py: the screw jack at its working point with a shaft angle (docs/errors.md, 6)."""
+    rows = []
+    for r in load(name)["rows"]:
+        kin = r.get("transmission_error_kinematic_p2p_urad")
+        play = r.get("backlash_measured_mm")
+        rows.append(
+            [
+                f"{r['shaft_angle_deg']:+g} deg" if r["shaft_angle_deg"] else "none",
+                f"{r['contact_pattern_centroid_face_mm']:+.2f} mm",
+                f"{r['contact_pattern_extent_face_mm']:.1f} mm",
+                f"{r['contact_pressure_max_mpa']:.0f} / {r['contact_pressure_mean_mpa']:.0f} MPa",
+                f"{r['tangential_force_p2p_n']:.1f} N",
+                f"{r['transmission_error_p2p_urad']:.0f}" + (f" ({kin:.0f})" if kin is not None else "") + " urad",
+                f"{r['efficiency']:.3f}",
+                "j" if play is None else f"{play:.3f} mm",
+            ]
+        )
+    head = ["shaft angle", "pattern centroid face", "95 % extent", "p_H max / mean", "F_t p2p", "TE p2p (kin.)"]
+    head += ["efficiency", "play"]
+    return _table(head, rows) + "\n" + _source(name)
+
+
 TABLES: dict[str, Callable[[], str]] = {
+    "errors_shaft_angle": errors_shaft_angle_table,
     "bench_full": bench_full_table,
     "bench_stability": bench_stability_table,
     "bench_flanks_vs_pieces": bench_flanks_vs_pieces_table,
