@@ -40,9 +40,20 @@ def machine() -> str:
     return f"{platform.platform()}, Python {platform.python_version()}, {os.cpu_count()} CPUs, load {load:.2f}"
 
 
+def _program() -> str:
+    """This process's program as a reader would type it: `python sweeps/x.py` for a script in the repository,
+    `wormsim` for the console script."""
+    prog = Path(sys.argv[0])
+    try:
+        rel = prog.resolve().relative_to(ROOT)
+    except ValueError:
+        return prog.name
+    return f"python {rel}" if rel.suffix == ".py" else str(rel)
+
+
 def provenance(command: str | None = None) -> dict:
     """{command, commit, date, machine} of a measurement made now; command defaults to this process's argv."""
-    cmd = command if command is not None else " ".join([Path(sys.argv[0]).name, *sys.argv[1:]])
+    cmd = command if command is not None else " ".join([_program(), *sys.argv[1:]])
     date = datetime.datetime.now(datetime.timezone.utc).replace(microsecond=0).isoformat()
     return {"command": cmd, "commit": git_commit(), "date": date, "machine": machine()}
 
