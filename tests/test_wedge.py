@@ -45,6 +45,8 @@ def sliding(res, code):
 
 def test_motor_force_at_rest_is_the_kloss_value():
     p = wedge.params_from_scenario(load_scenario(ROOT / "scenarios" / "mov_1.yaml"))
+    # Kloss (seed 000): F = 2 F_k / (s / s_k + s_k / s), slip s = 1 at rest, s_k = (7.85 - 6.5) / 7.85 = 0.17197:
+    # 2 x 2178 / (1 / 0.17197 + 0.17197) = 727.6 N
     assert wedge.motor_force_n(0.0, p) == pytest.approx(727.6, abs=0.1)
     assert wedge.motor_force_n(6.5, p) == pytest.approx(2178.0, rel=1e-12)  # peak at Vmax
     assert wedge.motor_force_n(7.85, p) == 0.0  # synchronous speed
