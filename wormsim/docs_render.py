@@ -174,6 +174,8 @@ def seat_motor_20s_table(name: str = "seat_motor_20s") -> str:
         ("ratio", "ratio", 6),
         ("tangential_force_mean_n", "F_t mean N", 6),
         ("tangential_force_p2p_n", "F_t p2p N", 3),
+        ("mesh_frequency_hz", "f_mesh Hz", 5),
+        ("mesh_frequency_theory_hz", "z1 n1 / 60 Hz", 5),
         ("steady_window_s", "steady window s", 0),
     ]
     row = []
@@ -276,7 +278,57 @@ def errors_shaft_angle_table(name: str = "errors_shaft_angle") -> str:
     return _table(head, rows) + "\n" + _source(name)
 
 
+def contact_pattern_table(name: str = "ci_seeds_flanks") -> str:
+    """The loaded contact pattern and Hertz pressure of the seeds' CI runs with exact flanks (sweeps/ci_seeds.py)."""
+    rows = []
+    for seed, run in load(name)["runs"].items():
+        s = run["summary"]
+        rows.append(
+            [
+                seed,
+                f"{s['contact_pattern_centroid_face_mm']:.2f} / {s['contact_pattern_centroid_radius_mm']:.2f} mm",
+                f"{s['contact_pattern_extent_face_mm']:.2f} mm",
+                f"{s['contact_pressure_mean_mpa']:.0f} MPa",
+                f"{s['contact_pressure_max_mpa']:.0f} MPa ({s['contact_pressure_max_face_mm']:.2f}, "
+                f"{s['contact_pressure_max_radius_mm']:.2f} mm)",
+            ]
+        )
+    head = ["seed (CI run)", "pattern centroid face / radius", "95 % extent", "p_H mean", "p_H max (face, radius)"]
+    return _table(head, rows) + "\n" + _source(name)
+
+
+def ci_seeds_table(name: str = "ci_seeds_flanks") -> str:
+    """The seeds' CI runs with exact flanks against the closed forms (sweeps/ci_seeds.py)."""
+    rows = []
+    for seed, run in load(name)["runs"].items():
+        s = run["summary"]
+        rows.append(
+            [
+                seed,
+                f"{s['ratio']:.5f} ({s['ratio_theory']:g})",
+                f"{s['mesh_frequency_hz']:.4f} ({s['mesh_frequency_theory_hz']:.4f}) Hz",
+                f"{s['tangential_force_mean_n']:.1f} ({s['tangential_force_theory_n']:.1f}) N",
+                f"{s['radial_force_line_of_centres_mean_n']:.1f} ({s['radial_force_theory_n']:.1f}) N",
+                f"{s['efficiency']:.4f} ({s['efficiency_theory_at_contact_radius']:.4f})",
+                f"{s['tangential_force_p2p_n']:.3g} N",
+                f"{s['transmission_error_p2p_urad']:.4g} urad",
+                f"{s['resolution']}, {s['flank_slices']} slices, {s['timestep_s']:g} s",
+            ]
+        )
+    head = [
+        "seed",
+        "ratio (z2 / z1)",
+        "f_mesh (z1 n1 / 60)",
+        "F_t mean (T2 / r2)",
+        "F_r on the line of centres (DIN 3975)",
+    ]
+    head += ["efficiency (wedge at r_c)", "F_t p2p", "TE p2p", "resolution, slices, step"]
+    return _table(head, rows) + "\n" + _source(name)
+
+
 TABLES: dict[str, Callable[[], str]] = {
+    "contact_pattern": contact_pattern_table,
+    "ci_seeds": ci_seeds_table,
     "errors_shaft_angle": errors_shaft_angle_table,
     "bench_full": bench_full_table,
     "bench_stability": bench_stability_table,
