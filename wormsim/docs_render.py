@@ -183,6 +183,8 @@ def seat_motor_20s_table(name: str = "seat_motor_20s") -> str:
         v = s.get(k, r.get(k))
         if isinstance(v, list):
             row.append(f"{v[0]:.2f}-{v[1]:.2f}")
+        elif k == "ratio":
+            row.append(f"{v:.5f}")
         elif isinstance(v, float) and d:
             row.append(f"{v:.{d}g}")
         else:
