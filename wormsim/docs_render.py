@@ -328,7 +328,54 @@ def ci_seeds_table(name: str = "ci_seeds_flanks") -> str:
     return _table(head, rows) + "\n" + _source(name)
 
 
+def torsional_seeds_table(name: str = "torsional_seeds") -> str:
+    """The torsional level on each seed file as it is (sweeps/torsional_seeds.py), closed forms in brackets."""
+    rows = []
+    for seed, run in load(name)["runs"].items():
+        r = run["default"]
+        rows.append(
+            [
+                f"{seed} ({r['sim_time_s']:.3g} s)",
+                f"{r['wall_s']:.3g} s",
+                f"{r['wall_s'] / r['sim_time_s']:.2g}",
+                f"{r['ratio']:.4f}",
+                f"{r['tangential_force_mean_n']:.2f} ({r['tangential_force_theory_n']:.2f})",
+                f"{r['efficiency']:.5f} ({r['efficiency_theory']:.5f})",
+                f"{r['mesh_frequency_hz']:.4g} ({r['mesh_frequency_theory_hz']:.4g})",
+            ]
+        )
+    head = ["scenario (sim time)", "wall", "wall / sim s", "ratio", "F_t mean [N] (T2 / r2)"]
+    head += ["efficiency (wedge)", "mesh freq [Hz] (z1 n1 / 60)"]
+    return _table(head, rows) + "\n" + _source(name)
+
+
+def torsional_samples_table(name: str = "torsional_seeds") -> str:
+    """The torsional level against its k(theta) samples per mesh cycle N (sweeps/torsional_seeds.py)."""
+    rows = []
+    for seed, run in load(name)["runs"].items():
+        rs = run["samples"]
+        ns = list(rs)
+
+        def col(f) -> str:
+            return " / ".join(f(rs[n]) for n in ns)
+
+        rows.append(
+            [
+                seed,
+                " / ".join(ns),
+                col(lambda r: f"{r['timestep_s']:g}"),
+                col(lambda r: f"{r['wall_s'] / r['sim_time_s']:.2g}"),
+                col(lambda r: f"{r['tangential_force_p2p_n']:.3g}"),
+                col(lambda r: f"{r['transmission_error_p2p_urad']:.3g}"),
+            ]
+        )
+    head = ["scenario", "N", "timestep [s]", "wall / sim s", "F_t p2p [N]", "TE p2p [urad]"]
+    return _table(head, rows) + "\n" + _source(name)
+
+
 TABLES: dict[str, Callable[[], str]] = {
+    "torsional_seeds": torsional_seeds_table,
+    "torsional_samples": torsional_samples_table,
     "contact_pattern": contact_pattern_table,
     "ci_seeds": ci_seeds_table,
     "errors_shaft_angle": errors_shaft_angle_table,
