@@ -88,6 +88,10 @@ def test_torque_balance_ft2_r2_equals_load(seed_runs, name):
 
 @pytest.mark.parametrize("name", SEEDS)
 def test_efficiency_is_the_wedge_law(seed_runs, name):
+    """The torsional level is built on the wedge law and the DIN 3975 forces: this checks that the element and the
+    metrics implement them (a wrong sign or angle fails), not the physics; the independent check of the efficiency
+    and the forces is contact3d on the same gear (test_contact3d_seeds_flanks.py::
+    test_torsional_agrees_with_contact3d_on_the_same_gear)."""
     s = seed_runs[name][0]
     g = derive(scen(name).gear)
     eta = math.tan(g.gamma) / math.tan(g.gamma + rho_prime(s, g))
