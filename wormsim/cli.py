@@ -48,7 +48,7 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("run", help="run one scenario: summary.json, timeseries.npz, recording.rrd, report.png")
     _add_scenario_args(p)
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
-    p = sub.add_parser("mesh", help="geometry only: worm.stl, wheel.stl, assembly.json, recording.rrd")
+    p = sub.add_parser("mesh", help="geometry only: worm.stl, wheel.stl, assembly.json, recording.rrd, section.png")
     _add_scenario_args(p)
     p = sub.add_parser(
         "model", help="write a standalone MJCF (model.xml + mesh assets, collision pieces) for MuJoCo's viewer"
@@ -120,7 +120,7 @@ def _cmd_mesh(args) -> int:
     from wormsim.output import locked_dir
 
     sc = load_scenario(args.scenario, args.overrides)
-    with locked_dir(args.out, names=("worm.stl", "wheel.stl", "assembly.json", "recording.rrd")):
+    with locked_dir(args.out, names=("worm.stl", "wheel.stl", "assembly.json", "recording.rrd", "section.png")):
         write_mesh_outputs(sc, args.out)
     return EXIT_OK
 
