@@ -108,6 +108,8 @@ def _cmd_run(args) -> int:
         print(f"  {k:<{width}}  {v:.6g}" if isinstance(v, float) else f"  {k:<{width}}  {v}")
     print(f"wrote {out / 'summary.json'}, {out / 'timeseries.npz'}, {out / 'report.png'}")
     print(f"recording: {out / 'recording.rrd'}  (view with: rerun {out / 'recording.rrd'})")
+    for w in summary.get("warnings") or []:  # also in summary.json (wormsim.run_warnings)
+        print(f"warning: {w}", file=sys.stderr)
     return EXIT_OK
 
 

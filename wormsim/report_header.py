@@ -81,14 +81,46 @@ def results_line(summary: dict, geo) -> str:
     return ",  ".join(parts)
 
 
+def warning_text(summary: dict, first: str = "") -> str:
+    """The red line(s) of the header: `first` (a level's own caveat) and the run's `warnings`, each cut to one line."""
+    ws = [first] if first else []
+    ws += [f"warning: {w}" for w in summary.get("warnings") or []]
+    return "\n".join(w if len(w) <= 170 else w[:167] + "..." for w in ws)
+
+
+def header_rows(lines: list[str], warn: str = "") -> float:
+    """Height of the header row in inches: the title, the non-empty lines and the warning lines."""
+    n = 1.4 + sum(x.count("\n") + 1 for x in lines if x) + (warn.count("\n") + 1 if warn else 0)
+    return 0.2 * n
+
+
 def draw_header(ax, lines: list[str], title: str, warn: str = "") -> None:
-    """Write the header text into `ax` (an axes without frame), title bold, `warn` in red below."""
+    """Write the header text into `ax` (an axes without frame): the title bold at the top, the lines below it, `warn`
+    in red below them. The texts stay out of the layout engine's bounding boxes (a long line must not shrink the
+    plots); the figure gives the header row header_rows() inches."""
     ax.set_axis_off()
-    ax.text(0.0, 1.0, title, fontsize=11, fontweight="bold", va="top", ha="left", transform=ax.transAxes)
-    text = "\n".join(x for x in lines if x)
-    ax.text(0.0, 0.72, text, fontsize=9, va="top", ha="left", transform=ax.transAxes, linespacing=1.5)
+    head = ax.text(0.0, 1.0, title, fontsize=11, fontweight="bold", va="top", ha="left", transform=ax.transAxes)
+    body = ax.annotate(
+        "\n".join(x for x in lines if x),
+        (0, 0),
+        xycoords=head,
+        xytext=(0, -3),
+        textcoords="offset points",
+        fontsize=9,
+        va="top",
+        ha="left",
+        linespacing=1.5,
+    )
+    texts = [head, body]
     if warn:
-        ax.text(0.0, 0.0, warn, fontsize=9, color="C3", va="bottom", ha="left", transform=ax.transAxes)
+        texts.append(
+            ax.annotate(
+                warn, (0, 0), xycoords=body, xytext=(0, -3), textcoords="offset points", fontsize=9, color="C3",
+                va="top", ha="left", linespacing=1.5,
+            )
+        )  # fmt: skip
+    for x in texts:
+        x.set_in_layout(False)
 
 
 def steady_ylim(t, ys, window, pad: float = 0.25) -> tuple[float, float]:

@@ -21,7 +21,16 @@ from meshgen import assembly
 from wormsim.contact3d.mjcf import visual_vertex_normals
 from wormsim.metrics import dominant_frequency
 from wormsim.recording import log_mesh, log_series, log_transforms, recording
-from wormsim.report_header import draw_header, gear_line, results_line, shafts_line, speed_ylim, steady_ylim
+from wormsim.report_header import (
+    draw_header,
+    gear_line,
+    header_rows,
+    results_line,
+    shafts_line,
+    speed_ylim,
+    steady_ylim,
+    warning_text,
+)
 from wormsim.result import Result
 
 MAX_FRAMES = 1500
@@ -52,21 +61,25 @@ def write_report(result: Result, path) -> None:
     w0, w1 = s["steady_window_s"]
     sl = (t >= w0) & (t <= w1)
     geo = result.extra["built"].geometry
-    fig = plt.figure(figsize=(13, 10))
-    gs = fig.add_gridspec(3, 2, height_ratios=[0.45, 3, 3])
-    ax = np.array([[fig.add_subplot(gs[i, j]) for j in range(2)] for i in (1, 2)])
     scaled = s.get("mass_scaling", 1) > 1  # wormsim.contact3d.mass_scaling: say so where the plots are
+    lines = [gear_line(geo), shafts_line(s), results_line(s, geo)]
+    warn = warning_text(
+        s,
+        f"MASS SCALING x {s['mass_scaling']:g} (kinetic energy {100 * s['kinetic_energy_share']:.2g} % "
+        f"of the work): means only; force fluctuation, speeds' rattle and start-up peaks are not physical"
+        if scaled
+        else "",
+    )
+    hh = header_rows(lines, warn)
+    fig = plt.figure(figsize=(13, 8.8 + hh))
+    gs = fig.add_gridspec(3, 2, height_ratios=[hh, 4.4, 4.4])
+    ax = np.array([[fig.add_subplot(gs[i, j]) for j in range(2)] for i in (1, 2)])
     draw_header(
         fig.add_subplot(gs[0, :]),
-        [gear_line(geo), shafts_line(s), results_line(s, geo)],
+        lines,
         f"{s.get('scenario', '')} (contact3d): dt {s['timestep_s']:.3g} s, resolution {s['resolution']}, "
         f"contacts {s.get('contact_geometry', '')}, steady window {w0:.3g}-{w1:.3g} s",
-        warn=(
-            f"MASS SCALING x {s['mass_scaling']:g} (kinetic energy {100 * s['kinetic_energy_share']:.2g} % "
-            f"of the work): means only; force fluctuation, speeds' rattle and start-up peaks are not physical"
-            if scaled
-            else ""
-        ),
+        warn=warn,
     )
     a = ax[0, 0]
     forces = [S[k] for k in ("tangential_force_n", "radial_force_n", "axial_force_n")]

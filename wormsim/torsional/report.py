@@ -8,7 +8,16 @@ from pathlib import Path
 import numpy as np
 
 from wormsim.recording import save_series_recording
-from wormsim.report_header import draw_header, gear_line, results_line, shafts_line, speed_ylim, steady_ylim
+from wormsim.report_header import (
+    draw_header,
+    gear_line,
+    header_rows,
+    results_line,
+    shafts_line,
+    speed_ylim,
+    steady_ylim,
+    warning_text,
+)
 from wormsim.result import Result
 from wormsim.torsional.mesh_stiffness import MeshStiffness
 
@@ -28,13 +37,17 @@ def write_report(result: Result, path) -> None:
     geo = result.extra.get("geometry")
     t = S["t_s"]
     w0, w1 = sm["steady_window_s"]
-    fig = plt.figure(figsize=(12, 8.4), constrained_layout=True)
-    gs = fig.add_gridspec(3, 2, height_ratios=[0.62, 3, 3])
+    lines = [gear_line(geo) if geo is not None else "", shafts_line(sm), results_line(sm, geo)]
+    warn = warning_text(sm)
+    hh = header_rows(lines, warn)
+    fig = plt.figure(figsize=(12, 7.6 + hh), constrained_layout=True)
+    gs = fig.add_gridspec(3, 2, height_ratios=[hh, 3.8, 3.8])
     ax = np.array([[fig.add_subplot(gs[i, j]) for j in range(2)] for i in (1, 2)])
     draw_header(
         fig.add_subplot(gs[0, :]),
-        [gear_line(geo) if geo is not None else "", shafts_line(sm), results_line(sm, geo)],
+        lines,
         f"{sm.get('scenario', '')} (torsional): timestep {sm['timestep_s']:.3g} s, steady window {w0:.3g}-{w1:.3g} s",
+        warn=warn,
     )
     a = ax[0, 0]
     speeds = [S["worm_speed_rpm"], S["wheel_speed_rpm"] * sm["ratio_theory"]]

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from wormsim.recording import save_series_recording
-from wormsim.report_header import draw_header, self_locking_text, shafts_line, speed_ylim
+from wormsim.report_header import draw_header, header_rows, self_locking_text, shafts_line, speed_ylim, warning_text
 from wormsim.result import Result
 from wormsim.wedge.dynamics import INVERSE, LOCKED, TRACTIVE, UNLOADED
 
@@ -20,10 +20,6 @@ def write_report(result: Result, path) -> None:
 
     s, m = result.series, result.summary
     t_ms = s["t_s"] * 1e3
-    fig = plt.figure(figsize=(10, 11.5))
-    gs = fig.add_gridspec(5, 1, height_ratios=[1.35, 3, 3, 2, 1])
-    ax = [fig.add_subplot(gs[1])]
-    ax += [fig.add_subplot(gs[i], sharex=ax[0]) for i in (2, 3, 4)]
     name = result.extra.get("name", "wedge")
     p = result.extra.get("params")
     fr = (f"friction {p.friction:g}" if p.friction is not None else f"friction group {p.group}") if p else ""
@@ -45,7 +41,13 @@ def write_report(result: Result, path) -> None:
         + f",  stalled {'yes' if m['stalled'] else 'no'}",
         f"regimes: {' -> '.join(m['regimes'])}",
     ]
-    draw_header(fig.add_subplot(gs[0]), lines, f"{name} (wedge, monitor {m['monitor']})")
+    warn = warning_text(m)
+    hh = header_rows(lines, warn)
+    fig = plt.figure(figsize=(10, 9.5 + hh))
+    gs = fig.add_gridspec(5, 1, height_ratios=[hh, 3, 3, 2.2, 1.1])
+    ax = [fig.add_subplot(gs[1])]
+    ax += [fig.add_subplot(gs[i], sharex=ax[0]) for i in (2, 3, 4)]
+    draw_header(fig.add_subplot(gs[0]), lines, f"{name} (wedge, monitor {m['monitor']})", warn=warn)
     ax[0].plot(t_ms, s["S1_n"], label="S1 (internal, worm side)")
     ax[0].plot(t_ms, s["F1_n"], "--", lw=1, label="F1 (motor)")
     ax[0].plot(m["S1_peak_time_s"] * 1e3, m["S1_peak_n"], "ro", ms=4, label=f"peak {m['S1_peak_n']:.0f} N")
