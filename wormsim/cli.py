@@ -135,6 +135,8 @@ def _cmd_model(args) -> int:
     with locked_dir(args.out, names=("model.xml",)):
         path = write_model(sc, args.out)
     print(f"wrote {path}  (open with: python -m mujoco.viewer --mjcf {path})")
+    print("controls: drive = speed in rpm (or torque in N m), load = torque in N m; keyframe 'scenario' holds the")
+    print("scenario's values (viewer: Load key 0); docs/mjcf.md")
     return EXIT_OK
 
 
