@@ -310,6 +310,32 @@ class PatternLog:
         }
 
 
+def draw_tooth_outline(ax, geo: GearGeometry) -> None:
+    """The wheel tooth's tip (throat torus, capped at the rim), r2 and root (root torus) across the face, dashed over
+    the pattern, each named where it is unambiguous: the tip and r2 in the right margin at the face edge, the root
+    (lowest at the mid-plane) under its lowest point, with the radius there."""
+    zf = np.linspace(-geo.face_width / 2, geo.face_width / 2, 101)
+    edge = 0.5 * geo.face_width * 1e3
+    tip, root = wheel.tip_rho(geo, zf), wheel.root_rho(geo, zf)
+    for r_, lab, (x, y, va) in (
+        (tip, f"tip {tip[-1] * 1e3:.2f} mm (face edge)", (1.04 * edge, tip[-1] * 1e3, "center")),
+        (np.full_like(zf, geo.r2), f"r2 {geo.r2 * 1e3:.2f} mm", (1.04 * edge, geo.r2 * 1e3, "center")),
+        (root, f"wheel root {geo.r_f2 * 1e3:.2f} mm (mid-plane)", (0.0, float(root.min()) * 1e3, "top")),
+    ):
+        ax.plot(zf * 1e3, r_ * 1e3, color="0.55", lw=0.8, ls="--", zorder=3)
+        ax.annotate(
+            lab,
+            (x, y),
+            xytext=(0, -4 if va == "top" else 0),
+            textcoords="offset points",
+            fontsize=8,
+            va=va,
+            ha="center" if va == "top" else "left",
+            zorder=4,
+            bbox=dict(facecolor="white", edgecolor="0.6", alpha=0.9, pad=1.5),
+        )
+
+
 def draw_pattern(ax, fig, grid: dict, geo: GearGeometry, summary: dict) -> None:
     """report.png's pattern panel with flanks: the loaded cells of the working flank (the one carrying more load) as
     a band, face position against flank radius, coloured by the largest Hertz pressure (3) over the steady window;
@@ -359,28 +385,7 @@ def draw_pattern(ax, fig, grid: dict, geo: GearGeometry, summary: dict) -> None:
             label=f"p_H max {summary['contact_pressure_max_mpa']:.0f} MPa "
             f"(mean {summary['contact_pressure_mean_mpa']:.0f} MPa)",
         )
-    zf = np.linspace(-geo.face_width / 2, geo.face_width / 2, 101)
-    edge = 0.5 * geo.face_width * 1e3
-    tip, root = wheel.tip_rho(geo, zf), wheel.root_rho(geo, zf)
-    # each curve drawn over the band and named where it is unambiguous: the tip and r2 in the right margin at the
-    # face edge, the root (a torus: lowest at the mid-plane) under its lowest point, with the radius there
-    for r_, lab, (x, y, va) in (
-        (tip, f"tip {tip[-1] * 1e3:.2f} mm (face edge)", (1.04 * edge, tip[-1] * 1e3, "center")),
-        (np.full_like(zf, geo.r2), f"r2 {geo.r2 * 1e3:.2f} mm", (1.04 * edge, geo.r2 * 1e3, "center")),
-        (root, f"wheel root {geo.r_f2 * 1e3:.2f} mm (mid-plane)", (0.0, float(root.min()) * 1e3, "top")),
-    ):
-        ax.plot(zf * 1e3, r_ * 1e3, color="0.55", lw=0.8, ls="--", zorder=3)
-        ax.annotate(
-            lab,
-            (x, y),
-            xytext=(0, -4 if va == "top" else 0),
-            textcoords="offset points",
-            fontsize=8,
-            va=va,
-            ha="center" if va == "top" else "left",
-            zorder=4,
-            bbox=dict(facecolor="white", edgecolor="0.6", alpha=0.9, pad=1.5),
-        )
+    draw_tooth_outline(ax, geo)
     ax.set_xlim(-0.6 * geo.face_width * 1e3, 1.15 * geo.face_width * 1e3)
     lo = min(geo.r_f2, float(np.nanmin(R)) * 1e-3) * 1e3
     hi = max(geo.r_a2, float(np.nanmax(R)) * 1e-3) * 1e3

@@ -95,7 +95,7 @@ def write_report(result: Result, path) -> None:
         off = " (off scale)" if max(float(np.max(y)) for y in forces) > hi else ""
         a.plot([], [], " ", label=f"start-up peak F_t {peak:.4g} N{off}")
     a.set(xlabel="time [s]", ylabel="force on the wheel [N]", title="tooth forces on the wheel (axes: steady window)")
-    a.legend(fontsize=8, loc="center right")
+    a.legend(fontsize=7, loc="best")
     a = ax[0, 1]
     # raw traces faint (the wheel rattles at the contact frequencies and would hide the worm), interval means bold
     worm, wheel = np.abs(S["worm_speed_rpm"]) / s["ratio_theory"], np.abs(S["wheel_speed_rpm"])
@@ -151,20 +151,13 @@ def write_report(result: Result, path) -> None:
         r = np.hypot(p[ok, 0], p[ok, 1]) * 1e3
         sc = a.scatter(p[ok, 2] * 1e3, r, c=f[ok], s=3, cmap="viridis")
         fig.colorbar(sc, ax=a, label="contact force [N]")
-        for rr_, lab in ((geo.r2, "r2 (reference)"), (geo.r_a2, "r_a2 (tip)"), (geo.r_f2, "r_f2 (root)")):
-            a.axhline(rr_ * 1e3, color="0.4", lw=0.7, ls="--", zorder=1)
-            # labels in the margin right of the face (x > b2/2), where no contact point lies
-            a.text(
-                0.52 * geo.face_width * 1e3,
-                rr_ * 1e3,
-                lab,
-                fontsize=9,
-                va="center",
-                ha="left",
-                zorder=3,
-                bbox=dict(facecolor="white", edgecolor="0.6", alpha=0.9, pad=1.5),
-            )
-        a.set_xlim(-0.6 * geo.face_width * 1e3, 0.85 * geo.face_width * 1e3)
+        from wormsim.contact3d.flank_outputs import draw_tooth_outline
+
+        draw_tooth_outline(a, geo)
+        a.set_xlim(-0.6 * geo.face_width * 1e3, 1.15 * geo.face_width * 1e3)
+        rr = r if len(r) else np.array([geo.r2 * 1e3])
+        lo, hi = min(geo.r_f2 * 1e3, float(rr.min())), max(geo.r_e2 * 1e3, float(rr.max()))
+        a.set_ylim(lo - 0.15 * (hi - lo), hi + 0.1 * (hi - lo))
         a.set(xlabel="across the face (wheel z) [mm]", ylabel="radius [mm]", title="contact pattern on a wheel tooth")
     fig.tight_layout()
     fig.set_layout_engine(None)  # tight_layout leaves a placeholder engine: savefig would draw twice
