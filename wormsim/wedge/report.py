@@ -3,7 +3,16 @@
 from __future__ import annotations
 
 from wormsim.recording import save_series_recording
-from wormsim.report_header import draw_header, header_rows, self_locking_text, shafts_line, speed_ylim, warning_text
+from wormsim.report_header import (
+    draw_header,
+    gear_line,
+    header_rows,
+    results_line,
+    self_locking_text,
+    shafts_line,
+    speed_ylim,
+    warning_text,
+)
 from wormsim.result import Result
 from wormsim.wedge.dynamics import INVERSE, LOCKED, TRACTIVE, UNLOADED
 
@@ -22,24 +31,32 @@ def write_report(result: Result, path) -> None:
     t_ms = s["t_s"] * 1e3
     name = result.extra.get("name", "wedge")
     p = result.extra.get("params")
+    geo = result.extra.get("geometry")  # where the wedge comes from a gear: block
+
+    def f(key: str, spec: str) -> str:  # a summary number, "-" where this run does not write the key
+        v = m.get(key)
+        return format(v, spec) if isinstance(v, int | float) and not isinstance(v, bool) else "-"
+
     fr = (f"friction {p.friction:g}" if p.friction is not None else f"friction group {p.group}") if p else ""
     lines = [
+        gear_line(geo) if geo is not None else "",
         (
-            f"wedge: gamma {m['lead_angle_deg']:.3g} deg, m1 {p.m1_kg:.4g} kg (worm side), m2 {p.m2_kg:.4g} kg "
-            f"(driven), {fr}:\nfriction angle rho {m['rho_steady_deg']:.3g} deg at the steady speed, "
-            f"{m['rho_static_deg']:.3g} deg at rest"
+            f"wedge: gamma {f('lead_angle_deg', '.3g')} deg, m1 {p.m1_kg:.4g} kg (worm side), m2 {p.m2_kg:.4g} kg "
+            f"(driven), {fr}:\nfriction angle rho {f('rho_steady_deg', '.3g')} deg at the steady speed, "
+            f"{f('rho_static_deg', '.3g')} deg at rest"
             if p
             else ""
         ),
         shafts_line(m),
-        f"S1 steady {m['S1_steady_n']:.4g} N (peak {m['S1_peak_n']:.4g} N, Kd1 {m['Kd1']:.2f}),  S2 steady "
-        f"{m['S2_steady_n']:.4g} N (peak {m['S2_peak_n']:.4g} N, Kd2 {m['Kd2']:.2f}),  steady speed "
-        f"{m['speed_steady_m_s']:.4g} m/s",
-        f"efficiency {m['efficiency_forward']:.3f} (worm driving), back-driving {m['efficiency_backward']:.3f},  "
-        + self_locking_text(m, None)
-        + (" (rho at rest >= gamma)" if m["self_locking"] else "")
-        + f",  stalled {'yes' if m['stalled'] else 'no'}",
-        f"regimes: {' -> '.join(m['regimes'])}",
+        results_line(m, geo) if "ratio" in m else "",
+        f"S1 steady {f('S1_steady_n', '.4g')} N (peak {f('S1_peak_n', '.4g')} N, Kd1 {f('Kd1', '.2f')}),  S2 steady "
+        f"{f('S2_steady_n', '.4g')} N (peak {f('S2_peak_n', '.4g')} N, Kd2 {f('Kd2', '.2f')}),  steady speed "
+        f"{f('speed_steady_m_s', '.4g')} m/s",
+        f"efficiency {f('efficiency_forward', '.3f')} (worm driving), back-driving {f('efficiency_backward', '.3f')},  "
+        + self_locking_text(m, geo)
+        + (" (rho at rest >= gamma)" if m.get("self_locking") is True else "")
+        + f",  stalled {'yes' if m.get('stalled') else 'no'}",
+        f"regimes: {' -> '.join(m.get('regimes', []))}",
     ]
     warn = warning_text(m)
     hh = header_rows(lines, warn)
@@ -47,7 +64,7 @@ def write_report(result: Result, path) -> None:
     gs = fig.add_gridspec(5, 1, height_ratios=[hh, 3, 3, 2.2, 1.1])
     ax = [fig.add_subplot(gs[1])]
     ax += [fig.add_subplot(gs[i], sharex=ax[0]) for i in (2, 3, 4)]
-    draw_header(fig.add_subplot(gs[0]), lines, f"{name} (wedge, monitor {m['monitor']})", warn=warn)
+    draw_header(fig.add_subplot(gs[0]), lines, f"{name} (wedge, monitor {m.get('monitor', '-')})", warn=warn)
     ax[0].plot(t_ms, s["S1_n"], label="S1 (internal, worm side)")
     ax[0].plot(t_ms, s["F1_n"], "--", lw=1, label="F1 (motor)")
     ax[0].plot(m["S1_peak_time_s"] * 1e3, m["S1_peak_n"], "ro", ms=4, label=f"peak {m['S1_peak_n']:.0f} N")
