@@ -70,3 +70,14 @@ def test_run_writes_warnings_to_summary_and_stderr(torsional_args, tmp_path, cap
     summary = json.loads((tmp_path / "out" / "summary.json").read_text())
     assert len(summary["warnings"]) == 1 and summary["warnings"][0].startswith("tangential force p2p")
     assert f"warning: {summary['warnings'][0]}" in out.err
+
+
+def test_sweep_row_carries_the_warnings():
+    """sweep.csv: a point's warnings in one `warnings` cell (a list is no CSV scalar); none, no cell."""
+    from wormsim.sweep.runner import row_of
+    from wormsim.sweep.spec import Point
+
+    pt = Point(index=0, values={"load.torque_nm": 5.0}, scenario={}, scenario_hash="0" * 16)
+    row = row_of(pt, {"status": "ok", "ratio": 15.0, "warnings": ["a", "b"]})
+    assert row["warnings"] == "a; b" and row["ratio"] == 15.0
+    assert "warnings" not in row_of(pt, {"status": "ok", "warnings": []})
