@@ -45,6 +45,10 @@ def test_mesh_command_writes_geometry(name, tmp_path, capsys):
     ents = recorded_entities(out / "recording.rrd")
     assert {"/assembly/worm", "/assembly/wheel"} <= ents
     assert data["piece_error_um"]["worm"]["max"] >= 0
+    # section.png: a PNG file (its 8-byte signature, PNG spec 5.2) of a real picture, not an empty canvas
+    png = (out / "section.png").read_bytes()
+    assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 20_000
+    assert not list(out.glob(".*.png"))  # the temporary name was renamed
 
 
 def test_assembly_transforms_consistent():

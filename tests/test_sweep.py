@@ -317,3 +317,32 @@ def test_a_lost_worker_is_a_failed_row(tmp_path, monkeypatch):
     rows = _rows(tmp_path / "out")
     assert [r["status"] for r in rows] == ["ok", "ok", "failed"]
     assert rows[2]["message"].startswith("worker lost: KilledWorker")
+
+
+def test_sweep_png_plain_tick_labels(tmp_path, monkeypatch):
+    """sweep.png of an output constant to 1e-9 (a torsional efficiency against mu-independent inputs): no offset
+    text on any axis ("1e-7+8.04e-1" made a constant look like a slope) and a y range of at least 1 % of the value,
+    so the line draws flat."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from wormsim.sweep.plot import write_sweep_png
+
+    figs = []
+    monkeypatch.setattr(plt, "close", figs.append)  # keep the figure to inspect it
+    rows = [
+        {"status": "ok", "load.torque_nm": 1000.0 + i, "efficiency": 0.8040233 + 1e-9 * i, "ratio": 15.0}
+        for i in range(5)
+    ]
+    write_sweep_png(rows, ["load.torque_nm"], None, tmp_path / "sweep.png")
+    assert (tmp_path / "sweep.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    (fig,) = figs
+    fig.canvas.draw()
+    axes = [a for a in fig.axes if a.get_visible()]
+    assert {a.get_ylabel() for a in axes} == {"efficiency", "ratio"}
+    for a in axes:
+        assert a.yaxis.get_offset_text().get_text() == "" and a.xaxis.get_offset_text().get_text() == ""
+        lo, hi = a.get_ylim()
+        assert hi - lo >= 0.0099 * abs(0.5 * (lo + hi))

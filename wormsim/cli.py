@@ -48,7 +48,7 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("run", help="run one scenario: summary.json, timeseries.npz, recording.rrd, report.png")
     _add_scenario_args(p)
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
-    p = sub.add_parser("mesh", help="geometry only: worm.stl, wheel.stl, assembly.json, recording.rrd")
+    p = sub.add_parser("mesh", help="geometry only: worm.stl, wheel.stl, assembly.json, recording.rrd, section.png")
     _add_scenario_args(p)
     p = sub.add_parser(
         "model", help="write a standalone MJCF (model.xml + mesh assets, collision pieces) for MuJoCo's viewer"
@@ -108,6 +108,8 @@ def _cmd_run(args) -> int:
         print(f"  {k:<{width}}  {v:.6g}" if isinstance(v, float) else f"  {k:<{width}}  {v}")
     print(f"wrote {out / 'summary.json'}, {out / 'timeseries.npz'}, {out / 'report.png'}")
     print(f"recording: {out / 'recording.rrd'}  (view with: rerun {out / 'recording.rrd'})")
+    for w in summary.get("warnings") or []:  # also in summary.json (wormsim.run_warnings)
+        print(f"warning: {w}", file=sys.stderr)
     return EXIT_OK
 
 
@@ -120,7 +122,7 @@ def _cmd_mesh(args) -> int:
     from wormsim.output import locked_dir
 
     sc = load_scenario(args.scenario, args.overrides)
-    with locked_dir(args.out, names=("worm.stl", "wheel.stl", "assembly.json", "recording.rrd")):
+    with locked_dir(args.out, names=("worm.stl", "wheel.stl", "assembly.json", "recording.rrd", "section.png")):
         write_mesh_outputs(sc, args.out)
     return EXIT_OK
 
@@ -133,6 +135,8 @@ def _cmd_model(args) -> int:
     with locked_dir(args.out, names=("model.xml",)):
         path = write_model(sc, args.out)
     print(f"wrote {path}  (open with: python -m mujoco.viewer --mjcf {path})")
+    print("controls: drive = speed in rpm (or torque in N m), load = torque in N m; keyframe 'scenario' holds the")
+    print("scenario's values (viewer: Load key 0); docs/mjcf.md")
     return EXIT_OK
 
 

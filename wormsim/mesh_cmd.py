@@ -1,5 +1,6 @@
-"""`wormsim mesh SCENARIO --out DIR`: worm.stl, wheel.stl, assembly.json (meshgen.export) and recording.rrd, each
-written to a temporary name and renamed (atomic). The recording shows both meshes placed in the assembly frame,
+"""`wormsim mesh SCENARIO --out DIR`: worm.stl, wheel.stl, assembly.json (meshgen.export), recording.rrd and
+section.png (the wheel mid-plane section of both meshes, meshgen.section), each written to a temporary name and
+renamed (atomic). The recording shows both meshes placed in the assembly frame,
 turning through one worm turn with theta2 = hand theta1 z1 / z2."""
 
 from __future__ import annotations
@@ -45,6 +46,15 @@ def _recording(path: Path, name: str, g: GearGeometry, gs: GearSet, n_frames: in
         )
 
 
+def _section_png(path: Path, name: str, g: GearGeometry, gs: GearSet) -> None:
+    from meshgen.section import plot_section
+
+    tmp = path.with_name(f".{path.stem}.tmp.png")
+    plot_section(g, gs, tmp, name)
+    os.chmod(tmp, 0o644)
+    os.replace(tmp, path)
+
+
 def write_mesh_outputs(scenario: Scenario, out_dir: str | Path) -> dict:
     """Generate and write the geometry files; print the derived quantities. Returns the assembly.json dict."""
     if scenario.gear is None:
@@ -56,6 +66,7 @@ def write_mesh_outputs(scenario: Scenario, out_dir: str | Path) -> dict:
     _write_stl_atomic(gs.wheel_visual, out / "wheel.stl")
     data = assembly_data(g, gs)
     _recording(out / "recording.rrd", scenario.name, g, gs)
+    _section_png(out / "section.png", scenario.name, g, gs)
     write_json_atomic(out / "assembly.json", data)
     os.chmod(out / "assembly.json", 0o644)
     derived = data["derived"]
@@ -76,6 +87,6 @@ def write_mesh_outputs(scenario: Scenario, out_dir: str | Path) -> dict:
     )
     if gs.undercut_fraction > 0:
         print(f"  note: wheel undercut {100 * gs.undercut_fraction:.0f} % of the dedendum working depth (mid-plane)")
-    print(f"wrote {out / 'worm.stl'}, {out / 'wheel.stl'}, {out / 'assembly.json'}")
+    print(f"wrote {out / 'worm.stl'}, {out / 'wheel.stl'}, {out / 'assembly.json'}, {out / 'section.png'}")
     print(f"recording: {out / 'recording.rrd'}  (view with: rerun {out / 'recording.rrd'})")
     return data

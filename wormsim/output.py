@@ -1,6 +1,6 @@
 """Result folders: atomic writes, one writer at a time, and what an interrupt or a failure leaves behind.
 
-Guarantees for a run's folder DIR (README, "Reliability"):
+Guarantees for a run's folder DIR (docs/cli.md, "Reliability"):
 
 * Files are written into a hidden staging folder DIR/.staging-* and moved in with os.replace; the old
   summary.json is removed first and the new one moved in last, so a reader that sees an "ok" summary sees

@@ -15,6 +15,7 @@ from wormsim.errors import ScenarioError, SimulationError
 from wormsim.output import ResultDir
 from wormsim.progress import Progress
 from wormsim.result import Result
+from wormsim.run_warnings import run_warnings
 from wormsim.scenario import Scenario
 from wormsim.validate import validate_geometry
 
@@ -32,8 +33,10 @@ def model_module(name: str) -> ModuleType:
 
 
 def simulate(scenario: Scenario, progress: Progress | None = None) -> Result:
-    """Simulate only (no files): for tests and the benchmark."""
-    return model_module(scenario.model).simulate(scenario, progress=progress)
+    """Simulate only (no files): for tests and the benchmark. The summary carries `warnings` (wormsim.run_warnings)."""
+    res = model_module(scenario.model).simulate(scenario, progress=progress)
+    res.summary["warnings"] = run_warnings(res)
+    return res
 
 
 def run_scenario(scenario: Scenario, out_dir: str | Path, progress: bool | None = None) -> dict:
@@ -56,6 +59,7 @@ def run_scenario(scenario: Scenario, out_dir: str | Path, progress: bool | None 
         ) as bar:
             res = mod.simulate(scenario, progress=bar)
         wall = time.perf_counter() - t0
+        res.summary["warnings"] = run_warnings(res)  # results to read with care (F_t p2p, off-flank contacts)
         warm.release()
         np.savez_compressed(rd.path("timeseries.npz"), **res.series)
         warm.join()

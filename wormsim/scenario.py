@@ -99,7 +99,7 @@ class Materials(_Strict):
 
 
 class Contact(_Strict):
-    """Tooth contact. Every key optional; defaults derived from Hertz (README, 'Contact law')."""
+    """Tooth contact. Every key optional; defaults derived from Hertz (docs/models.md, 'Contact law')."""
 
     stiffness_n_per_m: float | None = Field(None, gt=0, le=1e13, description="ADAMS IMPACT K")
     exponent: float = Field(1.5, ge=1, le=3, description="ADAMS IMPACT e")

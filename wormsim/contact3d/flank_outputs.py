@@ -310,6 +310,32 @@ class PatternLog:
         }
 
 
+def draw_tooth_outline(ax, geo: GearGeometry) -> None:
+    """The wheel tooth's tip (throat torus, capped at the rim), r2 and root (root torus) across the face, dashed over
+    the pattern, each named where it is unambiguous: the tip and r2 in the right margin at the face edge, the root
+    (lowest at the mid-plane) under its lowest point, with the radius there."""
+    zf = np.linspace(-geo.face_width / 2, geo.face_width / 2, 101)
+    edge = 0.5 * geo.face_width * 1e3
+    tip, root = wheel.tip_rho(geo, zf), wheel.root_rho(geo, zf)
+    for r_, lab, (x, y, va) in (
+        (tip, f"tip {tip[-1] * 1e3:.2f} mm (face edge)", (1.04 * edge, tip[-1] * 1e3, "center")),
+        (np.full_like(zf, geo.r2), f"r2 {geo.r2 * 1e3:.2f} mm", (1.04 * edge, geo.r2 * 1e3, "center")),
+        (root, f"wheel root {geo.r_f2 * 1e3:.2f} mm (mid-plane)", (0.0, float(root.min()) * 1e3, "top")),
+    ):
+        ax.plot(zf * 1e3, r_ * 1e3, color="0.55", lw=0.8, ls="--", zorder=3)
+        ax.annotate(
+            lab,
+            (x, y),
+            xytext=(0, -4 if va == "top" else 0),
+            textcoords="offset points",
+            fontsize=8,
+            va=va,
+            ha="center" if va == "top" else "left",
+            zorder=4,
+            bbox=dict(facecolor="white", edgecolor="0.6", alpha=0.9, pad=1.5),
+        )
+
+
 def draw_pattern(ax, fig, grid: dict, geo: GearGeometry, summary: dict) -> None:
     """report.png's pattern panel with flanks: the loaded cells of the working flank (the one carrying more load) as
     a band, face position against flank radius, coloured by the largest Hertz pressure (3) over the steady window;
@@ -322,13 +348,22 @@ def draw_pattern(ax, fig, grid: dict, geo: GearGeometry, summary: dict) -> None:
     keep = L > 1e-3 * max(float(L.max()), 1e-300)
     dr = np.gradient(R, axis=1)
     polys, vals = [], []
-    for j, i in zip(*np.nonzero(keep)):
+    # per face slice, the band from its lowest to its highest loaded cell: cells inside it that the sampled contact
+    # lines missed are filled with the pressure interpolated along the slice, so sampling leaves no white stripes
+    for j in range(keep.shape[0]):
+        idx = np.nonzero(keep[j])[0]
+        if not len(idx):
+            continue
+        cells = np.arange(idx[0], idx[-1] + 1)
+        pj = np.interp(cells, idx, P[j, idx])
         x0, x1 = Z[j] - w / 2, Z[j] + w / 2
-        y0, y1 = R[j, i] - dr[j, i] / 2, R[j, i] + dr[j, i] / 2
-        polys.append([(x0, y0), (x1, y0), (x1, y1), (x0, y1)])
-        vals.append(P[j, i])
+        for i, pv in zip(cells, pj, strict=True):
+            y0, y1 = R[j, i] - dr[j, i] / 2, R[j, i] + dr[j, i] / 2
+            polys.append([(x0, y0), (x1, y0), (x1, y1), (x0, y1)])
+            vals.append(pv)
     if polys:
-        pc = PolyCollection(polys, array=np.asarray(vals), cmap="inferno", edgecolors="none")
+        # the cells' own colour as edge colour: no hairline gaps between neighbouring cells when rasterised
+        pc = PolyCollection(polys, array=np.asarray(vals), cmap="inferno", edgecolors="face", linewidths=0.3)
         ax.add_collection(pc)
         fig.colorbar(pc, ax=ax, label="largest Hertz pressure p_H [MPa]")
     cz, cr = summary.get("contact_pattern_centroid_face_mm"), summary.get("contact_pattern_centroid_radius_mm")
@@ -350,28 +385,11 @@ def draw_pattern(ax, fig, grid: dict, geo: GearGeometry, summary: dict) -> None:
             label=f"p_H max {summary['contact_pressure_max_mpa']:.0f} MPa "
             f"(mean {summary['contact_pressure_mean_mpa']:.0f} MPa)",
         )
-    zf = np.linspace(-geo.face_width / 2, geo.face_width / 2, 101)
-    edge = 0.5 * geo.face_width * 1e3
-    for r_, lab in (
-        (wheel.tip_rho(geo, zf), "wheel tip"),
-        (np.full_like(zf, geo.r2), "r2 (reference)"),
-        (wheel.root_rho(geo, zf), "wheel root"),
-    ):
-        ax.plot(zf * 1e3, r_ * 1e3, color="0.4", lw=0.7, ls="--", zorder=1)
-        ax.text(
-            1.04 * edge,
-            r_[-1] * 1e3,
-            lab,
-            fontsize=9,
-            va="center",
-            ha="left",
-            zorder=3,
-            bbox=dict(facecolor="white", edgecolor="0.6", alpha=0.9, pad=1.5),
-        )
-    ax.set_xlim(-0.6 * geo.face_width * 1e3, 0.85 * geo.face_width * 1e3)
+    draw_tooth_outline(ax, geo)
+    ax.set_xlim(-0.6 * geo.face_width * 1e3, 1.15 * geo.face_width * 1e3)
     lo = min(geo.r_f2, float(np.nanmin(R)) * 1e-3) * 1e3
     hi = max(geo.r_a2, float(np.nanmax(R)) * 1e-3) * 1e3
-    ax.set_ylim(lo - 0.1 * (hi - lo), hi + 0.25 * (hi - lo))
+    ax.set_ylim(lo - 0.15 * (hi - lo), hi + 0.25 * (hi - lo))
     ax.legend(fontsize=7, loc="upper left")
     ax.set(
         xlabel="across the face: wheel axis position, 0 at the mid-plane [mm]",

@@ -570,16 +570,28 @@ def _set_inv_mass_hat(
 # ----------------------------------------------------------------------------- standalone MJCF
 
 
+RPM_PER_RAD_S = 30.0 / math.pi  # the standalone model's drive control is a speed in rpm (gear of its servo)
+CTRL_RANGE_FACTOR = 2.0  # the controls' range: +- this times the scenario's value (the viewer's sliders)
+
+
 def write_model(scenario: Scenario, out_dir: str | Path) -> Path:
     """DIR/model.xml + DIR/meshes/*.stl: opens with `python -m mujoco.viewer --mjcf DIR/model.xml`.
 
     The standalone file gives every wheel tooth its collision pieces (the viewer does not re-pose a window,
     so the wheel can turn any number of turns), and MuJoCo recomputes body_invweight0 on load, so its
-    contact stiffness differs from a wormsim run's. Its drive and load act with both controls at zero: the
-    scenario's final drive command (speed or torque) and load torque are the actuators' constant bias terms
-    (without the STEP ramps), so the viewer's play button turns the worm; a control adds to them.
-    It always carries the collision pieces (contact.geometry pieces): the flank contacts are found by wormsim's own
-    step (wormsim.contact3d.flank_step), which a plain MuJoCo viewer does not run.
+    contact stiffness differs from a wormsim run's. It always carries the collision pieces (contact.geometry
+    pieces): the flank contacts are found by wormsim's own step (wormsim.contact3d.flank_step), which a plain
+    MuJoCo viewer does not run.
+
+    Actuators (docs/mjcf.md), both on their controls, without bias terms:
+    - `drive` on `{drive.on}_hinge`: a speed drive is a velocity servo whose control is the shaft speed in rpm
+      (gear RPM_PER_RAD_S, kv / gear^2: the joint sees the run's servo gain kv in N m s/rad); a torque drive is a
+      motor whose control is the torque in N m;
+    - `load` on `{load.on}_hinge`: a motor whose control is the load torque in N m (signed in the hinge's sense:
+      the scenario's resisting load is opposite to the motion).
+    The keyframe `scenario` holds the scenario's final commands (without the STEP ramps); MuJoCo starts with both
+    controls at 0 (the shafts at rest), so load that key (the viewer's "Load key", or mj_resetDataKeyframe) or
+    set the controls. Each control is limited to +- CTRL_RANGE_FACTOR times the scenario's value.
     """
     if scenario.contact.geometry != "pieces":
         scenario = scenario.model_copy(update={"contact": scenario.contact.model_copy(update={"geometry": "pieces"})})
@@ -589,15 +601,19 @@ def write_model(scenario: Scenario, out_dir: str | Path) -> Path:
     bm = build_model(scenario, window_teeth=geo.z2 if geo is not None else None)
     spec = bm.spec
     cmds = gt.commands(scenario, bm.direction)
-    drive_final, load_final = cmds.drive_target, cmds.load_target_nm
+    ctrl = {"drive": float(cmds.drive_target), "load": float(cmds.load_target_nm)}
     for act in spec.actuators:
-        bias = list(act.biasprm)
         if act.name == "drive" and gt.gear_drive(scenario).speed_rpm is not None:
-            bias[0] = act.gainprm[0] * drive_final  # velocity servo: kv (ctrl + w_final - qdot)
-        else:
-            bias[0] = drive_final if act.name == "drive" else load_final
-        act.biastype = mujoco.mjtBias.mjBIAS_AFFINE
-        act.biasprm = bias
+            kv = float(act.gainprm[0])
+            act.set_to_velocity(kv=kv / RPM_PER_RAD_S**2)
+            act.gear = [RPM_PER_RAD_S, 0, 0, 0, 0, 0]
+            ctrl["drive"] *= RPM_PER_RAD_S  # rad/s -> rpm
+        lim = CTRL_RANGE_FACTOR * abs(ctrl[act.name]) or 1.0
+        act.ctrllimited = True
+        act.ctrlrange = [-lim, lim]
+    key = spec.add_key()
+    key.name = "scenario"
+    key.ctrl = [ctrl[act.name] for act in spec.actuators]
     import trimesh
 
     for me in spec.meshes:

@@ -21,6 +21,16 @@ from meshgen import assembly
 from wormsim.contact3d.mjcf import visual_vertex_normals
 from wormsim.metrics import dominant_frequency
 from wormsim.recording import log_mesh, log_series, log_transforms, recording
+from wormsim.report_header import (
+    draw_header,
+    gear_line,
+    header_rows,
+    results_line,
+    shafts_line,
+    speed_ylim,
+    steady_ylim,
+    warning_text,
+)
 from wormsim.result import Result
 
 MAX_FRAMES = 1500
@@ -50,15 +60,42 @@ def write_report(result: Result, path) -> None:
     t = S["t_s"]
     w0, w1 = s["steady_window_s"]
     sl = (t >= w0) & (t <= w1)
-    fig, ax = plt.subplots(2, 2, figsize=(13, 8.5))
+    geo = result.extra["built"].geometry
+    scaled = s.get("mass_scaling", 1) > 1  # wormsim.contact3d.mass_scaling: say so where the plots are
+    lines = [gear_line(geo), shafts_line(s), results_line(s, geo)]
+    warn = warning_text(
+        s,
+        f"MASS SCALING x {s['mass_scaling']:g} (kinetic energy {100 * s['kinetic_energy_share']:.2g} % "
+        f"of the work): means only; force fluctuation, speeds' rattle and start-up peaks are not physical"
+        if scaled
+        else "",
+    )
+    hh = header_rows(lines, warn)
+    fig = plt.figure(figsize=(13, 8.8 + hh))
+    gs = fig.add_gridspec(3, 2, height_ratios=[hh, 4.4, 4.4])
+    ax = np.array([[fig.add_subplot(gs[i, j]) for j in range(2)] for i in (1, 2)])
+    draw_header(
+        fig.add_subplot(gs[0, :]),
+        lines,
+        f"{s.get('scenario', '')} (contact3d): dt {s['timestep_s']:.3g} s, resolution {s['resolution']}, "
+        f"contacts {s.get('contact_geometry', '')}, steady window {w0:.3g}-{w1:.3g} s",
+        warn=warn,
+    )
     a = ax[0, 0]
-    for k, lab in (("tangential_force_n", "tangential"), ("radial_force_n", "radial"), ("axial_force_n", "axial")):
-        a.plot(t, S[k], lw=0.6, label=lab)
+    forces = [S[k] for k in ("tangential_force_n", "radial_force_n", "axial_force_n")]
+    for y, lab in zip(forces, ("tangential", "radial", "axial"), strict=True):
+        a.plot(t, y, lw=0.6, label=lab)
     a.axvspan(w0, w1, color="0.9", zorder=-1, label="steady window")
     if np.isfinite(s.get("tangential_force_theory_n", float("nan"))):
         a.axhline(s["tangential_force_theory_n"], color="k", ls="--", lw=0.8, label="T_load / r2")
-    a.set(xlabel="time [s]", ylabel="force on the wheel [N]", title="tooth forces (wheel frame)")
-    a.legend(fontsize=8)
+    lo, hi = steady_ylim(t, forces, (w0, w1), pad=0.15)
+    a.set_ylim(lo, hi)
+    peak = s.get("startup_tangential_force_peak_n")
+    if peak is not None and np.isfinite(peak):
+        off = " (off scale)" if peak > hi else ""
+        a.plot([], [], " ", label=f"start-up peak F_t {peak:.4g} N{off}")
+    a.set(xlabel="time [s]", ylabel="force on the wheel [N]", title="tooth forces on the wheel (axes: steady window)")
+    a.legend(fontsize=7, loc="best")
     a = ax[0, 1]
     # raw traces faint (the wheel rattles at the contact frequencies and would hide the worm), interval means bold
     worm, wheel = np.abs(S["worm_speed_rpm"]) / s["ratio_theory"], np.abs(S["wheel_speed_rpm"])
@@ -70,15 +107,14 @@ def write_report(result: Result, path) -> None:
     )
     a.plot(tm, worm_m, "--", color="C0", lw=1.6, label="worm / (z2/z1) (interval means)")
     a.axvspan(w0, w1, color="0.9", zorder=-1)
-    top = 1.6 * max(float(np.max(worm_m)), float(np.max(wheel_m)), 1e-9)
-    a.set_ylim(min(0.0, 1.2 * float(min(np.min(worm_m), np.min(wheel_m)))), top)  # the raw rattle is clipped
+    a.set_ylim(*speed_ylim(tm, [worm_m, wheel_m], (w0, w1)))  # the raw rattle and start-up are clipped
     a.set(
         xlabel="time [s]",
-        ylabel="speed [rpm] (raw traces faint, clipped)",
-        title=f"speeds: ratio {s['ratio']:.4g} (theory {s['ratio_theory']:.4g}), efficiency {s['efficiency']:.3f} "
-        f"(theory {s['efficiency_theory']:.3f})",
+        ylabel="wheel speed [rpm] (raw traces faint, clipped)",
+        title=f"speeds: wheel {s['wheel_speed_mean_rpm']:.4g} rpm, worm {s['worm_speed_mean_rpm']:.4g} rpm "
+        f"(ratio {s['ratio']:.5g})",
     )
-    a.legend(fontsize=8)
+    a.legend(fontsize=8, loc="lower right")
     a = ax[1, 0]
     _, df, fr, sp = dominant_frequency(t[sl], S["tangential_force_n"][sl])
     if len(fr):
@@ -97,7 +133,8 @@ def write_report(result: Result, path) -> None:
             lw=1.0,
             label=f"peak {s['mesh_frequency_hz']:.4g} Hz (bin {df:.3g} Hz)",
         )
-        a.set_xlim(0, min(fr[-1], 10 * max(s["mesh_frequency_theory_hz"], df)))
+        # up to the 10th meshing harmonic, and past the reported peak wherever it lies
+        a.set_xlim(0, min(fr[-1], max(10 * max(s["mesh_frequency_theory_hz"], df), 1.2 * s["mesh_frequency_hz"])))
     a.set(xlabel="frequency [Hz]", ylabel="|F_t| amplitude [N]", title="spectrum of the tangential force (Hann)")
     a.legend(fontsize=8)
     a = ax[1, 1]
@@ -114,34 +151,14 @@ def write_report(result: Result, path) -> None:
         r = np.hypot(p[ok, 0], p[ok, 1]) * 1e3
         sc = a.scatter(p[ok, 2] * 1e3, r, c=f[ok], s=3, cmap="viridis")
         fig.colorbar(sc, ax=a, label="contact force [N]")
-        geo = result.extra["built"].geometry
-        for rr_, lab in ((geo.r2, "r2 (reference)"), (geo.r_a2, "r_a2 (tip)"), (geo.r_f2, "r_f2 (root)")):
-            a.axhline(rr_ * 1e3, color="0.4", lw=0.7, ls="--", zorder=1)
-            # labels in the margin right of the face (x > b2/2), where no contact point lies
-            a.text(
-                0.52 * geo.face_width * 1e3,
-                rr_ * 1e3,
-                lab,
-                fontsize=9,
-                va="center",
-                ha="left",
-                zorder=3,
-                bbox=dict(facecolor="white", edgecolor="0.6", alpha=0.9, pad=1.5),
-            )
-        a.set_xlim(-0.6 * geo.face_width * 1e3, 0.85 * geo.face_width * 1e3)
+        from wormsim.contact3d.flank_outputs import draw_tooth_outline
+
+        draw_tooth_outline(a, geo)
+        a.set_xlim(-0.6 * geo.face_width * 1e3, 1.15 * geo.face_width * 1e3)
+        rr = r if len(r) else np.array([geo.r2 * 1e3])
+        lo, hi = min(geo.r_f2 * 1e3, float(rr.min())), max(geo.r_e2 * 1e3, float(rr.max()))
+        a.set_ylim(lo - 0.15 * (hi - lo), hi + 0.1 * (hi - lo))
         a.set(xlabel="across the face (wheel z) [mm]", ylabel="radius [mm]", title="contact pattern on a wheel tooth")
-    scaled = s.get("mass_scaling", 1) > 1  # wormsim.contact3d.mass_scaling: say so where the plots are
-    fig.suptitle(
-        f"{result.summary.get('scenario', '')} contact3d: dt {s['timestep_s']:.3g} s, resolution "
-        f"{s['resolution']}, steady window {w0:.3g}-{w1:.3g} s"
-        + (
-            f"\nMASS SCALING x {s['mass_scaling']:g} (kinetic energy {100 * s['kinetic_energy_share']:.2g} % "
-            f"of the work): means only; force fluctuation, speeds' rattle and start-up peaks are not physical"
-            if scaled
-            else ""
-        ),
-        color="C3" if scaled else "k",
-    )
     fig.tight_layout()
     fig.set_layout_engine(None)  # tight_layout leaves a placeholder engine: savefig would draw twice
     fig.savefig(path, dpi=110)

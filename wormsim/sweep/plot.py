@@ -64,6 +64,24 @@ def _label(v) -> str:
     return f"{v:.4g}" if isinstance(v, float) else str(v)
 
 
+MIN_REL_SPAN = 0.01  # a y axis spans at least this fraction of its value: a constant output reads as flat
+
+
+def _plain_axes(ax, numeric_x: bool) -> None:
+    """Tick labels as plain numbers, without matplotlib's offset ("1e-7+8.04e-1"), and a y range of at least
+    MIN_REL_SPAN of the value, so that an output constant to rounding draws as a flat line, not as a slope."""
+    from matplotlib.ticker import ScalarFormatter
+
+    lo, hi = ax.get_ylim()
+    mid = 0.5 * (lo + hi)
+    if math.isfinite(mid) and hi - lo < MIN_REL_SPAN * abs(mid):
+        half = 0.5 * MIN_REL_SPAN * abs(mid)
+        ax.set_ylim(mid - half, mid + half)
+    ax.yaxis.set_major_formatter(ScalarFormatter(useOffset=False))
+    if numeric_x:
+        ax.xaxis.set_major_formatter(ScalarFormatter(useOffset=False))
+
+
 def write_sweep_png(rows: list[dict], swept: list[str], plot: Plot | None, path: str | Path, title: str = "") -> None:
     import matplotlib
 
@@ -147,6 +165,7 @@ def write_sweep_png(rows: list[dict], swept: list[str], plot: Plot | None, path:
             ax.set_xscale("log")
         if not numeric_x:
             ax.set_xticks(range(len(cats)), cats)
+        _plain_axes(ax, numeric_x and not log_x)
         ax.grid(alpha=0.3)
         if ax.get_legend_handles_labels()[0]:
             ax.legend(fontsize=7)

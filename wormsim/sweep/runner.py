@@ -125,6 +125,8 @@ def row_of(point: Point, summary: dict) -> dict:
         "message": summary.get("message", ""),
     }
     row.update({k: v for k, v in summary.items() if k not in _NOT_COLUMNS and _scalar(v)})
+    if summary.get("warnings"):  # the run's warnings (wormsim.run_warnings) as one cell
+        row["warnings"] = "; ".join(summary["warnings"])
     row["wall_time_s"] = summary.get("wall_time_s")
     row["scenario_hash"] = point.scenario_hash
     return row

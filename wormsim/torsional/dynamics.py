@@ -530,7 +530,7 @@ def simulate(scenario: Scenario, progress=None, method: str = "implicit") -> Res
         series=S,
         steps=len(t) - 1,
         sim_time_s=float(t[-1]),
-        extra={"mesh_stiffness": ms},
+        extra={"mesh_stiffness": ms, "geometry": g},
     )
 
 
