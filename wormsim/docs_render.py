@@ -373,6 +373,141 @@ def torsional_samples_table(name: str = "torsional_seeds") -> str:
     return _table(head, rows) + "\n" + _source(name)
 
 
+# ----------------------------------------------------------------------------- the shipped sweeps (docs/sweeps/*.csv)
+
+
+def _sweep_rows(name: str) -> list[dict]:
+    """The ok rows of docs/sweeps/NAME.csv, numbers parsed (an empty cell is None)."""
+    import csv
+
+    def num(v: str):
+        try:
+            return float(v)
+        except ValueError:
+            return v or None
+
+    with (ROOT / "docs" / "sweeps" / f"{name}.csv").open(newline="") as fh:
+        return [{k: num(v) for k, v in r.items()} for r in csv.DictReader(fh) if r["status"] == "ok"]
+
+
+def _sweep_source(*names: str) -> str:
+    """The line under a sweep table: its csv files and their provenance (docs/data/sweeps.json)."""
+    files = load("sweeps")["files"]
+    parts = []
+    for n in names:
+        p = files[f"docs/sweeps/{n}.csv"]
+        parts.append(f"`docs/sweeps/{n}.csv` (`{p['command'].split(';')[0]}`; commit {p['commit']}, {p['date'][:10]})")
+    return "Records: " + ", ".join(parts) + "; provenance in `docs/data/sweeps.json`.\n"
+
+
+def _sweeps_module(name: str):
+    """sweeps/NAME.py as a module (its constants: the seeds' tables, the tolerance study's fits)."""
+    import importlib.util
+
+    sys.path.insert(0, str(ROOT / "sweeps"))
+    spec = importlib.util.spec_from_file_location(name, ROOT / "sweeps" / f"{name}.py")
+    assert spec is not None and spec.loader is not None
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def _screw_jack_sweep_table(name: str, key: str, head0: str, seed: dict) -> str:
+    """Seed 002's Table 3 or 4 beside the contact3d (exact flanks) and torsional sweeps of the same points."""
+    tors = {r[key]: r for r in _sweep_rows(f"{name}_torsional")}
+    rows = []
+    for r in _sweep_rows(name):
+        t = tors.get(r[key], {})
+        s = seed.get(r[key]) or seed.get(int(r[key]), ("-", "-", "-"))
+        rows.append(
+            [
+                f"{r[key]:.3g}".replace("e+0", "e"),
+                " / ".join(f"{v:g}" for v in s),
+                f"{r['tangential_force_mean_n']:.1f} / {r['tangential_force_p2p_n']:.1f} / "
+                f"{r['tangential_force_max_n']:.1f} / {r['startup_tangential_force_peak_n']:.1f}, "
+                f"{r['transmission_error_p2p_urad']:.3g}",
+                f"{_fmt(t.get('tangential_force_mean_n'), 4)} / {_fmt(t.get('tangential_force_p2p_n'), 2)}, "
+                f"{_fmt(t.get('transmission_error_p2p_urad'), 2)}",
+            ]
+        )
+    head = [head0, "seed 002: mean / p2p / max [N]"]
+    head += ["contact3d (flanks): F_t mean / p2p / max (steady) / start-up peak [N], TE p2p [urad]"]
+    head += ["torsional: F_t mean / p2p [N], TE p2p [urad]"]
+    return _table(head, rows) + "\n" + _sweep_source(name, f"{name}_torsional")
+
+
+def sweep_screw_jack_stiffness_table() -> str:
+    """Seed 002 Table 3: contact stiffness at 1330 rpm (sweeps/screw_jack_stiffness*.yaml)."""
+    seed = _sweeps_module("figures").SEED_K
+    return _screw_jack_sweep_table("screw_jack_stiffness", "contact.stiffness_n_per_m", "K [N/m] at 1330 rpm", seed)
+
+
+def sweep_screw_jack_speed_table() -> str:
+    """Seed 002 Table 4: worm speed at 4.39e8 N/m (sweeps/screw_jack_speed*.yaml)."""
+    seed = _sweeps_module("figures").SEED_N
+    return _screw_jack_sweep_table("screw_jack_speed", "drive.speed_rpm", "worm speed [rpm] at 4.39e8 N/m", seed)
+
+
+def sweep_seat_motor_friction_table() -> str:
+    """The lubricant study (sweeps/seat_motor_friction.yaml): contact3d's efficiency against the wedge law at the
+    pitch radius and at the contacts' radius, and the torsional level."""
+    rows_all = _sweep_rows("seat_motor_friction")
+    tors = {r["contact.friction"]: r for r in rows_all if r["model"] == "torsional"}
+    rows = []
+    for r in (r for r in rows_all if r["model"] == "contact3d"):
+        e, e1, ec = r["efficiency"], r["efficiency_theory"], r["efficiency_theory_at_contact_radius"]
+        t = tors.get(r["contact.friction"], {})
+        rows.append(
+            [
+                f"{r['contact.friction']:g}",
+                f"{e:.4f}",
+                f"{e1:.4f} ({(e / e1 - 1) * 100:+.1f} %)",
+                f"{ec:.4f} ({(e / ec - 1) * 100:+.2f} %)",
+                _fmt(t.get("efficiency"), 4),
+                f"{r['tangential_force_mean_n']:.1f} ({r['tangential_force_theory_n']:.1f})",
+            ]
+        )
+    head = ["mu", "contact3d efficiency", "tan g / tan(g + rho') at the pitch radius"]
+    head += ["the same at the contacts' radius"]
+    head += ["torsional", "contact3d F_t mean [N] (T2 / r2)"]
+    return _table(head, rows) + "\n" + _sweep_source("seat_motor_friction")
+
+
+def _tolerance_table(gear: str) -> str:
+    """The tolerance study's spread and dominant error (sweeps/errors_figures.py's regression)."""
+    import numpy as np
+
+    ef = _sweeps_module("errors_figures")
+    rows = ef._tol_rows(ROOT / "docs" / "sweeps" / f"{gear}_tolerance.csv", gear)
+    out = []
+    for key, label in ef.TOL_OUT:
+        v = np.array([r[key] for r in rows if r.get(key) is not None], float)
+        q = np.percentile(v, [5, 50, 95])
+        inputs = ef.TOL_IN_SIGNED if key == "contact_pattern_centroid_face_mm" else ef.TOL_IN
+        beta, r2, _ = ef.regression(rows, key, inputs)
+        top = max(beta, key=lambda p: abs(beta[p]))
+        out.append(
+            [
+                label,
+                f"{q[1]:.4g}",
+                f"{q[0]:.4g} to {q[2]:.4g}",
+                f"{v.max():.4g}",
+                f"{dict(inputs)[top]} ({beta[top]:+.2f}; R^2 {r2:.2f})",
+            ]
+        )
+    head = [f"{gear.replace('_', ' ')}, {len(rows)} points", "median", "5-95 %", "max"]
+    head += ["largest standardised beta (R^2 of the fit)"]
+    return _table(head, out) + "\n" + _sweep_source(f"{gear}_tolerance")
+
+
+def sweep_tolerance_screw_jack_table() -> str:
+    return _tolerance_table("screw_jack")
+
+
+def sweep_tolerance_seat_motor_table() -> str:
+    return _tolerance_table("seat_motor")
+
+
 TABLES: dict[str, Callable[[], str]] = {
     "torsional_seeds": torsional_seeds_table,
     "torsional_samples": torsional_samples_table,
@@ -386,6 +521,11 @@ TABLES: dict[str, Callable[[], str]] = {
     "seat_motor_20s": seat_motor_20s_table,
     "sweep_speedup": sweep_speedup_table,
     "errors_study": errors_study_table,
+    "sweep_screw_jack_stiffness": sweep_screw_jack_stiffness_table,
+    "sweep_screw_jack_speed": sweep_screw_jack_speed_table,
+    "sweep_seat_motor_friction": sweep_seat_motor_friction_table,
+    "sweep_tolerance_screw_jack": sweep_tolerance_screw_jack_table,
+    "sweep_tolerance_seat_motor": sweep_tolerance_seat_motor_table,
 }
 
 
