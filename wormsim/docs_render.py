@@ -508,6 +508,32 @@ def sweep_tolerance_seat_motor_table() -> str:
     return _tolerance_table("seat_motor")
 
 
+def wedge_seed000_table(name: str = "wedge_seed000") -> str:
+    """The wedge level on seed 000's valve cases beside the seed's results table (sweeps/wedge_seed000.py)."""
+    rows = []
+    for case, r in load(name)["runs"].items():
+        sd = r.get("seed") or {}
+
+        def pair(ours: str, seed: str, spec: str) -> str:
+            return f"{r[ours]:{spec}} / " + (f"{sd[seed]:g}" if seed in sd else "-")
+
+        rows.append(
+            [
+                case,
+                f"{r['driven_mass_kg']:g} kg",
+                f"{r['load_force_n']:g} N",
+                pair("S1_peak_n", "S1_n", ".0f"),
+                pair("Kd1", "Kd1", ".2f"),
+                pair("S2_peak_n", "S2_n", ".0f"),
+                pair("Kd2", "Kd2", ".2f"),
+                f"{r['speed_steady_m_s']:.2f} m/s",
+            ]
+        )
+    head = ["case", "m2", "F2", "S1 peak ours / seed [N]", "Kd1 ours / seed", "S2 peak ours / seed [N]"]
+    head += ["Kd2 ours / seed", "steady speed (ours)"]
+    return _table(head, rows) + "\n" + _source(name)
+
+
 TABLES: dict[str, Callable[[], str]] = {
     "torsional_seeds": torsional_seeds_table,
     "torsional_samples": torsional_samples_table,
@@ -521,6 +547,7 @@ TABLES: dict[str, Callable[[], str]] = {
     "seat_motor_20s": seat_motor_20s_table,
     "sweep_speedup": sweep_speedup_table,
     "errors_study": errors_study_table,
+    "wedge_seed000": wedge_seed000_table,
     "sweep_screw_jack_stiffness": sweep_screw_jack_stiffness_table,
     "sweep_screw_jack_speed": sweep_screw_jack_speed_table,
     "sweep_seat_motor_friction": sweep_seat_motor_friction_table,
