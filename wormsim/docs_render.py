@@ -534,6 +534,52 @@ def wedge_seed000_table(name: str = "wedge_seed000") -> str:
     return _table(head, rows) + "\n" + _source(name)
 
 
+def mass_scaling_table(name: str = "mass_scaling", ref: str = "seat_motor_20s") -> str:
+    """The 20 s seat motor with mass scaling (sweeps/mass_scaling.py) beside the unscaled run with pieces (its fixed
+    steady window): relative deviations in brackets."""
+    r0 = load(ref)
+    run0 = r0["summary_as_written_by_the_run"]
+    s0 = r0.get("recomputed_with_the_fixed_steady_window") or run0
+
+    def dev(v: float, k: str) -> str:
+        return f"({(v / s0[k] - 1) * 100:+.3g} %)"
+
+    rows = [
+        [
+            "pieces, unscaled (`seat_motor_20s`)",
+            "1",
+            f"{run0['timestep_s']:.2g} s",
+            f"{r0['steps']}",
+            f"{r0['wall_time_s']:.0f}",
+            f"{r0['wall_time_s'] / run0['sim_time_s']:.3g}",
+            f"{s0['efficiency']:.5f}",
+            f"{s0['ratio']:.5f}",
+            f"{s0['tangential_force_mean_n']:.2f}",
+            f"{s0['mesh_frequency_hz']:.5f}",
+            "-",
+        ]
+    ]
+    for scale, r in load(name)["runs"].items():
+        rows.append(
+            [
+                f"flanks, `{scale}`",
+                f"{r['mass_scaling']:g}",
+                f"{r['timestep_s']:.2g} s",
+                f"{r['steps']}",
+                f"{r['wall_s']:.3g}",
+                f"{r['wall_s'] / r['sim_time_s']:.3g}",
+                f"{r['efficiency']:.5f} {dev(r['efficiency'], 'efficiency')}",
+                f"{r['ratio']:.5f} {dev(r['ratio'], 'ratio')}",
+                f"{r['tangential_force_mean_n']:.2f} {dev(r['tangential_force_mean_n'], 'tangential_force_mean_n')}",
+                f"{r['mesh_frequency_hz']:.5f} {dev(r['mesh_frequency_hz'], 'mesh_frequency_hz')}",
+                f"{100 * r['kinetic_energy_share']:.2g} % / {100 * r['kinetic_energy_share_estimate']:.2g} %",
+            ]
+        )
+    head = ["run", "S", "step", "steps", "wall [s]", "wall per simulated s", "efficiency", "ratio", "mean F_t [N]"]
+    head += ["f_mesh [Hz]", "KE share measured / estimated"]
+    return _table(head, rows) + "\n" + _source(ref) + _source(name)
+
+
 TABLES: dict[str, Callable[[], str]] = {
     "torsional_seeds": torsional_seeds_table,
     "torsional_samples": torsional_samples_table,
@@ -548,6 +594,7 @@ TABLES: dict[str, Callable[[], str]] = {
     "sweep_speedup": sweep_speedup_table,
     "errors_study": errors_study_table,
     "wedge_seed000": wedge_seed000_table,
+    "mass_scaling": mass_scaling_table,
     "sweep_screw_jack_stiffness": sweep_screw_jack_stiffness_table,
     "sweep_screw_jack_speed": sweep_screw_jack_speed_table,
     "sweep_seat_motor_friction": sweep_seat_motor_friction_table,
