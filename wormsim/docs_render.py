@@ -580,6 +580,54 @@ def mass_scaling_table(name: str = "mass_scaling", ref: str = "seat_motor_20s") 
     return _table(head, rows) + "\n" + _source(ref) + _source(name)
 
 
+def piece_error_table(name: str = "piece_error") -> str:
+    """The seeds' convex collision pieces and their error against the exact flanks (sweeps/piece_error.py)."""
+    rows = []
+    for r in load(name)["rows"]:
+        e = r["piece_error_um"]
+        fillet = e.get("wheel_undercut_zone")
+        rows.append(
+            [
+                r["gear"],
+                f"{r['resolution']} ({r['worm_segments_per_turn']}, {r['wheel_slabs']}, {r['profile_points']})",
+                f"{r['worm_pieces']}",
+                f"{r['wheel_tooth_pieces']}",
+                f"{e['worm']['max']:.2g} / {e['worm']['rms']:.2g}",
+                f"{e['wheel']['max']:.3g} / {e['wheel']['rms']:.3g}",
+                f"{e['wheel']['min_signed']:.2g}",
+                "-" if not fillet else f"{fillet['min_signed']:.2g}",
+                f"{r['normal_half_backlash_um']:.3g}",
+                f"{r['wall_s']:.2g}",
+            ]
+        )
+    head = ["gear", "level (segments/turn, slabs, profile pts)", "worm pieces", "pieces/tooth", "worm max / rms um"]
+    head += ["wheel max / rms um", "wheel min signed um", "fillet zone min um", "normal j/2 um", "time s"]
+    return _table(head, rows) + "\n" + _source(name)
+
+
+def backlash_min_table(name: str = "piece_error") -> str:
+    """The pieces' bulge b and the smallest backlash j_min of each seed and level (wormsim.contact3d.backlash, from
+    the record of the pieces, sweeps/piece_error.py) beside the scenario's backlash."""
+    from meshgen.geometry import derive
+    from wormsim.contact3d.backlash import min_backlash_m, piece_bulge_m
+    from wormsim.scenario import load_scenario
+
+    rows: dict[str, list[str]] = {}
+    levels: list[str] = []
+    for r in load(name)["rows"]:
+        sc = load_scenario(ROOT / "scenarios" / f"{r['gear']}.yaml")
+        geo = derive(sc.gear)
+        b = piece_bulge_m(r["piece_error_um"])
+        row = rows.setdefault(r["gear"], [r["gear"]])
+        row.append(f"{b * 1e6:.2g} um / {min_backlash_m(geo, b) * 1e3:.2g} mm")
+        if r["resolution"] not in levels:
+            levels.append(r["resolution"])
+        if len(row) == 1 + 3:
+            row.append(f"{sc.gear.backlash_mm:g} mm")
+    head = ["gear", *[f"b / j_min {lv}" for lv in levels], "scenario j"]
+    return _table(head, list(rows.values())) + "\n" + _source(name)
+
+
 TABLES: dict[str, Callable[[], str]] = {
     "torsional_seeds": torsional_seeds_table,
     "torsional_samples": torsional_samples_table,
@@ -595,6 +643,8 @@ TABLES: dict[str, Callable[[], str]] = {
     "errors_study": errors_study_table,
     "wedge_seed000": wedge_seed000_table,
     "mass_scaling": mass_scaling_table,
+    "piece_error": piece_error_table,
+    "backlash_min": backlash_min_table,
     "sweep_screw_jack_stiffness": sweep_screw_jack_stiffness_table,
     "sweep_screw_jack_speed": sweep_screw_jack_speed_table,
     "sweep_seat_motor_friction": sweep_seat_motor_friction_table,
