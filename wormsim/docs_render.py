@@ -220,6 +220,8 @@ def _study_value(v) -> str:
     """The error's value: a number, or the pitch deviations of every other tooth as one phrase."""
     if v in (None, ""):
         return "-"
+    if isinstance(v, str) and v.startswith("["):
+        v = json.loads(v)
     if isinstance(v, list):
         return f"every other tooth +{max(v):g} um"
     return str(v)
@@ -628,12 +630,61 @@ def backlash_min_table(name: str = "piece_error") -> str:
     return _table(head, list(rows.values())) + "\n" + _source(name)
 
 
+def errors_seat_motor_table(name: str = "errors_seat_motor") -> str:
+    """sweeps/errors_seat_motor.py: the seat motor's loaded pattern under each error alone, at 4 and 24 N m, with the
+    kinematic TCA's pattern centroid of the same errors (docs/errors.md, 6)."""
+    rows = []
+    for r in load(name)["rows"]:
+        kin = r.get("transmission_error_kinematic_p2p_urad")
+        tca = r.get("kinematic_contact_pattern_centroid_face_mm")
+        play = r.get("backlash_measured_mm")
+        errs = ", ".join(e.removeprefix("errors.").replace("=", " ") for e in r["errors"]) or "none"
+        rows.append(
+            [
+                f"{r['load_torque_nm']:g} N m",
+                errs,
+                f"{r['contact_pattern_centroid_face_mm']:+.2f} mm" + (f" ({tca:+.2f})" if tca is not None else ""),
+                f"{r['contact_pattern_extent_face_mm']:.2f} mm",
+                f"{r['contact_pressure_max_mpa']:.0f} / {r['contact_pressure_mean_mpa']:.0f} MPa",
+                f"{r['tangential_force_p2p_n']:.2g} N",
+                f"{r['transmission_error_p2p_urad']:.0f}" + (f" ({kin:.0f})" if kin is not None else "") + " urad",
+                f"{r['efficiency']:.3f}",
+                "j" if play is None else f"{play:.3f} mm",
+            ]
+        )
+    head = ["load", "error", "pattern centroid face (kinematic TCA)", "95 % extent", "p_H max / mean", "F_t p2p"]
+    head += ["TE p2p (kin.)", "efficiency", "play"]
+    return _table(head, rows) + "\n" + _source(name)
+
+
+def _tolerance_full(gear: str) -> str:
+    """The tolerance study's spread and the standardised coefficients of every error (docs/errors.md, 8)."""
+    import numpy as np
+
+    ef = _sweeps_module("errors_figures")
+    rows = ef._tol_rows(ROOT / "docs" / "sweeps" / f"{gear}_tolerance.csv", gear)
+    spread, fits = [], []
+    for key, label in ef.TOL_OUT:
+        v = np.array([r[key] for r in rows if r.get(key) is not None], float)
+        q = np.percentile(v, [5, 50, 95])
+        spread.append([label, *(f"{x:.4g}" for x in (v.mean(), v.std(), v.min(), q[0], q[1], q[2], v.max()))])
+        signed = key == "contact_pattern_centroid_face_mm"
+        beta, r2, _ = ef.regression(rows, key, ef.TOL_IN_SIGNED if signed else ef.TOL_IN)
+        top = max(beta, key=lambda p: abs(beta[p]))
+        cells = [f"**{b:+.2f}**" if p == top and r2 > 0.2 else f"{b:+.2f}" for p, b in beta.items()]
+        fits.append([label + (" (signed)" if signed else ""), f"{r2:.2f}", *cells])
+    text = _table(["output", "mean", "sd", "min", "5 %", "median", "95 %", "max"], spread) + "\n"
+    text += _table(["output", "R^2", *(lbl for _, lbl in ef.TOL_IN)], fits)
+    return text + "\n" + _sweep_source(f"{gear}_tolerance")
+
+
 TABLES: dict[str, Callable[[], str]] = {
     "torsional_seeds": torsional_seeds_table,
     "torsional_samples": torsional_samples_table,
     "contact_pattern": contact_pattern_table,
     "ci_seeds": ci_seeds_table,
     "errors_shaft_angle": errors_shaft_angle_table,
+    "errors_seat_motor": errors_seat_motor_table,
     "bench_full": bench_full_table,
     "bench_stability": bench_stability_table,
     "bench_flanks_vs_pieces": bench_flanks_vs_pieces_table,
@@ -650,6 +701,8 @@ TABLES: dict[str, Callable[[], str]] = {
     "sweep_seat_motor_friction": sweep_seat_motor_friction_table,
     "sweep_tolerance_screw_jack": sweep_tolerance_screw_jack_table,
     "sweep_tolerance_seat_motor": sweep_tolerance_seat_motor_table,
+    "tolerance_screw_jack": lambda: _tolerance_full("screw_jack"),
+    "tolerance_seat_motor": lambda: _tolerance_full("seat_motor"),
 }
 
 
