@@ -678,9 +678,32 @@ def _tolerance_full(gear: str) -> str:
     return text + "\n" + _sweep_source(f"{gear}_tolerance")
 
 
+def mesh_stiffness_seeds_table(name: str = "mesh_stiffness_seeds") -> str:
+    """k(theta) of the torsional level on each seed file (sweeps/mesh_stiffness_seeds.py)."""
+    rows = []
+    for seed, r in load(name)["runs"].items():
+        k, kp = r["mesh_stiffness_mean_n_per_m"], r["pair_stiffness_n_per_m"]
+        f = r.get("force_peak_full_band_hz")
+        fm = r.get("mesh_frequency_theory_hz")
+        rows.append(
+            [
+                f"{seed} (N = {r['mesh_stiffness_samples']})",
+                f"{k:.3g} N/m ({r['mesh_stiffness_min_n_per_m']:.3g}-{r['mesh_stiffness_max_n_per_m']:.3g})",
+                f"{kp:.3g} N/m ({r['mesh_stiffness_source']}): {k / kp:.2f}",
+                f"{r['teeth_in_contact_mean']:.2f}",
+                f"{r['contact_line_length_mean_mm']:.1f} mm on b2 = {r['face_width_mm']:.3g} mm",
+                "-" if f is None or not fm else f"{f:.3g} Hz = {f / fm:.1f} f_mesh",
+            ]
+        )
+    head = ["seed", "k_mesh mean (min-max)", "tooth-pair K (source): k_mesh / K", "teeth in contact"]
+    head += ["contact lines", "F_t full-band peak"]
+    return _table(head, rows) + "\n" + _source(name)
+
+
 TABLES: dict[str, Callable[[], str]] = {
     "torsional_seeds": torsional_seeds_table,
     "torsional_samples": torsional_samples_table,
+    "mesh_stiffness_seeds": mesh_stiffness_seeds_table,
     "contact_pattern": contact_pattern_table,
     "ci_seeds": ci_seeds_table,
     "errors_shaft_angle": errors_shaft_angle_table,
