@@ -752,10 +752,53 @@ def _errors_study_png(path: Path) -> None:
     mod.study(path)
 
 
+def _sweep_png(module: str, func: str, name: str, runs: tuple[str, ...]) -> Callable[[Path], None]:
+    """A chart of sweeps/MODULE.py's FUNC drawn from the csv files under docs/sweeps/ (the shipped studies'
+    records): the module reads RUNS/NAME/sweep.csv and writes IMG/NAME.png, both redirected to a temporary folder."""
+
+    def draw(path: Path) -> None:
+        import contextlib
+        import io
+        import shutil
+        import tempfile
+
+        mod = _sweeps_module(module)
+        with tempfile.TemporaryDirectory() as tmp:
+            t = Path(tmp)
+            for run in runs:
+                (t / "runs" / run).mkdir(parents=True)
+                shutil.copy(ROOT / "docs" / "sweeps" / f"{run}.csv", t / "runs" / run / "sweep.csv")
+            mod.IMG, mod.CSV_DIR = t / "img", t / "csv"
+            mod.IMG.mkdir()
+            with contextlib.redirect_stdout(io.StringIO()):
+                getattr(mod, func)(t / "runs")
+            shutil.copy(t / "img" / f"{name}.png", path)
+
+    return draw
+
+
 FIGURES: dict[str, Callable[[Path], None]] = {
     "bench_full": _bench_png("bench_full"),
     "bench_quick": _bench_png("bench_quick"),
     "errors_study": _errors_study_png,
+    "sweep_screw_jack": _sweep_png(
+        "figures",
+        "screw_jack",
+        "sweep_screw_jack",
+        ("screw_jack_stiffness", "screw_jack_stiffness_torsional", "screw_jack_speed", "screw_jack_speed_torsional"),
+    ),
+    "sweep_seat_motor_friction": _sweep_png(
+        "figures", "friction", "sweep_seat_motor_friction", ("seat_motor_friction",)
+    ),
+    "sweep_screw_jack_resonance": _sweep_png(
+        "figures", "resonance", "sweep_screw_jack_resonance", ("screw_jack_resonance",)
+    ),
+    "tolerance_screw_jack": _sweep_png(
+        "errors_figures", "tolerance", "tolerance_screw_jack", ("screw_jack_tolerance", "seat_motor_tolerance")
+    ),
+    "tolerance_seat_motor": _sweep_png(
+        "errors_figures", "tolerance", "tolerance_seat_motor", ("screw_jack_tolerance", "seat_motor_tolerance")
+    ),
 }
 
 
