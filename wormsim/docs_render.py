@@ -701,6 +701,14 @@ def mesh_stiffness_seeds_table(name: str = "mesh_stiffness_seeds") -> str:
     return _table(head, rows) + "\n" + _source(name)
 
 
+def cli_wall_table(name: str = "cli_wall") -> str:
+    """The whole CLI run's wall time (sweeps/measure_cli_wall.py), after a warm-up run."""
+    r = load(name)
+    p = r["provenance"]
+    row = [f"`{r['command']}`", " / ".join(f"{w:.3g} s" for w in r["wall_s"]), p["machine"]]
+    return _table(["command", "wall time of each run", "machine (load)"], [row]) + "\n" + _source(name)
+
+
 TABLES: dict[str, Callable[[], str]] = {
     "torsional_seeds": torsional_seeds_table,
     "torsional_samples": torsional_samples_table,
@@ -718,6 +726,7 @@ TABLES: dict[str, Callable[[], str]] = {
     "errors_study": errors_study_table,
     "wedge_seed000": wedge_seed000_table,
     "mass_scaling": mass_scaling_table,
+    "cli_wall": cli_wall_table,
     "piece_error": piece_error_table,
     "backlash_min": backlash_min_table,
     "sweep_screw_jack_stiffness": sweep_screw_jack_stiffness_table,
