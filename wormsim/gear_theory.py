@@ -62,6 +62,28 @@ def efficiency_self_locking(lead_angle_rad: float, rho_rad: float) -> float:
     return max(0.0, math.tan(rho_rad - lead_angle_rad) / math.tan(lead_angle_rad))
 
 
+def self_locking(lead_angle_rad: float, rho_rad: float) -> bool:
+    """A pair self-locks (the wheel cannot drive the worm) when the friction angle reaches the lead angle:
+    rho' >= gamma, where tan(gamma - rho') / tan(gamma) (efficiency_backward) falls to 0 (DIN 3975-2; Niemann /
+    Winter III, ch. 24: static self-locking with the friction at rest, dynamic with the friction while sliding)."""
+    return bool(rho_rad >= lead_angle_rad)
+
+
+def backdrive_keys(lead_angle_rad: float, rho_static_rad: float, rho_dynamic_rad: float) -> dict:
+    """The summary keys every level writes on back-driving (docs/outputs.md): `self_locking` (static: rho' at rest
+    >= gamma, the pair holds the load from standstill), `self_locking_dynamic` (rho' while sliding >= gamma: a
+    back-driven pair comes to rest), `efficiency_backdrive` = tan(gamma - rho') / tan(gamma) with the sliding
+    friction, 0 when it self-locks dynamically (DIN 3975-2), and the angles used."""
+    return {
+        "self_locking": self_locking(lead_angle_rad, rho_static_rad),
+        "self_locking_dynamic": self_locking(lead_angle_rad, rho_dynamic_rad),
+        "efficiency_backdrive": efficiency_backward(lead_angle_rad, rho_dynamic_rad),
+        "friction_angle_static_deg": math.degrees(rho_static_rad),
+        "friction_angle_dynamic_deg": math.degrees(rho_dynamic_rad),
+        "lead_angle_deg": math.degrees(lead_angle_rad),
+    }
+
+
 def efficiency_theory(
     lead_angle_rad: float, normal_pressure_angle_rad: float, mu: float, backdriving: bool = False
 ) -> float:

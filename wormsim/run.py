@@ -4,13 +4,14 @@ report.png, recording.rrd and summary.json atomically (wormsim.output)."""
 from __future__ import annotations
 
 import importlib
+import sys
 import time
 from pathlib import Path
 from types import ModuleType
 
 import numpy as np
 
-from wormsim import interrupt, prewarm
+from wormsim import interrupt, outputs, prewarm
 from wormsim.errors import ScenarioError, SimulationError
 from wormsim.output import ResultDir
 from wormsim.progress import Progress
@@ -107,5 +108,8 @@ def run_scenario(scenario: Scenario, out_dir: str | Path, progress: bool | None 
         "steps": res.steps,
         **res.summary,
     }
+    missing = outputs.undocumented(summary)
+    if missing:  # every key has its entry in wormsim.outputs (docs/outputs.md); never written silently
+        print(f"wormsim: summary keys without an entry in docs/outputs.md: {', '.join(missing)}", file=sys.stderr)
     rd.commit(summary)
     return summary
