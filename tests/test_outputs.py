@@ -17,6 +17,8 @@ MINIMAL = ROOT / "tests" / "assets" / "minimal_contact3d.yaml"
 SHORT = {
     # seed 000's MOV case as it is (0.3 s simulated, under a second)
     "wedge": (SCENARIOS / "mov_1.yaml", []),
+    # the wedge derived from the minimal gear (no wedge: block)
+    "wedge-derived": (MINIMAL, ["model=wedge", "simulation.duration_s=0.05"]),
     # the minimal gear at torsional, with an assembly error (the kinematic TCA's keys: backlash, kinematic TE)
     "torsional": (
         MINIMAL,
@@ -54,7 +56,7 @@ def test_no_level_writes_a_key_without_an_entry(runs, level):
     assert summary["status"] == "ok"
     assert outputs.undocumented(summary) == []
     for key in summary:  # the table's levels are right too: no key turns up at a level its entry does not name
-        assert level in outputs.KEYS[key].levels, key
+        assert summary["model"] in outputs.KEYS[key].levels, key
 
 
 @pytest.mark.parametrize("level", list(SHORT))
@@ -69,7 +71,7 @@ def test_every_level_reports_self_locking_and_backdriving(runs, level):
     assert s["self_locking_dynamic"] == (rho >= g)
 
 
-@pytest.mark.parametrize("level", ["torsional", "contact3d"])
+@pytest.mark.parametrize("level", ["wedge-derived", "torsional", "contact3d"])
 def test_summary_and_timeseries_forces_agree_in_sign_and_value(runs, level):
     """A forward run (right-hand worm driving at positive speed): the series' steady-window means are positive
     (docs/outputs.md, Force signs) and equal the summary's magnitudes."""

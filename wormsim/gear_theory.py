@@ -173,6 +173,18 @@ DEFAULT_DAMPING_RATIO = 0.1  # mesh damping when none is given, of one tooth pai
 MAX_DAMPING_RATIO = 0.1  # cap of the mesh damping (measured gear-mesh damping ratios: 0.03-0.17)
 
 
+def shaft_inertias_kg_m2(scenario: Scenario, r1_m: float, worm_length_m: float, r2_m: float, face_width_m: float):
+    """(I1, I2) in kg m^2: the worm a solid cylinder r1 x threaded length, the wheel a solid cylinder r2 x face width
+    (I = m r^2 / 2, densities from materials:), plus the driven-machine inertia load.inertia_kg_m2 on the loaded
+    shaft (rigid on it, as contact3d's joint armature). The torsional and the derived wedge level use it."""
+    mats = scenario.materials
+    m1 = mats.worm.density_kg_m3 * math.pi * r1_m**2 * worm_length_m
+    m2 = mats.wheel.density_kg_m3 * math.pi * r2_m**2 * face_width_m
+    j = scenario.load.inertia_kg_m2
+    j1, j2 = (j, 0.0) if scenario.load.on == "worm" else (0.0, j)
+    return 0.5 * m1 * r1_m**2 + j1, 0.5 * m2 * r2_m**2 + j2
+
+
 def effective_modulus_pa(materials: Materials) -> float:
     """E* with 1/E* = (1 - nu1^2)/E1 + (1 - nu2^2)/E2 (Hertz; seeds 001, 002)."""
     w, g = materials.worm, materials.wheel

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 ALL = ("wedge", "torsional", "contact3d")
 GEAR = ("torsional", "contact3d")
 W, T, C = ("wedge",), ("torsional",), ("contact3d",)
+GW = ALL  # the gear levels, and wedge when derived from gear: (no wedge: block)
 
 FORCE_SIGNS = {
     "tangential": "F_t2 along the wheel's positive sense of rotation (right-hand rule about the wheel axis +z): "
@@ -51,6 +52,12 @@ KEYS: dict[str, Key] = {
     "wall_time_s": Key("s", ALL, "wall-clock time of the simulation (without writing the files)"),
     "sim_time_s": Key("s", ALL, "simulated time reached"),
     "steps": Key("-", ALL, "integrator steps taken"),
+    "ignored_inputs": Key(
+        "list",
+        ALL,
+        "the blocks and keys given that this level does not use, one line each (also printed on stderr); empty "
+        "when every input is used",
+    ),
     "steady_window_s": Key(
         "s",
         ALL,
@@ -83,26 +90,26 @@ KEYS: dict[str, Key] = {
     ),
     "lead_angle_deg": Key("deg", ALL, "lead angle gamma at the worm reference diameter"),
     # ------------------------------------------------------------------ gear levels: drive
-    "ratio": Key("-", GEAR, "mean worm speed / mean wheel speed over the steady window (from the angle increments)"),
-    "ratio_theory": Key("-", GEAR, "z2 / z1"),
-    "tangential_force_mean_n": Key("N", GEAR, "F_t2 on the wheel, magnitude of its steady-window mean", _F),
-    "tangential_force_p2p_n": Key("N", GEAR, "peak-to-peak (max - min) of F_t2 over the steady window", _F),
-    "tangential_force_theory_n": Key("N", GEAR, "T_load / r2 (DIN 3975-2); null when the load is on the worm"),
-    "radial_force_mean_n": Key("N", GEAR, "F_r2 on the wheel, magnitude of its steady-window mean", _F),
-    "axial_force_mean_n": Key("N", GEAR, "F_a2 on the wheel, magnitude of its steady-window mean", _F),
-    "worm_torque_mean_nm": Key("N m", GEAR, "magnitude of the mean torque applied to the worm shaft (drive or load)"),
-    "wheel_torque_mean_nm": Key("N m", GEAR, "magnitude of the mean torque applied to the wheel shaft (drive or load)"),
-    "worm_speed_mean_rpm": Key("rpm", GEAR, "mean worm speed over the steady window (angle increment / time)"),
-    "wheel_speed_mean_rpm": Key("rpm", GEAR, "mean wheel speed over the steady window (angle increment / time)"),
-    "efficiency": Key("-", GEAR, "output power / input power, means over the steady window"),
+    "ratio": Key("-", GW, "mean worm speed / mean wheel speed over the steady window (from the angle increments)"),
+    "ratio_theory": Key("-", GW, "z2 / z1"),
+    "tangential_force_mean_n": Key("N", GW, "F_t2 on the wheel, magnitude of its steady-window mean", _F),
+    "tangential_force_p2p_n": Key("N", GW, "peak-to-peak (max - min) of F_t2 over the steady window", _F),
+    "tangential_force_theory_n": Key("N", GW, "T_load / r2 (DIN 3975-2); null when the load is on the worm"),
+    "radial_force_mean_n": Key("N", GW, "F_r2 on the wheel, magnitude of its steady-window mean", _F),
+    "axial_force_mean_n": Key("N", GW, "F_a2 on the wheel, magnitude of its steady-window mean", _F),
+    "worm_torque_mean_nm": Key("N m", GW, "magnitude of the mean torque applied to the worm shaft (drive or load)"),
+    "wheel_torque_mean_nm": Key("N m", GW, "magnitude of the mean torque applied to the wheel shaft (drive or load)"),
+    "worm_speed_mean_rpm": Key("rpm", GW, "mean worm speed over the steady window (angle increment / time)"),
+    "wheel_speed_mean_rpm": Key("rpm", GW, "mean wheel speed over the steady window (angle increment / time)"),
+    "efficiency": Key("-", GW, "output power / input power, means over the steady window"),
     "efficiency_theory": Key(
         "-",
-        GEAR,
+        GW,
         "tan(gamma) / tan(gamma + rho') (tan(gamma - rho') / tan(gamma) back-driving), rho' = atan(mu / cos "
         "alpha_n) with `friction_coefficient_mean` (DIN 3975-2)",
     ),
-    "friction_coefficient_mean": Key("-", GEAR, "mean Coulomb coefficient mu applied over the steady window"),
-    "friction": Key("text", GEAR, "the friction law used (constant, static -> dynamic, or a seed 000 group)"),
+    "friction_coefficient_mean": Key("-", GW, "mean Coulomb coefficient mu applied over the steady window"),
+    "friction": Key("text", GW, "the friction law used (constant, static -> dynamic, or a seed 000 group)"),
     "transmission_error_p2p_urad": Key(
         "urad", GEAR, "peak-to-peak of the loaded transmission error theta2 - theta1 z1 / z2 over the steady window"
     ),
@@ -115,7 +122,7 @@ KEYS: dict[str, Key] = {
         "dominant FFT peak of the meshing signal over the steady window (contact3d: F_t2 below half the "
         "piece-passing frequency; torsional: see mesh_frequency_source)",
     ),
-    "mesh_frequency_theory_hz": Key("Hz", GEAR, "z1 n1 / 60 with n1 the mean worm speed"),
+    "mesh_frequency_theory_hz": Key("Hz", GW, "z1 n1 / 60 with n1 the mean worm speed"),
     "mesh_frequency_resolution_hz": Key("Hz", GEAR, "FFT bin width 1 / T_window"),
     "mesh_frequency_source": Key("text", T, "the signal the torsional meshing frequency is taken from"),
     "mesh_frequency_search_max_hz": Key("Hz", C, "upper end of the meshing-frequency search"),
@@ -234,6 +241,11 @@ KEYS: dict[str, Key] = {
     "regimes": Key("list", W, "regimes visited in order: tractive, inverse, locked, unloaded"),
     "regime_timeline": Key("list", W, "[{regime, start_s, end_s}, ...]"),
     "monitor": Key("text", W, "regime monitor: three_regime or seed"),
+    "wedge_source": Key("text", W, "the wedge: block (seed 000) or derived from gear:, drive:, load:"),
+    "driving_mass_kg": Key("kg", W, "derived: m1 = I1 / r1^2, the worm shaft reduced to its pitch radius"),
+    "driven_mass_kg": Key("kg", W, "derived: m2 = I2 / r2^2, the wheel shaft (and load inertia) at its pitch radius"),
+    "motor_peak_force_n": Key("N", W, "derived: peak force of the Kloss curve standing in for the speed drive"),
+    "motor_synchronous_speed_m_s": Key("m/s", W, "derived: synchronous pitch-line speed of that curve"),
 }
 
 

@@ -16,7 +16,7 @@ from wormsim.errors import ScenarioError, SimulationError
 from wormsim.output import ResultDir
 from wormsim.progress import Progress
 from wormsim.result import Result
-from wormsim.scenario import Scenario
+from wormsim.scenario import Scenario, ignored_inputs
 from wormsim.validate import validate_geometry
 
 # fidelity level -> its package, which exports simulate(scenario, progress) -> Result, write_report(result, path) and
@@ -45,6 +45,9 @@ def run_scenario(scenario: Scenario, out_dir: str | Path, progress: bool | None 
     (wormsim.output).
     """
     validate_geometry(scenario)  # the checks `wormsim check` makes, before anything is written
+    ignored = ignored_inputs(scenario)
+    for line in ignored:  # never silence: what the level does not use is said (and kept in the summary)
+        print(f"wormsim: {line}", file=sys.stderr)
     mod = model_module(scenario.model)
     rd = ResultDir(out_dir)
     base = {"model": scenario.model, "scenario": scenario.name}
@@ -107,6 +110,7 @@ def run_scenario(scenario: Scenario, out_dir: str | Path, progress: bool | None 
         "sim_time_s": res.sim_time_s,
         "steps": res.steps,
         **res.summary,
+        "ignored_inputs": ignored,
     }
     missing = outputs.undocumented(summary)
     if missing:  # every key has its entry in wormsim.outputs (docs/outputs.md); never written silently

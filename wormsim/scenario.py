@@ -387,7 +387,7 @@ class Scenario(_Strict):
             )
         if self.model == "wedge":
             if self.wedge is None:
-                raise ValueError("model: wedge needs a wedge: block")
+                _derivable_wedge(self)
             if not self.errors.is_zero():
                 raise ValueError(
                     "errors: the wedge model has no gear geometry to displace; use model: torsional or "
@@ -401,6 +401,65 @@ class Scenario(_Strict):
             if self.drive.on == self.load.on:
                 raise ValueError("drive.on and load.on must name different shafts")
         return self
+
+
+def _derivable_wedge(sc: "Scenario") -> None:
+    """model: wedge without a wedge: block derives the reduced model from gear:, drive:, load: (wormsim.wedge.derive):
+    the worm driven at a speed, the load a torque on the wheel."""
+    if sc.gear is None or sc.drive is None:
+        missing = " and ".join(b for b, v in (("gear:", sc.gear), ("drive:", sc.drive)) if v is None)
+        raise ValueError(
+            f"model: wedge needs a wedge: block (seed 000's reduced model) or gear: and drive: blocks to derive it "
+            f"from; {missing} missing"
+        )
+    if sc.drive.on != "worm" or sc.drive.speed_rpm is None or sc.drive.speed_rpm <= 0:
+        raise ValueError(
+            f"model: wedge derived from gear: drives the worm at a speed (its motor is a Kloss curve on the worm); "
+            f"given drive.on = {sc.drive.on}"
+            + (f", drive.torque_nm = {sc.drive.torque_nm:g}" if sc.drive.torque_nm is not None else "")
+            + (f", drive.speed_rpm = {sc.drive.speed_rpm:g}" if sc.drive.speed_rpm is not None else "")
+            + "; allowed: drive.on worm with drive.speed_rpm > 0, or model torsional / contact3d"
+        )
+    if sc.load.on != "wheel":
+        raise ValueError("model: wedge derived from gear: loads the wheel; allowed: load.on wheel")
+
+
+def ignored_inputs(sc: Scenario) -> list[str]:
+    """The blocks and keys the user gave that the scenario's level does not use, one line each (wormsim.run prints
+    them on stderr and writes them to summary.json `ignored_inputs`)."""
+    given = sc.model_fields_set
+    out = []
+    if sc.model == "wedge" and sc.wedge is not None:
+        blocks = [b for b in ("gear", "drive", "load", "contact", "materials") if b in given]
+        if blocks:
+            out.append(
+                f"{', '.join(b + ':' for b in blocks)} ignored: the wedge: block gives the whole reduced model "
+                "(remove wedge: to derive it from gear:, drive:, load:)"
+            )
+    elif sc.model == "wedge":
+        rigid = [f"contact.{k}" for k in WEDGE_IGNORES_CONTACT if k in sc.contact.model_fields_set]
+        if sc.gear is not None and "backlash_mm" in sc.gear.model_fields_set:
+            rigid.append("gear.backlash_mm")
+        if rigid:
+            out.append(f"{', '.join(rigid)} ignored: the wedge is rigid and without backlash")
+        if sc.drive is not None and sc.drive.ramp_s > 0:
+            out.append(
+                f"drive.ramp_s = {sc.drive.ramp_s:g} ignored: the derived wedge starts its Kloss motor curve at once"
+            )
+    elif sc.wedge is not None:
+        out.append(f"wedge: ignored: model {sc.model} uses gear:, drive:, load:")
+    return out
+
+
+WEDGE_IGNORES_CONTACT = (
+    "stiffness_n_per_m",
+    "exponent",
+    "damping_n_s_per_m",
+    "penetration_depth_m",
+    "geometry",
+    "slices",
+    "flank_contacts",
+)
 
 
 # ----------------------------------------------------------------------------- loading
