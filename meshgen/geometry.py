@@ -206,9 +206,16 @@ def derive(gear: GearData) -> GearGeometry:
     r_a1, r_f1 = r1 + h_a, r1 - h_f
     r_a2, r_f2 = r2 + h_a, r2 - h_f
     if r_f1 <= 0.2 * r1:
+        q_min = 2.5 * gear.dedendum_coef
+        given = (
+            f"gear.diameter_quotient = {q:g}: allowed diameter_quotient >= {q_min:.1f}"
+            if gear.lead_angle_deg is None
+            else f"gear.lead_angle_deg = {gear.lead_angle_deg:g} (q = z1 / tan(gamma) = {q:.2f}): allowed "
+            f"lead_angle_deg <= {math.atan(z1 / q_min) / DEG:.3g} for {z1} start(s)"
+        )
         raise GeometryError(
-            f"gear: worm root radius {r_f1 / MM:.3f} mm is too small for reference radius {r1 / MM:.3f} mm "
-            f"(diameter quotient q = {q:.2f}); use a lead angle giving q >= {2.5 * gear.dedendum_coef:.1f}"
+            f"{given} (the worm root radius {r_f1 / MM:.3f} mm is too small for the reference radius {r1 / MM:.3f} mm "
+            f"with dedendum_coef {gear.dedendum_coef:g})"
         )
     r_e2 = r_a2 + 0.5 * m_x
     b2 = gear.face_width_mm * MM if gear.face_width_mm is not None else (0.75 if z1 <= 3 else 0.67) * 2 * r_a1

@@ -16,6 +16,7 @@ from wormsim import scenario as S
 BLOCKS = [
     ("(top level)", S.Scenario),
     ("gear", S.Gear),
+    ("materials", S.Materials),
     ("materials.worm / materials.wheel", S.Material),
     ("contact", S.Contact),
     ("drive", S.Drive),
