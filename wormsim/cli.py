@@ -1,4 +1,4 @@
-"""`wormsim` console script (INTERFACE.md): run, mesh, model, bench, sweep, schema, check.
+"""`wormsim` console script (INTERFACE.md): run, mesh, model, bench, sweep, schema, check, init.
 
 Exit codes: 0 ok, 2 invalid input or an output path that cannot be written (the message names the field or
 the path), 3 the simulation failed (with a diagnosis), 130 / 143 interrupted by SIGINT (Ctrl-C) / SIGTERM
@@ -94,6 +94,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", help="write to this file instead of stdout")
     p = sub.add_parser("check", help="validate a scenario and print it with defaults filled in")
     _add_scenario_args(p, out_required=False)
+    p = sub.add_parser("init", help="write a commented scenario template to fill in (default my_gear.yaml)")
+    p.add_argument("path", nargs="?", default="my_gear.yaml", help="the new scenario file")
     return ap
 
 
@@ -193,6 +195,14 @@ def _cmd_check(args) -> int:
     return EXIT_OK
 
 
+def _cmd_init(args) -> int:
+    from wormsim.init_cmd import write_template
+
+    path = write_template(args.path)
+    print(f"wrote {path}: fill in your gear, then: wormsim run {path} --out out/{path.stem}")
+    return EXIT_OK
+
+
 COMMANDS = {
     "run": _cmd_run,
     "mesh": _cmd_mesh,
@@ -201,6 +211,7 @@ COMMANDS = {
     "sweep": _cmd_sweep,
     "schema": _cmd_schema,
     "check": _cmd_check,
+    "init": _cmd_init,
 }
 
 

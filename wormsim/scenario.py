@@ -22,7 +22,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_valida
 
 
 class ScenarioError(ValueError):
-    """Invalid input: the message names the field, the value and what is allowed (exit code 2)."""
+    """Invalid input: the message names the field, the value and what is allowed (exit code 2 at the CLI)."""
 
 
 class _Strict(BaseModel):
@@ -392,6 +392,14 @@ class Errors(_Strict):
 
 
 class Scenario(_Strict):
+    """A validated scenario (the YAML file as Python objects; units in the key names, docs/scenario.md).
+
+    Blocks: `gear`, `materials`, `contact`, `drive`, `load`, `simulation`, `errors` (gear levels) and `wedge` (seed
+    000's reduced model). Build one with load_scenario(path) or Scenario.model_validate(dict); change one with
+    attribute assignment (validated) or `sc.model_copy(update=...)` (not validated: prefer load_scenario's
+    overrides).
+    """
+
     name: str = Field(..., pattern=r"^[a-z0-9_-]+$", description="case name, used in outputs")
     description: str = Field("", description="free text")
     model: Literal["contact3d", "torsional", "wedge"] = Field(
@@ -773,6 +781,21 @@ def scenario_from_dict(data: Any, source: str = "scenario", overrides: list[str]
 
 
 def load_scenario(path: str | Path, overrides: list[str] | None = None) -> Scenario:
+    """Read and validate a scenario YAML file (docs/scenario.md has every key, its unit and default).
+
+    Args:
+        path: the scenario file (YAML, UTF-8, at most 256 kB).
+        overrides: `--set` style "dotted.key=VALUE" strings applied before validation, e.g.
+            ["model=torsional", "gear.wheel_teeth=41", "simulation.duration_s=0.1"]; VALUE is read as YAML.
+
+    Returns:
+        Scenario: the validated model; its blocks validate on assignment (`sc.gear.axial_module_mm = -3` raises
+        ScenarioError and leaves the block as it was).
+
+    Raises:
+        ScenarioError: the file is missing or unreadable, or a value is invalid; the message names the field, the
+            value and what is allowed, one line per problem (exit 2 at the CLI).
+    """
     path = Path(path)
     if not path.is_file():
         raise ScenarioError(f"{path}: no such scenario file")
