@@ -89,6 +89,19 @@ KEYS: dict[str, Key] = {
         "deg", ALL, "rho' while sliding used for `self_locking_dynamic` and `efficiency_backdrive`"
     ),
     "lead_angle_deg": Key("deg", ALL, "lead angle gamma at the worm reference diameter"),
+    "backdrive_measured_self_locking": Key(
+        "bool",
+        C,
+        "simulation.backdrive_probe: the wheel, speed-driven at the run's wheel speed, could not turn the worm "
+        "(loaded with T2 efficiency_backdrive / ratio): the lock guard stopped it, or the worm turned below half "
+        "the wheel command times the ratio",
+    ),
+    "backdrive_measured_efficiency": Key(
+        "-", C, "simulation.backdrive_probe: worm power out / wheel power in of the back-driven run (0 when locked)"
+    ),
+    "backdrive_measured_message": Key("text", C, "simulation.backdrive_probe: the lock diagnosis or the worm speed"),
+    "backdrive_probe_wheel_speed_rpm": Key("rpm", C, "simulation.backdrive_probe: the wheel's speed command"),
+    "backdrive_probe_worm_torque_nm": Key("N m", C, "simulation.backdrive_probe: the worm's load torque"),
     # ------------------------------------------------------------------ gear levels: drive
     "ratio": Key("-", GW, "mean worm speed / mean wheel speed over the steady window (from the angle increments)"),
     "ratio_theory": Key("-", GW, "z2 / z1"),

@@ -249,6 +249,13 @@ class Simulation(_Strict):
     mesh_stiffness_samples: int = Field(
         64, ge=8, le=4096, description="torsional: k(theta) samples per mesh cycle (tooth contact analysis)"
     )
+    backdrive_probe: bool = Field(
+        False,
+        description=(
+            "contact3d, worm driving: after the run, a second run of duration_s with the wheel speed-driven and the "
+            "worm loaded, measuring self-locking and the back-driving efficiency (summary backdrive_measured_*)"
+        ),
+    )
     mass_scaling: Annotated[float, Field(ge=1, le=1e8)] | Literal["auto"] = Field(
         1.0,
         description=(
@@ -429,6 +436,14 @@ class Scenario(_Strict):
                 "simulation.speculative = true: MuJoCo's speculative contacts act on its collision of convex pieces, "
                 "not on the contacts found on the exact flanks; allowed: simulation.speculative = false with "
                 "contact.geometry flanks, or contact.geometry pieces"
+            )
+        if self.simulation.backdrive_probe and (
+            self.model != "contact3d" or self.drive is None or self.drive.on != "worm"
+        ):
+            raise ValueError(
+                "simulation.backdrive_probe = true: measures back-driving after a forward contact3d run; allowed: "
+                "model contact3d with drive.on worm (a run with drive.on wheel measures it itself; torsional and "
+                "wedge state it from rho' and gamma)"
             )
         if self.model == "wedge":
             if self.wedge is None:

@@ -534,4 +534,9 @@ def simulate(scenario: Scenario, progress=None) -> Result:
     bm = build_model(scenario)
     if progress is not None and scenario.simulation.mass_scaling != 1:
         progress.note(mass_scaling.note(bm.meta["mass_scaling_check"], scenario.simulation.mass_scaling, bm.timestep_s))
-    return run_model(bm, scenario, progress)
+    res = run_model(bm, scenario, progress)
+    if scenario.simulation.backdrive_probe:  # a second run with the wheel driving (wormsim.contact3d.backdrive)
+        from wormsim.contact3d.backdrive import probe
+
+        res.summary.update(probe(scenario, res.summary, simulate))
+    return res
