@@ -82,3 +82,21 @@ def test_summary_and_timeseries_forces_agree_in_sign_and_value(runs, level):
         mean = float(np.mean(S[f"{comp}_force_n"][sl]))
         assert mean > 0, (comp, mean)
         assert mean == pytest.approx(s[f"{comp}_force_mean_n"], rel=1e-9), comp
+
+
+def test_a_left_hand_worm_gives_the_same_force_signs_at_torsional_and_contact3d():
+    """Left hand: the wheel turns negative, F_t2 < 0 along the wheel's positive sense, F_a2 with F_t2's sign
+    (F_a2 = F_t2 tan(gamma + rho'), DIN 3975-2), F_r2 separating (> 0): the same signs at both levels."""
+    from wormsim.run import simulate
+
+    means = {}
+    for level, sets in (
+        ("torsional", ["simulation.duration_s=0.03"]),
+        ("contact3d", ["simulation.duration_s=0.015", "simulation.resolution=coarse"]),
+    ):
+        r = simulate(load_scenario(MINIMAL, ["gear.hand=left", f"model={level}", *sets]))
+        t0, t1 = r.summary["steady_window_s"]
+        sl = (r.series["t_s"] >= t0) & (r.series["t_s"] <= t1)
+        means[level] = [float(np.mean(r.series[f"{c}_force_n"][sl])) for c in ("tangential", "radial", "axial")]
+    for level, (ft, fr, fa) in means.items():
+        assert ft < 0 and fr > 0 and fa < 0, (level, ft, fr, fa)
