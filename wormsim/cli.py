@@ -23,7 +23,7 @@ import yaml
 from wormsim import interrupt
 from wormsim.errors import ScenarioError, SimulationError
 from wormsim.run import run_scenario
-from wormsim.scenario import json_schema, load_scenario
+from wormsim.scenario import ignored_inputs, json_schema, load_scenario
 
 EXIT_OK, EXIT_INTERNAL, EXIT_INPUT, EXIT_SIM = 0, 1, 2, 3
 
@@ -191,6 +191,8 @@ def _cmd_check(args) -> int:
 
     sc = load_scenario(args.scenario, args.overrides)
     validate_geometry(sc)  # the same geometric checks as mesh and run
+    for line in ignored_inputs(sc):
+        print(f"wormsim: {line}", file=sys.stderr)
     print(yaml.safe_dump(sc.model_dump(mode="json", exclude_none=True), sort_keys=False), end="")
     return EXIT_OK
 
