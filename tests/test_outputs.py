@@ -57,6 +57,9 @@ def test_no_level_writes_a_key_without_an_entry(runs, level):
     assert outputs.undocumented(summary) == []
     for key in summary:  # the table's levels are right too: no key turns up at a level its entry does not name
         assert summary["model"] in outputs.KEYS[key].levels, key
+    series = runs[level][1]
+    for key in series:  # the time series too
+        assert key in outputs.SERIES and summary["model"] in outputs.SERIES[key][0], key
 
 
 @pytest.mark.parametrize("level", list(SHORT))

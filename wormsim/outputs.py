@@ -262,6 +262,50 @@ KEYS: dict[str, Key] = {
 }
 
 
+# the time series (timeseries.npz, the recording's /series/): name -> (levels, meaning); the unit is in the name
+SERIES: dict[str, tuple[tuple[str, ...], str]] = {
+    "t_s": (ALL, "sample time; every series is sampled on it"),
+    "worm_angle_rad": (GEAR, "worm rotation about its axis"),
+    "wheel_angle_rad": (GEAR, "wheel rotation about its axis"),
+    "worm_speed_rpm": (ALL, "worm speed (wedge derived: x1' / r1)"),
+    "wheel_speed_rpm": (ALL, "wheel speed (wedge derived: x2' / r2)"),
+    "worm_torque_nm": (GEAR, "torque applied to the worm shaft by its drive or load (signed about its axis)"),
+    "wheel_torque_nm": (GEAR, "torque applied to the wheel shaft by its drive or load (signed about its axis)"),
+    "drive_command": (GEAR, "the drive's command: speed in rad/s or torque in N m, after the STEP ramp"),
+    "tangential_force_n": (ALL, "F_t2 on the wheel (Force signs)"),
+    "radial_force_n": (ALL, "F_r2 on the wheel (Force signs; wedge derived: from DIN 3975-2)"),
+    "axial_force_n": (ALL, "F_a2 on the wheel (Force signs)"),
+    "friction_coefficient": (ALL, "Coulomb coefficient mu applied (wedge derived: tan(rho') cos(alpha_n))"),
+    "transmission_error_rad": (GEAR, "theta2 - hand theta1 z1 / z2 (loaded)"),
+    "teeth_in_contact": (GEAR, "wheel teeth in contact"),
+    "contacts": (C, "MuJoCo contacts between worm and wheel (mean over the sample's steps)"),
+    "max_penetration_m": (C, "largest contact penetration"),
+    "wheel_contact_torque_nm": (C, "contact torque on the wheel about its axis"),
+    "worm_power_w": (C, "power into the worm shaft from its drive or load (mean over the sample's steps)"),
+    "wheel_power_w": (C, "power into the wheel shaft from its drive or load (mean over the sample's steps)"),
+    "tangential_force_abs_max_n": (C, "largest |F_t2| within the sample's steps"),
+    "radial_force_line_of_centres_n": (C, "each contact's force turned onto the line of centres, summed (Force signs)"),
+    "worm_contact_radius_m": (C, "force-weighted radius of the contacts on the worm"),
+    "efficiency_theory_at_contact_radius": (C, "efficiency_theory with the lead angle at the contact radius"),
+    "mesh_torque_worm_nm": (T, "torque the mesh puts on the worm"),
+    "mesh_deflection_m": (T, "mesh deflection along the line of action"),
+    "mesh_stiffness_n_per_m": (T, "mesh stiffness k(theta) used"),
+    "transmission_error_kinematic_rad": (T, "unloaded transmission error of the displaced flanks (with errors:)"),
+    "x1_m": (W, "worm pitch-line travel"),
+    "v1_m_s": (W, "worm pitch-line speed x1'"),
+    "a1_m_s2": (W, "worm pitch-line acceleration x1''"),
+    "x2_m": (W, "wheel pitch-line travel x1 tan(gamma)"),
+    "v2_m_s": (W, "wheel pitch-line speed"),
+    "vs_m_s": (W, "sliding speed x1' / cos(gamma)"),
+    "F1_n": (W, "motor force on body 1 (worm)"),
+    "F2_n": (W, "load force on body 2 (wheel); negative resists"),
+    "S1_n": (W, "internal reduced force, worm side (= F_a2)"),
+    "S2_n": (W, "internal reduced force, wheel side (= -F_t2)"),
+    "rho_deg": (W, "friction angle applied"),
+    "regime_code": (W, "0 locked, 1 tractive, 2 inverse, 3 unloaded"),
+}
+
+
 def undocumented(summary: dict) -> list[str]:
     """The summary's keys without an entry in KEYS (wormsim.run names them on stderr; a test keeps this empty)."""
     return [k for k in summary if k not in KEYS]
@@ -288,6 +332,18 @@ def markdown() -> str:
         lv = "".join(x[0].upper() for x in ALL if x in k.levels)
         sign = f" Sign: {k.sign}." if k.sign else ""
         lines.append(f"| `{name}` | {k.unit} | {lv} | {k.meaning}.{sign} |")
+    lines += [
+        "",
+        "## Time series (timeseries.npz, recording.rrd /series/)",
+        "",
+        "Arrays sampled on `t_s`; the unit is in the name.",
+        "",
+        "| series | levels | meaning |",
+        "| --- | --- | --- |",
+    ]
+    for name, (levels, meaning) in SERIES.items():
+        lv = "".join(x[0].upper() for x in ALL if x in levels)
+        lines.append(f"| `{name}` | {lv} | {meaning}. |")
     return "\n".join(lines) + "\n"
 
 
