@@ -314,7 +314,7 @@ def undocumented(summary: dict) -> list[str]:
 def markdown() -> str:
     """docs/outputs.md."""
     lines = [
-        "# Outputs: summary.json keys",
+        "# Outputs: summary.json keys and time series",
         "",
         "Generated from `wormsim/outputs.py` (`python -m wormsim.outputs > docs/outputs.md`); do not edit by hand.",
         "Every run writes `DIR/summary.json`, `DIR/timeseries.npz` (arrays on `t_s`, units in the names), "
