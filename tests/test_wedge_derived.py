@@ -79,3 +79,12 @@ def test_derived_wedge_refuses_a_drive_it_cannot_model(tmp_path, capsys, sets, n
     assert cli.main(argv + [x for s in sets for x in ("--set", s)]) == 2
     err = capsys.readouterr().err
     assert names in err and "allowed: drive.on worm with drive.speed_rpm > 0" in err
+
+
+def test_an_assisting_load_is_held_at_the_drive_speed_by_a_braking_motor():
+    s = simulate(load_scenario(DEMO, ["model=wedge", "load.torque_nm=-5"])).summary
+    assert s["worm_speed_mean_rpm"] == pytest.approx(1800.0, rel=1e-3)
+    assert s["regimes"][-1] == "inverse"
+    # the worm brakes with F_t1 = F_t2 tan(gamma - rho') (DIN 3975-2, back-driving), rho' = atan(0.05 / cos 10 deg)
+    g, rho = math.radians(s["lead_angle_deg"]), math.radians(s["friction_angle_dynamic_deg"])
+    assert s["S1_steady_n"] == pytest.approx(-s["tangential_force_mean_n"] * math.tan(g - rho), rel=1e-4)

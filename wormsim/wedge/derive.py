@@ -11,7 +11,8 @@ From gear:, materials:, contact:, drive:, load: (docs/wedge.md, "Derived from ge
   atan(mu));
 - load: F2 = -load.torque_nm / r2 on the wheel, with load.start_s / load.ramp_s (STEP);
 - drive: a Kloss motor curve on the worm (seed 000's motor) through the working point: the worm's pitch-line speed
-  v = n1 r1 (drive.speed_rpm) at the force the load needs there, F1 = |F2| tan(gamma + rho'), with a peak force
+  v = n1 r1 (drive.speed_rpm) at the force the load needs there, F1 = |F2| tan(gamma + rho') (an assisting load:
+  F1 = -F2 tan(gamma - rho'), the motor braking), with a peak force
   KLOSS_PEAK_FACTOR x that force (plus what runs the masses up in RUNUP_S) and a peak-force speed SLIP_SPAN below
   the synchronous speed. The speed servo of the gear levels becomes this stiff speed-force curve: the steady speed
   lands on drive.speed_rpm at the steady friction. drive.ramp_s is not used (the run says so).
@@ -49,10 +50,13 @@ def params_from_gear(scenario) -> tuple[WedgeParams, dict]:
     mu = float(friction_coefficient(scenario.contact, v / math.cos(gamma)))
     rho = gt.virtual_friction_angle_rad(mu, g.alpha_n)
     F2 = -scenario.load.torque_nm / g.r2
-    f_work = abs(F2) * math.tan(gamma + rho) if F2 < 0 else 0.0
-    f_peak = KLOSS_PEAK_FACTOR * f_work + (m1 + m2 * tg * tg) * v / RUNUP_S
-    # 2 Fmax V / (1 + V^2) = f_work: the small root V_w, then V0 - V_w (V0 - Vmax) = v
-    V_w = (f_peak - math.sqrt(f_peak**2 - f_work**2)) / f_work if f_work > 0 else 0.0
+    # the worm force that holds the load at the working speed (seed 000's psi): a resisting load (F2 < 0) slides
+    # tractive, F1 = -F2 tan(gamma + rho'); an assisting one (F2 > 0) inverse, F1 = -F2 tan(gamma - rho') (< 0: the
+    # motor brakes, in its generator range above the synchronous speed)
+    f_work = -F2 * math.tan(gamma + rho) if F2 < 0 else -F2 * math.tan(gamma - rho)
+    f_peak = KLOSS_PEAK_FACTOR * abs(f_work) + (m1 + m2 * tg * tg) * v / RUNUP_S
+    # 2 Fmax V / (1 + V^2) = f_work: the root of smaller |V|, then V0 - V_w (V0 - Vmax) = v
+    V_w = (f_peak - math.sqrt(f_peak**2 - f_work**2)) / f_work if f_work != 0 else 0.0
     span = SLIP_SPAN * v
     v_sync = v + V_w * span
     p = WedgeParams(
@@ -64,7 +68,7 @@ def params_from_gear(scenario) -> tuple[WedgeParams, dict]:
         peak_force_n=f_peak,
         sync_speed_m_s=v_sync,
         peak_speed_m_s=v_sync - span,
-        nominal_force_n=f_work if f_work > 0 else f_peak,
+        nominal_force_n=abs(f_work) if f_work != 0 else f_peak,
         nominal_speed_m_s=v,
         load_initial_n=0.0,
         load_final_n=F2,
