@@ -220,9 +220,15 @@ def derive(gear: GearData) -> GearGeometry:
     r_e2 = r_a2 + 0.5 * m_x
     b2 = gear.face_width_mm * MM if gear.face_width_mm is not None else (0.75 if z1 <= 3 else 0.67) * 2 * r_a1
     if b2 >= 2 * (a - r_f1) * 0.999 or b2 > 2 * r_a1 * 1.2:
+        given = (
+            f"gear.face_width_mm = {b2 / MM:.3f}"
+            if gear.face_width_mm is not None
+            else f"gear.face_width_mm not given: its default {b2 / MM:.3f} mm (DIN 3975 guide, 0.75 worm tip diameter)"
+        )
         raise GeometryError(
-            f"gear.face_width_mm = {b2 / MM:.3f}: too wide for this worm; allowed up to {1.2 * 2 * r_a1 / MM:.3f} mm "
-            f"(1.2 x worm tip diameter)"
+            f"{given}: too wide for this worm; allowed up to "
+            f"{min(1.2 * 2 * r_a1, 2 * (a - r_f1) * 0.999) / MM:.3f} mm (1.2 x worm tip diameter, and within the "
+            f"wheel's root)"
         )
     # the wheel root torus (tube radius a - r_f2) rises towards the face edges; the tooth must keep at least
     # 0.1 of its full depth h_a + h_f under the rim radius r_e2 at zeta = +-b2/2

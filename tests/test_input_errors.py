@@ -88,3 +88,9 @@ def test_objects_validate_on_assignment():
         sc.simulation.duration = 1.0
     sc.gear.axial_module_mm = 3  # a valid value is taken
     assert sc.gear.axial_module_mm == 3
+
+
+def test_a_refused_default_names_the_key_left_out(tmp_path, capsys):
+    # z2 10, q 40: the default face width 0.75 d_a1 = 0.75 x 84 mm = 63 mm exceeds the small wheel's root (24.8 mm)
+    err = run_err(tmp_path, capsys, "gear.wheel_teeth=10", "gear.diameter_quotient=40")
+    assert "gear.face_width_mm not given: its default 63.000 mm" in err and "allowed up to 24.775 mm" in err
