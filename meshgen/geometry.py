@@ -223,7 +223,8 @@ def derive(gear: GearData) -> GearGeometry:
         given = (
             f"gear.face_width_mm = {b2 / MM:.3f}"
             if gear.face_width_mm is not None
-            else f"gear.face_width_mm not given: its default {b2 / MM:.3f} mm (DIN 3975 guide, 0.75 worm tip diameter)"
+            else f"gear.face_width_mm not given: its default {b2 / MM:.3f} mm ({0.75 if z1 <= 3 else 0.67:g} x worm "
+            "tip diameter, DIN 3975 guide)"
         )
         raise GeometryError(
             f"{given}: too wide for this worm; allowed up to "
