@@ -88,3 +88,21 @@ def test_an_assisting_load_is_held_at_the_drive_speed_by_a_braking_motor():
     # the worm brakes with F_t1 = F_t2 tan(gamma - rho') (DIN 3975-2, back-driving), rho' = atan(0.05 / cos 10 deg)
     g, rho = math.radians(s["lead_angle_deg"]), math.radians(s["friction_angle_dynamic_deg"])
     assert s["S1_steady_n"] == pytest.approx(-s["tangential_force_mean_n"] * math.tan(g - rho), rel=1e-4)
+
+
+@pytest.mark.parametrize(
+    "model, sets, line",
+    [
+        (
+            "torsional",
+            ["contact.slices=16", "simulation.resolution=fine"],
+            "contact.slices, simulation.resolution ignored: used by model contact3d only",
+        ),
+        ("contact3d", ["simulation.mesh_stiffness_samples=32"], "simulation.mesh_stiffness_samples ignored"),
+        ("wedge", ["contact.slices=16"], "contact.slices ignored: the wedge is rigid and without backlash"),
+    ],
+)
+def test_keys_a_level_does_not_use_are_named(model, sets, line):
+    lines = ignored_inputs(load_scenario(MINIMAL, [f"model={model}", *sets]))
+    assert any(x.startswith(line) for x in lines), lines
+    assert len(lines) == 1, lines

@@ -72,8 +72,6 @@ def run_scenario(scenario: Scenario, out_dir: str | Path, progress: bool | None 
     """
     validate_geometry(scenario)  # the checks `wormsim check` makes, before anything is written
     ignored = ignored_inputs(scenario)
-    for line in ignored:  # never silence: what the level does not use is said (and kept in the summary)
-        print(f"wormsim: {line}", file=sys.stderr)
     mod = model_module(scenario.model)
     rd = ResultDir(out_dir)
     base = {"model": scenario.model, "scenario": scenario.name}
@@ -142,4 +140,7 @@ def run_scenario(scenario: Scenario, out_dir: str | Path, progress: bool | None 
     if missing:  # every key has its entry in wormsim.outputs (docs/outputs.md); never written silently
         print(f"wormsim: summary keys without an entry in docs/outputs.md: {', '.join(missing)}", file=sys.stderr)
     rd.commit(summary)
+    # never silence: what the level does not use is said after the run (a failed run prints its error alone)
+    for line in ignored:
+        print(f"wormsim: {line}", file=sys.stderr)
     return summary

@@ -508,7 +508,30 @@ def ignored_inputs(sc: Scenario) -> list[str]:
             )
     elif sc.wedge is not None:
         out.append(f"wedge: ignored: model {sc.model} uses gear:, drive:, load:")
+    if sc.model != "wedge" or sc.wedge is None:
+        by_level: dict[tuple[str, ...], list[str]] = {}
+        for k, levels in LEVEL_KEYS.items():
+            block, key = k.split(".")
+            reported = sc.model == "wedge" and block == "contact"  # named above with the rigid wedge
+            if sc.model not in levels and not reported and key in getattr(sc, block).model_fields_set:
+                by_level.setdefault(levels, []).append(k)
+        for levels, keys in by_level.items():
+            out.append(f"{', '.join(keys)} ignored: used by model {' / '.join(levels)} only")
     return out
+
+
+# keys only some levels use (given at another level, the run names them)
+LEVEL_KEYS: dict[str, tuple[str, ...]] = {
+    "contact.geometry": ("contact3d",),
+    "contact.slices": ("contact3d",),
+    "contact.flank_contacts": ("contact3d",),
+    "contact.exponent": ("contact3d",),
+    "simulation.resolution": ("contact3d",),
+    "simulation.integrator": ("contact3d",),
+    "simulation.speculative": ("contact3d",),
+    "simulation.record_every": ("contact3d",),
+    "simulation.mesh_stiffness_samples": ("torsional",),
+}
 
 
 WEDGE_IGNORES_CONTACT = (
