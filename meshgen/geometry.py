@@ -206,16 +206,30 @@ def derive(gear: GearData) -> GearGeometry:
     r_a1, r_f1 = r1 + h_a, r1 - h_f
     r_a2, r_f2 = r2 + h_a, r2 - h_f
     if r_f1 <= 0.2 * r1:
+        q_min = 2.5 * gear.dedendum_coef
+        given = (
+            f"gear.diameter_quotient = {q:g}: allowed diameter_quotient >= {q_min:.1f}"
+            if gear.lead_angle_deg is None
+            else f"gear.lead_angle_deg = {gear.lead_angle_deg:g} (q = z1 / tan(gamma) = {q:.2f}): allowed "
+            f"lead_angle_deg <= {math.atan(z1 / q_min) / DEG:.3g} for {z1} start(s)"
+        )
         raise GeometryError(
-            f"gear: worm root radius {r_f1 / MM:.3f} mm is too small for reference radius {r1 / MM:.3f} mm "
-            f"(diameter quotient q = {q:.2f}); use a lead angle giving q >= {2.5 * gear.dedendum_coef:.1f}"
+            f"{given} (the worm root radius {r_f1 / MM:.3f} mm is too small for the reference radius {r1 / MM:.3f} mm "
+            f"with dedendum_coef {gear.dedendum_coef:g})"
         )
     r_e2 = r_a2 + 0.5 * m_x
     b2 = gear.face_width_mm * MM if gear.face_width_mm is not None else (0.75 if z1 <= 3 else 0.67) * 2 * r_a1
     if b2 >= 2 * (a - r_f1) * 0.999 or b2 > 2 * r_a1 * 1.2:
+        given = (
+            f"gear.face_width_mm = {b2 / MM:.3f}"
+            if gear.face_width_mm is not None
+            else f"gear.face_width_mm not given: its default {b2 / MM:.3f} mm ({0.75 if z1 <= 3 else 0.67:g} x worm "
+            "tip diameter, DIN 3975 guide)"
+        )
         raise GeometryError(
-            f"gear.face_width_mm = {b2 / MM:.3f}: too wide for this worm; allowed up to {1.2 * 2 * r_a1 / MM:.3f} mm "
-            f"(1.2 x worm tip diameter)"
+            f"{given}: too wide for this worm; allowed up to "
+            f"{min(1.2 * 2 * r_a1, 2 * (a - r_f1) * 0.999) / MM:.3f} mm (1.2 x worm tip diameter, and within the "
+            f"wheel's root)"
         )
     # the wheel root torus (tube radius a - r_f2) rises towards the face edges; the tooth must keep at least
     # 0.1 of its full depth h_a + h_f under the rim radius r_e2 at zeta = +-b2/2

@@ -2,9 +2,16 @@
 
 Data flows one way: scenario -> geometry (meshgen) -> model -> simulation -> metrics -> recording/report.
 
-    from wormsim import load_scenario, run_scenario
-    summary = run_scenario(load_scenario("scenarios/mov_1.yaml"), "out/mov_1")    # writes DIR, returns the summary
-    result = simulate(load_scenario("scenarios/mov_1.yaml"))                      # no files: a Result
+    import wormsim
+
+    sc = wormsim.load_scenario("my_gear.yaml", ["model=torsional"])  # validated; ScenarioError names a bad field
+    sc.load.torque_nm = 80  # validated on assignment
+    res = wormsim.simulate(sc)  # no files: a Result
+    res.summary["efficiency"], res.summary["self_locking"]  # docs/outputs.md: every key, unit, sign
+    res.series["t_s"], res.series["tangential_force_n"]  # numpy arrays on t_s
+    summary = wormsim.run_scenario(sc, "out/my_gear")  # writes summary.json, timeseries.npz, ...
+
+The reference: docs/api.md (generated from these docstrings), docs/scenario.md, docs/outputs.md.
 """
 
 from wormsim.errors import ScenarioError, SimulationError

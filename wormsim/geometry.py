@@ -3,6 +3,7 @@ turned into ScenarioError (exit 2; the message already names the `gear:` field).
 
 from __future__ import annotations
 
+import re
 from collections.abc import Iterator
 from contextlib import contextmanager
 from typing import TYPE_CHECKING
@@ -13,7 +14,7 @@ from meshgen import kinematic_tca as _kinematic_tca
 from meshgen.displaced import Deviations, ErrorsData
 from meshgen.geometry import GearData, GearGeometry, GeometryError
 from meshgen.kinematic_tca import KinematicTCA
-from wormsim.scenario import Scenario, ScenarioError
+from wormsim.scenario import Scenario, ScenarioError, unit_hint
 
 if TYPE_CHECKING:  # meshgen.pieces (trimesh, scipy.spatial: ~1 s) is imported only where pieces are built
     from meshgen.pieces import GearSet
@@ -25,7 +26,9 @@ def geometry_errors() -> Iterator[None]:
     try:
         yield
     except GeometryError as exc:
-        raise ScenarioError(str(exc)) from None
+        msg = str(exc)
+        m = re.match(r"gear\.(\w+_mm) = ([-+0-9.eE]+)", msg)
+        raise ScenarioError(msg + (unit_hint(m.group(1), float(m.group(2))) if m else "")) from None
 
 
 def derive(gear: GearData) -> GearGeometry:

@@ -423,9 +423,9 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
         guards.contact(t, pen, w1 if worm_is_drive else w2, cmd)
         # the mean resultant on the wheel resolved at the pitch point P = (0, -r2, 0) on the line of centres, in the
         # wheel's directions there (DIN 3975 F_t2, F_r2, F_a2; seed 001 resolves ADAMS's contact force the same
-        # way): tangential e_t = +x, radial e_r = -y (outward, towards the worm), axial e_z. The contact torque M_z
-        # is kept apart: M_z / r2 equals the mean F_t, but by the wheel's torque balance it varies only through
-        # I2 alpha2 and hides the mesh
+        # way): tangential e_t = +x, radial e_r = -y (outward, towards the worm), axial e_z, turned into the sign
+        # convention of docs/outputs.md after the loop (force_signs). The contact torque M_z is kept apart: M_z / r2
+        # equals the mean F_t, but by the wheel's torque balance it varies only through I2 alpha2 and hides the mesh
         S_all[:, i] = (  # in SERIES order
             t,  # t_s
             th1,  # worm_angle_rad
@@ -454,6 +454,7 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
         if progress is not None:
             progress.update(t)
         i += 1
+    force_signs(S, geo.hand)
     S["efficiency_theory_at_contact_radius"][:] = rlog.efficiency(S["friction_coefficient"], geo, worm_is_drive)
     wall = time.perf_counter() - t_wall
     summary = _run_summary(
@@ -473,6 +474,15 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
     return Result(
         model="contact3d", summary=summary, series=S, steps=n_rec * rec, sim_time_s=float(d.time), extra=extra
     )
+
+
+def force_signs(S: dict, hand: int) -> None:
+    """The samples' forces (e_t = +x, e_r = -y outward, e_z) into the sign convention of docs/outputs.md
+    (wormsim.outputs.FORCE_SIGNS), in place: radial positive towards the wheel axis (separating), axial along
+    -hand e_z (F_a2 = F_t2 tan(gamma + rho') with its sign, as at torsional)."""
+    S["radial_force_n"] *= -1.0
+    S["radial_force_line_of_centres_n"] *= -1.0
+    S["axial_force_n"] *= -float(hand)
 
 
 def _run_summary(
@@ -524,4 +534,9 @@ def simulate(scenario: Scenario, progress=None) -> Result:
     bm = build_model(scenario)
     if progress is not None and scenario.simulation.mass_scaling != 1:
         progress.note(mass_scaling.note(bm.meta["mass_scaling_check"], scenario.simulation.mass_scaling, bm.timestep_s))
-    return run_model(bm, scenario, progress)
+    res = run_model(bm, scenario, progress)
+    if scenario.simulation.backdrive_probe:  # a second run with the wheel driving (wormsim.contact3d.backdrive)
+        from wormsim.contact3d.backdrive import probe
+
+        res.summary.update(probe(scenario, res.summary, simulate))
+    return res

@@ -99,12 +99,7 @@ SIGN_VELOCITY_FRACTION = 0.1  # v_s / v_t: friction-direction regularisation (mo
 def inertias(scenario: Scenario, g: GearGeometry) -> tuple[float, float]:
     """(I1, I2) in kg m^2: solid cylinders (module docstring), plus the driven-machine inertia
     load.inertia_kg_m2 on the loaded shaft (rigid on it, as contact3d's joint armature)."""
-    mats = scenario.materials
-    m1 = mats.worm.density_kg_m3 * math.pi * g.r1**2 * g.worm_length
-    m2 = mats.wheel.density_kg_m3 * math.pi * g.r2**2 * g.face_width
-    j = scenario.load.inertia_kg_m2
-    j1, j2 = (j, 0.0) if scenario.load.on == "worm" else (0.0, j)
-    return 0.5 * m1 * g.r1**2 + j1, 0.5 * m2 * g.r2**2 + j2
+    return gt.shaft_inertias_kg_m2(scenario, g.r1, g.worm_length, g.r2, g.face_width)
 
 
 class _TorqueTable:
