@@ -254,7 +254,7 @@ def derive(gear: GearData) -> GearGeometry:
     # flank form settings (meshgen.worm_forms; defaults documented in docs/flank_forms.md)
     tool_d = getattr(gear, "tool_diameter_mm", None)
     rho_c = getattr(gear, "profile_radius_mm", None)
-    return GearGeometry(
+    g = GearGeometry(
         zn_section=getattr(gear, "zn_section", "thread"),
         tool_diameter=(DEFAULT_TOOL_DIAMETER_MM if tool_d is None else tool_d) * MM,
         profile_radius=rho_c * MM if rho_c is not None else DEFAULT_PROFILE_RADIUS_MODULES * m_x,
@@ -291,3 +291,8 @@ def derive(gear: GearData) -> GearGeometry:
         wheel_tooth_thickness=s2,
         ratio=z2 / z1,
     )
+    from meshgen import worm_forms  # the flank form's tool (it imports this module)
+
+    if g.profile in worm_forms.TABLE_FORMS:
+        worm_forms.form_table(g)  # GeometryError here where the tool cannot generate the flank
+    return g
