@@ -88,3 +88,30 @@ def test_contact3d_validation_per_form(name):
     assert abs(s["tangential_force_mean_n"] * derive(sc.gear).r2 / sc.load.torque_nm - 1) < 0.02
     assert abs(s["efficiency"] / s["efficiency_theory_at_contact_radius"] - 1) < 0.03
     assert_mesh_frequency(s, "mesh_frequency_hz")
+
+
+@pytest.mark.parametrize("name", list(FORMS))
+def test_mesh_command_writes_each_form(name, tmp_path, monkeypatch, capsys):
+    """`wormsim mesh` writes each form's worm and wheel (watertight); ZC with the arc radius 10 m_x on the screw jack.
+    ZN1 and ZK in LONG_TESTS."""
+    import trimesh
+
+    from wormsim.cli import main
+
+    monkeypatch.setenv("WORMSIM_CACHE", str(tmp_path / "cache"))
+    sets = [a for s in _sets("screw_jack", name) for a in ("--set", s)]
+    out = tmp_path / "out"
+    assert main(["mesh", str(SCENARIOS / "screw_jack.yaml"), "--out", str(out), *sets]) == 0
+    for part in ("worm", "wheel"):
+        m = trimesh.load(out / f"{part}.stl")
+        assert m.is_watertight and m.volume > 0
+
+
+def test_zc_default_arc_undercuts_the_screw_jack(tmp_path, capsys):
+    """ZC at the default arc radius 5.5 m_x undercuts the screw jack's unshifted wheel (75 % > 60 %,
+    docs/flank_forms.md): exit 2, one line naming gear.profile_radius_mm."""
+    from wormsim.cli import main
+
+    code = main(["mesh", str(SCENARIOS / "screw_jack.yaml"), "--out", str(tmp_path / "o"), "--set", "gear.profile=ZC"])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and len(err.splitlines()) == 1 and "gear.profile_radius_mm" in err
