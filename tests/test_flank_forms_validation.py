@@ -5,7 +5,7 @@ the contacts' radius (contact3d) or of the wedge law (torsional), the meshing fr
 Gears: the screw jack (a seed) and involute_41 (another valid set). ZC's arc radius: 10 m_x on the screw jack (25 mm,
 INTERFACE.md's example) and 8 m_x on involute_41; the default 5.5 m_x undercuts these unshifted wheels (refused,
 docs/flank_forms.md). contact3d: short runs (screw jack at 3000 rpm so that the steady window holds > 5 mesh periods);
-ZN and ZK at contact3d are in LONG_TESTS (tests/conftest.py)."""
+ZN and ZK at contact3d and at `wormsim mesh` are in LONG_TESTS (tests/conftest.py)."""
 
 from __future__ import annotations
 
@@ -93,13 +93,13 @@ def test_contact3d_validation_per_form(name):
 @pytest.mark.parametrize("name", list(FORMS))
 def test_mesh_command_writes_each_form(name, tmp_path, monkeypatch, capsys):
     """`wormsim mesh` writes each form's worm and wheel (watertight); ZC with the arc radius 10 m_x on the screw jack.
-    ZN1 and ZK in LONG_TESTS."""
+    ZN1, ZN2 and ZK in LONG_TESTS."""
     import trimesh
 
     from wormsim.cli import main
 
     monkeypatch.setenv("WORMSIM_CACHE", str(tmp_path / "cache"))
-    sets = [a for s in _sets("screw_jack", name) for a in ("--set", s)]
+    sets = [a for s in _sets("screw_jack", name) + ["simulation.resolution=coarse"] for a in ("--set", s)]
     out = tmp_path / "out"
     assert main(["mesh", str(SCENARIOS / "screw_jack.yaml"), "--out", str(out), *sets]) == 0
     for part in ("worm", "wheel"):
