@@ -2,10 +2,10 @@
 the seeds' validation: ratio 0.1 %, torque balance 2 %, efficiency within 3 % of tan(gamma) / tan(gamma + rho') at
 the contacts' radius (contact3d) or of the wedge law (torsional), the meshing frequency z1 n1 / 60.
 
-Gears: the screw jack (a seed) and involute_41 (another valid set). ZC's arc radius: 10 m_x on the screw jack (25 mm,
+Gears: the screw jack (a seed; every form) and involute_41 (another valid set; ZK and ZC at torsional). ZC's arc radius: 10 m_x on the screw jack (25 mm,
 INTERFACE.md's example) and 8 m_x on involute_41; the default 5.5 m_x undercuts these unshifted wheels (refused,
 docs/flank_forms.md). contact3d: short runs (screw jack at 3000 rpm so that the steady window holds > 5 mesh periods);
-ZN and ZK at contact3d and at `wormsim mesh` are in LONG_TESTS (tests/conftest.py)."""
+`wormsim mesh` of ZN1, ZN2 and ZK is in LONG_TESTS (tests/conftest.py)."""
 
 from __future__ import annotations
 
@@ -25,7 +25,7 @@ FORMS = {
     "ZC": ["gear.profile=ZC"],
 }
 ZC_RADIUS = {"screw_jack": "gear.profile_radius_mm=25", "involute_41": "gear.profile_radius_mm=80"}
-CASES = [(g, f) for g in ("screw_jack", "involute_41") for f in FORMS]
+CASES = [("screw_jack", f) for f in FORMS] + [("involute_41", f) for f in ("ZK", "ZC")]
 _CACHE: dict = {}
 
 
@@ -50,7 +50,7 @@ def test_torsional_validation_per_form(gear, form, tmp_path_factory):
 
 
 # involute_41 at torsional, as ZI and ZA (tests/test_torsional.py's strict xfail): the transmission error's FFT peak is
-# the 2nd meshing harmonic, 48.29 Hz against 24.14 Hz (measured for ZN1, ZN2, ZK; ZC's peak is the 1st)
+# the 2nd meshing harmonic, 48.29 Hz against 24.14 Hz (measured for ZK, also ZN1 and ZN2; ZC's peak is the 1st)
 MESH_XFAIL = "TE's FFT peak at 48.29 Hz = 2 z1 n1 / 60 (theory 24.14 Hz), as ZI / ZA on involute_41"
 
 
@@ -79,7 +79,7 @@ CONTACT3D = [
 ]
 
 
-@pytest.mark.parametrize("name", ["ZC", "ZN1", "ZK"])
+@pytest.mark.parametrize("name", list(FORMS))
 def test_contact3d_validation_per_form(name):
     gear = "screw_jack"
     sc = load_scenario(SCENARIOS / f"{gear}.yaml", CONTACT3D + _sets(gear, name))
@@ -90,7 +90,7 @@ def test_contact3d_validation_per_form(name):
     assert_mesh_frequency(s, "mesh_frequency_hz")
 
 
-@pytest.mark.parametrize("name", list(FORMS))
+@pytest.mark.parametrize("name", [f"mesh_{f}" for f in FORMS])
 def test_mesh_command_writes_each_form(name, tmp_path, monkeypatch, capsys):
     """`wormsim mesh` writes each form's worm and wheel (watertight); ZC with the arc radius 10 m_x on the screw jack.
     ZN1, ZN2 and ZK in LONG_TESTS."""
@@ -99,7 +99,8 @@ def test_mesh_command_writes_each_form(name, tmp_path, monkeypatch, capsys):
     from wormsim.cli import main
 
     monkeypatch.setenv("WORMSIM_CACHE", str(tmp_path / "cache"))
-    sets = [a for s in _sets("screw_jack", name) + ["simulation.resolution=coarse"] for a in ("--set", s)]
+    form = name.removeprefix("mesh_")
+    sets = [a for s in _sets("screw_jack", form) + ["simulation.resolution=coarse"] for a in ("--set", s)]
     out = tmp_path / "out"
     assert main(["mesh", str(SCENARIOS / "screw_jack.yaml"), "--out", str(out), *sets]) == 0
     for part in ("worm", "wheel"):
