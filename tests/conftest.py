@@ -24,7 +24,8 @@ LONG_TESTS: dict[str, set[str] | None] = {
     # test_contact3d_seeds_flanks.py and stays in `make test`
     "test_contact3d_seeds.py": {"seat_motor", "screw_jack", "involute_41"},
     "test_errors_sidebands.py": None,  # F_t sidebands of a wheel runout over a wheel revolution (~1 min)
-    "test_flank_forms_validation.py": {"mesh_ZN1", "mesh_ZN2", "mesh_ZK"},  # `wormsim mesh` per form (~10 s each)
+    # contact3d and `wormsim mesh` per flank form (ZC's stay in `make test`; torsional's of every form too)
+    "test_flank_forms_validation.py": {f"{k}_{f}" for k in ("contact3d", "mesh") for f in ("ZN1", "ZN2", "ZK")},
 }
 
 

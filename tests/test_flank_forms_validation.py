@@ -5,7 +5,7 @@ the contacts' radius (contact3d) or of the wedge law (torsional), the meshing fr
 Gears: the screw jack (a seed; every form) and involute_41 (another valid set; ZK and ZC at torsional). ZC's arc radius: 10 m_x on the screw jack (25 mm,
 INTERFACE.md's example) and 8 m_x on involute_41; the default 5.5 m_x undercuts these unshifted wheels (refused,
 docs/flank_forms.md). contact3d: short runs (screw jack at 3000 rpm so that the steady window holds > 5 mesh periods);
-`wormsim mesh` of ZN1, ZN2 and ZK is in LONG_TESTS (tests/conftest.py)."""
+contact3d and `wormsim mesh` of ZN1, ZN2 and ZK are in LONG_TESTS (tests/conftest.py)."""
 
 from __future__ import annotations
 
@@ -79,10 +79,11 @@ CONTACT3D = [
 ]
 
 
-@pytest.mark.parametrize("name", list(FORMS))
+@pytest.mark.parametrize("name", [f"contact3d_{f}" for f in FORMS])
 def test_contact3d_validation_per_form(name):
+    """ZN1, ZN2 and ZK in LONG_TESTS (about 5 s each with the geometry cached, 15-45 s without)."""
     gear = "screw_jack"
-    sc = load_scenario(SCENARIOS / f"{gear}.yaml", CONTACT3D + _sets(gear, name))
+    sc = load_scenario(SCENARIOS / f"{gear}.yaml", CONTACT3D + _sets(gear, name.removeprefix("contact3d_")))
     s = simulate(sc).summary
     assert abs(s["ratio"] / s["ratio_theory"] - 1) < 1e-3
     assert abs(s["tangential_force_mean_n"] * derive(sc.gear).r2 / sc.load.torque_nm - 1) < 0.02
