@@ -2,7 +2,7 @@
 
 The kernel's scalars P carry the table at P[off:off + 2 + N_CHEB] = [r_lo, r_hi, Chebyshev coefficients]
 (FormTable.params); `half_thickness` evaluates the series by Clenshaw's recurrence with its derivative, continued
-linearly outside [r_lo, r_hi], as FormTable.half_thickness / half_thickness_dr do (tests/test_worm_forms_jit.py).
+linearly outside [r_lo, r_hi], as FormTable.half_thickness / half_thickness_dr do (tests/test_flank_forms_contact.py).
 """
 
 from __future__ import annotations

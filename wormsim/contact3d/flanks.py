@@ -37,8 +37,8 @@ end at the worm tip's reach) pressed into the worm flank, its depth the gap ther
 over the outer TAPER_SHARE of the candidate window, so that it leaves at zero load also where the flanks are still
 pressed together at the window's edge (seat motor: 30 um deep, 0.1 pitch past the profile's end).
 
-The kernel repeats the worm's H(r) (meshgen.worm.half_thickness, ZI/ZA) in compiled form; tests/test_flank_contact.py
-pins the kernel's distance to meshgen.worm.thread_gap.
+The kernel repeats the worm's H(r) (meshgen.worm.half_thickness, ZI/ZA; ZN/ZK/ZC meshgen.worm_forms_jit) compiled;
+tests/test_flank_contact.py pins the kernel's distance to meshgen.worm.thread_gap.
 """
 
 from __future__ import annotations
