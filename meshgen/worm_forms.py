@@ -39,7 +39,8 @@ with the tool's half-thickness W_t (its axial profile):
         W_t(rho) = w_c + sqrt(rho_c^2 - (rho - rho_m)^2),
         w_c = w_0 - rho_c cos(alpha_n),  rho_m = R_t - rho_c sin(alpha_n)
 
-The tool removes, at worm radius r, the u values of its points on the cylinder r: the space's half-width is
+for rho up to the disc's tip radius (tool_tip_radius). The tool removes, at worm radius r, the u values of its points on
+the cylinder r: the space's half-width is
 
     W(r) = max over theta of u(X(rho(theta), theta)),  with rho(theta) from r(X) = r                                 (4)
 
@@ -54,7 +55,9 @@ set by gear.backlash_mm alone.
 
 Evaluation (`FormTable`): H is interpolated on [r1 - h_f - 0.1 m_x, r1 + h_f + 0.1 m_x] (the worm root up to the hob's
 tip, which cuts the wheel root, meshgen.wheel) by a Chebyshev series of N_CHEB terms through the exact values (2)-(4)
-at the Chebyshev points, and continued linearly (C1) outside. tests/test_worm_forms.py pins the series to the exact
+at the Chebyshev points, and continued linearly (C1) outside. form_table refuses (GeometryError) a flank that does not
+narrow outwards from the root to the hob's tip (the tool undercuts the thread) or that the series misses by more than
+TABLE_TOL_M. tests/test_worm_forms.py pins the series to the exact
 solution (max |error| below 1 nm on the seeds' gears) and the exact solution to the definitions: ZN's normal section
 straight, ZK's and ZC's axial sections against an independent simulation of the disc cutting (the tool's positions
 swept densely, the lower envelope of the cut), ZC's axial section concave.
@@ -74,6 +77,7 @@ from numpy.polynomial import chebyshev as C
 from meshgen.geometry import DEFAULT_PROFILE_RADIUS_MODULES, DEFAULT_TOOL_DIAMETER_MM, GearGeometry, GeometryError
 
 N_CHEB = 40  # Chebyshev terms of the H(r) table
+TABLE_TOL_M = 1e-9  # the table's largest allowed deviation from the exact H(r) (form_table's check)
 FORMS = ("ZA", "ZN", "ZI", "ZK", "ZC")
 TABLE_FORMS = ("ZN", "ZK", "ZC")  # the forms evaluated by the table (ZA, ZI: closed forms in meshgen.worm)
 __all__ = [
@@ -149,9 +153,17 @@ def _u_on_cylinder(g: GearGeometry, r, theta, w0: float):
         if np.all(np.abs(step) < 1e-15 * Rt):
             break
     X, _ = _tool_point(g, rho, theta, w0)
-    ok = np.abs(np.hypot(X[0], X[1]) - r) < 1e-12 * Rt
+    ok = (np.abs(np.hypot(X[0], X[1]) - r) < 1e-12 * Rt) & (rho <= tool_tip_radius(g))
     u = X[2] - ap * np.arctan2(X[1], X[0])
     return np.where(ok, u, np.nan)
+
+
+def tool_tip_radius(g: GearGeometry) -> float:
+    """The disc's tip radius: R_t + (r1 - r_lo) + 0.5 m_x, 0.5 m_x past the depth of the table's range (module
+    docstring). The disc exists only up to it; an unbounded disc would reach round a slender worm's axis and cut it
+    on the far side."""
+    lo, _ = table_range(g)
+    return g.tool_diameter / 2 + (g.r1 - lo) + 0.5 * g.m_x
 
 
 def _space_half_width_tool(g: GearGeometry, r, w0: float, n_grid: int = 41, n_newton: int = 12):
@@ -281,4 +293,17 @@ def form_table(g: GearGeometry) -> FormTable:
             f"gear.tool_diameter_mm or gear.profile_radius_mm"
         )
     coef = C.chebfit(x, H, N_CHEB - 1)
-    return FormTable(lo, hi, coef)
+    table = FormTable(lo, hi, coef)
+    # the thread must narrow outwards from the root to the hob's tip, and the series hold the exact flank there
+    # (a disc at a large lead angle on a slender worm undercuts the thread's root: the flank turns back)
+    r = np.linspace(g.r_f1, g.r1 + g.h_f, 65)
+    Ht = table.half_thickness(r)
+    check = r[::8]
+    err = np.max(np.abs(table.half_thickness(check) - exact_half_thickness(g, check)))
+    if not (np.all(np.diff(Ht) < 0) and err < TABLE_TOL_M):
+        raise GeometryError(
+            f"gear.profile = {g.profile}: the tool undercuts the worm thread's root at this lead angle "
+            f"({math.degrees(g.gamma):.2f} deg, diameter quotient {g.q:.3g}); allowed: a thread narrowing outwards "
+            f"from root to tip; raise gear.diameter_quotient or gear.tool_diameter_mm, or use gear.profile ZI"
+        )
+    return table

@@ -80,7 +80,7 @@ def _cut_simulation(g, r, n_pos: int = 6001):
 
     Position t: the tool turned by t about the worm axis and moved |p| t along it. The axial-plane point (r, 0, z)
     is inside the tool there iff its image X' = (r cos t, -r sin t, z - |p| t) has |w| <= W_t(rho) in the tool's
-    coordinates (w along the axis A, rho from it; the tool's outer radius R_t + 3 (h_f + 0.1 m_x)). The upper
+    coordinates (w along the axis A, rho from it, up to the disc's tip radius worm_forms.tool_tip_radius). The upper
     boundary z_top(r, t) by bisection; W(r) = max over t (parabolic vertex through the best three)."""
     ap = abs(g.p)
     L = math.hypot(g.r1, ap)
@@ -89,7 +89,7 @@ def _cut_simulation(g, r, n_pos: int = 6001):
     cx = g.r1 + Rt
     w0 = worm_forms.tool_setting(g)
     an = g.alpha_n
-    rho_out = Rt + 3 * (g.h_f + 0.1 * g.m_x)
+    rho_out = worm_forms.tool_tip_radius(g)
 
     def Wt(rho):
         if g.profile == "ZK":
@@ -218,3 +218,43 @@ def test_zk_tends_to_zi_as_the_disc_grows(name):
     d = [np.max(np.abs(worm.half_thickness(_g(name, profile="ZK", tool_diameter_mm=D), r) - Hi)) for D in (1e4, 1e5)]
     assert d[1] < 0.1e-6
     assert 8 < d[0] / d[1] < 12
+
+
+from hypothesis import HealthCheck, given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+
+from meshgen import wheel  # noqa: E402
+
+
+@settings(max_examples=10, deadline=None, derandomize=True, database=None, suppress_health_check=[HealthCheck.too_slow])
+@given(
+    gear=st.fixed_dictionaries(
+        {
+            "worm_starts": st.integers(1, 4),
+            "wheel_teeth": st.integers(20, 80),
+            "axial_module_mm": st.floats(0.5, 12),
+            "diameter_quotient": st.floats(6, 16),
+            "normal_pressure_angle_deg": st.floats(10, 25),
+            "hand": st.sampled_from(["right", "left"]),
+            "profile": st.sampled_from(["ZN", "ZK", "ZC"]),
+            "zn_section": st.sampled_from(["thread", "space"]),
+            "tool_diameter_mm": st.one_of(st.none(), st.floats(20, 400)),
+            "profile_radius_mm": st.one_of(st.none(), st.floats(1, 200)),
+        }
+    )
+)
+def test_random_gear_of_every_form_is_made_or_refused(gear):
+    """Valid gear data of any form: the flank is made (H finite, the thread thinner outwards over its depth, the table
+    within 1 nm of the exact solution at d1's neighbours) and the wheel checked, or GeometryError names a gear field."""
+    try:
+        g = derive(GearSpec(backlash_mm=0.05 * gear["axial_module_mm"], **gear))
+        worm.check_worm(g, wheel.hob_radius(g))
+        wheel.check_wheel(g)
+    except GeometryError as exc:
+        assert "gear" in str(exc)
+        return
+    r = np.linspace(g.r_f1, g.r_a1, 33)
+    H = worm.half_thickness(g, r)
+    assert np.all(np.isfinite(H)) and np.all(np.diff(H) < 0)
+    rr = g.r1 + np.array([-0.5, 0.5]) * g.m_x
+    assert np.max(np.abs(worm.half_thickness(g, rr) - worm_forms.exact_half_thickness(g, rr))) < 1e-9
