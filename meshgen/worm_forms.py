@@ -159,11 +159,11 @@ def _u_on_cylinder(g: GearGeometry, r, theta, w0: float):
 
 
 def tool_tip_radius(g: GearGeometry) -> float:
-    """The disc's tip radius: R_t + (r1 - r_lo) + 0.5 m_x, 0.5 m_x past the depth of the table's range (module
-    docstring). The disc exists only up to it; an unbounded disc would reach round a slender worm's axis and cut it
-    on the far side."""
+    """The disc's tip radius: R_t + (r1 - r_lo) + 1.5 m_x, 1.5 m_x past the depth of the table's range (module
+    docstring; at a large lead angle the contact at r_lo lies off the disc's mid-plane, further out on the disc). The
+    disc exists only up to it; an unbounded disc would reach round a slender worm's axis and cut it on the far side."""
     lo, _ = table_range(g)
-    return g.tool_diameter / 2 + (g.r1 - lo) + 0.5 * g.m_x
+    return g.tool_diameter / 2 + (g.r1 - lo) + 1.5 * g.m_x
 
 
 def _space_half_width_tool(g: GearGeometry, r, w0: float, n_grid: int = 41, n_newton: int = 12):
