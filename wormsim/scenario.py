@@ -55,8 +55,12 @@ FrictionGroup = Literal["I", "II", "III"]
 class Gear(_Strict):
     """Worm gear data (DIN 3975 / ISO 1122 names). Exactly one module and one of lead angle / q."""
 
-    profile: Literal["ZI", "ZA"] = Field(
-        "ZI", description="ZI: involute helicoid (seed 003); ZA: straight-sided axial profile"
+    profile: Literal["ZA", "ZN", "ZI", "ZK", "ZC"] = Field(
+        "ZI",
+        description=(
+            "flank form (DIN 3975): ZI involute helicoid (seed 003); ZA straight in the axial section; ZN straight in "
+            "the normal section; ZK disc with straight sides; ZC disc with a convex arc (Cavex); docs/flank_forms.md"
+        ),
     )
     hand: Literal["right", "left"] = Field("right", description="thread hand of the worm")
     worm_starts: int = Field(1, ge=1, le=8, description="z1")
@@ -89,6 +93,15 @@ class Gear(_Strict):
     )
     addendum_coef: float = Field(1.0, gt=0, le=1.5, description="h_a / m_axial")
     dedendum_coef: float = Field(1.2, gt=0, le=2.0, description="h_f / m_axial")
+    zn_section: Literal["thread", "space"] = Field(
+        "thread", description="ZN: the straight line in the normal section of the thread (ZN1) or of the space (ZN2)"
+    )
+    tool_diameter_mm: float | None = Field(
+        None, gt=0, le=2000, description="ZK, ZC: disc / grinding wheel diameter; default 100 (docs/flank_forms.md)"
+    )
+    profile_radius_mm: float | None = Field(
+        None, gt=0, le=2000, description="ZC: the tool's arc profile radius; default 5.5 m_axial (docs/flank_forms.md)"
+    )
 
     @model_validator(mode="after")
     def _one_of(self) -> "Gear":

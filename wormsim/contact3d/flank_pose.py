@@ -33,7 +33,9 @@ import math
 import numba
 import numpy as np
 
-N_WORM_PARAMS = 13  # len(wormsim.contact3d.flanks.worm_params(g)): the nominal kernel's P
+from meshgen.worm_forms_jit import TABLE_LEN
+
+N_WORM_PARAMS = 13 + TABLE_LEN  # len(wormsim.contact3d.flanks.worm_params(g)): the nominal kernel's P
 WHEEL = N_WORM_PARAMS  # offsets into the displaced P (module docstring)
 WORM = WHEEL + 12
 SHIFT = WORM + 12

@@ -37,8 +37,8 @@ end at the worm tip's reach) pressed into the worm flank, its depth the gap ther
 over the outer TAPER_SHARE of the candidate window, so that it leaves at zero load also where the flanks are still
 pressed together at the window's edge (seat motor: 30 um deep, 0.1 pitch past the profile's end).
 
-The kernel repeats the worm's H(r) (meshgen.worm.half_thickness, ZI/ZA) in compiled form; tests/test_flank_contact.py
-pins the kernel's distance to meshgen.worm.thread_gap.
+The kernel repeats the worm's H(r) (meshgen.worm.half_thickness, ZI/ZA; ZN/ZK/ZC meshgen.worm_forms_jit) compiled;
+tests/test_flank_contact.py pins the kernel's distance to meshgen.worm.thread_gap.
 """
 
 from __future__ import annotations
@@ -52,7 +52,7 @@ from dataclasses import asdict, dataclass
 import numba
 import numpy as np
 
-from meshgen import wheel, worm
+from meshgen import wheel, worm, worm_forms, worm_forms_jit
 from meshgen.cache import cached
 from meshgen.geometry import GearGeometry
 from wormsim.contact3d.flank_merge import merge_flanks
@@ -115,9 +115,10 @@ class FlankGrid:
 
 def worm_params(g: GearGeometry) -> np.ndarray:
     """Scalars of meshgen.worm's closed form, in the order the kernel reads them."""
-    zi = 1.0 if g.profile == "ZI" else 0.0
-    t1 = math.sqrt(max(g.r1**2 / g.r_b**2 - 1.0, 0.0)) if zi else 0.0
-    return np.array(
+    zi = 1.0 if g.profile == "ZI" else 2.0 if g.profile in worm_forms.TABLE_FORMS else 0.0
+    t1 = math.sqrt(max(g.r1**2 / g.r_b**2 - 1.0, 0.0)) if zi == 1.0 else 0.0
+    table = worm_forms.form_table(g).params() if zi == 2.0 else np.zeros(worm_forms_jit.TABLE_LEN)
+    head = np.array(
         [
             g.p,
             g.p_x,
@@ -135,6 +136,7 @@ def worm_params(g: GearGeometry) -> np.ndarray:
         ],
         dtype=float,
     )
+    return np.concatenate([head, table])  # ZN, ZK, ZC: H(r)'s table at P[13:] (meshgen.worm_forms_jit)
 
 
 @functools.lru_cache(maxsize=16)
@@ -154,7 +156,7 @@ def _grid_code_hash() -> str:
     from meshgen import geometry as mg
     from wormsim.contact3d import flank_pose, flank_trim, window
 
-    mods = (sys.modules[__name__], flank_trim, flank_pose, window, mg, worm, wheel)
+    mods = (sys.modules[__name__], flank_trim, flank_pose, window, mg, worm, wheel, worm_forms)
     return hashlib.sha256("".join(inspect.getsource(m) for m in mods).encode()).hexdigest()
 
 
@@ -203,8 +205,10 @@ def _cut_by_worm(g: GearGeometry, R: np.ndarray, psi0: np.ndarray, zeta: np.ndar
 
 @numba.njit(cache=True, inline="always")
 def _half_thickness(r, P):
-    """meshgen.worm.half_thickness and its derivative dH/dr (ZI equation (2), ZA straight)."""
+    """meshgen.worm.half_thickness and its derivative dH/dr (ZI equation (2), ZA straight; ZN, ZK, ZC the table)."""
     p, p_x, r1 = P[0], P[1], P[9]
+    if P[5] > 1.5:
+        return worm_forms_jit.half_thickness(r, P, 13)
     if P[5] > 0.5:
         r_b = P[6]
         x = r * r / (r_b * r_b) - 1.0
