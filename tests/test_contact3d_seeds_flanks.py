@@ -24,7 +24,7 @@ def run(name: str) -> dict:
     return _CACHE[name]
 
 
-# all three pass since contacts leave at zero load (wormsim.contact3d.flanks, docs/contact3d.md): F_t peaks at
+# all three pass since contacts leave at zero load (wormsim.tooth.kernel, docs/contact3d.md): F_t peaks at
 # 29.97 / 22.14 / 24.14 Hz (before: the 3rd harmonic, 89.9 / 66.4 Hz, from half a slice's load dropped at once; and
 # involute_41's mesh mode at 1087 Hz with p2p 55 kN, now 292 N on 13.8 kN)
 MESH_XFAIL: dict[str, str] = {}

@@ -1,4 +1,4 @@
-"""The exact-flank step loop compiled (issue 13): the steps of one record interval of wormsim.contact3d.runner in one
+"""The exact-flank step loop compiled: the steps of one record interval of wormsim.contact3d.runner in one
 numba call, MuJoCo's C stage functions called by address.
 
 Each step does what the runner's Python loop did with `FlankContacts.step` (wormsim.contact3d.flank_step), in the
@@ -40,10 +40,10 @@ from numba.extending import intrinsic
 
 from wormsim.contact3d.contact_sums import radial_and_radius, radius_mean
 from wormsim.contact3d.flank_handoff import _MJ_ADD_CONTACT, _fill_add, _library
-from wormsim.contact3d.flank_outputs import _rows
-from wormsim.contact3d.flank_pose import set_pose
 from wormsim.contact3d.flank_step import _contact_forces
-from wormsim.contact3d.flanks import find_packed
+from wormsim.tooth.hertz import _rows
+from wormsim.tooth.kernel import find_packed
+from wormsim.tooth.pose import set_pose
 
 STAGES_BEFORE = ("mj_checkPos", "mj_checkVel", "mj_fwdKinematics", "mj_makeM", "mj_factorM", "mj_collision")
 STAGES_AFTER = (

@@ -1,4 +1,4 @@
-"""MuJoCo's step split so that contacts found on the exact flanks (wormsim.contact3d.flanks) enter its constraint
+"""MuJoCo's step split so that contacts found on the exact flanks (wormsim.tooth.kernel) enter its constraint
 solver.
 
 mj_step (MuJoCo 4.0.0, engine_forward.c) is mj_checkPos, mj_checkVel, mj_forward, mj_checkAcc, integrate, and
@@ -30,27 +30,23 @@ import numba
 import numpy as np
 
 from wormsim.contact3d.flank_handoff import ContactBuffer
-from wormsim.contact3d.flank_merge import split_forces
-from wormsim.contact3d.flanks import (
-    MARGIN_PITCH,
-    TAPER_SHARE,
-    PackedKernel,
-    find_packed,
-    flank_grid,
-)
+from wormsim.tooth.grid import flank_grid
+from wormsim.tooth.kernel import MARGIN_PITCH, TAPER_SHARE, PackedKernel, find_packed
+from wormsim.tooth.merge import split_forces
 
 
 class FlankContacts:
     """The flank contacts of one model: the grid, the window, the template contact and the step."""
 
     def __init__(self, bm, slices: int, merge: bool | None = None):
-        """merge: one MuJoCo contact per tooth flank (wormsim.contact3d.flank_merge; contact.flank_contacts tooth);
+        """merge: one MuJoCo contact per tooth flank (wormsim.tooth.merge; contact.flank_contacts tooth);
         None: from the model's scenario (bm.meta's flank_contacts)."""
         g = bm.geometry
         self.merge = bm.meta.get("flank_contacts", "slice") == "tooth" if merge is None else bool(merge)
         m = bm.model
         self.bm = bm
-        self.grid = flank_grid(g, slices)
+        plan_grid = bm.plan.grid if getattr(bm, "plan", None) is not None else None
+        self.grid = plan_grid if plan_grid is not None and plan_grid.slices == slices else flank_grid(g, slices)
         self.pitch = 2 * math.pi / g.z2
         self.margin0 = MARGIN_PITCH * self.pitch + g.backlash / (2 * g.r2)
         self.taper_rad = TAPER_SHARE * self.margin0  # of the error-free window (flanks.find_contacts)
@@ -93,12 +89,12 @@ class FlankContacts:
         self.buffer = None
         self.set_friction(float(m.geom_friction[gw, 0]))
         self.buffer = ContactBuffer(m, t, cap)  # the bulk hand-off (wormsim.contact3d.flank_handoff)
-        # errors: (issue 12): the kernel gets the displaced bodies' poses each step (wormsim.contact3d.flank_pose)
+        # with errors: the kernel gets the displaced bodies' poses each step (wormsim.tooth.pose)
         self.params = self.grid.params
         dev = getattr(bm, "deviations", None)
         self.displaced = dev is not None and not dev.is_zero()
         if self.displaced:
-            from wormsim.contact3d import flank_pose
+            from wormsim.tooth import pose as flank_pose
 
             shift = bm.tooth_shift_rad if bm.tooth_shift_rad is not None else np.zeros(g.z2)
             self.params = flank_pose.displaced_params(self.grid.params, np.asarray(shift, dtype=float))
@@ -215,7 +211,7 @@ class FlankContacts:
         # each contact's stiffness and damping scaled by its share of its slice (direct solref: -k, -b)
         c.solref[k0:k1] = np.multiply.outer(weight[: k1 - k0], self.solref)
         wf = weight[: k1 - k0]
-        if self.merge:  # friction mu / c_w and its damping by W (wormsim.contact3d.flank_merge)
+        if self.merge:  # friction mu / c_w and its damping by W (wormsim.tooth.merge)
             fs = self.kernel.mfric[: k1 - k0]
             wf = wf * fs
             c.friction[k0:k1, 0] = c.friction[k0:k1, 1] = self.mu * fs
@@ -284,8 +280,8 @@ def flank_contact_details(fc: FlankContacts, d: mujoco.MjData):
         out,
     )
     p0, F, pw = out[0, :m], out[1, :m], out[2, :m]
-    if fc.displaced:  # via the displaced wheel body's frame (wormsim.contact3d.flank_pose)
-        from wormsim.contact3d.flank_pose import tooth_shift_of, wheel_body_points
+    if fc.displaced:  # via the displaced wheel body's frame (wormsim.tooth.pose)
+        from wormsim.tooth.pose import tooth_shift_of, wheel_body_points
 
         adr = np.asarray(adr_all)
         ks = fc.meta[:n, 0][adr >= 0]

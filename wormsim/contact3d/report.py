@@ -104,7 +104,7 @@ def write_report(result: Result, path) -> None:
     P = result.extra.get("points_tooth0")
     F = result.extra.get("forces_world")
     if "flank_pattern" in result.extra:  # exact flanks: the loaded band coloured by pressure (flank_outputs)
-        from wormsim.contact3d.flank_outputs import draw_pattern
+        from wormsim.tooth.hertz import draw_pattern
 
         draw_pattern(a, fig, result.extra["flank_pattern"], result.extra["built"].geometry, s)
     elif P is not None and sl.any():
@@ -168,7 +168,7 @@ def write_recording(result: Result, path) -> None:
         log_transforms(rec, "assembly/worm", t[idx], Tw)
         log_transforms(rec, "assembly/wheel", t[idx], Tg)
         if "flank_pattern" in result.extra:  # exact flanks: the loaded pattern on the wheel, coloured by pressure
-            from wormsim.contact3d.flank_outputs import log_pattern
+            from wormsim.tooth.hertz import log_pattern
 
             log_pattern(rec, "assembly/wheel/contact_pattern", result.extra["flank_pattern"], geo)
         P, F = result.extra["points_world"], result.extra["forces_world"]

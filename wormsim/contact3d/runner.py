@@ -8,7 +8,7 @@ forces, moment, contact count, torques and powers are the MEANS over those steps
 vibration at 10-80 kHz does not alias into the meshing band, and the box's nulls at multiples of the sampling
 rate cancel exactly what would fold onto 0 Hz), and whose angles and speeds are the values at its end. Then it
 
-- re-poses the wheel's collision window by whole pitches (wormsim.contact3d.window.repose_window),
+- re-poses the wheel's collision window by whole pitches (wormsim.contact3d.slots.repose_window),
 - sets the friction coefficient mu(Vs) from the sliding speed Vs = |omega1| r1 / cos(gamma),
 - resolves the mean resultant on the wheel in the wheel's directions at the pitch point on the line of centres
   (DIN 3975 F_t2, F_r2, F_a2; seed 001's x/y components): tangential, radial (outward), axial; the contact
@@ -30,6 +30,7 @@ The timestep is the model's, chosen before it was built (wormsim.contact3d.times
 
 from __future__ import annotations
 
+import functools
 import math
 import time
 
@@ -40,25 +41,13 @@ from wormsim import gear_theory as gt
 from wormsim import prewarm
 from wormsim.contact3d import jit_warmup, mass_scaling
 from wormsim.contact3d.contact_sums import RadiusLog
+from wormsim.contact3d.diagnosis import diverged_error
+from wormsim.contact3d.guards import Guards
 from wormsim.contact3d.metrics import contact3d_summary
 from wormsim.contact3d.mjcf import BuiltModel, build_model
 from wormsim.contact3d.ringing_check import ringing
-from wormsim.contact3d.timestep import (
-    MAX_WORM_TURN_PER_STEP_RAD,
-    OVERSPEED_GUARD,
-    default_timestep,
-    speed_timestep_limit_s,
-)
-from wormsim.contact3d.window import repose_window
-from wormsim.errors import (
-    DivergedError,
-    LockedError,
-    OverspeedError,
-    PenetrationError,
-    SimulationError,
-    TeethJumpedError,
-)
-from wormsim.friction import friction_coefficient, friction_coefficient_scalar, friction_mode
+from wormsim.contact3d.slots import repose_window
+from wormsim.friction import friction_coefficient_scalar, friction_mode
 from wormsim.result import Result
 from wormsim.scenario import Scenario
 from wormsim.units import rad_s_to_rpm
@@ -67,7 +56,6 @@ MAX_POINTS = 48  # contact points kept per sample (for the pattern and the recor
 TARGET_SAMPLES = 20000  # automatic record_every aims at about this many samples per run (each the mean
 # over its interval, so decimation does not alias the contact vibration)
 _ROWS3 = np.arange(3)  # the normal and two tangent rows of an elliptic-cone contact
-JUMP_PITCH = 0.5  # transmission error (in pitches) that counts as teeth jumping
 
 
 def _record_every(scenario: Scenario, dt: float, n_steps: int, scaled: bool = False) -> int:
@@ -113,111 +101,22 @@ def contact_details(bm: BuiltModel, d: mujoco.MjData, window_ks: np.ndarray):
     return int(np.unique(ks).size), pen, p0, F, pos
 
 
-def diverged_error(t: float, dt: float, bm: BuiltModel, what: str) -> SimulationError:
-    """Divergence diagnosis. Above the explicit stability limit of the contact spring-damper with three pairs in
-    parallel (ContactLaw.stable_timestep_s: h < 2/omega (sqrt(1 + zeta^2) - zeta)) the cure is the timestep: the
-    message names the limit and wormsim's default (wormsim.contact3d.timestep.default_timestep, 0.4 x the limit
-    rounded down to 1-2-5). Within the limit the blow-up comes from a command step the light shafts cannot follow."""
-    lim = bm.law.stable_limit_s
-    h0 = default_timestep(bm.law)
-    if dt > lim:
-        return DivergedError(
-            f"diverged at t = {t:.4g} s ({what}): timestep {dt:.3g} s is above the contact's stable limit "
-            f"{lim:.3g} s (contact stiffness {bm.law.pair_stiffness_n_per_m:.3g} N/m per tooth pair); set "
-            f"simulation.timestep_s <= {h0:.3g} s (the default for this contact: leave it unset) or lower "
-            f"contact.stiffness_n_per_m"
-        )
-    return DivergedError(
-        f"diverged at t = {t:.4g} s ({what}) at timestep {dt:.3g} s, within the contact's stable limit {lim:.3g} s: "
-        f"a torque or speed step the light shafts cannot follow; lengthen drive.ramp_s / load.ramp_s, lower "
-        f"load.torque_nm"
-    )
-
-
-def jump_error(t: float, te_pitch: float, dt: float, bm: BuiltModel, scenario: Scenario) -> SimulationError:
-    """Transmission error beyond half a pitch. Above the stable timestep this is the integration running away
-    (reported as divergence: a stiffer contact would make it worse); within it the teeth really passed each
-    other: the load overpowers the mesh. With contact.geometry flanks (the working flanks only: no tips, edges or
-    roots) the jump itself is not modelled, and the message says so."""
-    lim = bm.law.stable_limit_s
-    if dt > lim:
-        return diverged_error(t, dt, bm, f"the transmission error ran away to {te_pitch:.2f} pitch")
-    flanks_note = (
-        "; contact.geometry flanks models the working flanks only (no tips or edges), so the jump itself is not "
-        "simulated: contact.geometry pieces models it"
-        if bm.meta.get("contact_geometry") == "flanks"
-        else ""
-    )
-    return TeethJumpedError(
-        f"teeth jumped a pitch at t = {t:.4g} s (transmission error {te_pitch:.2f} pitch) at timestep {dt:.3g} s, "
-        f"within the contact's stable limit {lim:.3g} s: the load overpowers the mesh (load {scenario.load.torque_nm} "
-        f"N m over {scenario.load.ramp_s} s, contact stiffness {bm.law.pair_stiffness_n_per_m:.3g} N/m per tooth "
-        f"pair); lower load.torque_nm or lengthen load.ramp_s, or raise contact.stiffness_n_per_m (with a smaller "
-        f"simulation.timestep_s){flanks_note}"
-    )
-
-
-def overspeed_error(t: float, w1: float, dt: float) -> SimulationError:
-    """The worm turns more than OVERSPEED_GUARD x MAX_WORM_TURN_PER_STEP_RAD per step (a torque drive running away,
-    or a timestep set past the speed check): its pieces would pass through the wheel's between steps."""
-    lim = speed_timestep_limit_s(abs(w1))
-    return OverspeedError(
-        f"worm overspeed at t = {t:.4g} s: the worm turns {rad_s_to_rpm(abs(w1)):.0f} rpm, {abs(w1) * dt:.3g} rad per "
-        f"step of {dt:.3g} s, beyond the {MAX_WORM_TURN_PER_STEP_RAD} rad contact3d resolves (the thread passes "
-        f"through the wheel's teeth between steps); set simulation.timestep_s <= {lim:.3g} s (or leave it unset for "
-        f"a speed-driven worm), or lower the drive (drive.speed_rpm / drive.torque_nm); simulation.speculative does "
-        f"not prevent it (measured: it tunnels sooner, docs/stability_speed.md)"
-    )
-
-
-def locked_error(t: float, w_drive: float, w_cmd: float, bm: BuiltModel, scenario: Scenario) -> SimulationError:
-    """A speed-driven drive held below half its command. When the wheel drives and the pair is self-locking at
-    standstill, rho' = atan(mu_static / cos alpha_n) >= gamma (DIN 3975: back-driving efficiency
-    tan(gamma - rho') / tan(gamma) <= 0), the diagnosis says so; otherwise the mesh is jammed."""
-    geo = bm.geometry
-    head = (
-        f"the drive locked at t = {t:.4g} s: the {scenario.drive.on} turns at {rad_s_to_rpm(w_drive):.3g} rpm "
-        f"against a command of {rad_s_to_rpm(w_cmd):.3g} rpm"
-    )
-    mu0 = float(friction_coefficient(scenario.contact, 0.0))
-    rho = gt.virtual_friction_angle_rad(mu0, geo.alpha_n)
-    if scenario.drive.on == "wheel" and rho >= geo.gamma:
-        mu_max = math.tan(geo.gamma) * math.cos(geo.alpha_n)
-        return LockedError(
-            f"{head}: the pair is self-locking (rho' = atan(mu / cos alpha_n) = {math.degrees(rho):.2f} deg at "
-            f"standstill friction mu = {mu0:.3g} >= lead angle gamma = {math.degrees(geo.gamma):.2f} deg), so the "
-            f"wheel cannot turn the worm; drive the worm (drive.on=worm, load.on=wheel), or, to back-drive, lower "
-            f"the friction below mu = tan(gamma) cos(alpha_n) = {mu_max:.3g} or raise gear.lead_angle_deg above "
-            f"{math.degrees(rho):.2f} deg"
-        )
-    return LockedError(
-        f"{head}: the mesh is jammed; check gear.backlash_mm, the load torque {scenario.load.torque_nm} N m "
-        f"against what the drive can deliver, and the friction"
-    )
-
-
-def penetration_error(t: float, pen: float, pen_lim: float, dt: float, bm: BuiltModel) -> SimulationError:
-    """Penetration beyond gear_theory.penetration_limit_m (0.4 m_x): the teeth are about to skip."""
-    return PenetrationError(
-        f"penetration {pen * 1e6:.1f} um at t = {t:.4g} s exceeds the tolerance {pen_lim * 1e6:.1f} um "
-        f"(0.4 m_x): contact too soft for the load or timestep {dt:.3g} s too large (stable limit "
-        f"~{bm.law.stable_limit_s:.2g} s); raise contact.stiffness_n_per_m, lower simulation.timestep_s or lower "
-        f"load.torque_nm"
-    )
-
-
-_SLOT_CACHE: dict[int, np.ndarray] = {}
-
-
 def _slot_lookup(bm: BuiltModel) -> np.ndarray:
-    key = id(bm)
-    if key not in _SLOT_CACHE:
-        lut = np.full(bm.model.ngeom, -1, dtype=int)
-        for s, row in enumerate(bm.wheel_slot_geoms):
-            lut[row] = s
-        _SLOT_CACHE.clear()
-        _SLOT_CACHE[key] = lut
-    return _SLOT_CACHE[key]
+    """Geom id -> window slot of the wheel's collision geoms (-1 elsewhere), computed once per model layout."""
+    rows = np.ascontiguousarray(bm.wheel_slot_geoms, dtype=np.int64)
+    return _slot_table(int(bm.model.ngeom), rows.shape, rows.tobytes())
+
+
+@functools.lru_cache(maxsize=8)
+def _slot_table(ngeom: int, shape: tuple[int, ...], slot_geoms: bytes) -> np.ndarray:
+    """The lookup of _slot_lookup, keyed by its content: the model's geom count and the slots' geom ids (a sweep
+    that runs several scenarios in one process gets each model's own table)."""
+    rows = np.frombuffer(slot_geoms, dtype=np.int64).reshape(shape)
+    lut = np.full(ngeom, -1, dtype=int)
+    for s, row in enumerate(rows):
+        lut[row] = s
+    lut.flags.writeable = False
+    return lut
 
 
 SERIES = (
@@ -247,55 +146,6 @@ SERIES = (
 )
 
 
-class _Guards:
-    """The checks after every record interval (module docstring); each raises its SimulationError subclass."""
-
-    def __init__(self, bm: BuiltModel, scenario: Scenario, dt: float, rec: int):
-        self.bm, self.scenario, self.dt = bm, scenario, dt
-        geo = bm.geometry
-        self.pen_lim = gt.penetration_limit_m(geo.m_x)
-        self.pitch_angle = 2 * math.pi / geo.z2
-        self.lock_start = gt.lock_check_start_s(scenario)
-        self.lock_hold = max(gt.LOCK_HOLD_S, 20 * rec * dt)
-        self.speed_driven = scenario.drive.speed_rpm is not None
-        self.locked_since: float | None = None
-        self.turn_max = 0.0
-        # sliding contacts' friction against their slip (wormsim.contact3d.friction_guard)
-        from wormsim.contact3d.friction_guard import FrictionGuard
-        from wormsim.contact3d.mjcf import nominal_normal_force_n
-
-        self.friction = FrictionGuard(scenario, bm, nominal_normal_force_n(scenario, geo), rec * dt)
-
-    def state(self, d: mujoco.MjData, t: float, th1: float, th2: float, w1: float, w2: float) -> float:
-        """Divergence, overspeed, teeth jumped, friction against the slip; returns the transmission error (rad)."""
-        bm, dt = self.bm, self.dt
-        if not math.isfinite(th1 + th2 + w1 + w2) or d.warning[mujoco.mjtWarning.mjWARN_BADQACC].number:
-            raise diverged_error(t, dt, bm, "non-finite state or huge acceleration (MuJoCo's bad-qacc warning)")
-        turn = abs(w1) * dt
-        self.turn_max = max(self.turn_max, turn)
-        if turn > OVERSPEED_GUARD * MAX_WORM_TURN_PER_STEP_RAD:
-            if dt > bm.law.stable_limit_s:
-                raise diverged_error(t, dt, bm, f"the worm ran away to {rad_s_to_rpm(abs(w1)):.0f} rpm")
-            raise overspeed_error(t, w1, dt)
-        te = th2 - bm.direction * th1 / bm.geometry.ratio
-        if abs(te) > JUMP_PITCH * self.pitch_angle:
-            raise jump_error(t, te / self.pitch_angle, dt, bm, self.scenario)
-        self.friction.check(d, t, w1, w2)
-        return te
-
-    def contact(self, t: float, pen: float, w_drive: float, cmd: float) -> None:
-        """Penetration beyond the limit; a speed-driven drive stuck below half its command (locked)."""
-        if pen > self.pen_lim:
-            raise penetration_error(t, pen, self.pen_lim, self.dt, self.bm)
-        if self.speed_driven and t > self.lock_start:
-            if gt.drive_stuck(w_drive, cmd):
-                self.locked_since = t if self.locked_since is None else self.locked_since
-                if t - self.locked_since > self.lock_hold:
-                    raise locked_error(t, w_drive, cmd, self.bm, self.scenario)
-            else:
-                self.locked_since = None
-
-
 def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
     """Step the built model over simulation.duration_s at its timestep; sample, guard, summarise (module docstring)."""
     m = bm.model
@@ -308,7 +158,7 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
     qa_worm = int(m.jnt_qposadr[m.dof_jntid[bm.worm_dof]])
     qa_wheel = int(m.jnt_qposadr[m.dof_jntid[bm.wheel_dof]])
     coll = np.concatenate([bm.worm_geoms, bm.wheel_slot_geoms.ravel()])
-    guards = _Guards(bm, scenario, dt, rec)
+    guards = Guards(bm, scenario, dt, rec)
 
     S_all = np.zeros((len(SERIES), n_rec))  # one column per sample, written at once
     S = dict(zip(SERIES, S_all))
@@ -321,8 +171,8 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
     fc = pattern = loop = None
     if bm.meta.get("contact_geometry") == "flanks":
         # contacts found on the exact flanks and added between collision and constraints (wormsim.contact3d.flank_step)
-        from wormsim.contact3d.flank_outputs import PatternLog
         from wormsim.contact3d.flank_step import FlankContacts, flank_contact_details, split_forward
+        from wormsim.tooth.hertz import PatternLog
 
         fc = FlankContacts(bm, bm.law.contacts_per_pair)
         pattern = PatternLog(fc, gt.effective_modulus_pa(scenario.materials))  # contact pattern and stress
@@ -347,7 +197,7 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
 
         loop = FlankLoop(fc, d, ia_drv, ia_load, a1, a2, s0)
     # the commands at each step's midpoint, evaluated for blocks of about 4096 steps at once
-    cmds = gt.commands(scenario, bm.direction)
+    cmds = bm.plan.commands
     block = max(1, 4096 // rec)
     fast = None
     if loop is not None:  # whole stretches of samples in one compiled call (wormsim.contact3d.flank_samples)
@@ -467,7 +317,7 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
     rang = ringing(S, summary, dt, bm.law.stable_limit_s) if fc is not None else None  # flanks (ringing_check)
     if rang is not None:
         raise diverged_error(rang[0], dt, bm, rang[1])
-    if bm.kinematic_tca is not None:  # errors: the displaced exact flanks' kinematic TE and play (issue 12)
+    if bm.kinematic_tca is not None:  # errors: the displaced exact flanks' kinematic TE and play
         kin = bm.kinematic_tca.summary(bm.geometry, gt.working_flank(scenario, bm.geometry.hand))
         summary.update({k: v for k, v in kin.items() if not k.startswith("contact_pattern")})
     return Result(

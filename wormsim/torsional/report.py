@@ -9,7 +9,7 @@ import numpy as np
 
 from wormsim.recording import save_series_recording
 from wormsim.result import Result
-from wormsim.torsional.mesh_stiffness import MeshStiffness
+from wormsim.tooth.mesh_stiffness import MeshStiffness
 
 # ----------------------------------------------------------------------------- report, recording
 

@@ -1,4 +1,4 @@
-"""One MuJoCo contact per tooth flank (`contact.flank_contacts: tooth`; issue 13): the slice contacts of one tooth
+"""One MuJoCo contact per tooth flank (`contact.flank_contacts: tooth`): the slice contacts of one tooth
 flank (same tooth, same side: meta[:, 0:2], contiguous in the kernel's order) handed to MuJoCo as one contact.
 
 The contact law is a linear spring per contact whose stiffness is scaled by the contact's share w_i of its slice
