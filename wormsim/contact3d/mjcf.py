@@ -33,7 +33,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from meshgen import assembly
+from meshgen import assembly, wheel
 from meshgen.cache import cached
 from meshgen.displaced import Deviations, wheel_mount, worm_mount
 from meshgen.geometry import GearGeometry
@@ -46,7 +46,7 @@ from wormsim.contact3d.law import ContactLaw, contact_law, friction_damping_n_s_
 from wormsim.contact3d.mass_scaling import ScalingCheck
 from wormsim.contact3d.timestep import choose_timestep
 from wormsim.friction import friction_coefficient
-from wormsim.geometry import derive, displaced_pair, gear_set
+from wormsim.geometry import derive, displaced_pair, gear_set, solid_set
 from wormsim.scenario import Scenario, ScenarioError
 from wormsim.tooth.grid import SLICES_MASS_SCALED, FlankGrid, default_slices, flank_grid
 from wormsim.tooth.window import slot_quat, window_size, window_teeth_at
@@ -224,12 +224,8 @@ def _slabs_per_flank(gs: GearSet) -> int:
     return len(set(zs))
 
 
-def _tooth0_angle(gs: GearSet) -> float:
-    """Angle of tooth 0's centre (mean of its pieces' centroids) in the wheel frame (cached: _on_gear_set)."""
-    return _on_gear_set(gs, "tooth0_angle", _pieces_angle, gs.wheel_tooth_pieces)
-
-
 def _pieces_angle(pieces) -> float:
+    """Angle of the pieces' mean centroid in the wheel frame (tests: tooth 0's pieces sit on wheel.tooth_angle)."""
     c = np.mean([p.centroid for p in pieces], axis=0)
     return math.atan2(c[1], c[0])
 
@@ -251,7 +247,8 @@ def prepare(scenario: Scenario, gs: GearSet | None = None) -> Prepared:
     everything the timestep and the model need, without compiling anything."""
     if scenario.gear is None or scenario.drive is None:
         raise ScenarioError("model: contact3d needs gear: and drive: blocks")
-    geo, gs = (derive(scenario.gear), gs) if gs is not None else gear_set(scenario)
+    flanks = scenario.contact.geometry == "flanks"  # the flank contacts need the solid meshes only, no pieces
+    geo, gs = (derive(scenario.gear), gs) if gs is not None else (solid_set if flanks else gear_set)(scenario)
     ine = shaft_inertias(scenario, geo, gs)
     arm1, arm2 = gt.mesh_arms_m(geo.r1, geo.r2, geo.alpha_n, geo.gamma)
     # driven-machine inertia J on the loaded shaft (joint armature) belongs to that shaft's effective mass
@@ -274,7 +271,6 @@ def prepare(scenario: Scenario, gs: GearSet | None = None) -> Prepared:
         segments_per_turn=0 if scenario.contact.geometry == "flanks" else gs.resolution.worm_segments_per_turn or 0,
     )
     S = scaling.factor
-    flanks = scenario.contact.geometry == "flanks"
     a1, a2 = arm1**2 / (S * I1), arm2**2 / (S * I2)
     law = law1
     if S != 1:  # the law again with the scaled inertias
@@ -393,7 +389,7 @@ def build_model(
         wheel_slot_geoms=slot_geoms,
         slot_bodies=slot_bodies,
         window_teeth=W,
-        tooth0_angle_rad=_tooth0_angle(gs),
+        tooth0_angle_rad=wheel.tooth_angle(geo, 0),
         direction=expected_direction(scenario, geo),
         drive_sign=drive_sign,
         pieces=gs,
@@ -497,12 +493,12 @@ def _add_geoms(
         g.name = g.meshname = f"worm_piece_{i}"
         set_contact(g)
         worm_names.append(g.name)
-    for j, piece in enumerate(gs.wheel_tooth_pieces):
+    for j, piece in enumerate([] if flanks else gs.wheel_tooth_pieces):
         _add_mesh(spec, f"tooth_piece_{j}", piece)
     W = window_size(geo) if window_teeth is None else int(min(max(window_teeth, 1), geo.z2))
     n_pieces = 0 if flanks else len(gs.wheel_tooth_pieces)
     slot_names = [[""] * n_pieces for _ in range(W)]
-    for k in window_teeth_at(0.0, geo.z2, W, _tooth0_angle(gs)):
+    for k in window_teeth_at(0.0, geo.z2, W, wheel.tooth_angle(geo, 0)):
         s = int(k % W)
         sb = wheel_b.add_body()
         sb.name = f"slot{s}"
