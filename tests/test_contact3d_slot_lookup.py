@@ -1,4 +1,4 @@
-"""The pieces' geom -> window slot lookup (wormsim.contact3d.runner._slot_lookup) is keyed by the model's content, not
+"""The pieces' geom -> window slot lookup (wormsim.contact3d.sources.slot_lookup) is keyed by the model's content, not
 by the Python object: two models in one process (a sweep's worker) each get their own table, also when the second
 lives at the first one's address."""
 
@@ -8,7 +8,7 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from wormsim.contact3d.runner import _slot_lookup
+from wormsim.contact3d.sources import slot_lookup as _slot_lookup
 
 
 def _model(ngeom: int, slots: list[list[int]]) -> SimpleNamespace:

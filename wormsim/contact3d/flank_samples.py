@@ -4,9 +4,9 @@ the per-sample Python (~45-60 us a sample: dispatch, guards, the series column) 
 
 Per sample, in the runner's order and with its floating-point operations (bit-identical series, pattern and radius
 logs, contact points: tests/test_flank_samples.py): the steps; the state read from d (shaft angles and speeds,
-d.time); the runner's _Guards.state checks (non-finite state or MuJoCo's bad-qacc warning, overspeed, teeth jumped);
+d.time); the runner's Guards.state checks (non-finite state or MuJoCo's bad-qacc warning, overspeed, teeth jumped);
 mu from the friction law (wormsim.friction.friction_coefficient_scalar's three forms); flank_loop.sample_flanks; the
-penetration and lock checks of _Guards.contact; the series column (runner.SERIES order).
+penetration and lock checks of Guards.contact; the series column (series.SERIES order).
 
 Anything else hands the sample back to the runner's Python path, after its steps and before any of its per-sample
 work: a guard that would act (it raises or keeps state: a stuck drive, the friction guard's next check), a friction
@@ -30,7 +30,10 @@ from numba import types
 from numba.extending import intrinsic
 
 from wormsim.contact3d.flank_loop import _f1, _f64_at, _i1, _i64_at, run_table, sample_table
+from wormsim.contact3d.friction_law import mu_at, mu_params
+from wormsim.contact3d.guards import state_event
 from wormsim.contact3d.mjdata_layout import mjdata_offsets
+from wormsim.contact3d.series import column
 from wormsim.tooth.merge import split_forces
 
 ENABLED = True  # the runner's switch (tests compare against the per-sample path)
@@ -84,26 +87,10 @@ def _i32_at(typingctx, addr):
     return sig, codegen
 
 
-@numba.njit(cache=True, inline="always")
-def _friction(vs, g):
-    """wormsim.friction.friction_coefficient_scalar at the sliding speed vs, with its operations."""
-    kind = g[11]
-    if kind == 0.0:
-        return g[12]
-    if kind == 1.0:  # units.step(abs(vs), 0.0, static, v_t, dynamic)
-        t, h0, t1, h1 = abs(vs), g[12], g[13], g[14]
-        if t1 <= 0.0:
-            return h1 if t >= 0.0 else h0
-        s = (t - 0.0) / (t1 - 0.0)
-        s = 0.0 if s < 0.0 else (1.0 if s > 1.0 else s)
-        return h0 + (h1 - h0) * s * s * (3.0 - 2.0 * s)
-    return math.tan(g[28] / (g[12] * abs(vs) ** g[13] + g[14]))  # tan(DEG / (a |Vs|^b + c))
-
-
 @numba.njit(cache=True, nogil=True)
 def run_samples(T, Ts, m_addr, d_addr, cmd, load, i0, i1, o0, rec, S, g, off, frame, pos, adr, pat_buf, r_buf, io, mrg):
     """Samples i0..i1-1 (module docstring); sample i's steps are o0 + (i - i0) rec .. + rec of cmd and load.
-    T, Ts: flank_loop's run and sample tables; S the series (runner.SERIES rows); g the parameters (G_NAMES); off
+    T, Ts: flank_loop's run and sample tables; S the series (series.SERIES rows); g the parameters (G_NAMES); off
     the checked mjData offsets (wormsim.contact3d.mjdata_layout); frame, pos the kernel's contacts; adr (ADR_CAP) work
     room; pat_buf, r_buf the pattern's and the radius log's rows; io: IO_* (io[IO_PM], io[IO_RM] the logs' rows used
     on entry); mrg: with one contact per tooth flank (merge) the kernel's (grp, share, mfric, mwrap) and the per-slice
@@ -138,25 +125,17 @@ def run_samples(T, Ts, m_addr, d_addr, cmd, load, i0, i1, o0, rec, S, g, off, fr
         io[IO_DROPPED] = dropped
         if dropped:
             return
-        t1, t2, p1, p2, nc = acc[0], acc[1], acc[2], acc[3], acc[4]
-        fx, fy, fz, mz, fpk = acc[5], acc[6], acc[7], acc[8], acc[9]
         cmd_i = cmd[o + rec - 1]
         th1, th2 = qpos[qa1], qpos[qa2]
         w1, w2 = qvel[dof1], qvel[dof2]
         t = tptr[0]
-        # _Guards.state
-        if not math.isfinite(th1 + th2 + w1 + w2) or bptr[0] != 0:
-            return
-        turn = abs(w1) * dt
-        if turn > turn_lim:
-            return
-        te = th2 - direction * th1 / ratio
-        if abs(te) > jump_rad:
+        event, te, turn = state_event(th1, th2, w1, w2, bptr[0], dt, turn_lim, direction, ratio, jump_rad)
+        if event != 0:  # Guards.state raises: the Python path
             return
         if t > g[8]:  # the friction guard's next check
             return
         vs = abs(w1) * g[9] / g[10]
-        mu = _friction(vs, g)
+        mu = mu_at(vs, g[11], g[12], g[13], g[14], g[28])
         if mu != mu_now:  # FlankContacts.set_friction: the records' friction, where the cone's dimension stays
             if (mu > 0.0) != (mu_now > 0.0):
                 return
@@ -169,7 +148,7 @@ def run_samples(T, Ts, m_addr, d_addr, cmd, load, i0, i1, o0, rec, S, g, off, fr
                 recs[r, o5 + 1] = mu
             mu_now = mu
             g[16] = mu
-        # the sample's contacts: d.contact's efc addresses, the largest penetration (_Guards.contact's first check)
+        # the sample's contacts: d.contact's efc addresses, the largest penetration (Guards.contact's first check)
         ncon = nptr[0]
         n_fc = state[1]
         if ncon > adr.shape[0] or pm + n_fc > pat_buf.shape[0] or rm + n_fc > r_buf.shape[0]:
@@ -237,32 +216,8 @@ def run_samples(T, Ts, m_addr, d_addr, cmd, load, i0, i1, o0, rec, S, g, off, fr
             )
         turn_max = max(turn_max, turn)
         r_c = wr / W if W > 0 else math.nan
-        rpm = g[17]
-        col = (
-            t,
-            th1,
-            th2,
-            w1 / rpm,
-            w2 / rpm,
-            t1 / rec,
-            t2 / rec,
-            cmd_i,
-            fx / rec,
-            -fy / rec,
-            fz / rec,
-            nc / rec,
-            float(nteeth),
-            pen2,
-            mu,
-            te,
-            mz / rec,
-            p1 / rec,
-            p2 / rec,
-            fpk,
-            fr,
-            r_c,
-            0.0,
-        )
+        sums = (acc[0], acc[1], acc[2], acc[3], acc[4], acc[5], acc[6], acc[7], acc[8], acc[9])
+        col = column(t, th1, th2, w1, w2, cmd_i, sums, rec, nteeth, pen2, mu, te, fr, r_c, g[17])
         for k in range(len(col)):
             S[k, i] = col[k]
         io[IO_PENDING] = 0.0
@@ -277,36 +232,25 @@ class FlankSamples:
 
     def __init__(self, loop, guards, scenario, bm, worm_is_drive: bool, rec: int, series: np.ndarray):
         from wormsim import gear_theory as gt
-        from wormsim.contact3d.diagnosis import JUMP_PITCH
-        from wormsim.contact3d.timestep import MAX_WORM_TURN_PER_STEP_RAD, OVERSPEED_GUARD
-        from wormsim.friction import GROUPS, friction_coefficient
-        from wormsim.units import DEG, RPM
+        from wormsim.units import RPM
 
-        fc, geo, c = loop.fc, bm.geometry, scenario.contact
+        fc, geo = loop.fc, bm.geometry
         self.loop, self.fc, self.guards, self.rec, self.S = loop, fc, guards, rec, series
         self.off = mjdata_offsets()
         g = np.zeros(len(G_NAMES))
         g[G["dt"]] = guards.dt
         g[G["direction"]] = bm.direction
         g[G["ratio"]] = geo.ratio
-        g[G["overspeed_turn"]] = OVERSPEED_GUARD * MAX_WORM_TURN_PER_STEP_RAD
-        g[G["jump_rad"]] = JUMP_PITCH * guards.pitch_angle
+        g[G["overspeed_turn"]] = guards.turn_lim
+        g[G["jump_rad"]] = guards.jump_rad
         g[G["pen_lim"]] = guards.pen_lim
         g[G["lock_start"]] = guards.lock_start
         g[G["lock_fraction"]] = gt.LOCK_SPEED_FRACTION
         g[G["r1"]] = geo.r1
         g[G["cos_gamma"]] = math.cos(geo.gamma)
-        if c.friction_group is not None:
-            g[G["mu_kind"]] = 2.0
-            g[G["mu_a"]], g[G["mu_b"]], g[G["mu_c"]] = GROUPS[c.friction_group]
-        elif c.friction is None and c.friction_static is None:
-            g[G["mu_a"]] = float(friction_coefficient(c, 0.0))
-        elif c.friction is not None:
-            g[G["mu_a"]] = float(c.friction)
-        else:
-            g[G["mu_kind"]] = 1.0
-            g[G["mu_a"]], g[G["mu_b"]], g[G["mu_c"]] = c.friction_static, c.transition_velocity_m_s, c.friction_dynamic
-        g[G["deg"]] = DEG
+        kind, a, b, c_, deg = mu_params(scenario.contact)
+        g[G["mu_kind"]], g[G["mu_a"]], g[G["mu_b"]], g[G["mu_c"]] = kind, a, b, c_
+        g[G["deg"]] = deg
         g[G["rpm"]] = RPM
         g[G["a"]] = geo.a
         g[G["speed_driven"]] = float(guards.speed_driven)

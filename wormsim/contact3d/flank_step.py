@@ -49,7 +49,7 @@ class FlankContacts:
         self.grid = plan_grid if plan_grid is not None and plan_grid.slices == slices else flank_grid(g, slices)
         self.pitch = 2 * math.pi / g.z2
         self.margin0 = MARGIN_PITCH * self.pitch + g.backlash / (2 * g.r2)
-        self.taper_rad = TAPER_SHARE * self.margin0  # of the error-free window (flanks.find_contacts)
+        self.taper_rad = TAPER_SHARE * self.margin0  # of the error-free window (wormsim.tooth.kernel.find_contacts)
         W = bm.window_teeth
         cap = 2 * W * slices
         self.pos = np.zeros((cap, 3))
@@ -57,7 +57,7 @@ class FlankContacts:
         self.depth = np.zeros(cap)
         self.meta = np.zeros((cap, 4))
         self.line = np.zeros((cap, 2))
-        self.weight = np.zeros(cap)  # each contact's share of its slice (flanks.slice_weights)
+        self.weight = np.zeros(cap)  # each contact's share of its slice (wormsim.tooth.kernel.slice_weights)
         self.slices = slices
         self.frame = np.zeros((cap, 9))
         self.n = 0
@@ -103,7 +103,7 @@ class FlankContacts:
         self._pack()
 
     def _pack(self) -> None:
-        """The kernel's arrays, memo included, in two buffers: one compiled call per step (flanks.find_packed);
+        """The kernel's arrays, memo included, in two buffers: one compiled call per step (kernel.find_packed);
         again when self.params was replaced."""
         k = self.kernel = PackedKernel(
             self.grid, self.params, len(self.depth), len(self.ks), self.bm.geometry.z2, self.merge
@@ -112,8 +112,8 @@ class FlankContacts:
         self.pos, self.nrm, self.depth, self.meta, self.line = k.pos, k.nrm, k.depth, k.meta, k.line
         self.weight, self.frame, self.ks, self.params = k.weight, k.frame, k.ks, k.P
         self.memo = (k.memo, k.memo_consts)  # find_contacts' open-slice memo
-        k.axes[:] = self._hinges()  # the merge's moment arms (flank_merge)
-        # what is handed to MuJoCo: the slice contacts, or one per tooth flank (flank_merge)
+        k.axes[:] = self._hinges()  # the merge's moment arms (wormsim.tooth.merge)
+        # what is handed to MuJoCo: the slice contacts, or one per tooth flank (wormsim.tooth.merge)
         self.handed = (k.mdepth, k.mpos, k.mframe, k.mweight) if self.merge else (k.depth, k.pos, k.frame, k.weight)
         self._adr = np.zeros(len(k.depth), dtype=np.int64)  # slice_rows' per-slice rows (merge)
         self._efc = np.zeros(3 * len(k.depth))
@@ -125,7 +125,9 @@ class FlankContacts:
         d = mujoco.MjData(m)
         mujoco.mj_kinematics(m, d)
         j1, j2 = m.dof_jntid[bm.worm_dof], m.dof_jntid[bm.wheel_dof]
-        ratio = float(self.grid.params[12])  # the conjugate motion: theta2 = ratio theta1 (flanks._find_contacts)
+        ratio = float(
+            self.grid.params[12]
+        )  # the conjugate motion: theta2 = ratio theta1 (wormsim.tooth.kernel._find_contacts)
         return np.concatenate([d.xanchor[j1], d.xaxis[j1], d.xanchor[j2], d.xaxis[j2], [ratio]])
 
     def n_handed(self) -> int:
@@ -135,7 +137,7 @@ class FlankContacts:
     def slice_rows(self, d: mujoco.MjData):
         """Per slice contact (the kernel's last fc.n): (efc_address, efc_force, frame, pos, cone3) to read its
         constraint force from, as d.contact's last fc.n entries give it; with merge, the merged contacts' forces split
-        over their slices (flank_merge.split_forces: efc_address into the returned efc_force, three rows each)."""
+        over their slices (merge.split_forces: efc_address into the returned efc_force, three rows each)."""
         dim3 = self.template.dim == 3
         if not self.merge:
             n = min(self.n, d.ncon)
@@ -169,7 +171,7 @@ class FlankContacts:
         return self.ks
 
     def find(self, d: mujoco.MjData) -> int:
-        """Run the kernel at the current positions (flanks.find_packed: find_contacts with its memo, slice_weights,
+        """Run the kernel at the current positions (kernel.find_packed: find_contacts with its memo, slice_weights,
         contact_frames); returns the number of contacts."""
         q = d.qpos  # one view (each d.qpos builds one: ~1 us)
         th1, th2 = q[self.qa1], q[self.qa2]
@@ -257,7 +259,7 @@ def split_forward(m: mujoco.MjModel, d: mujoco.MjData, add_contacts) -> None:
 
 
 def flank_contact_details(fc: FlankContacts, d: mujoco.MjData):
-    """As wormsim.contact3d.runner.contact_details for flank contacts: (n teeth touching, max penetration, points in
+    """As wormsim.contact3d.sources.contact_details for flank contacts: (n teeth touching, max penetration, points in
     the frame of wheel tooth 0, forces on the wheel (world), points (world)). The kernel's contacts are d.contact's
     last fc.n entries; the force on the wheel (geom 2) is the elliptic-cone rows turned into the world frame
     (`_contact_forces`, compiled: this runs at every sample)."""

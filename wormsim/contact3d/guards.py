@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 
 import mujoco
+import numba
 
 from wormsim import gear_theory as gt
 from wormsim.contact3d.diagnosis import (
@@ -26,6 +27,25 @@ from wormsim.contact3d.timestep import MAX_WORM_TURN_PER_STEP_RAD, OVERSPEED_GUA
 from wormsim.scenario import Scenario
 from wormsim.units import rad_s_to_rpm
 
+DIVERGED, OVERSPEED, JUMPED = 1, 2, 3  # state_event's codes (0: none)
+
+
+@numba.njit(cache=True, inline="always")
+def state_event(th1, th2, w1, w2, badqacc, dt, turn_lim, direction, ratio, jump_rad):
+    """The state checks of a sample, in order: DIVERGED (non-finite state or MuJoCo's bad-qacc warning count
+    badqacc), OVERSPEED (the worm's turn per step |w1| dt beyond turn_lim), JUMPED (the transmission error
+    th2 - direction th1 / ratio beyond jump_rad), 0 when none fires; with (the TE, the turn). Guards.state and the
+    compiled samples (wormsim.contact3d.flank_samples) both decide by it."""
+    if not math.isfinite(th1 + th2 + w1 + w2) or badqacc != 0:
+        return DIVERGED, 0.0, 0.0
+    turn = abs(w1) * dt
+    if turn > turn_lim:
+        return OVERSPEED, 0.0, turn
+    te = th2 - direction * th1 / ratio
+    if abs(te) > jump_rad:
+        return JUMPED, te, turn
+    return 0, te, turn
+
 
 class Guards:
     """The checks after every record interval (module docstring); each raises its SimulationError subclass."""
@@ -35,6 +55,8 @@ class Guards:
         geo = bm.geometry
         self.pen_lim = gt.penetration_limit_m(geo.m_x)
         self.pitch_angle = 2 * math.pi / geo.z2
+        self.turn_lim = OVERSPEED_GUARD * MAX_WORM_TURN_PER_STEP_RAD
+        self.jump_rad = JUMP_PITCH * self.pitch_angle
         self.lock_start = gt.lock_check_start_s(scenario)
         self.lock_hold = max(gt.LOCK_HOLD_S, 20 * rec * dt)
         self.speed_driven = scenario.drive.speed_rpm is not None
@@ -46,16 +68,18 @@ class Guards:
     def state(self, d: mujoco.MjData, t: float, th1: float, th2: float, w1: float, w2: float) -> float:
         """Divergence, overspeed, teeth jumped, friction against the slip; returns the transmission error (rad)."""
         bm, dt = self.bm, self.dt
-        if not math.isfinite(th1 + th2 + w1 + w2) or d.warning[mujoco.mjtWarning.mjWARN_BADQACC].number:
+        badqacc = d.warning[mujoco.mjtWarning.mjWARN_BADQACC].number
+        code, te, turn = state_event(
+            th1, th2, w1, w2, badqacc, dt, self.turn_lim, float(bm.direction), bm.geometry.ratio, self.jump_rad
+        )
+        if code == DIVERGED:
             raise diverged_error(t, dt, bm, "non-finite state or huge acceleration (MuJoCo's bad-qacc warning)")
-        turn = abs(w1) * dt
         self.turn_max = max(self.turn_max, turn)
-        if turn > OVERSPEED_GUARD * MAX_WORM_TURN_PER_STEP_RAD:
+        if code == OVERSPEED:
             if dt > bm.law.stable_limit_s:
                 raise diverged_error(t, dt, bm, f"the worm ran away to {rad_s_to_rpm(abs(w1)):.0f} rpm")
             raise overspeed_error(t, w1, dt)
-        te = th2 - bm.direction * th1 / bm.geometry.ratio
-        if abs(te) > JUMP_PITCH * self.pitch_angle:
+        if code == JUMPED:
             raise jump_error(t, te / self.pitch_angle, dt, bm, self.scenario)
         self.friction.check(d, t, w1, w2)
         return te

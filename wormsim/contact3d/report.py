@@ -9,8 +9,8 @@ recording.rrd (wormsim.recording layout): /series/* time series on the sim_time 
 wheel meshes under /assembly/worm and /assembly/wheel moved by their 4x4 transforms; contact points
 (/assembly/contacts/points) and force arrows on the wheel (/assembly/contacts/forces, 1 mm per
 `ARROW_N_PER_MM` newtons) at up to MAX_FRAMES instants. With exact flanks: the steady-window contact
-pattern on every wheel tooth, coloured by pressure (/assembly/wheel/contact_pattern, flank_outputs.log_pattern),
-and in report.png the pattern as a band on the wheel flank coloured by pressure (flank_outputs.draw_pattern).
+pattern on every wheel tooth, coloured by pressure (/assembly/wheel/contact_pattern, wormsim.tooth.hertz.log_pattern),
+and in report.png the pattern as a band on the wheel flank coloured by pressure (wormsim.tooth.hertz.draw_pattern).
 """
 
 from __future__ import annotations
@@ -103,7 +103,7 @@ def write_report(result: Result, path) -> None:
     a = ax[1, 1]
     P = result.extra.get("points_tooth0")
     F = result.extra.get("forces_world")
-    if "flank_pattern" in result.extra:  # exact flanks: the loaded band coloured by pressure (flank_outputs)
+    if "flank_pattern" in result.extra:  # exact flanks: the loaded band coloured by pressure (wormsim.tooth.hertz)
         from wormsim.tooth.hertz import draw_pattern
 
         draw_pattern(a, fig, result.extra["flank_pattern"], result.extra["built"].geometry, s)

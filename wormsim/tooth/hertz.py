@@ -180,7 +180,7 @@ def _lerp_rows(a, sg, j, f):
 @numba.njit(cache=True)
 def _rows(i, adr, efc_force, meta, weight, inv_rho, line_len, e_star, out, m):
     """Appends (i, sigma, j, f, F_n, p_H (3)) per contact with a constraint row to out (float32) from row m. The
-    contact carries the share weight[c] of its slice (flanks.slice_weights), so its line is weight[c] x L long."""
+    contact carries the share weight[c] of its slice (kernel.slice_weights), so its line is weight[c] x L long."""
     for c in range(adr.shape[0]):
         if adr[c] < 0 or weight[c] <= 0.0:
             continue

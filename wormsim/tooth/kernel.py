@@ -51,7 +51,7 @@ def _eval(x0, y0, zeta, ca, sa, theta1, P, out):
     """Extended gap and excess (worm_gap_ext) of the wheel point (x0, y0, zeta) turned by the angle (cos ca, sin sa)
     about z (assembly frame), and the turned point in out[3:6]. With a displaced pose in P
     (wormsim.tooth.pose) the turned point is in the wheel body's frame and goes through the poses instead
-    (flank_pose.to_static)."""
+    (pose.to_static)."""
     x, y = ca * x0 - sa * y0, sa * x0 + ca * y0
     if P.shape[0] > N_WORM_PARAMS:
         xs, ys, zs = to_static(x, y, zeta, P, out)
@@ -162,7 +162,7 @@ def _find_contacts(xy, c, c_range, span, zeta, ks, theta1, theta2, margin, taper
         ang = theta2 + pitch * k
         dk = 0.0
         if P.shape[0] > N_WORM_PARAMS:
-            ang, dk = tooth_angle(k, P)  # wheel body frame, pitch deviation dk (flank_pose)
+            ang, dk = tooth_angle(k, P)  # wheel body frame, pitch deviation dk (wormsim.tooth.pose)
         ca, sa = math.cos(ang), math.sin(ang)
         for sg in range(2):
             target = _wrap(theta2 + pitch * (k + sg) + dk, 2 * math.pi)
@@ -195,7 +195,7 @@ def _find_contacts(xy, c, c_range, span, zeta, ks, theta1, theta2, margin, taper
                 while b - a > 1:
                     mid = (a + b) // 2
                     cm = c[sg, j, mid]
-                    if cm != cm:  # a point trimmed inside the row (flank_trim): scan the row instead
+                    if cm != cm:  # a point trimmed inside the row (wormsim.tooth.trim): scan the row instead
                         a = -1
                         break
                     if (cm < target) == inc:
@@ -436,7 +436,18 @@ def contact_frames(nrm, n, frame):
 
 _F_FIELDS = ("xy", "c", "c_range", "zeta", "P", "pos", "nrm", "depth", "meta", "line", "weight", "frame", "memo")
 _F_FIELDS += ("memo_consts", "tmp", "gaps", "exc", "pts", "nrs")
-_F_FIELDS += ("mpos", "mnrm", "mdepth", "mweight", "mframe", "grp", "share", "mfric", "mwrap", "axes")  # flank_merge
+_F_FIELDS += (
+    "mpos",
+    "mnrm",
+    "mdepth",
+    "mweight",
+    "mframe",
+    "grp",
+    "share",
+    "mfric",
+    "mwrap",
+    "axes",
+)  # wormsim.tooth.merge
 _I_HEADER = 8  # S, N, cap, len(P), W, z2, merge (one contact per tooth flank), merged contacts
 
 
@@ -569,7 +580,7 @@ def find_packed(fb, ib, theta1, theta2, margin, taper_rad):
     )
     n = slice_weights(meta, line, n, S, pos, nrm, depth, weight)
     contact_frames(nrm, n, frame)
-    if ib[6]:  # one contact per tooth flank (flank_merge)
+    if ib[6]:  # one contact per tooth flank (wormsim.tooth.merge)
         nm = merge_flanks(meta, n, pos, nrm, depth, weight, grp, share, mpos, mnrm, mdepth, mweight, mfric, mwrap, axes)
         ib[7] = nm
         contact_frames(mnrm, nm, mframe)

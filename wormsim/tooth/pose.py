@@ -42,7 +42,7 @@ SHIFT = WORM + 12
 def displaced_params(worm_p: np.ndarray, tooth_shift_rad: np.ndarray) -> np.ndarray:
     """The kernel's P with room for the poses (module docstring); set_pose fills them each step."""
     if worm_p.shape[0] != N_WORM_PARAMS:
-        raise ValueError("flank_pose: worm_params changed length; update N_WORM_PARAMS")
+        raise ValueError("wormsim.tooth.pose: worm_params changed length; update N_WORM_PARAMS")
     P = np.zeros(SHIFT + len(tooth_shift_rad))
     P[:N_WORM_PARAMS] = worm_p
     P[SHIFT:] = tooth_shift_rad
