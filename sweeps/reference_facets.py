@@ -1,6 +1,6 @@
 """Issue 13's reference figure (an exact-surface simulator fed `wormsim mesh`'s STL: screw jack F_t p2p 40-50 N at
-400 N mean) against our exact flanks (1.64 N): how much of it the STL's triangle facets can give. docs/contact3d.md,
-"The reference simulator's 40-50 N".
+400 N mean) against our exact flanks (1.64 N): how much of it the STL's triangle facets can give:
+docs/decisions/0012-reference-simulator-facets.md.
 
 (a) chordal deviation of the exported meshes (meshgen.meshes, what worm.stl / wheel.stl hold) from the exact flanks
     on the working flanks: wheel, exact flank points of tooth 0 (the flank grid) against the wheel mesh (a ray along

@@ -1,5 +1,5 @@
 """Quasi-static F_t harmonics of the exact-flank kernel on the variety variants against slice count (issue 13;
-docs/contact3d.md, "Variants against slice count"). No MuJoCo step: the worm is set over one mesh cycle, the wheel at
+docs/contact3d.md, "Variety with exact flanks"). No MuJoCo step: the worm is set over one mesh cycle, the wheel at
 the conjugate angle minus a fixed lag, and F_t = sum(w k_c depth (r x n)_z) / r2 from FlankContacts.find. The lag is
 solved so that the cycle's mean F_t carries the run's load (load.torque_nm / r2). Printed per slice count: the
 harmonics 1..N of F_t / mean, next to the TCA's k(theta) harmonics / mean (wormsim.tooth.mesh_stiffness, zero

@@ -50,7 +50,7 @@ RADIAL_XFAIL = {
     "seat_motor": "the radial force's largest peak is the 2nd meshing harmonic, 59.94 Hz against 29.97 Hz, since "
     "contacts leave at zero load (F_t: 29.97 Hz, p2p 1.04 N on 1289 N at 16 slices, 0.87 N at 32); before, the slices' load steps put 29.97 Hz "
     "on top. Physical for the kernel: quasi-static at constant torque its radial harmonics 1-4 are 0.998, 1.239, "
-    "0.688, 0.091 N (docs/contact3d.md, third pass)",
+    '0.688, 0.091 N (docs/contact3d.md, "Contacts leaving at zero load")',
 }
 
 

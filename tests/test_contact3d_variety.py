@@ -98,7 +98,7 @@ HARMONIC = (
     "F_t's mesh lines are 0.02-1.6 N, rising towards the contact mode's band (2-7 kHz, lines 0.9-2.9 N); at constant "
     "load torque the mesh stiffness's fluctuation goes into the TE, and F_t's lines are the wheel's inertia times its "
     "acceleration, I2 (2 pi k f_m)^2 TE_k / r2 (test_flanks_harmonic_tangential_force_lines_...). Not a slicing artefact "
-    "(docs/contact3d.md, 'Variants against slice count'; sweeps/variant_harmonics.py): "
+    "(docs/contact3d.md, 'Variety with exact flanks'; sweeps/variant_harmonics.py): "
 )
 # left-ZA passes since contacts leave at zero load (docs/contact3d.md): 99.9 Hz, p2p 55.7 N on 833 N (before 499.5 Hz,
 # the 5th harmonic, p2p 77 N)
