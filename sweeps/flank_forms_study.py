@@ -25,10 +25,10 @@ sys.path.insert(0, str(ROOT / "tests"))
 from test_contact3d_seeds import CI  # noqa: E402  (the seeds' CI settings)
 
 from meshgen.geometry import derive  # noqa: E402
-from wormsim.contact3d.flank_outputs import draw_pattern  # noqa: E402
 from wormsim.contact3d.runner import simulate  # noqa: E402
 from wormsim.run import run_scenario  # noqa: E402
 from wormsim.scenario import ScenarioError, load_scenario  # noqa: E402
+from wormsim.tooth.hertz import draw_pattern  # noqa: E402
 from wormsim.validate import validate_geometry  # noqa: E402
 
 FORMS = {

@@ -12,8 +12,8 @@ from test_flank_contact import test_kernel_distance_is_meshgen_thread_gap as ker
 from meshgen import worm, worm_forms
 from meshgen.geometry import derive
 from meshgen.worm_forms_jit import half_thickness
-from wormsim.contact3d import flanks as F
 from wormsim.scenario import load_scenario
+from wormsim.tooth import gap as F
 
 
 @pytest.mark.parametrize(

@@ -246,7 +246,7 @@ def commands(scenario: Scenario, direction: int) -> Commands:
 def working_flank(scenario: Scenario, hand: int) -> int:
     """+1 when the mesh torque on the wheel is positive in the intended running (the worm drives against a resisting
     load: hand x sign(command)), -1 otherwise (the wheel drives: the mesh resists its motion). The flank side of
-    meshgen.kinematic_tca and wormsim.torsional.mesh_stiffness."""
+    meshgen.kinematic_tca and wormsim.tooth.mesh_stiffness."""
     drv = gear_drive(scenario)
     s = 1 if drive_target(drv) >= 0 else -1
     return s * hand if drv.on == "worm" else -s

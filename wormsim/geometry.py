@@ -48,6 +48,17 @@ def gear_set(scenario: Scenario, resolution: str | None = None) -> tuple[GearGeo
         return geo, _pieces.build_gear_set(geo, resolution=resolution or scenario.simulation.resolution)
 
 
+def solid_set(scenario: Scenario, resolution: str | None = None) -> tuple[GearGeometry, GearSet]:
+    """(geometry, the solid meshes without collision pieces: meshgen.pieces.build_solids) of the scenario's gear."""
+    if scenario.gear is None:
+        raise ScenarioError("gear: this needs a gear: block (model contact3d or torsional)")
+    from meshgen import pieces as _pieces
+
+    geo = derive(scenario.gear)
+    with geometry_errors():
+        return geo, _pieces.build_solids(geo, resolution=resolution or scenario.simulation.resolution)
+
+
 def displaced_pair(errors: ErrorsData, geo: GearGeometry) -> tuple[Deviations, KinematicTCA] | None:
     """The errors: block as meshgen.displaced's Deviations, checked against its limits, and the kinematic TCA of the
     displaced flanks (meshgen.kinematic_tca, with its play check); None without errors (the perfect pair's path).

@@ -350,7 +350,7 @@ class Wedge(_Strict):
 
 
 class Errors(_Strict):
-    """Assembly errors and manufacturing deviations of the gear pair (issue 12), every key 0 by default.
+    """Assembly errors and manufacturing deviations of the gear pair, every key 0 by default.
     Their geometry, limits and signs: meshgen.displaced and docs/errors.md. The limits that depend on the gear
     (backlash, tooth depth, face width, threaded length) are checked against the derived geometry (exit 2)."""
 

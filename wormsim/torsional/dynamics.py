@@ -14,7 +14,7 @@ worm pushes in forward drive (side +1) touches for e > g and the opposite flank 
 in between, no force. (With assembly errors, `errors:`, the gaps are the kinematic TCA's g_side(theta1) and the
 elastic torque is the loaded TCA's table of the displaced flanks, wormsim.torsional.loaded_tca; docs/errors.md 5a.)
 The penetration along the line of action is delta = arm0 (|e| - g), arm0 = r2 cos(alpha_n)
-cos(gamma) (wormsim.torsional.mesh_stiffness: k(theta1) is computed there, once, from the generated flanks).
+cos(gamma) (wormsim.tooth.mesh_stiffness: k(theta1) is computed there, once, from the generated flanks).
 
 Mesh torque on the wheel (ADAMS IMPACT form with e = 1, damping blended in over the penetration depth d_max
 like IMPACT's STEP, never pulling):
@@ -86,7 +86,7 @@ from wormsim.geometry import derive, displaced_pair
 from wormsim.metrics import dominant_frequency, drive_summary, mean_speeds_rpm, window_of
 from wormsim.result import Result
 from wormsim.scenario import Scenario
-from wormsim.torsional.mesh_stiffness import MeshStiffness, mesh_stiffness, per_length_stiffness
+from wormsim.tooth.mesh_stiffness import MeshStiffness, mesh_stiffness, per_length_stiffness
 from wormsim.units import rad_s_to_rpm, step
 
 CHORD_ITER = 4  # backward Euler: Newton iterations that reuse the first Jacobian of a step
@@ -139,7 +139,7 @@ class _Mesh:
         self.g, self.ms = g, ms
         self.hz = g.hand * g.z1 / g.z2
         self.gap = g.backlash / (2 * g.r2)
-        # assembly errors (issue 12): the gaps of the displaced flanks from the kinematic TCA, per side, as tables
+        # assembly errors: the gaps of the displaced flanks from the kinematic TCA, per side, as tables
         # over its period of worm angle (meshgen.kinematic_tca); None: the perfect pair's constant gap
         self.kin = kin
         if kin is not None:
@@ -413,7 +413,7 @@ def simulate(scenario: Scenario, progress=None, method: str = "implicit") -> Res
     kin = pair[1] if pair is not None else None
     ltca, t_lt = None, 0.0
     if pair is not None:
-        from wormsim.torsional.loaded_tca import loaded_tca  # imports contact3d's kernel: only with errors
+        from wormsim.torsional.loaded_tca import loaded_tca  # only with errors
 
         t_lt = time.perf_counter()
         t2w = gt.working_wheel_torque_nm(scenario, g.ratio)
