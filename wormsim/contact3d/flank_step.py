@@ -65,8 +65,9 @@ class FlankContacts:
         self.qa2 = int(m.jnt_qposadr[m.dof_jntid[bm.wheel_dof]])
         self._c = None
         self.ks = np.zeros(W, dtype=np.int64)
-        gw = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, "worm_visual")
-        gg = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, "wheel_visual")
+        worm_geom, wheel_geom = bm.meta.get("flank_geoms", ("worm_visual", "wheel_visual"))  # wormsim.pair: prefixed
+        gw = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, worm_geom)
+        gg = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, wheel_geom)
         self.geoms = (gw, gg)
         law = bm.law
         t = mujoco.MjContact()
