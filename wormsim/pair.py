@@ -53,13 +53,13 @@ import numpy as np
 from meshgen import assembly
 from meshgen import wheel as mwheel
 from meshgen.displaced import Deviations, wheel_mount, worm_mount
+from wormsim.contact3d import shafts
 from wormsim.contact3d.flank_step import FlankContacts, split_step
 from wormsim.contact3d.mjcf import Prepared, prepare
 from wormsim.contact3d.timestep import MAX_WORM_TURN_PER_STEP_RAD, OVERSPEED_GUARD, default_timestep
 from wormsim.friction import friction_coefficient, friction_coefficient_scalar
 from wormsim.geometry import displaced_pair
 from wormsim.scenario import Scenario, load_scenario
-from wormsim.tooth import pose as tooth_pose
 from wormsim.tooth.window import window_size
 
 __all__ = ["PairStepError", "WormPair", "step"]
@@ -67,12 +67,6 @@ __all__ = ["PairStepError", "WormPair", "step"]
 
 class PairStepError(ValueError):
     """A model the pair cannot step: timestep above the contact's stable limit, RK4, the worm overspeeding."""
-
-
-def _quat(R: np.ndarray) -> np.ndarray:
-    q = np.zeros(4)
-    mujoco.mju_mat2Quat(q, np.ascontiguousarray(R, dtype=float).ravel())
-    return q
 
 
 def _frame(pos: Sequence[float], quat: Sequence[float]) -> np.ndarray:
@@ -84,19 +78,6 @@ def _frame(pos: Sequence[float], quat: Sequence[float]) -> np.ndarray:
     T[:3, :3] = R.reshape(3, 3)
     T[:3, 3] = pos
     return T
-
-
-class _PairContacts(FlankContacts):
-    """FlankContacts whose kernel always takes the bodies' poses from the data (wormsim.tooth.pose), one MuJoCo
-    contact per face slice."""
-
-    def __init__(self, bm, slices: int):
-        super().__init__(bm, slices, merge=False)
-        if not self.displaced:  # the error-free pair: the poses still come from the data (moving housing)
-            self.displaced = True
-            self.params = tooth_pose.displaced_params(self.grid.params, np.zeros(bm.geometry.z2))
-            self._set_pose = tooth_pose.set_pose
-        self.margin0 += bm.extra_margin_rad
 
 
 class _Binding:
@@ -129,7 +110,12 @@ class _Binding:
             geometry=geo,
             law=p.law,
             plan=p,
-            meta={"flank_contacts": "slice", "flank_geoms": (names["worm_geom"], names["wheel_geom"])},
+            meta={
+                "flank_contacts": "slice",
+                "flank_geoms": (names["worm_geom"], names["wheel_geom"]),
+                "poses_from_data": True,  # a moving housing, the shafts (wormsim.contact3d.flank_step)
+                "margin_rad": shafts.mesh_margin_rad(pair.supports, p.normal_force_n, geo),
+            },
             window_teeth=window_size(geo),
             worm_dof=self.worm_dof,
             wheel_dof=self.wheel_dof,
@@ -138,12 +124,11 @@ class _Binding:
             tooth0_angle_rad=mwheel.tooth_angle(geo, 0),
             deviations=pair.deviations,
             tooth_shift_rad=pair.tooth_shift_rad,
-            extra_margin_rad=0.0,
         )
         # the law's A_hat (wormsim.contact3d.law (1)) on the two bodies the flank contacts act between
         model.body_invweight0[self.worm_body, 0] = p.inv_mass_worm
         model.body_invweight0[self.wheel_body, 0] = p.inv_mass_wheel
-        self.contacts = _PairContacts(bm, p.law.contacts_per_pair)
+        self.contacts = FlankContacts(bm, p.law.contacts_per_pair, merge=False)
         self.mu_of = friction_coefficient_scalar(pair.scenario.contact)
         self.vs_per_w1 = geo.r1 / math.cos(geo.gamma)
         self.R0 = pair._placement[:3, :3]
@@ -164,6 +149,7 @@ class WormPair:
         self.geometry = plan.geometry
         self.deviations = deviations
         self.tooth_shift_rad = tooth_shift_rad
+        self.supports = {part: shafts.support(scenario, plan.geometry, part) for part in ("worm", "wheel")}
         self.prefix: str | None = None
         self.parent: str | None = None
         self._placement = np.eye(4)
@@ -293,21 +279,12 @@ class WormPair:
         for part in ("wheel", "worm"):
             M, E = mounts[part]
             X = T0 @ M @ E  # body -> parent at hinge angle 0 (meshgen.displaced (1), (2))
-            b = pb.add_body()
-            b.name = f"{prefix}{part}"
-            b.pos = X[:3, 3]
-            b.quat = _quat(X[:3, :3])
             mass, izz, length, rgba = props[part]
-            b.explicitinertial = True
-            b.mass = mass
-            b.ipos = [0, 0, 0]
             ixx = izz / 2 + mass * length**2 / 12  # a solid cylinder's transverse moment (as contact3d's model)
-            b.inertia = [ixx, ixx, izz]
-            j = b.add_joint()
-            j.name = f"{prefix}{part}_hinge"
-            j.type = mujoco.mjtJoint.mjJNT_HINGE
-            j.axis = [0, 0, 1]
-            j.pos = -E[:3, 3]  # the axis of rotation, off the part's axis by the runout
+            # the hinge on the axis of rotation, off the part's axis by the runout; on its bearings (shafts:)
+            b = shafts.add_part(
+                spec, pb, f"{prefix}{part}", X, -E[:3, 3], mass, [ixx, ixx, izz], self.supports[part], geo.r_f1
+            )
             me = spec.add_mesh()
             me.name = f"{prefix}{part}_visual"
             me.uservert = np.asarray(meshes[part].vertices, dtype=np.float32).ravel()
@@ -395,6 +372,10 @@ def _check_options(pair: WormPair, model: mujoco.MjModel) -> None:
             f"the pair's effective mass {pair.plan.law.effective_mass_kg:.3g} kg; wormsim.contact3d.law): set "
             f"model.opt.timestep <= {lim:.3g} s (contact3d uses {pair.default_timestep_s:.3g} s for this pair)"
         )
+    try:  # the shafts' bearing and bending springs (wormsim.contact3d.shafts)
+        shafts.check_timestep(model, h, pair.prefix or "")
+    except ValueError as e:
+        raise PairStepError(f"{pair.prefix}: {e}") from None
     if model.opt.integrator == mujoco.mjtIntegrator.mjINT_RK4:
         raise PairStepError(
             f"{pair.prefix}: the RK4 integrator cannot take the added flank contacts (its stages run MuJoCo's "

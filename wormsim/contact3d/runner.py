@@ -46,6 +46,7 @@ from wormsim.contact3d.guards import Guards
 from wormsim.contact3d.metrics import contact3d_summary
 from wormsim.contact3d.mjcf import BuiltModel, build_model
 from wormsim.contact3d.ringing_check import ringing
+from wormsim.contact3d.shafts import ShaftLog
 from wormsim.contact3d.slots import repose_window
 from wormsim.friction import friction_coefficient_scalar, friction_mode
 from wormsim.result import Result
@@ -205,6 +206,7 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
 
         fast = FlankSamples(loop, guards, scenario, bm, worm_is_drive, rec, S_all)
         fast.bind(store)
+    slog = ShaftLog(m, bm.meta["shafts"], n_rec) if "shafts" in bm.meta else None  # wormsim.contact3d.shafts
     prewarm.loop_started()  # the writers' warm-up thread goes now, beside the GIL-free loop (wormsim.prewarm)
     i = 0
     while i < n_rec:
@@ -271,6 +273,8 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
             fc.set_friction(mu)
             nteeth, pen, fr_lc, r_c = loop.sample(i, pattern, rlog, store)
         guards.contact(t, pen, w1 if worm_is_drive else w2, cmd)
+        if slog is not None:
+            slog.record(i, d)
         # the mean resultant on the wheel resolved at the pitch point P = (0, -r2, 0) on the line of centres, in the
         # wheel's directions there (DIN 3975 F_t2, F_r2, F_a2; seed 001 resolves ADAMS's contact force the same
         # way): tangential e_t = +x, radial e_r = -y (outward, towards the worm), axial e_z. The contact torque M_z
@@ -310,6 +314,9 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
         S, scenario, bm, rec, guards.turn_max, len(coll), 1e6 * wall / max(n_rec * rec, 1), flanks=fc is not None
     )
     extra = {"points_tooth0": pts, "points_world": pts_world, "forces_world": forces, "built": bm}
+    if slog is not None:  # the shafts' deflections and bearing forces
+        S.update(slog.series())
+        summary.update(slog.summary(S["t_s"], summary["steady_window_s"]))
     if pattern is not None:  # the loaded contact pattern and Hertz stress (flank_outputs)
         summary.update(pattern.summary(S["t_s"], summary["steady_window_s"]))
         extra["flank_pattern"] = pattern.grid(S["t_s"], summary["steady_window_s"])
