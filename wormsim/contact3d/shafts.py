@@ -31,8 +31,8 @@ the shafts; its candidate window is widened for the expected mesh displacement (
 Outputs (ShaftLog): the mesh point's displacement across each axis (worm_deflection_mesh_um,
 wheel_deflection_mesh_um: the magnitude of the mean displacement vector over the steady window), the bearings'
 radial forces (one per bearing, the magnitude of the mean force vector) and the locating bearing's axial force,
-their maxima over the steady window, and their time series. A rigid direction has no spring and reports no force
-(None in the summary).
+their maxima over the steady window, and their time series. A rigid bearing's force is the constraint's reaction
+on the shaft (ShaftLog); a rigid shaft's deflection is 0.
 """
 
 from __future__ import annotations
@@ -257,9 +257,13 @@ def check_timestep(model: mujoco.MjModel, timestep_s: float, prefix: str = "") -
 
 
 class ShaftLog:
-    """The shafts' outputs (module docstring), one value per sample, from the joints and tendons of a model."""
+    """The shafts' outputs (module docstring), one value per sample: displacements from the joints, a compliant
+    bearing's force from its spring (tendon or slide), a rigid bearing's force from the reaction MuJoCo's constraint
+    solve puts on the shaft (mj_rnePostConstraint's cfrc_int of the outermost shaft body: the force and moment its
+    parent exerts), split over the two bearings by the shaft's statics (bearing_split)."""
 
     def __init__(self, model: mujoco.MjModel, supports: dict[str, Support | None], n: int, prefix: str = ""):
+        self.model = model
         self.supports = supports
         self.n = n
 
@@ -270,44 +274,74 @@ class ShaftLog:
         def tid(name: str) -> int:
             return mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_TENDON, prefix + name)
 
-        self.parts = {}
+        def bid(name: str) -> int:
+            return mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, prefix + name)
+
+        self.parts: dict[str, dict] = {}
+        self.reactions = False
         for part, sup in supports.items():
-            if sup is None or not sup.moves:
+            if sup is None:
                 continue
-            self.parts[part] = {
+            carrier = bid(f"{part}_carrier")
+            ids = {
                 "defl": [jq(f"{part}_radial_x"), jq(f"{part}_radial_y"), jq(f"{part}_bend_x"), jq(f"{part}_bend_y")],
                 "axial": jq(f"{part}_axial"),
                 "tendons": [(tid(f"{part}_bearing{i}_x"), tid(f"{part}_bearing{i}_y")) for i in range(2)],
+                "root": carrier if carrier >= 0 else bid(part),  # the outermost shaft body
+                "hinge": -1 if carrier >= 0 else jq(f"{part}_hinge"),  # its rotation to take out (no carrier)
             }
+            ids["rigid"] = ids["tendons"][0][0] < 0 or ids["axial"] < 0
+            self.reactions |= ids["rigid"]
+            self.parts[part] = ids
         self.S: dict[str, np.ndarray] = {}
-        for part, ids in self.parts.items():
-            self.S[f"{part}_deflection_mesh_x_m"] = np.zeros(n)
-            self.S[f"{part}_deflection_mesh_y_m"] = np.zeros(n)
-            if ids["tendons"][0][0] >= 0:
-                for i in range(2):
-                    self.S[f"{part}_bearing{i}_radial_x_n"] = np.zeros(n)
-                    self.S[f"{part}_bearing{i}_radial_y_n"] = np.zeros(n)
-            if ids["axial"] >= 0:
-                self.S[f"{part}_bearing_axial_n"] = np.zeros(n)
+        for part in self.parts:
+            keys = [f"{part}_deflection_mesh_{a}_m" for a in "xy"] + [f"{part}_bearing_axial_n"]
+            keys += [f"{part}_bearing{i}_radial_{a}_n" for i in range(2) for a in "xy"]
+            for k in keys:
+                self.S[k] = np.zeros(n)
 
     def record(self, i: int, d: mujoco.MjData) -> None:
-        """Sample i: the displacements and the bearings' forces on the shaft at this instant."""
+        """Sample i: the displacements and the bearings' forces on the shaft at this instant (shaft frame: z the
+        axis, x and y across it as the rigid model's part frame at hinge angle 0)."""
         q, L = d.qpos, d.ten_length
         S = self.S
+        if self.reactions:
+            mujoco.mj_rnePostConstraint(self.model, d)
         for part, ids in self.parts.items():
-            a = ids["defl"]
-            ux = sum(q[k] for k in (a[0], a[2]) if k >= 0)
-            uy = sum(q[k] for k in (a[1], a[3]) if k >= 0)
-            S[f"{part}_deflection_mesh_x_m"][i] = ux
-            S[f"{part}_deflection_mesh_y_m"][i] = uy
             sup = self.supports[part]
+            a = ids["defl"]
+            S[f"{part}_deflection_mesh_x_m"][i] = sum(q[k] for k in (a[0], a[2]) if k >= 0)
+            S[f"{part}_deflection_mesh_y_m"][i] = sum(q[k] for k in (a[1], a[3]) if k >= 0)
+            if ids["rigid"]:
+                f_loc, m_loc = self._reaction(d, ids)
+                split = bearing_split(f_loc, m_loc, sup.bearings_m)
             if ids["tendons"][0][0] >= 0:
                 k = sup.radial_n_per_m
                 for b, (tx, ty) in enumerate(ids["tendons"]):
                     S[f"{part}_bearing{b}_radial_x_n"][i] = -k * L[tx]
                     S[f"{part}_bearing{b}_radial_y_n"][i] = -k * L[ty]
+            else:
+                for b in range(2):
+                    S[f"{part}_bearing{b}_radial_x_n"][i] = split[b][0]
+                    S[f"{part}_bearing{b}_radial_y_n"][i] = split[b][1]
             if ids["axial"] >= 0:
                 S[f"{part}_bearing_axial_n"][i] = -sup.axial_n_per_m * q[ids["axial"]]
+            else:
+                S[f"{part}_bearing_axial_n"][i] = f_loc[2]
+
+    def _reaction(self, d: mujoco.MjData, ids: dict) -> tuple[np.ndarray, np.ndarray]:
+        """(force, moment about the mesh point) the parent exerts on the shaft, in the shaft frame."""
+        b = ids["root"]
+        c = d.subtree_com[self.model.body_rootid[b]]
+        torque, force = d.cfrc_int[b, :3], d.cfrc_int[b, 3:]
+        p = d.xpos[b]
+        moment = torque + np.cross(c - p, force)  # about p
+        R = d.xmat[b].reshape(3, 3)
+        if ids["hinge"] >= 0:  # the part body turns with its hinge: back to the shaft's own frame
+            th = float(d.qpos[ids["hinge"]])
+            ct, st = math.cos(th), math.sin(th)
+            R = R @ np.array([[ct, st, 0.0], [-st, ct, 0.0], [0.0, 0.0, 1.0]])
+        return R.T @ force, R.T @ moment
 
     def series(self) -> dict[str, np.ndarray]:
         return self.S
@@ -317,30 +351,35 @@ class ShaftLog:
         sl = (t >= window[0]) & (t <= window[1])
         if not sl.any():
             sl = np.ones_like(t, dtype=bool)
-        S, out = self.S, {}
+        S: dict[str, np.ndarray] = self.S
+        out: dict[str, float | list[float]] = {}
         for part in ("worm", "wheel"):
             if part not in self.parts:
                 continue
             ux, uy = S[f"{part}_deflection_mesh_x_m"][sl], S[f"{part}_deflection_mesh_y_m"][sl]
             out[f"{part}_deflection_mesh_um"] = 1e6 * float(np.hypot(ux.mean(), uy.mean()))
             out[f"{part}_deflection_mesh_max_um"] = 1e6 * float(np.hypot(ux, uy).max())
-            if f"{part}_bearing0_radial_x_n" in S:
-                mean, mx = [], []
-                for b in range(2):
-                    fx, fy = S[f"{part}_bearing{b}_radial_x_n"][sl], S[f"{part}_bearing{b}_radial_y_n"][sl]
-                    mean.append(float(np.hypot(fx.mean(), fy.mean())))
-                    mx.append(float(np.hypot(fx, fy).max()))
-                out[f"{part}_bearing_radial_mean_n"] = mean
-                out[f"{part}_bearing_radial_max_n"] = mx
-            else:
-                out[f"{part}_bearing_radial_mean_n"] = out[f"{part}_bearing_radial_max_n"] = None
-            if f"{part}_bearing_axial_n" in S:
-                fa = S[f"{part}_bearing_axial_n"][sl]
-                out[f"{part}_bearing_axial_mean_n"] = abs(float(fa.mean()))
-                out[f"{part}_bearing_axial_max_n"] = float(np.abs(fa).max())
-            else:
-                out[f"{part}_bearing_axial_mean_n"] = out[f"{part}_bearing_axial_max_n"] = None
+            mean, mx = [], []
+            for b in range(2):
+                fx, fy = S[f"{part}_bearing{b}_radial_x_n"][sl], S[f"{part}_bearing{b}_radial_y_n"][sl]
+                mean.append(float(np.hypot(fx.mean(), fy.mean())))
+                mx.append(float(np.hypot(fx, fy).max()))
+            out[f"{part}_bearing_radial_mean_n"] = mean
+            out[f"{part}_bearing_radial_max_n"] = mx
+            fa = S[f"{part}_bearing_axial_n"][sl]
+            out[f"{part}_bearing_axial_mean_n"] = abs(float(fa.mean()))
+            out[f"{part}_bearing_axial_max_n"] = float(np.abs(fa).max())
         return out
+
+
+def bearing_split(force: np.ndarray, moment: np.ndarray, bearings_m: tuple[float, float]) -> list[tuple[float, float]]:
+    """The radial forces (x, y) of two bearings at s0, s1 on the axis that carry a shaft load (force, moment about
+    the mesh point, shaft frame): F_0 + F_1 = F and sum s_i e_z x F_i = M across the axis, i.e.
+    s0 Fx0 + s1 Fx1 = M_y and s0 Fy0 + s1 Fy1 = -M_x (a statically determinate two-bearing shaft)."""
+    s0, s1 = bearings_m
+    fx1 = (moment[1] - s0 * force[0]) / (s1 - s0)
+    fy1 = (-moment[0] - s0 * force[1]) / (s1 - s0)
+    return [(float(force[0] - fx1), float(force[1] - fy1)), (float(fx1), float(fy1))]
 
 
 def mount(spec: mujoco.MjSpec, scenario: Scenario, geo: GearGeometry) -> dict[str, Support | None]:
