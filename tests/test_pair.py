@@ -176,3 +176,24 @@ def test_attach_names_and_placement():
         other.attach(spec, parent="housing", prefix="x_")
     with pytest.raises(ValueError, match="no body 'nowhere'"):
         other.attach(spec, parent="nowhere", prefix="y_")
+
+
+def test_pair_with_shafts_on_a_compliant_housing_meshes():
+    """The pair's shafts: block (worm on compliant bearings and bending) attached under a housing that sits on a
+    spring mount (a slide across the line of centres): bearings, bending and mount all yield under the mesh force."""
+    sc = _jack()
+    block = {"worm": {"bearings_mm": [-60, 60], "radial_stiffness_n_per_um": 500, "bending": True}}
+    sc = type(sc).model_validate({**sc.model_dump(), "shafts": block})
+    pair = wormsim.WormPair.from_scenario(sc)
+    joint = '<joint name="mount" type="slide" axis="0 1 0" stiffness="1e7" damping="2e3"/>'
+    model, data = _machine([pair], (12.0,), housing_joint=joint)
+    assert mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "p0_worm_bend") >= 0
+    out = _drive(model, data, [pair], (12.0,), 6000)
+    q_mount = model.jnt_qposadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, "mount")]
+    q_bend = model.jnt_qposadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, "p0_worm_bend_y")]
+    assert abs(data.qpos[q_mount]) > 0 and abs(data.qpos[q_bend]) > 1e-7  # they yielded (m)
+    sl = slice(3000, None)
+    ratio = _ratio(out[0, 0, sl], out[0, 1, sl])
+    ft = float(np.mean(out[0, 2, sl]))
+    assert abs(ratio / pair.ratio - 1) < 1e-3, ratio
+    assert abs(ft / (12.0 / pair.wheel_pitch_radius_m) - 1) < 0.02, ft
