@@ -197,3 +197,7 @@ def test_pair_with_shafts_on_a_compliant_housing_meshes():
     ft = float(np.mean(out[0, 2, sl]))
     assert abs(ratio / pair.ratio - 1) < 1e-3, ratio
     assert abs(ft / (12.0 / pair.wheel_pitch_radius_m) - 1) < 0.02, ft
+    # the worm's (rigid) locating bearing takes the worm's axial force, the wheel's tangential force (DIN 3975)
+    loads = pair.shaft_loads(data)
+    assert abs(abs(loads["worm_bearing_axial_n"]) / abs(pair.mesh_forces(data)[0]) - 1) < 0.03, loads
+    assert loads["worm_deflection_mesh_x_m"] != 0.0

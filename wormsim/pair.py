@@ -132,6 +132,7 @@ class _Binding:
         self.mu_of = friction_coefficient_scalar(pair.scenario.contact)
         self.vs_per_w1 = geo.r1 / math.cos(geo.gamma)
         self.R0 = pair._placement[:3, :3]
+        self.shaft_log: shafts.ShaftLog | None = None  # WormPair.shaft_loads
         self.k0 = 0  # the pair's contacts in d.contact at the last step: [k0, k0 + n)
         self.n = 0
 
@@ -334,6 +335,17 @@ class WormPair:
     def wheel_speed_rad_s(self, data: mujoco.MjData) -> float:
         """The wheel hinge's speed relative to its parent [rad/s]."""
         return float(data.qvel[self._bound().wheel_dof])
+
+    def shaft_loads(self, data: mujoco.MjData) -> dict[str, float]:
+        """The shafts' state at the last step, for parts with a shafts: block (wormsim.contact3d.shafts, ShaftLog):
+        `<part>_deflection_mesh_{x,y}_m` (the axis's displacement at the mesh point across the axis, shaft frame),
+        `<part>_bearing{0,1}_radial_{x,y}_n` and `<part>_bearing_axial_n` (the bearings' forces on the shaft [N]: a
+        compliant bearing's spring, a rigid one's share of the constraint reaction)."""
+        b = self._bound()
+        if b.shaft_log is None:
+            b.shaft_log = shafts.ShaftLog(b.model, self.supports, 1, self.prefix or "")
+        b.shaft_log.record(0, data)
+        return {k: float(v[0]) for k, v in b.shaft_log.series().items()}
 
     def _bound(self) -> _Binding:
         if self._binding is None:
