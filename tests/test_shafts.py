@@ -136,6 +136,14 @@ def test_bad_shafts_input_names_the_field():
         _scenario({"worm": {"bearings_mm": [10, 60]}})
     with pytest.raises(ValueError, match="shafts.wheel.bending"):
         _scenario({"wheel": {"bearings_mm": [-10, 60], "bending": True}})
+    with pytest.raises(ValueError, match="simulation.mass_scaling"):
+        Scenario.model_validate(
+            {
+                **_scenario(None).model_dump(),
+                "shafts": {"worm": {"bearings_mm": [-9, 9]}},
+                "simulation": {"duration_s": 1, "mass_scaling": 10},
+            }
+        )
     stiff = {"worm": {"bearings_mm": [-60, 60], "radial_stiffness_n_per_um": 1e6}}
     with pytest.raises(ScenarioError, match="simulation.timestep_s"):
         build_model(_scenario(stiff))

@@ -429,6 +429,11 @@ class Scenario(_Strict):
                 "shafts: the shafts on bearings are modelled by contact3d with contact.geometry flanks; allowed: "
                 "model contact3d with contact.geometry flanks, or no shafts: block"
             )
+        if self.shafts is not None and self.simulation.mass_scaling != 1:
+            raise ValueError(
+                f"simulation.mass_scaling = {self.simulation.mass_scaling}: the shafts' masses and bearing modes are "
+                f"not scaled; allowed: simulation.mass_scaling = 1 with a shafts: block"
+            )
         if self.model != "contact3d" and self.simulation.mass_scaling != 1:
             raise ValueError(
                 f"simulation.mass_scaling = {self.simulation.mass_scaling}: only model contact3d scales "
