@@ -1,7 +1,7 @@
 """`WormPair`: a worm gear pair with exact-flank tooth contact as a component of any MuJoCo model.
 
     import mujoco, wormsim
-    pair = wormsim.WormPair.from_scenario("scenarios/screw_jack.yaml")   # gear, materials, contact law, errors
+    pair = wormsim.WormPair.from_scenario("scenarios/screw_jack.yaml")   # gear, materials, contact law, errors, shafts
     spec = mujoco.MjSpec.from_file("my_machine.xml")
     pair.attach(spec, parent="housing")        # worm + wheel bodies, hinges, inertias under that body
     worm_joint, wheel_joint = pair.joint_names  # the user's actuators, tendons, equalities go on these
@@ -16,9 +16,11 @@ y = -a; `pos`/`quat` move that frame within the parent): a wheel body and a worm
 own z axis (named `<prefix>wheel_hinge`, `<prefix>worm_hinge`), their masses and axial moments from the solid meshes
 and the materials' densities (wormsim.contact3d.mjcf's inertias), and one visual mesh geom each
 (`<prefix>worm_visual`, `<prefix>wheel_visual`, contype/conaffinity 0: MuJoCo never collides them itself). The
-scenario's errors: block places and tilts the bodies as contact3d does (meshgen.displaced). The scenario's drive:
-and load: blocks add nothing: the drive and the load are the user's model. They only set the working point the
-contact law's friction rows are sized for (wormsim.contact3d.law (3), (4)).
+scenario's errors: block places and tilts the bodies as contact3d does (meshgen.displaced), and its shafts: block
+puts them on compliant bearings with the worm shaft bending, as contact3d does (wormsim.contact3d.shafts: carrier
+and bend bodies, `shaft_loads`). The scenario's drive: and load: blocks add nothing: the drive and the load are the
+user's model. They only set the working point the contact law's friction rows are sized for (wormsim.contact3d.law
+(3), (4)).
 
 What a step does: MuJoCo's own step, split so that the flank contacts are added between mj_collision and
 mj_makeConstraint (wormsim.contact3d.flank_step.split_step), so the user's contacts, actuators, tendons, equalities
@@ -160,7 +162,8 @@ class WormPair:
 
     @classmethod
     def from_scenario(cls, source: str | Path | Scenario) -> WormPair:
-        """The pair of a scenario (a YAML path or a Scenario): its gear:, materials:, contact: and errors: blocks.
+        """The pair of a scenario (a YAML path or a Scenario): its gear:, materials:, contact:, errors: and shafts:
+        blocks.
         The drive: and load: blocks give only the working point the friction rows are sized for (module docstring);
         a driven-machine inertia (load.inertia_kg_m2) and mass scaling are not used: the user's model holds its
         machine. contact.flank_contacts is taken as slice (one MuJoCo contact per face slice)."""
