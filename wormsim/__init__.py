@@ -12,6 +12,8 @@ Data flows one way: scenario -> geometry (meshgen) -> model -> simulation -> met
     summary = wormsim.run_scenario(sc, "out/my_gear")  # writes summary.json, timeseries.npz, ...
 
 The reference: docs/api.md (generated from these docstrings), docs/scenario.md, docs/outputs.md.
+
+The worm pair as a component of a MuJoCo model of one's own: wormsim.WormPair (wormsim.pair, docs/multibody.md).
 """
 
 from wormsim.errors import ScenarioError, SimulationError
@@ -26,7 +28,19 @@ __all__ = [
     "Scenario",
     "ScenarioError",
     "SimulationError",
+    "WormPair",
     "load_scenario",
     "run_scenario",
     "simulate",
+    "step",
 ]
+
+_PAIR = ("WormPair", "step")  # wormsim.pair, imported on first use (it loads MuJoCo and the compiled kernel)
+
+
+def __getattr__(name: str):
+    if name in _PAIR:
+        from wormsim import pair
+
+        return getattr(pair, name)
+    raise AttributeError(f"module 'wormsim' has no attribute {name!r}")

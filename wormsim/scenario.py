@@ -408,6 +408,56 @@ class Errors(_Strict):
         )
 
 
+# ----------------------------------------------------------------------------- shafts on bearings
+
+
+class ShaftSupport(_Strict):
+    """One shaft on two bearings (wormsim.contact3d.shafts): positions, stiffnesses, the worm's bending."""
+
+    bearings_mm: list[Annotated[float, Field(ge=-10000, le=10000)]] = Field(
+        ...,
+        min_length=2,
+        max_length=2,
+        description="the two bearing centres along the shaft axis, from the mesh point (one each side: [-l1, l2])",
+    )
+    locating_bearing: int = Field(0, ge=0, le=1, description="index of the bearing that takes the axial force")
+    radial_stiffness_n_per_um: float | None = Field(
+        None, gt=0, le=1e6, description="radial stiffness of each bearing; omitted = rigid"
+    )
+    axial_stiffness_n_per_um: float | None = Field(
+        None, gt=0, le=1e6, description="axial stiffness of the locating bearing; omitted = rigid"
+    )
+    bending: bool = Field(
+        False, description="worm: the shaft bends between the bearings (root-diameter section, worm material)"
+    )
+
+    @model_validator(mode="after")
+    def _straddle(self) -> "ShaftSupport":
+        b0, b1 = self.bearings_mm
+        if not b0 < 0 < b1:
+            raise ValueError(
+                f"bearings_mm = {self.bearings_mm}: one bearing each side of the mesh point; allowed: "
+                f"bearings_mm[0] < 0 < bearings_mm[1] (mm along the shaft axis)"
+            )
+        return self
+
+
+class Shafts(_Strict):
+    """The worm and the wheel on compliant bearings, the worm shaft bending (absent: rigid hinges)."""
+
+    worm: ShaftSupport | None = None
+    wheel: ShaftSupport | None = None
+
+    @model_validator(mode="after")
+    def _wheel_rigid_section(self) -> "Shafts":
+        if self.wheel is not None and self.wheel.bending:
+            raise ValueError(
+                "shafts.wheel.bending = true: only the worm shaft bends (the wheel's shaft section is not given); "
+                "allowed: shafts.wheel.bending = false"
+            )
+        return self
+
+
 # ----------------------------------------------------------------------------- scenario
 
 
@@ -435,9 +485,20 @@ class Scenario(_Strict):
     simulation: Simulation = Simulation()
     wedge: Wedge | None = None
     errors: Errors = Errors()
+    shafts: Shafts | None = None
 
     @model_validator(mode="after")
     def _blocks(self) -> "Scenario":
+        if self.shafts is not None and (self.model != "contact3d" or self.contact.geometry != "flanks"):
+            raise ValueError(
+                "shafts: the shafts on bearings are modelled by contact3d with contact.geometry flanks; allowed: "
+                "model contact3d with contact.geometry flanks, or no shafts: block"
+            )
+        if self.shafts is not None and self.simulation.mass_scaling != 1:
+            raise ValueError(
+                f"simulation.mass_scaling = {self.simulation.mass_scaling}: the shafts' masses and bearing modes are "
+                f"not scaled; allowed: simulation.mass_scaling = 1 with a shafts: block"
+            )
         if self.model != "contact3d" and self.simulation.mass_scaling != 1:
             raise ValueError(
                 f"simulation.mass_scaling = {self.simulation.mass_scaling}: only model contact3d scales "

@@ -65,8 +65,9 @@ class FlankContacts:
         self.qa2 = int(m.jnt_qposadr[m.dof_jntid[bm.wheel_dof]])
         self._c = None
         self.ks = np.zeros(W, dtype=np.int64)
-        gw = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, "worm_visual")
-        gg = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, "wheel_visual")
+        worm_geom, wheel_geom = bm.meta.get("flank_geoms", ("worm_visual", "wheel_visual"))  # wormsim.pair: prefixed
+        gw = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, worm_geom)
+        gg = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, wheel_geom)
         self.geoms = (gw, gg)
         law = bm.law
         t = mujoco.MjContact()
@@ -92,13 +93,15 @@ class FlankContacts:
         # with errors: the kernel gets the displaced bodies' poses each step (wormsim.tooth.pose)
         self.params = self.grid.params
         dev = getattr(bm, "deviations", None)
-        self.displaced = dev is not None and not dev.is_zero()
+        # poses_from_data: bodies that move on their own (wormsim.contact3d.shafts, wormsim.pair), margin_rad theirs
+        self.displaced = (dev is not None and not dev.is_zero()) or bool(bm.meta.get("poses_from_data"))
         if self.displaced:
             from wormsim.tooth import pose as flank_pose
 
             shift = bm.tooth_shift_rad if bm.tooth_shift_rad is not None else np.zeros(g.z2)
             self.params = flank_pose.displaced_params(self.grid.params, np.asarray(shift, dtype=float))
-            self.margin0 += flank_pose.error_margin_rad(g, self.grid, dev)
+            self.margin0 += flank_pose.error_margin_rad(g, self.grid, dev) if dev is not None else 0.0
+            self.margin0 += float(bm.meta.get("margin_rad", 0.0))
             self._set_pose = flank_pose.set_pose
         self._pack()
 

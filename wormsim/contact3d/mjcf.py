@@ -40,7 +40,7 @@ from meshgen.geometry import GearGeometry
 from meshgen.kinematic_tca import KinematicTCA
 from meshgen.pieces import GearSet
 from wormsim import gear_theory as gt
-from wormsim.contact3d import mass_scaling
+from wormsim.contact3d import mass_scaling, shafts
 from wormsim.contact3d.backlash import check_backlash, check_conjugate_interference
 from wormsim.contact3d.law import ContactLaw, contact_law, friction_damping_n_s_per_m, friction_impratio
 from wormsim.contact3d.mass_scaling import ScalingCheck
@@ -332,6 +332,7 @@ def build_model(
     spec = mujoco.MjSpec.from_file(str(TEMPLATE))
     spec.modelname = scenario.name
     _place_bodies(spec, geo, p.inertias, dev)
+    sups = shafts.mount(spec, scenario, geo) if scenario.shafts is not None else None  # bearings, bending
     worm_names, slot_names, W = _add_geoms(
         spec, geo, gs, law, float(friction_coefficient(scenario.contact, 0.0)), window_teeth, shift, flanks
     )
@@ -361,6 +362,8 @@ def build_model(
     meta["load_inertia_kg_m2"] = scenario.load.inertia_kg_m2
     meta["mass_scaling"] = p.scaling.factor
     meta["mass_scaling_check"] = p.scaling
+    if sups is not None:  # the shafts' joints (wormsim.contact3d.shafts): the kernel takes the poses from the data
+        meta.update(shafts.model_meta(model, sups, p.normal_force_n, geo, h))
     meta["shaft_inertias_kg_m2"] = (
         ine.worm_inertia_kg_m2 + ine.worm_load_inertia_kg_m2,
         ine.wheel_inertia_kg_m2 + ine.wheel_load_inertia_kg_m2,

@@ -36,6 +36,7 @@ from wormsim.contact3d.metrics import contact3d_summary
 from wormsim.contact3d.mjcf import BuiltModel, build_model
 from wormsim.contact3d.ringing_check import ringing
 from wormsim.contact3d.series import SERIES, column
+from wormsim.contact3d.shafts import ShaftLog
 from wormsim.contact3d.sources import FlankSource, PieceSource
 from wormsim.friction import friction_mode
 from wormsim.result import Result
@@ -74,9 +75,10 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
     io = (ia_drv, ia_load, a1, a2, s0)
     flanks = bm.meta.get("contact_geometry") == "flanks"
     src = FlankSource(bm, d, io, scenario, guards, rec, S_all, store) if flanks else PieceSource(bm, d, io)
+    slog = ShaftLog(m, bm.meta["shafts"], n_rec) if "shafts" in bm.meta else None  # wormsim.contact3d.shafts
     t_wall = time.perf_counter()
     prewarm.loop_started()  # the writers' warm-up thread goes now, beside the GIL-free loop (wormsim.prewarm)
-    _loop(src, bm, scenario, d, guards, S_all, rlog, store, rec, progress)
+    _loop(src, bm, scenario, d, guards, S_all, rlog, store, rec, progress, slog)
     force_signs(S, bm.geometry.hand)  # into docs/outputs.md's convention
     S["efficiency_theory_at_contact_radius"][:] = rlog.efficiency(S["friction_coefficient"], bm.geometry, worm_is_drive)
     wall = time.perf_counter() - t_wall
@@ -85,6 +87,9 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
     )
     extra = {"points_tooth0": store[0], "points_world": store[2], "forces_world": store[1], "built": bm}
     src.finish(S, summary, extra)
+    if slog is not None:  # the shafts' deflections and bearing forces
+        S.update(slog.series())
+        summary.update(slog.summary(S["t_s"], summary["steady_window_s"]))
     summary.update(mass_scaling.run_summary(S, scenario, bm.meta, summary))  # and the ringing guard (exit 3)
     rang = ringing(S, summary, dt, bm.law.stable_limit_s) if flanks else None  # flanks (ringing_check)
     if rang is not None:
@@ -97,9 +102,10 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
     )
 
 
-def _loop(src, bm: BuiltModel, scenario: Scenario, d, guards, S_all, rlog, store, rec: int, progress) -> None:
+def _loop(src, bm: BuiltModel, scenario: Scenario, d, guards, S_all, rlog, store, rec: int, progress, slog) -> None:
     """The samples: each record interval's steps (the compiled stretch of samples where the source has one), then
-    the state, the guards, mu(Vs), the source's contact outputs and the series column."""
+    the state, the guards, mu(Vs), the source's contact outputs, the shafts' log (slog, None without `shafts:`) and
+    the series column."""
     m, geo, dt = bm.model, bm.geometry, bm.timestep_s
     n_rec = S_all.shape[1]
     qa_worm = int(m.jnt_qposadr[m.dof_jntid[bm.worm_dof]])
@@ -140,6 +146,8 @@ def _loop(src, bm: BuiltModel, scenario: Scenario, d, guards, S_all, rlog, store
         # single pitch-point contact means; the force-weighted contact radius and efficiency there (contact_sums)
         nteeth, pen, fr_lc, r_c = src.sample(i, th2, mu, rlog, store)
         guards.contact(t, pen, w1 if worm_is_drive else w2, cmd)
+        if slog is not None:
+            slog.record(i, d)
         S_all[:, i] = column(t, th1, th2, w1, w2, cmd, sums, rec, nteeth, pen, mu, te, fr_lc, r_c, RPM)
         if progress is not None:
             progress.update(t)
