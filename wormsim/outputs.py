@@ -96,6 +96,38 @@ KEYS: dict[str, Key] = {
         "deg", ALL, "rho' while sliding used for `self_locking_dynamic` and `efficiency_backdrive`"
     ),
     "lead_angle_deg": Key("deg", ALL, "lead angle gamma at the worm reference diameter"),
+    "worm_deflection_mesh_um": Key(
+        "um",
+        C,
+        "shafts: the worm axis's displacement at the mesh point across the axis, the magnitude of its mean "
+        "over the steady window (wormsim.contact3d.shafts)",
+    ),
+    "worm_deflection_mesh_max_um": Key("um", C, "shafts: the largest worm axis displacement at the mesh point"),
+    "worm_bearing_radial_mean_n": Key(
+        "list",
+        C,
+        "shafts: the worm bearings' radial forces [N], one per bearing (bearings_mm order), the magnitude "
+        "of the mean force vector over the steady window",
+    ),
+    "worm_bearing_radial_max_n": Key("list", C, "shafts: the worm bearings' largest radial forces [N]"),
+    "worm_bearing_axial_mean_n": Key("N", C, "shafts: the worm's locating bearing's axial force, |mean|"),
+    "worm_bearing_axial_max_n": Key("N", C, "shafts: the worm's locating bearing's largest axial force"),
+    "wheel_deflection_mesh_um": Key(
+        "um",
+        C,
+        "shafts: the wheel axis's displacement at the mesh point across the axis, the magnitude of its mean "
+        "over the steady window (wormsim.contact3d.shafts)",
+    ),
+    "wheel_deflection_mesh_max_um": Key("um", C, "shafts: the largest wheel axis displacement at the mesh point"),
+    "wheel_bearing_radial_mean_n": Key(
+        "list",
+        C,
+        "shafts: the wheel bearings' radial forces [N], one per bearing (bearings_mm order), the magnitude "
+        "of the mean force vector over the steady window",
+    ),
+    "wheel_bearing_radial_max_n": Key("list", C, "shafts: the wheel bearings' largest radial forces [N]"),
+    "wheel_bearing_axial_mean_n": Key("N", C, "shafts: the wheel's locating bearing's axial force, |mean|"),
+    "wheel_bearing_axial_max_n": Key("N", C, "shafts: the wheel's locating bearing's largest axial force"),
     "backdrive_measured_self_locking": Key(
         "bool",
         C,
@@ -310,6 +342,20 @@ SERIES: dict[str, tuple[tuple[str, ...], str]] = {
     "S2_n": (W, "internal reduced force, wheel side (= -F_t2)"),
     "rho_deg": (W, "friction angle applied"),
     "regime_code": (W, "0 locked, 1 tractive, 2 inverse, 3 unloaded"),
+    "worm_deflection_mesh_x_m": (C, "shafts: the worm axis's displacement at the mesh point along the carrier's x"),
+    "worm_deflection_mesh_y_m": (C, "shafts: the worm axis's displacement at the mesh point along the carrier's y"),
+    "worm_bearing0_radial_x_n": (C, "shafts: worm bearing 0's radial force, carrier x"),
+    "worm_bearing0_radial_y_n": (C, "shafts: worm bearing 0's radial force, carrier y"),
+    "worm_bearing1_radial_x_n": (C, "shafts: worm bearing 1's radial force, carrier x"),
+    "worm_bearing1_radial_y_n": (C, "shafts: worm bearing 1's radial force, carrier y"),
+    "worm_bearing_axial_n": (C, "shafts: the worm's locating bearing's axial force"),
+    "wheel_deflection_mesh_x_m": (C, "shafts: the wheel axis's displacement at the mesh point along the carrier's x"),
+    "wheel_deflection_mesh_y_m": (C, "shafts: the wheel axis's displacement at the mesh point along the carrier's y"),
+    "wheel_bearing0_radial_x_n": (C, "shafts: wheel bearing 0's radial force, carrier x"),
+    "wheel_bearing0_radial_y_n": (C, "shafts: wheel bearing 0's radial force, carrier y"),
+    "wheel_bearing1_radial_x_n": (C, "shafts: wheel bearing 1's radial force, carrier x"),
+    "wheel_bearing1_radial_y_n": (C, "shafts: wheel bearing 1's radial force, carrier y"),
+    "wheel_bearing_axial_n": (C, "shafts: the wheel's locating bearing's axial force"),
 }
 
 
