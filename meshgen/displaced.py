@@ -1,4 +1,4 @@
-"""Geometry of a displaced worm gear pair: assembly errors and manufacturing deviations (issue 12), SI units.
+"""Geometry of a displaced worm gear pair: assembly errors and manufacturing deviations, SI units.
 
 The nominal frames are meshgen.assembly's (assembly frame: wheel axis z through the origin, worm axis parallel to x
 at y = -a, z = 0). The errors enter as rigid transforms of each part's BODY (the frame its surfaces are written in:

@@ -87,7 +87,7 @@ class GearSpec:
     axial_module_mm: float | None = None
     lead_angle_deg: float | None = None
     diameter_quotient: float | None = None
-    profile: Literal["ZI", "ZA"] = "ZI"
+    profile: Literal["ZA", "ZN", "ZI", "ZK", "ZC"] = "ZI"
     hand: Literal["right", "left"] = "right"
     worm_starts: int = 1
     normal_pressure_angle_deg: float = 20.0
@@ -96,11 +96,14 @@ class GearSpec:
     backlash_mm: float = 0.05
     addendum_coef: float = 1.0
     dedendum_coef: float = 1.2
+    zn_section: Literal["thread", "space"] = "thread"
+    tool_diameter_mm: float | None = None
+    profile_radius_mm: float | None = None
 
 
 @dataclass(frozen=True)
 class GearGeometry:
-    profile: str  # "ZI" | "ZA"
+    profile: str  # "ZA" | "ZN" | "ZI" | "ZK" | "ZC" (meshgen.worm, meshgen.worm_forms)
     hand: int  # +1 right, -1 left
     z1: int
     z2: int
@@ -132,6 +135,9 @@ class GearGeometry:
     backlash: float  # circumferential at d2, m
     wheel_tooth_thickness: float  # s2 on d2 (arc), m
     ratio: float  # z2 / z1
+    zn_section: str = "thread"  # ZN: "thread" (ZN1) | "space" (ZN2)
+    tool_diameter: float = 0.1  # ZK, ZC: disc diameter at the pitch point, m
+    profile_radius: float = 0.0  # ZC: the disc's arc profile radius, m
 
     @property
     def r1(self) -> float:
@@ -149,7 +155,7 @@ class GearGeometry:
         """For printing: lengths in mm, angles in deg, names carrying the unit."""
         out = {}
         angles = {"gamma", "alpha_n", "alpha_x", "gamma_b"}
-        plain = {"profile", "hand", "z1", "z2", "q", "ratio"}
+        plain = {"profile", "hand", "z1", "z2", "q", "ratio", "zn_section"}
         for k, v in asdict(self).items():
             if k in plain:
                 out[k] = v
@@ -162,6 +168,8 @@ class GearGeometry:
         return out
 
 
+DEFAULT_TOOL_DIAMETER_MM = 100.0  # ZK, ZC disc (meshgen.worm_forms, docs/flank_forms.md)
+DEFAULT_PROFILE_RADIUS_MODULES = 5.5  # ZC tool arc radius / m_x (meshgen.worm_forms, docs/flank_forms.md)
 Q_MAX = 40.0  # largest diameter quotient (the schema's bound on gear.diameter_quotient)
 WORM_LENGTH_MAX = 4.0  # threaded length at most 4 x the mesh zone (the default length)
 
@@ -206,16 +214,30 @@ def derive(gear: GearData) -> GearGeometry:
     r_a1, r_f1 = r1 + h_a, r1 - h_f
     r_a2, r_f2 = r2 + h_a, r2 - h_f
     if r_f1 <= 0.2 * r1:
+        q_min = 2.5 * gear.dedendum_coef
+        given = (
+            f"gear.diameter_quotient = {q:g}: allowed diameter_quotient >= {q_min:.1f}"
+            if gear.lead_angle_deg is None
+            else f"gear.lead_angle_deg = {gear.lead_angle_deg:g} (q = z1 / tan(gamma) = {q:.2f}): allowed "
+            f"lead_angle_deg <= {math.atan(z1 / q_min) / DEG:.3g} for {z1} start(s)"
+        )
         raise GeometryError(
-            f"gear: worm root radius {r_f1 / MM:.3f} mm is too small for reference radius {r1 / MM:.3f} mm "
-            f"(diameter quotient q = {q:.2f}); use a lead angle giving q >= {2.5 * gear.dedendum_coef:.1f}"
+            f"{given} (the worm root radius {r_f1 / MM:.3f} mm is too small for the reference radius {r1 / MM:.3f} mm "
+            f"with dedendum_coef {gear.dedendum_coef:g})"
         )
     r_e2 = r_a2 + 0.5 * m_x
     b2 = gear.face_width_mm * MM if gear.face_width_mm is not None else (0.75 if z1 <= 3 else 0.67) * 2 * r_a1
     if b2 >= 2 * (a - r_f1) * 0.999 or b2 > 2 * r_a1 * 1.2:
+        given = (
+            f"gear.face_width_mm = {b2 / MM:.3f}"
+            if gear.face_width_mm is not None
+            else f"gear.face_width_mm not given: its default {b2 / MM:.3f} mm ({0.75 if z1 <= 3 else 0.67:g} x worm "
+            "tip diameter, DIN 3975 guide)"
+        )
         raise GeometryError(
-            f"gear.face_width_mm = {b2 / MM:.3f}: too wide for this worm; allowed up to {1.2 * 2 * r_a1 / MM:.3f} mm "
-            f"(1.2 x worm tip diameter)"
+            f"{given}: too wide for this worm; allowed up to "
+            f"{min(1.2 * 2 * r_a1, 2 * (a - r_f1) * 0.999) / MM:.3f} mm (1.2 x worm tip diameter, and within the "
+            f"wheel's root)"
         )
     # the wheel root torus (tube radius a - r_f2) rises towards the face edges; the tooth must keep at least
     # 0.1 of its full depth h_a + h_f under the rim radius r_e2 at zeta = +-b2/2
@@ -243,7 +265,13 @@ def derive(gear: GearData) -> GearGeometry:
             f"gear.backlash_mm = {gear.backlash_mm}: leaves a wheel tooth of {s2 / MM:.3f} mm on d2; "
             f"allowed below {0.4 * p_x / MM:.3f} mm (0.4 axial pitch)"
         )
-    return GearGeometry(
+    # flank form settings (meshgen.worm_forms; defaults documented in docs/flank_forms.md)
+    tool_d = getattr(gear, "tool_diameter_mm", None)
+    rho_c = getattr(gear, "profile_radius_mm", None)
+    g = GearGeometry(
+        zn_section=getattr(gear, "zn_section", "thread"),
+        tool_diameter=(DEFAULT_TOOL_DIAMETER_MM if tool_d is None else tool_d) * MM,
+        profile_radius=rho_c * MM if rho_c is not None else DEFAULT_PROFILE_RADIUS_MODULES * m_x,
         profile=gear.profile,
         hand=hand,
         z1=z1,
@@ -277,3 +305,8 @@ def derive(gear: GearData) -> GearGeometry:
         wheel_tooth_thickness=s2,
         ratio=z2 / z1,
     )
+    from meshgen import worm_forms  # the flank form's tool (it imports this module)
+
+    if g.profile in worm_forms.TABLE_FORMS:
+        worm_forms.form_table(g)  # GeometryError here where the tool cannot generate the flank
+    return g

@@ -1,4 +1,4 @@
-"""Kinematic (unloaded) tooth contact analysis of a displaced worm gear pair (issue 12; docs/errors.md).
+"""Kinematic (unloaded) tooth contact analysis of a displaced worm gear pair (docs/errors.md).
 
 For each worm angle theta1 it finds, on each flank side, the wheel angle at which the displaced flanks first touch,
 from the exact surfaces: the wheel teeth are meshgen.wheel's enveloped (hob-generated) flanks, sampled on a
@@ -8,7 +8,7 @@ wheel flank point's distance from the thread, d = meshgen.worm.thread_gap of the
 (points outside r_f1 <= r <= r_a1 or beyond the threaded length are off the worm), is positive in the clearance.
 
 Side +1 is the flank the worm pushes when it leads (the wheel lags: theta2 < hand theta1 z1 / z2), side -1 the
-other (as wormsim.torsional.mesh_stiffness). At the conjugate wheel angle theta2c = hand theta1 z1 / z2 every point
+other (as wormsim.tooth.mesh_stiffness). At the conjugate wheel angle theta2c = hand theta1 z1 / z2 every point
 i has a clearance d_i; turning the wheel by -side Delta closes it at the rate r_i = -dd_i / dDelta (a finite
 difference). The first touch is
 

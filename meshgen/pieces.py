@@ -481,3 +481,38 @@ def build_gear_set(geometry: GearGeometry, resolution: Resolution | str = "mediu
         undercut_fraction=data["undercut_fraction"],
         info={"cache_key": cache_key(gear_set_key(g, res)), "code_version": CODE_VERSION},
     )
+
+
+def _generate_solids(g: GearGeometry) -> dict:
+    from meshgen import meshes
+
+    worm.check_worm(g, wheel.hob_radius(g))
+    wheel.check_wheel(g)
+    return {
+        "worm_visual": _pack(meshes.worm_mesh(g)),
+        "wheel_visual": _pack(meshes.wheel_mesh(g)),
+        "undercut_fraction": wheel.undercut_fraction(g),
+    }
+
+
+def build_solids(geometry: GearGeometry, resolution: Resolution | str = "medium", use_cache: bool = True) -> GearSet:
+    """The solid worm and wheel meshes alone, as a GearSet without collision pieces: what a run with exact flanks
+    needs (the shafts' inertias, the visual geoms, the recording). The same meshes as build_gear_set's; resolution
+    only labels the set. Raises GeometryError for undercut / pointed teeth."""
+    res = RESOLUTIONS[resolution] if isinstance(resolution, str) else resolution
+    g = geometry
+    key = {"g": asdict(g), "v": CODE_VERSION, "solids": True}
+    data = cached("solids", key, lambda: _generate_solids(g), use_cache)
+    return GearSet(
+        geometry=g,
+        resolution=res,
+        worm_pieces=[],
+        wheel_tooth_pieces=[],
+        tooth_angle_rad=functools.partial(wheel.tooth_angle, g),
+        worm_visual=_unpack(data["worm_visual"]),
+        wheel_visual=_unpack(data["wheel_visual"]),
+        worm_core_radius_m=g.r_f1,
+        piece_error_um={},
+        undercut_fraction=data["undercut_fraction"],
+        info={"cache_key": cache_key(key), "code_version": CODE_VERSION, "solids_only": True},
+    )

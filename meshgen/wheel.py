@@ -160,6 +160,7 @@ def check_wheel(g: GearGeometry, n: int = 25) -> None:
             f"gear: the wheel teeth are undercut: on the mid-plane the hob tip edge removes {100 * frac:.0f} % of "
             f"the working flank below the reference circle (limit {100 * UNDERCUT_LIMIT:.0f} %); raise "
             f"gear.normal_pressure_angle_deg (now {math.degrees(g.alpha_n):.2f}) or gear.wheel_teeth (now {g.z2})"
+            + (f", or gear.profile_radius_mm (now {g.profile_radius * 1e3:.4g})" if g.profile == "ZC" else "")
         )
 
 

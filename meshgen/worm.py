@@ -1,4 +1,5 @@
-"""Worm thread surfaces (ZI involute helicoid, ZA straight axial profile), in the WORM frame.
+"""Worm thread surfaces (ZI involute helicoid, ZA straight axial profile; ZN, ZK, ZC by their axial profile from
+meshgen.worm_forms), in the WORM frame.
 
 Worm frame: axis +z, origin on the axis at mid-length; at worm angle 0 a thread is centred on
 phi = 0 (the +x axis, which points at the wheel centre in the assembly, see `meshgen.assembly`) at z = 0.
@@ -37,6 +38,7 @@ import math
 
 import numpy as np
 
+from meshgen import worm_forms
 from meshgen.geometry import GearGeometry, GeometryError
 
 
@@ -45,8 +47,11 @@ def _t_of_r(g: GearGeometry, r):
 
 
 def half_thickness(g: GearGeometry, r):
-    """H(r): axial half-thickness of the thread at radius r (equations (1), (2) above), m."""
+    """H(r): axial half-thickness of the thread at radius r (equations (1), (2) above; ZN, ZK, ZC:
+    meshgen.worm_forms), m."""
     r = np.asarray(r, dtype=float)
+    if g.profile in worm_forms.TABLE_FORMS:
+        return worm_forms.form_table(g).half_thickness(r)
     if g.profile == "ZA":
         return g.p_x / 4 - (r - g.r1) * math.tan(g.alpha_x)
     t, t1 = _t_of_r(g, r), float(_t_of_r(g, g.r1))
@@ -55,8 +60,10 @@ def half_thickness(g: GearGeometry, r):
 
 
 def half_thickness_dr(g: GearGeometry, r):
-    """dH/dr: ZA -tan(alpha_x); ZI -|p| t / r (0 below r_b)."""
+    """dH/dr: ZA -tan(alpha_x); ZI -|p| t / r (0 below r_b); ZN, ZK, ZC: meshgen.worm_forms."""
     r = np.asarray(r, dtype=float)
+    if g.profile in worm_forms.TABLE_FORMS:
+        return worm_forms.form_table(g).half_thickness_dr(r)
     if g.profile == "ZA":
         return np.full_like(r, -math.tan(g.alpha_x))
     return -abs(g.p) * _t_of_r(g, r) / r

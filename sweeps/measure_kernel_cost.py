@@ -1,4 +1,4 @@
-"""Cost of the exact-flank kernel alone (wormsim.contact3d.flanks.find_contacts and FlankContacts.find) per call, on
+"""Cost of the exact-flank kernel alone (wormsim.tooth.kernel.find_contacts and FlankContacts.find) per call, on
 recorded states (issue 13 speed work; docs/contact3d.md, "Exact flanks: cost").
 
 Per seed (medium resolution, 5 ms ramps): the split step runs to load, then one mesh cycle of consecutive states
@@ -6,8 +6,8 @@ Per seed (medium resolution, 5 ms ramps): the split step runs to load, then one 
 initial offset from the conjugate angle (mid-backlash, no contact: "unloaded"). Each variant is timed over the
 states in turn, the seeds and variants interleaved, REPEATS rounds; the best round per variant is reported (the
 machine is shared: compare ratios from one run). Variants: `find` = FlankContacts.find as the step calls it;
-`find_contacts` = the kernel call alone; with `--ref FILE` also the same two for another version of flanks.py
-(e.g. `git show main:wormsim/contact3d/flanks.py > /tmp/flanks_main.py`), whose contacts must equal this one's.
+`find_contacts` = the kernel call alone; with `--ref FILE` also the same two for another version of tooth/kernel.py
+(e.g. `git show main:wormsim/tooth/kernel.py > /tmp/flanks_main.py`), whose contacts must equal this one's.
 
     .venv/bin/python sweeps/measure_kernel_cost.py [--ref /tmp/flanks_main.py] [--repeats 5]
 """

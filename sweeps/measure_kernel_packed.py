@@ -1,6 +1,6 @@
-"""find_packed (flanks.PackedKernel: kernel with its memo, slice_weights, contact frames, and with merge the one
-contact per tooth flank) per call on recorded states, this flanks.py against another version of it (--ref FILE, e.g.
-`git show main:wormsim/contact3d/flanks.py > /tmp/flanks_main.py`), both modes (per slice, merged). States:
+"""find_packed (kernel.PackedKernel: kernel with its memo, slice_weights, contact frames, and with merge the one
+contact per tooth flank) per call on recorded states, this kernel.py against another version of it (--ref FILE, e.g.
+`git show main:wormsim/contact3d/kernel.py > /tmp/flanks_main.py`), both modes (per slice, merged). States:
 sweeps/measure_kernel_cost.record_states (medium resolution: screw jack 16, seat motor 32 slices; loaded and unloaded).
 Checks that both versions give the same contacts (max abs difference over every output field) and times them
 interleaved, best of --repeats rounds (the machine is shared: compare the ratios).
@@ -52,21 +52,21 @@ def _run(mod, fc, k, states, keep):
 
 
 def main(ref: str, repeats: int, seeds: list[str]) -> dict:
-    from wormsim.contact3d import flanks
+    from wormsim.tooth import kernel
 
     refmod = _load_ref(ref)
     setups = {}
     for name in seeds:
         bm, loaded, unloaded = record_states(name)
         for merge in (False, True):
-            fc, kt = _kernels(bm, flanks, merge)
+            fc, kt = _kernels(bm, kernel, merge)
             _, kr = _kernels(bm, refmod, merge)
             setups[(name, merge)] = (fc, kt, kr, loaded, unloaded)
     res: dict = {"repeats": repeats, "runs": {}}
     for (name, merge), (fc, kt, kr, loaded, unloaded) in setups.items():
         r = {"slices": fc.slices, "states": len(loaded)}
         for tag, states in (("loaded", loaded), ("unloaded", unloaded)):
-            a = _run(flanks, fc, kt, states, True)[1]
+            a = _run(kernel, fc, kt, states, True)[1]
             b = _run(refmod, fc, kr, states, True)[1]
             r[f"same_counts_{tag}"] = all(len(x[0]) == len(y[0]) and len(x[7]) == len(y[7]) for x, y in zip(a, b))
             dev = 0.0
@@ -81,7 +81,7 @@ def main(ref: str, repeats: int, seeds: list[str]) -> dict:
     for _ in range(repeats):
         for (name, merge), (fc, kt, kr, loaded, unloaded) in setups.items():
             for tag, states in (("loaded", loaded), ("unloaded", unloaded)):
-                for ver, mod, k in (("this", flanks, kt), ("ref", refmod, kr)):
+                for ver, mod, k in (("this", kernel, kt), ("ref", refmod, kr)):
                     us = _run(mod, fc, k, states, False)[0]
                     key = (f"{name}_{'tooth' if merge else 'slice'}", f"us_{ver}_{tag}")
                     best[key] = min(best.get(key, math.inf), us)

@@ -1,5 +1,5 @@
 """Per step (flank_step.split_step, the stages called from Python) and per kernel call (FlankContacts.find), this
-flanks.py against another version of it (--ref FILE), both contact modes (per slice, one per tooth flank); seat motor
+kernel.py against another version of it (--ref FILE), both contact modes (per slice, one per tooth flank); seat motor
 unscaled (5 us steps, 32 slices) and screw jack (16 slices), medium resolution, 5 ms ramps. Each version runs the
 same steps from the same start (the kernels agree, so do the trajectories); versions interleaved, best of --repeats
 rounds (the machine is shared: compare the ratios).
@@ -94,7 +94,7 @@ def _time(s, steps):
 
 
 def main(ref: str, steps: int, repeats: int, warm_s: float) -> dict:
-    from wormsim.contact3d import flanks
+    from wormsim.tooth import kernel
 
     refmod = _load_ref(ref)
     res: dict = {"steps": steps, "repeats": repeats, "runs": {}}
@@ -102,7 +102,7 @@ def main(ref: str, steps: int, repeats: int, warm_s: float) -> dict:
         for merge in (False, True):
             key = f"{name}_{'tooth' if merge else 'slice'}"
             ss = {}
-            for ver, mod in (("ref", refmod), ("this", flanks)):
+            for ver, mod in (("ref", refmod), ("this", kernel)):
                 s0 = _setup(name, extra, merge, mod, 10)
                 warm = int(round(warm_s / s0["dt"]))
                 ss[ver] = _setup(name, extra, merge, mod, warm)

@@ -67,7 +67,8 @@ def contact_rows(m: mujoco.MjModel, d: mujoco.MjData, worm_dof: int) -> dict:
 
 def main(geometry: str = "flanks", mu: float = 0.2, duration_s: float = 0.085) -> None:
     from wormsim.contact3d import friction_guard
-    from wormsim.contact3d.runner import _Guards, simulate
+    from wormsim.contact3d.guards import Guards as _Guards
+    from wormsim.contact3d.runner import simulate
     from wormsim.errors import SimulationError
     from wormsim.scenario import load_scenario
 

@@ -1,6 +1,6 @@
 """Issue 13's reference figure (an exact-surface simulator fed `wormsim mesh`'s STL: screw jack F_t p2p 40-50 N at
-400 N mean) against our exact flanks (1.64 N): how much of it the STL's triangle facets can give. docs/contact3d.md,
-"The reference simulator's 40-50 N".
+400 N mean) against our exact flanks (1.64 N): how much of it the STL's triangle facets can give:
+docs/decisions/0012-reference-simulator-facets.md.
 
 (a) chordal deviation of the exported meshes (meshgen.meshes, what worm.stl / wheel.stl hold) from the exact flanks
     on the working flanks: wheel, exact flank points of tooth 0 (the flank grid) against the wheel mesh (a ray along
@@ -43,9 +43,9 @@ from meshgen import meshes  # noqa: E402
 from meshgen import worm as worm_geo  # noqa: E402
 from wormsim.contact3d import flank_step  # noqa: E402
 from wormsim.contact3d.flank_step import FlankContacts  # noqa: E402
-from wormsim.contact3d.flanks import flank_grid  # noqa: E402
 from wormsim.contact3d.mjcf import build_model  # noqa: E402
 from wormsim.scenario import load_scenario  # noqa: E402
+from wormsim.tooth.grid import flank_grid  # noqa: E402
 
 SCENARIO = ROOT / "scenarios" / "screw_jack.yaml"
 REFERENCE_STIFFNESS_SHARE = 0.66  # issue 13: the reference's mesh about 0.66x as stiff as ours
@@ -232,11 +232,12 @@ class worm_facet_kernel:
     def __enter__(self):
         import importlib
 
-        from wormsim.contact3d import flank_loop, flanks
+        from wormsim.contact3d import flank_loop
+        from wormsim.tooth import gap, kernel
 
         self.folder.mkdir(parents=True, exist_ok=True)
-        src = Path(flanks.__file__).read_text()
-        assert src.count(self.HOOK) == 1, "flanks.worm_gap_ext changed: update worm_facet_kernel.HOOK"
+        src = Path(gap.__file__).read_text()
+        assert src.count(self.HOOK) == 1, "gap.worm_gap_ext changed: update worm_facet_kernel.HOOK"
         dphi = 2 * math.pi / self.segments
         src = src.replace(
             self.HOOK,
@@ -245,9 +246,11 @@ class worm_facet_kernel:
             f"    return (abs(u) - H + r * t * (1.0 - t) * {dphi**2 / 2!r} * abs(dH)) * inrm, ex\n",
         )
         name = f"facet_flanks_{self.segments}"
-        (self.folder / f"{name}.py").write_text(src)
+        (self.folder / f"{name}_gap.py").write_text(src)
+        ksrc = Path(kernel.__file__).read_text().replace("from wormsim.tooth.gap import", f"from {name}_gap import")
+        (self.folder / f"{name}.py").write_text(ksrc)
         lsrc = Path(flank_loop.__file__).read_text()
-        old = "from wormsim.contact3d.flanks import find_packed"
+        old = "from wormsim.tooth.kernel import find_packed"
         assert old in lsrc
         (self.folder / f"{name}_loop.py").write_text(lsrc.replace(old, f"from {name} import find_packed"))
         sys.path.insert(0, str(self.folder))

@@ -1,8 +1,8 @@
 """Quasi-static F_t harmonics of the exact-flank kernel on the variety variants against slice count (issue 13;
-docs/contact3d.md, "Variants against slice count"). No MuJoCo step: the worm is set over one mesh cycle, the wheel at
+docs/contact3d.md, "Variety with exact flanks"). No MuJoCo step: the worm is set over one mesh cycle, the wheel at
 the conjugate angle minus a fixed lag, and F_t = sum(w k_c depth (r x n)_z) / r2 from FlankContacts.find. The lag is
 solved so that the cycle's mean F_t carries the run's load (load.torque_nm / r2). Printed per slice count: the
-harmonics 1..N of F_t / mean, next to the TCA's k(theta) harmonics / mean (wormsim.torsional.mesh_stiffness, zero
+harmonics 1..N of F_t / mean, next to the TCA's k(theta) harmonics / mean (wormsim.tooth.mesh_stiffness, zero
 load, independent of the slices).
 
     .venv/bin/python sweeps/variant_harmonics.py [--slices 8 16 32] [--gears wide-z80-q16 ...] [--harmonics 12]
@@ -26,7 +26,7 @@ from test_contact3d_variety import FAST, FLANK_GEARS, FLANK_MESH_XFAIL, GEAR  # 
 from wormsim.contact3d.flank_step import FlankContacts  # noqa: E402
 from wormsim.contact3d.mjcf import build_model  # noqa: E402
 from wormsim.scenario import load_scenario  # noqa: E402
-from wormsim.torsional.mesh_stiffness import compute  # noqa: E402
+from wormsim.tooth.mesh_stiffness import compute  # noqa: E402
 
 
 def f_t(bm, fc, d, th1: float, lag: float) -> float:

@@ -7,7 +7,7 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
-from wormsim.contact3d.window import repose_window
+from wormsim.contact3d.slots import repose_window
 
 
 class Stepper:

@@ -31,7 +31,7 @@ def sliding_contacts(rpm: float, impratio: float | None = None) -> tuple[np.ndar
     """Seat motor (seed 001 gear, load and contact law; coarse, the default contact.geometry) with the worm at `rpm`:
     rows (f_n, |f_t|, mu, |v_t|, w) of every loaded contact sampled every 20 steps over the last 40 % of the run, the
     sliding speed Vs, and the model. w: the contact's share of the law's stiffness and damping (1 for pieces; a flank
-    contact's share of its face slice, wormsim.contact3d.flanks.slice_weights). mu(Vs) is set as
+    contact's share of its face slice, wormsim.tooth.kernel.slice_weights). mu(Vs) is set as
     wormsim.contact3d.runner sets it."""
     sc = load_scenario(
         SCEN / "seat_motor.yaml",

@@ -23,9 +23,10 @@ from conftest import SCENARIOS as SCEN
 
 from wormsim import cli
 from wormsim.bench.stability import FAILURE_CLASSES, classify_failure, stability_edge
+from wormsim.contact3d.diagnosis import JUMP_PITCH
 from wormsim.contact3d.friction_guard import ALIGN_MIN, friction_error
 from wormsim.contact3d.mjcf import build_model
-from wormsim.contact3d.runner import JUMP_PITCH, simulate
+from wormsim.contact3d.runner import simulate
 from wormsim.contact3d.timestep import default_timestep
 from wormsim.errors import LockedError, SimulationError
 from wormsim.gear_theory import penetration_limit_m

@@ -44,7 +44,7 @@ def _settle(st: Stepper, torque_nm: float, steps: int):
 def _contacts(st: Stepper):
     """Rows (normal force, penetration, moment arm about the wheel axis, w) of the active contacts. w: the contact's
     share of its stiffness k_c = K / n_ref; 1 for a piece contact, for a flank contact the share of its face slice that
-    the contact line covers (wormsim.contact3d.flanks.slice_weights, taken from the kernel, not from the model)."""
+    the contact line covers (wormsim.tooth.kernel.slice_weights, taken from the kernel, not from the model)."""
     bm, d = st.bm, st.d
     m = bm.model
     n_flank = st.fc.n if st.fc is not None else 0

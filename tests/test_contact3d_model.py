@@ -11,7 +11,7 @@ from conftest import SCENARIOS as SCEN
 
 from wormsim.contact3d.mjcf import build_model, write_model
 from wormsim.contact3d.runner import simulate
-from wormsim.contact3d.window import repose_window
+from wormsim.contact3d.slots import repose_window
 from wormsim.errors import SimulationError
 from wormsim.scenario import load_scenario
 

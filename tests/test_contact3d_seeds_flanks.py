@@ -24,7 +24,7 @@ def run(name: str) -> dict:
     return _CACHE[name]
 
 
-# all three pass since contacts leave at zero load (wormsim.contact3d.flanks, docs/contact3d.md): F_t peaks at
+# all three pass since contacts leave at zero load (wormsim.tooth.kernel, docs/contact3d.md): F_t peaks at
 # 29.97 / 22.14 / 24.14 Hz (before: the 3rd harmonic, 89.9 / 66.4 Hz, from half a slice's load dropped at once; and
 # involute_41's mesh mode at 1087 Hz with p2p 55 kN, now 292 N on 13.8 kN)
 MESH_XFAIL: dict[str, str] = {}
@@ -50,7 +50,7 @@ RADIAL_XFAIL = {
     "seat_motor": "the radial force's largest peak is the 2nd meshing harmonic, 59.94 Hz against 29.97 Hz, since "
     "contacts leave at zero load (F_t: 29.97 Hz, p2p 1.04 N on 1289 N at 16 slices, 0.87 N at 32); before, the slices' load steps put 29.97 Hz "
     "on top. Physical for the kernel: quasi-static at constant torque its radial harmonics 1-4 are 0.998, 1.239, "
-    "0.688, 0.091 N (docs/contact3d.md, third pass)",
+    '0.688, 0.091 N (docs/contact3d.md, "Contacts leaving at zero load")',
 }
 
 
@@ -197,7 +197,7 @@ HERTZ_XFAIL = {
 
 @pytest.mark.parametrize("name", [_xf(HERTZ_XFAIL, n) for n in SEEDS])
 def test_flanks_mean_contact_pressure_is_the_line_contact_formula(name):
-    """The F_n-weighted mean Hertz pressure of the run (wormsim.contact3d.flank_outputs: per cell, from the kernel's
+    """The F_n-weighted mean Hertz pressure of the run (wormsim.tooth.hertz: per cell, from the kernel's
     loads and the flanks' numerical curvature) against the line-contact formula p = sqrt(w E* / (pi rho')) (Johnson,
     Contact Mechanics, section 4.3: the peak p_0 of two cylinders) with the load per length w = F_n / L, F_n = T2 / (r2 cos alpha_n cos gamma)
     (DIN 3975-2), L the torsional TCA's mean total contact line length, and rho' the relative radius of curvature at

@@ -98,7 +98,7 @@ HARMONIC = (
     "F_t's mesh lines are 0.02-1.6 N, rising towards the contact mode's band (2-7 kHz, lines 0.9-2.9 N); at constant "
     "load torque the mesh stiffness's fluctuation goes into the TE, and F_t's lines are the wheel's inertia times its "
     "acceleration, I2 (2 pi k f_m)^2 TE_k / r2 (test_flanks_harmonic_tangential_force_lines_...). Not a slicing artefact "
-    "(docs/contact3d.md, 'Variants against slice count'; sweeps/variant_harmonics.py): "
+    "(docs/contact3d.md, 'Variety with exact flanks'; sweeps/variant_harmonics.py): "
 )
 # left-ZA passes since contacts leave at zero load (docs/contact3d.md): 99.9 Hz, p2p 55.7 N on 833 N (before 499.5 Hz,
 # the 5th harmonic, p2p 77 N)
@@ -231,7 +231,7 @@ def test_flanks_no_friction_driven_rattle(monkeypatch):
 
 
 def test_flanks_no_grid_point_is_cut_by_the_worm():
-    """wormsim.contact3d.flank_trim: at gamma 33.7 deg (z1 4, q 6) meshgen's envelope folds near the wheel tip and 7
+    """wormsim.tooth.trim: at gamma 33.7 deg (z1 4, q 6) meshgen's envelope folds near the wheel tip and 7
     points per flank lay 1-29 um inside the thread at other worm positions; the kernel took them as flank (76 um
     contacts against the conjugate 47 um, 14 um penetration under load). Trimmed, the wheel turned two backlash
     angles behind the conjugate angle meets the worm at the conjugate depth within 2 % over a whole mesh cycle."""
@@ -239,11 +239,11 @@ def test_flanks_no_grid_point_is_cut_by_the_worm():
 
     import numpy as np
 
-    from wormsim.contact3d import flanks as F
-    from wormsim.contact3d.window import window_size, window_teeth_at
+    from wormsim.tooth import grid, kernel
+    from wormsim.tooth.window import window_size, window_teeth_at
 
     g = derive(load_scenario(GEAR, FLANK_GEARS["left-q6-4start"]).gear)
-    fg = F.flank_grid(g, 8)
+    fg = grid.flank_grid(g, 8)
     W = window_size(g)
     cap = 4 * W * 8
     pos, nrm, dep, meta = np.zeros((cap, 3)), np.zeros((cap, 3)), np.zeros(cap), np.zeros((cap, 4))
@@ -254,7 +254,7 @@ def test_flanks_no_grid_point_is_cut_by_the_worm():
     for th1 in np.linspace(0, 2 * math.pi / g.z1, 60, endpoint=False):
         th2 = g.hand * th1 * g.z1 / g.z2
         ks = window_teeth_at(th2, g.z2, W, -math.pi / 2 + math.pi / g.z2).astype(np.int64)
-        n = F.find_contacts(
+        n = kernel.find_contacts(
             fg.xy,
             fg.c,
             fg.c_range,
@@ -263,7 +263,7 @@ def test_flanks_no_grid_point_is_cut_by_the_worm():
             ks,
             th1,
             th2 - g.hand * 2 * bl,
-            F.MARGIN_PITCH * pitch + 3 * bl,
+            kernel.MARGIN_PITCH * pitch + 3 * bl,
             fg.params,
             pos,
             nrm,

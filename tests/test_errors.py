@@ -19,7 +19,7 @@ from meshgen import kinematic_tca as kt
 from meshgen.geometry import GeometryError, derive
 from wormsim.geometry import displaced_pair
 from wormsim.scenario import ScenarioError, load_scenario
-from wormsim.torsional import mesh_stiffness as msk
+from wormsim.tooth import mesh_stiffness as msk
 
 SCEN = Path(__file__).resolve().parent.parent / "scenarios"
 warnings.filterwarnings("ignore", category=RuntimeWarning)
@@ -39,7 +39,7 @@ def line_theory(g, th1s, side, disp):
     """First-order theory (docs/errors.md (9)): a small rigid displacement u(p) of the wheel relative to the worm
     changes the clearance of flank `side` at a contact point p by side u . n / arm (wheel angle; n the flank normal
     oriented so that the wheel's rotation opens side +1, arm = |(e_z x p) . n|); the flank first touches where the
-    change is least, on the PERFECT pair's contact lines at theta1 (wormsim.torsional.mesh_stiffness's field and
+    change is least, on the PERFECT pair's contact lines at theta1 (wormsim.tooth.mesh_stiffness's field and
     lines, independent of the displaced-flank TCA). disp(theta1, P) -> (n, 3). Returns the change of g_side."""
     fld = msk._flank_field(g, side)
     gen = contourpy.contour_generator(z=fld.c, name="serial", corner_mask=True)
@@ -328,7 +328,7 @@ def test_contact3d_hinges_and_teeth_follow_the_displaced_geometry():
     import mujoco
 
     from wormsim.contact3d.mjcf import build_model
-    from wormsim.contact3d.window import repose_window
+    from wormsim.contact3d.slots import repose_window
 
     sets = [
         "simulation.resolution=coarse",

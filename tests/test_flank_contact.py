@@ -1,4 +1,4 @@
-"""Exact-flank contact of contact3d (wormsim.contact3d.flanks, flank_step): the kernel's distance is meshgen.worm's closed
+"""Exact-flank contact of contact3d (wormsim.tooth.kernel, flank_step): the kernel's distance is meshgen.worm's closed
 form, the rigid conjugate pose touches with the backlash as the only gap, and the MuJoCo model built on flank contacts
 shows the specified tooth-pair stiffness (issue 13: within 5 %, as tests/test_contact3d_law.py for pieces)."""
 
@@ -13,10 +13,10 @@ from conftest import SCENARIOS
 
 from meshgen import worm
 from meshgen.geometry import derive
-from wormsim.contact3d import flanks as F
 from wormsim.contact3d.mjcf import build_model
-from wormsim.contact3d.window import window_size, window_teeth_at
 from wormsim.scenario import load_scenario
+from wormsim.tooth import gap, grid, kernel
+from wormsim.tooth.window import window_size, window_teeth_at
 
 SCEN = SCENARIOS
 
@@ -32,21 +32,21 @@ def test_kernel_distance_is_meshgen_thread_gap(name, profile):
     pts = np.stack([r * np.cos(phi), r * np.sin(phi), z], axis=1)
     th1 = 0.37
     ref = worm.thread_gap(g, pts, th1)
-    P = F.worm_params(g)
+    P = gap.worm_params(g)
     out = np.zeros(6)
-    got = np.array([F.worm_gap(x, y, zz, th1, P, out) for x, y, zz in pts])
+    got = np.array([gap.worm_gap(x, y, zz, th1, P, out) for x, y, zz in pts])
     assert np.allclose(got, ref, rtol=0, atol=1e-12 * g.m_x / 1e-3)
     # the normal, on the flank itself (meshgen.worm.flank_points): along the numerical gradient of the distance
     for side in (+1, -1):
         q = worm.flank_points(g, 0.5 * (g.r_f1 + g.r_a1), 0.3, side)
         R = np.array([[math.cos(th1), math.sin(th1), 0], [-math.sin(th1), math.cos(th1), 0], [0, 0, 1.0]])
         x, y, zz = R.T @ q  # the flank turned with the worm by theta1
-        assert abs(F.worm_gap(x, y, zz, th1, P, out)) < 1e-12
+        assert abs(gap.worm_gap(x, y, zz, th1, P, out)) < 1e-12
         e = 1e-9
         grad = np.array(
             [
-                F.worm_gap(x + e * (i == 0), y + e * (i == 1), zz + e * (i == 2), th1, P, np.zeros(6))
-                - F.worm_gap(x - e * (i == 0), y - e * (i == 1), zz - e * (i == 2), th1, P, np.zeros(6))
+                gap.worm_gap(x + e * (i == 0), y + e * (i == 1), zz + e * (i == 2), th1, P, np.zeros(6))
+                - gap.worm_gap(x - e * (i == 0), y - e * (i == 1), zz - e * (i == 2), th1, P, np.zeros(6))
                 for i in range(3)
             ]
         ) / (2 * e)
@@ -59,7 +59,7 @@ def test_conjugate_pose_touches_across_the_backlash(name):
     no contact for |s| <= 0.95; at |s| = 2 the depth is the backlash angle times the moment arm of the flank normal
     (r2 cos(alpha_n) cos(gamma) at the pitch point; the deepest slice within 5 %), on flank A for a lagging wheel."""
     g = derive(load_scenario(SCEN / f"{name}.yaml").gear)
-    fg = F.flank_grid(g, 16)
+    fg = grid.flank_grid(g, 16)
     W = window_size(g)
     tooth0 = -math.pi / 2 + math.pi / g.z2
     cap = 2 * W * 16
@@ -71,7 +71,7 @@ def test_conjugate_pose_touches_across_the_backlash(name):
         th2c = g.hand * th1 * g.z1 / g.z2
         ks = window_teeth_at(th2c, g.z2, W, tooth0).astype(np.int64)
         for s in (-0.95, 0.95):
-            n = F.find_contacts(
+            n = kernel.find_contacts(
                 fg.xy,
                 fg.c,
                 fg.c_range,
@@ -80,7 +80,7 @@ def test_conjugate_pose_touches_across_the_backlash(name):
                 ks,
                 th1,
                 th2c + s * bl,
-                F.MARGIN_PITCH * pitch + 3 * bl,
+                kernel.MARGIN_PITCH * pitch + 3 * bl,
                 fg.params,
                 pos,
                 nrm,
@@ -90,7 +90,7 @@ def test_conjugate_pose_touches_across_the_backlash(name):
             )
             assert n == 0, (th1, s, dep[:n].max())
         for s, flank in ((-2.0, 0), (2.0, 1)):
-            n = F.find_contacts(
+            n = kernel.find_contacts(
                 fg.xy,
                 fg.c,
                 fg.c_range,
@@ -99,7 +99,7 @@ def test_conjugate_pose_touches_across_the_backlash(name):
                 ks,
                 th1,
                 th2c + g.hand * s * bl,
-                F.MARGIN_PITCH * pitch + 3 * bl,
+                kernel.MARGIN_PITCH * pitch + 3 * bl,
                 fg.params,
                 pos,
                 nrm,

@@ -1,6 +1,6 @@
 """Convergence of the exact-flank fluctuation (issue 13): tangential_force_p2p_n and transmission_error_p2p_urad of the
 seeds' CI runs (tests/test_contact3d_seeds.py) with contact.geometry flanks, the default slice count (medium:
-wormsim.contact3d.flanks.default_slices) against twice it and h against h/2 (at the default), each within 10 %; and
+wormsim.tooth.kernel.default_slices) against twice it and h against h/2 (at the default), each within 10 %; and
 F_t's meshing band (below 1 kHz) against the slices. The slice study compares the summaries as the CI runs write
 them; the step study compares per-step samples (record_every 1 in both runs: the p2p of the force itself; interval
 means over a fixed time, record_every 1 against 2, differ by more: screw jack -10.9 % at 16 slices). Measured numbers
@@ -59,7 +59,7 @@ DEFAULT_SLICES = {
     "screw_jack": 16,
     "seat_motor": 32,
     "involute_41": 24,
-}  # wormsim.contact3d.flanks.default_slices at medium
+}  # wormsim.tooth.grid.default_slices at medium
 
 
 SLICES_XFAIL = {

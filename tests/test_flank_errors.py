@@ -1,4 +1,4 @@
-"""Exact-flank contact with assembly errors (issue 12 on issue 13's flanks; wormsim.contact3d.flank_pose): the kernel
+"""Exact-flank contact with assembly errors (issue 12 on issue 13's flanks; wormsim.tooth.pose): the kernel
 maps the wheel flanks through the displaced bodies as MuJoCo places them. Checks: with the nominal poses the pose
 path gives the nominal kernel's contacts (1e-12), and with each error the kernel's first touch is where the kinematic
 TCA (meshgen.kinematic_tca: meshgen.displaced's transforms and meshgen.worm.thread_gap, no MuJoCo) puts it. Loaded
@@ -13,10 +13,10 @@ import numpy as np
 import pytest
 from conftest import SCENARIOS
 
-from wormsim.contact3d import flank_pose
 from wormsim.contact3d.flank_step import FlankContacts
 from wormsim.contact3d.mjcf import build_model
 from wormsim.scenario import load_scenario
+from wormsim.tooth import pose as flank_pose
 
 SEAT = ["contact.geometry=flanks", "simulation.resolution=medium"]
 

@@ -31,7 +31,7 @@ def _compare(m, d, fc, dim, least):
     assert np.all(np.asarray(d.contact.dim) == dim)
 
 
-@pytest.mark.parametrize("mode", ["slice", "tooth"])  # contact.flank_contacts (wormsim.contact3d.flank_merge)
+@pytest.mark.parametrize("mode", ["slice", "tooth"])  # contact.flank_contacts (wormsim.tooth.merge)
 def test_bulk_handoff_equals_python_loop(mode):
     sc = load_scenario(
         SCEN / "screw_jack.yaml",

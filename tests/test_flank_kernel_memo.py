@@ -1,4 +1,4 @@
-"""The exact-flank kernel's open-slice memo (wormsim.contact3d.flanks.find_contacts, memo = flank_memo): the contacts
+"""The exact-flank kernel's open-slice memo (wormsim.tooth.kernel.find_contacts, memo = flank_memo): the contacts
 with the memo are the contacts without it, bit for bit, over a mesh cycle of states in sequence: the wheel loaded
 with a varying transmission error, at mid-backlash, and jumping between the two (docs/contact3d.md, "Exact flanks:
 cost")."""
@@ -12,9 +12,9 @@ import pytest
 from conftest import SCENARIOS
 
 from meshgen.geometry import derive
-from wormsim.contact3d import flanks as F
-from wormsim.contact3d.window import window_size, window_teeth_at
 from wormsim.scenario import load_scenario
+from wormsim.tooth import grid, kernel
+from wormsim.tooth.window import window_size, window_teeth_at
 
 
 def _states(g, steps: int) -> np.ndarray:
@@ -34,14 +34,14 @@ def test_memo_gives_the_same_contacts(name):
     PackedKernel's buffers) against find_contacts without memo + slice_weights + contact_frames."""
     g = derive(load_scenario(SCENARIOS / f"{name}.yaml").gear)
     S = 16
-    fg = F.flank_grid(g, S)
+    fg = grid.flank_grid(g, S)
     W = window_size(g)
     tooth0 = -math.pi / 2 + math.pi / g.z2
     pitch = 2 * math.pi / g.z2
-    margin = F.MARGIN_PITCH * pitch + g.backlash / (2 * g.r2)
+    margin = kernel.MARGIN_PITCH * pitch + g.backlash / (2 * g.r2)
     cap = 2 * W * S
-    memo = F.flank_memo(fg, g.z2)
-    pk = F.PackedKernel(fg, fg.params, cap, W, g.z2)
+    memo = kernel.flank_memo(fg, g.z2)
+    pk = kernel.PackedKernel(fg, fg.params, cap, W, g.z2)
     runs: dict = {"memo": [], "none": [], "packed": []}
     for use in ("memo", "none"):
         bufs = [np.zeros((cap, 3)), np.zeros((cap, 3)), np.zeros(cap), np.zeros((cap, 4)), np.zeros((cap, 2))]
@@ -49,15 +49,15 @@ def test_memo_gives_the_same_contacts(name):
         for th1, th2 in _states(g, 600):
             ks = window_teeth_at(th2, g.z2, W, tooth0).astype(np.int64)
             args = (fg.xy, fg.c, fg.c_range, fg.span, fg.zeta, ks, th1, th2, margin, fg.params, *bufs, 0.0)
-            n = F.find_contacts(*args, memo if use == "memo" else None)
+            n = kernel.find_contacts(*args, memo if use == "memo" else None)
             runs[use].append([b[:n].copy() for b in bufs])
             if use == "none":
                 pos, nrm, dep, meta, line = bufs
-                n = F.slice_weights(meta, line, n, S, pos, nrm, dep, wf[0])
-                F.contact_frames(nrm, n, wf[1])
+                n = kernel.slice_weights(meta, line, n, S, pos, nrm, dep, wf[0])
+                kernel.contact_frames(nrm, n, wf[1])
                 runs["weights"] = runs.get("weights", []) + [[b[:n].copy() for b in bufs + wf]]
                 pk.ks[:] = ks
-                m = F.find_packed(pk.fb, pk.ib, th1, th2, margin, 0.0)
+                m = kernel.find_packed(pk.fb, pk.ib, th1, th2, margin, 0.0)
                 runs["packed"].append([b[:m].copy() for b in (pk.pos, pk.nrm, pk.depth, pk.meta, pk.line)])
                 runs["packed"][-1] += [pk.weight[:m].copy(), pk.frame[:m].copy()]
     loaded = sum(len(a[2]) > 0 for a in runs["none"])

@@ -95,8 +95,8 @@ def test_compiled_loop_equals_python_split_step(sets, mode):
 def test_compiled_sample_equals_numpy_path(mode):
     """FlankLoop.sample against flank_contact_details, PatternLog.record and the numpy sums the runner used."""
     from wormsim import gear_theory as gt
-    from wormsim.contact3d.flank_outputs import PatternLog
     from wormsim.contact3d.flank_step import flank_contact_details
+    from wormsim.tooth.hertz import PatternLog
 
     sc = load_scenario(SCEN / "screw_jack.yaml", BASE + [f"contact.flank_contacts={mode}"])
     bm = build_model(sc)

@@ -1,4 +1,4 @@
-"""One MuJoCo contact per tooth flank (wormsim.contact3d.flank_merge, `contact.flank_contacts: tooth`): the merged
+"""One MuJoCo contact per tooth flank (wormsim.tooth.merge, `contact.flank_contacts: tooth`): the merged
 contact carries the slices' spring resultant and their moment arms on both hinges exactly; a run agrees with the
 per-slice contacts (measured numbers in docs/contact3d.md, "One contact per tooth flank"); the key is validated."""
 
@@ -11,9 +11,9 @@ from test_contact3d_seeds import CI
 from test_contact3d_seeds_flanks import run as run_slice
 
 from wormsim import cli
-from wormsim.contact3d.flank_merge import _arm, _slip, merge_flanks, split_forces
 from wormsim.contact3d.runner import simulate
 from wormsim.scenario import load_scenario
+from wormsim.tooth.merge import _arm, _slip, merge_flanks, split_forces
 
 MINIMAL = ROOT / "tests" / "assets" / "minimal_contact3d.yaml"
 

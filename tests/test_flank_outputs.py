@@ -1,4 +1,4 @@
-"""Contact pattern and contact stress from the exact-flank contacts (wormsim.contact3d.flank_outputs; issue 13):
+"""Contact pattern and contact stress from the exact-flank contacts (wormsim.tooth.hertz; issue 13):
 the relative radius of curvature rho' of (1) against an independent fit of the two surfaces, the Hertz formula, and
 the run outputs (keys, symmetry of the screw jack's pattern, report and recording) on the cached CI runs of
 tests/test_contact3d_seeds_flanks.py."""
@@ -13,9 +13,9 @@ from conftest import SCENARIOS
 
 from meshgen import worm
 from meshgen.geometry import derive
-from wormsim.contact3d import flank_outputs as FO
-from wormsim.contact3d.flanks import flank_grid
 from wormsim.scenario import load_scenario
+from wormsim.tooth import hertz as FO
+from wormsim.tooth.grid import flank_grid
 
 
 def _quad_hessian(uv: np.ndarray, h: np.ndarray) -> np.ndarray:

@@ -3,12 +3,15 @@ path gives, bit for bit (series, summary, contact points, contact pattern), and 
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
+import mujoco
 import numpy as np
 import pytest
 
 import wormsim.contact3d.flank_samples as FS
+from wormsim.contact3d import mjdata_layout
 from wormsim.contact3d.runner import simulate
 from wormsim.errors import SimulationError
 from wormsim.scenario import load_scenario
@@ -57,11 +60,29 @@ def _same(a, b) -> bool:
     return np.array_equal(np.asarray(a), np.asarray(b), equal_nan=True)
 
 
-def test_mjdata_offsets_are_found_and_check():
-    """Without them every run would take the per-sample path (slower, same results): this MuJoCo's layout must be
-    found."""
-    off = FS.mjdata_offsets()
-    assert off is not None and off.min() >= 0, off
+def test_mjdata_layout_checks_on_this_mujoco():
+    """The offsets the compiled loop reads are MuJoCo's declared layout and read back the bindings' values."""
+    off = mjdata_layout.mjdata_offsets()
+    assert off.min() >= 0 and mjdata_layout.check(off) == [], off
+
+
+def test_mjdata_layout_that_does_not_check_raises_with_the_version(monkeypatch):
+    """A layout that does not match (here: mjData's time moved by 8 bytes, as a MuJoCo upgrade could) raises naming
+    the MuJoCo version and the fields; never a silent fallback."""
+    declared = mjdata_layout.declared_offsets()
+
+    def moved():
+        off = declared.copy()
+        off[0] += 8
+        return off
+
+    monkeypatch.setattr(mjdata_layout, "declared_offsets", moved)
+    mjdata_layout.mjdata_offsets.cache_clear()
+    try:
+        with pytest.raises(mjdata_layout.MjDataLayoutError, match=rf"MuJoCo {re.escape(mujoco.__version__)}.*'time'"):
+            mjdata_layout.mjdata_offsets()
+    finally:
+        mjdata_layout.mjdata_offsets.cache_clear()
 
 
 @pytest.mark.parametrize("case", list(CASES))

@@ -1,4 +1,4 @@
-"""Default slice count of the exact-flank contact (wormsim.contact3d.flanks.default_slices; docs/contact3d.md,
+"""Default slice count of the exact-flank contact (wormsim.tooth.kernel.default_slices; docs/contact3d.md,
 "Default slice count"): at medium and fine a slice's stiffness K / S is at most SLICE_SHARE of the zero-load mesh
 stiffness's fluctuation k_p2p over a mesh cycle, rounded up to a multiple of SLICES_STEP; coarse 8; contact.slices
 overrides. The counts the convergence study measured: seat motor 32 (16 was not converged), screw jack 16,
@@ -11,10 +11,10 @@ import pytest
 from conftest import SCENARIOS
 
 from meshgen.geometry import derive
-from wormsim.contact3d import flanks as F
 from wormsim.contact3d.mjcf import flank_slices
 from wormsim.scenario import load_scenario
-from wormsim.torsional.mesh_stiffness import mesh_stiffness
+from wormsim.tooth import grid
+from wormsim.tooth.mesh_stiffness import mesh_stiffness
 
 
 @pytest.mark.parametrize(("name", "slices"), [("seat_motor", 32), ("screw_jack", 16), ("involute_41", 24)])
@@ -22,15 +22,15 @@ def test_default_slices_follow_the_mesh_stiffness_fluctuation(name, slices):
     sc = load_scenario(SCENARIOS / f"{name}.yaml", ["simulation.resolution=medium"])
     assert flank_slices(sc) == slices
     assert flank_slices(load_scenario(SCENARIOS / f"{name}.yaml", ["simulation.resolution=fine"])) == slices
-    ms = mesh_stiffness(derive(sc.gear), 1.0, "slices", F.SLICES_TCA_SAMPLES)
+    ms = mesh_stiffness(derive(sc.gear), 1.0, "slices", grid.SLICES_TCA_SAMPLES)
     share = min(np.ptp(k) / np.mean(k) for k in (ms.k_mesh_fwd_n_per_m, ms.k_mesh_rev_n_per_m))
     # the smallest multiple of SLICES_STEP whose slice stiffness (k_mean / S) is within SLICE_SHARE of k_p2p
-    assert 1 / slices <= F.SLICE_SHARE * share < 1 / (slices - F.SLICES_STEP)
+    assert 1 / slices <= grid.SLICE_SHARE * share < 1 / (slices - grid.SLICES_STEP)
 
 
 def test_coarse_and_the_explicit_count():
     seat = SCENARIOS / "seat_motor.yaml"
-    assert flank_slices(load_scenario(seat, ["simulation.resolution=coarse"])) == F.SLICES_COARSE
+    assert flank_slices(load_scenario(seat, ["simulation.resolution=coarse"])) == grid.SLICES_COARSE
     assert flank_slices(load_scenario(seat, ["contact.slices=12"])) == 12
 
 
@@ -42,7 +42,7 @@ def test_a_mass_scaled_run_takes_at_most_16_slices():
 
     seat = SCENARIOS / "seat_motor.yaml"
     scaled = build_model(load_scenario(seat, ["simulation.mass_scaling=1000"]))
-    assert scaled.meta["mass_scaling"] == 1000 and scaled.law.contacts_per_pair == F.SLICES_MASS_SCALED == 16
+    assert scaled.meta["mass_scaling"] == 1000 and scaled.law.contacts_per_pair == grid.SLICES_MASS_SCALED == 16
     explicit = build_model(load_scenario(seat, ["simulation.mass_scaling=1000", "contact.slices=24"]))
     assert explicit.law.contacts_per_pair == 24
     assert build_model(load_scenario(seat)).law.contacts_per_pair == 32

@@ -9,6 +9,7 @@ import sys
 import numpy as np
 from conftest import ROOT, SCENARIOS
 
+from meshgen import wheel
 from wormsim.contact3d import mjcf
 from wormsim.geometry import gear_set
 from wormsim.scenario import load_scenario
@@ -22,7 +23,8 @@ def test_cached_inertias_angle_and_normals_equal_the_direct_computation():
         assert (ine.worm_mass_kg, ine.worm_inertia_kg_m2) == mjcf._axial_inertia(
             gs.worm_visual, sc.materials.worm.density_kg_m3, 0.0, geo.r1, geo.worm_length
         )
-        assert mjcf._tooth0_angle(gs) == mjcf._pieces_angle(gs.wheel_tooth_pieces)
+        # tooth 0's pieces sit on the geometry's tooth 0 (meshgen.wheel.tooth_angle), which the run uses
+        assert abs(mjcf._pieces_angle(gs.wheel_tooth_pieces) - wheel.tooth_angle(geo, 0)) < 1e-8
         assert np.array_equal(mjcf.visual_vertex_normals(gs, "wheel_visual"), gs.wheel_visual.vertex_normals)
     heavy = load_scenario(
         SCENARIOS / "screw_jack.yaml", ["simulation.resolution=coarse", "materials.wheel.density_kg_m3=9000"]

@@ -82,7 +82,7 @@ def test_pattern_band_has_no_holes(seat_geo):
     import matplotlib.pyplot as plt
     from matplotlib.collections import PolyCollection
 
-    from wormsim.contact3d.flank_outputs import draw_pattern
+    from wormsim.tooth.hertz import draw_pattern
 
     ns, nc = 8, 20
     zeta = (np.arange(ns) + 0.5) / ns * seat_geo.face_width - seat_geo.face_width / 2

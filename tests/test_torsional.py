@@ -1,4 +1,4 @@
-"""The torsional fidelity level (wormsim.torsional.dynamics) and its mesh stiffness TCA (wormsim.torsional.mesh_stiffness).
+"""The torsional fidelity level (wormsim.torsional.dynamics) and its mesh stiffness TCA (wormsim.tooth.mesh_stiffness).
 
 Closed forms checked against: ratio z2 / z1; meshing frequency z1 n1 / 60 (seed 001); torque balance
 F_t2 r2 = load torque (statics); efficiency tan g / tan(g + rho') and tan(g - rho') / tan g with
@@ -18,8 +18,8 @@ from wormsim.friction import friction_coefficient, friction_coefficient_scalar
 from wormsim.gear_theory import effective_modulus_pa
 from wormsim.run import run_scenario
 from wormsim.scenario import load_scenario
+from wormsim.tooth import mesh_stiffness as M
 from wormsim.torsional import dynamics as torsional
-from wormsim.torsional import mesh_stiffness as M
 
 SEEDS = ("seat_motor", "screw_jack", "involute_41")
 SUMMARY_KEYS = (

@@ -14,8 +14,8 @@ import pytest
 from wormsim import gear_theory as gt
 from wormsim.geometry import derive, displaced_pair
 from wormsim.scenario import load_scenario
+from wormsim.tooth.mesh_stiffness import mesh_stiffness, per_length_stiffness, stiffness_at
 from wormsim.torsional import loaded_tca as lt
-from wormsim.torsional.mesh_stiffness import mesh_stiffness, per_length_stiffness, stiffness_at
 
 SCEN = Path(__file__).resolve().parents[1] / "scenarios"
 # contact3d (exact flanks) on the same gear with the same shaft angles: the record of sweeps/errors_shaft_angle.py

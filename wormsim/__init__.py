@@ -2,9 +2,18 @@
 
 Data flows one way: scenario -> geometry (meshgen) -> model -> simulation -> metrics -> recording/report.
 
-    from wormsim import load_scenario, run_scenario
-    summary = run_scenario(load_scenario("scenarios/mov_1.yaml"), "out/mov_1")    # writes DIR, returns the summary
-    result = simulate(load_scenario("scenarios/mov_1.yaml"))                      # no files: a Result
+    import wormsim
+
+    sc = wormsim.load_scenario("my_gear.yaml", ["model=torsional"])  # validated; ScenarioError names a bad field
+    sc.load.torque_nm = 80  # validated on assignment
+    res = wormsim.simulate(sc)  # no files: a Result
+    res.summary["efficiency"], res.summary["self_locking"]  # docs/outputs.md: every key, unit, sign
+    res.series["t_s"], res.series["tangential_force_n"]  # numpy arrays on t_s
+    summary = wormsim.run_scenario(sc, "out/my_gear")  # writes summary.json, timeseries.npz, ...
+
+The reference: docs/api.md (generated from these docstrings), docs/scenario.md, docs/outputs.md.
+
+The worm pair as a component of a MuJoCo model of one's own: wormsim.WormPair (wormsim.pair, docs/multibody.md).
 """
 
 from wormsim.errors import ScenarioError, SimulationError
@@ -19,7 +28,19 @@ __all__ = [
     "Scenario",
     "ScenarioError",
     "SimulationError",
+    "WormPair",
     "load_scenario",
     "run_scenario",
     "simulate",
+    "step",
 ]
+
+_PAIR = ("WormPair", "step")  # wormsim.pair, imported on first use (it loads MuJoCo and the compiled kernel)
+
+
+def __getattr__(name: str):
+    if name in _PAIR:
+        from wormsim import pair
+
+        return getattr(pair, name)
+    raise AttributeError(f"module 'wormsim' has no attribute {name!r}")

@@ -1,4 +1,4 @@
-"""`wormsim` console script (INTERFACE.md): run, mesh, model, bench, sweep, schema, check.
+"""`wormsim` console script (INTERFACE.md): run, mesh, model, bench, sweep, schema, check, init.
 
 Exit codes: 0 ok, 2 invalid input or an output path that cannot be written (the message names the field or
 the path), 3 the simulation failed (with a diagnosis), 130 / 143 interrupted by SIGINT (Ctrl-C) / SIGTERM
@@ -23,7 +23,7 @@ import yaml
 from wormsim import interrupt
 from wormsim.errors import ScenarioError, SimulationError
 from wormsim.run import run_scenario
-from wormsim.scenario import json_schema, load_scenario
+from wormsim.scenario import ignored_inputs, json_schema, load_scenario
 
 EXIT_OK, EXIT_INTERNAL, EXIT_INPUT, EXIT_SIM = 0, 1, 2, 3
 
@@ -94,6 +94,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", help="write to this file instead of stdout")
     p = sub.add_parser("check", help="validate a scenario and print it with defaults filled in")
     _add_scenario_args(p, out_required=False)
+    p = sub.add_parser("init", help="write a commented scenario template to fill in (default my_gear.yaml)")
+    p.add_argument("path", nargs="?", default="my_gear.yaml", help="the new scenario file")
     return ap
 
 
@@ -193,7 +195,17 @@ def _cmd_check(args) -> int:
 
     sc = load_scenario(args.scenario, args.overrides)
     validate_geometry(sc)  # the same geometric checks as mesh and run
+    for line in ignored_inputs(sc):
+        print(f"wormsim: {line}", file=sys.stderr)
     print(yaml.safe_dump(sc.model_dump(mode="json", exclude_none=True), sort_keys=False), end="")
+    return EXIT_OK
+
+
+def _cmd_init(args) -> int:
+    from wormsim.init_cmd import write_template
+
+    path = write_template(args.path)
+    print(f"wrote {path}: fill in your gear, then: wormsim run {path} --out out/{path.stem}")
     return EXIT_OK
 
 
@@ -205,6 +217,7 @@ COMMANDS = {
     "sweep": _cmd_sweep,
     "schema": _cmd_schema,
     "check": _cmd_check,
+    "init": _cmd_init,
 }
 
 

@@ -62,6 +62,28 @@ def efficiency_self_locking(lead_angle_rad: float, rho_rad: float) -> float:
     return max(0.0, math.tan(rho_rad - lead_angle_rad) / math.tan(lead_angle_rad))
 
 
+def self_locking(lead_angle_rad: float, rho_rad: float) -> bool:
+    """A pair self-locks (the wheel cannot drive the worm) when the friction angle reaches the lead angle:
+    rho' >= gamma, where tan(gamma - rho') / tan(gamma) (efficiency_backward) falls to 0 (DIN 3975-2; Niemann /
+    Winter III, ch. 24: static self-locking with the friction at rest, dynamic with the friction while sliding)."""
+    return bool(rho_rad >= lead_angle_rad)
+
+
+def backdrive_keys(lead_angle_rad: float, rho_static_rad: float, rho_dynamic_rad: float) -> dict:
+    """The summary keys every level writes on back-driving (docs/outputs.md): `self_locking` (static: rho' at rest
+    >= gamma, the pair holds the load from standstill), `self_locking_dynamic` (rho' while sliding >= gamma: a
+    back-driven pair comes to rest), `efficiency_backdrive` = tan(gamma - rho') / tan(gamma) with the sliding
+    friction, 0 when it self-locks dynamically (DIN 3975-2), and the angles used."""
+    return {
+        "self_locking": self_locking(lead_angle_rad, rho_static_rad),
+        "self_locking_dynamic": self_locking(lead_angle_rad, rho_dynamic_rad),
+        "efficiency_backdrive": efficiency_backward(lead_angle_rad, rho_dynamic_rad),
+        "friction_angle_static_deg": math.degrees(rho_static_rad),
+        "friction_angle_dynamic_deg": math.degrees(rho_dynamic_rad),
+        "lead_angle_deg": math.degrees(lead_angle_rad),
+    }
+
+
 def efficiency_theory(
     lead_angle_rad: float, normal_pressure_angle_rad: float, mu: float, backdriving: bool = False
 ) -> float:
@@ -151,6 +173,18 @@ DEFAULT_DAMPING_RATIO = 0.1  # mesh damping when none is given, of one tooth pai
 MAX_DAMPING_RATIO = 0.1  # cap of the mesh damping (measured gear-mesh damping ratios: 0.03-0.17)
 
 
+def shaft_inertias_kg_m2(scenario: Scenario, r1_m: float, worm_length_m: float, r2_m: float, face_width_m: float):
+    """(I1, I2) in kg m^2: the worm a solid cylinder r1 x threaded length, the wheel a solid cylinder r2 x face width
+    (I = m r^2 / 2, densities from materials:), plus the driven-machine inertia load.inertia_kg_m2 on the loaded
+    shaft (rigid on it, as contact3d's joint armature). The torsional and the derived wedge level use it."""
+    mats = scenario.materials
+    m1 = mats.worm.density_kg_m3 * math.pi * r1_m**2 * worm_length_m
+    m2 = mats.wheel.density_kg_m3 * math.pi * r2_m**2 * face_width_m
+    j = scenario.load.inertia_kg_m2
+    j1, j2 = (j, 0.0) if scenario.load.on == "worm" else (0.0, j)
+    return 0.5 * m1 * r1_m**2 + j1, 0.5 * m2 * r2_m**2 + j2
+
+
 def effective_modulus_pa(materials: Materials) -> float:
     """E* with 1/E* = (1 - nu1^2)/E1 + (1 - nu2^2)/E2 (Hertz; seeds 001, 002)."""
     w, g = materials.worm, materials.wheel
@@ -212,7 +246,7 @@ def commands(scenario: Scenario, direction: int) -> Commands:
 def working_flank(scenario: Scenario, hand: int) -> int:
     """+1 when the mesh torque on the wheel is positive in the intended running (the worm drives against a resisting
     load: hand x sign(command)), -1 otherwise (the wheel drives: the mesh resists its motion). The flank side of
-    meshgen.kinematic_tca and wormsim.torsional.mesh_stiffness."""
+    meshgen.kinematic_tca and wormsim.tooth.mesh_stiffness."""
     drv = gear_drive(scenario)
     s = 1 if drive_target(drv) >= 0 else -1
     return s * hand if drv.on == "worm" else -s

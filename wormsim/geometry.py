@@ -3,6 +3,7 @@ turned into ScenarioError (exit 2; the message already names the `gear:` field).
 
 from __future__ import annotations
 
+import re
 from collections.abc import Iterator
 from contextlib import contextmanager
 from typing import TYPE_CHECKING
@@ -13,7 +14,7 @@ from meshgen import kinematic_tca as _kinematic_tca
 from meshgen.displaced import Deviations, ErrorsData
 from meshgen.geometry import GearData, GearGeometry, GeometryError
 from meshgen.kinematic_tca import KinematicTCA
-from wormsim.scenario import Scenario, ScenarioError
+from wormsim.scenario import Scenario, ScenarioError, unit_hint
 
 if TYPE_CHECKING:  # meshgen.pieces (trimesh, scipy.spatial: ~1 s) is imported only where pieces are built
     from meshgen.pieces import GearSet
@@ -25,7 +26,9 @@ def geometry_errors() -> Iterator[None]:
     try:
         yield
     except GeometryError as exc:
-        raise ScenarioError(str(exc)) from None
+        msg = str(exc)
+        m = re.match(r"gear\.(\w+_mm) = ([-+0-9.eE]+)", msg)
+        raise ScenarioError(msg + (unit_hint(m.group(1), float(m.group(2))) if m else "")) from None
 
 
 def derive(gear: GearData) -> GearGeometry:
@@ -43,6 +46,17 @@ def gear_set(scenario: Scenario, resolution: str | None = None) -> tuple[GearGeo
     geo = derive(scenario.gear)
     with geometry_errors():
         return geo, _pieces.build_gear_set(geo, resolution=resolution or scenario.simulation.resolution)
+
+
+def solid_set(scenario: Scenario, resolution: str | None = None) -> tuple[GearGeometry, GearSet]:
+    """(geometry, the solid meshes without collision pieces: meshgen.pieces.build_solids) of the scenario's gear."""
+    if scenario.gear is None:
+        raise ScenarioError("gear: this needs a gear: block (model contact3d or torsional)")
+    from meshgen import pieces as _pieces
+
+    geo = derive(scenario.gear)
+    with geometry_errors():
+        return geo, _pieces.build_solids(geo, resolution=resolution or scenario.simulation.resolution)
 
 
 def displaced_pair(errors: ErrorsData, geo: GearGeometry) -> tuple[Deviations, KinematicTCA] | None:

@@ -28,6 +28,7 @@ import math
 import numpy as np
 
 from wormsim import gear_theory as gt
+from wormsim.friction import friction_coefficient
 from wormsim.units import RPM, rad_s_to_rpm
 
 
@@ -174,6 +175,12 @@ def drive_summary(
         "efficiency": eff,
         "efficiency_theory": gt.efficiency_theory(geo.gamma, geo.alpha_n, mu, backdriving=drv.on == "wheel"),
         "friction_coefficient_mean": mu,
+        # static: mu at rest (the contact's friction law at Vs = 0); dynamic: the mean mu applied over the window
+        **gt.backdrive_keys(
+            geo.gamma,
+            gt.virtual_friction_angle_rad(float(friction_coefficient(scenario.contact, 0.0)), geo.alpha_n),
+            gt.virtual_friction_angle_rad(mu, geo.alpha_n),
+        ),
         "steady_window_s": [float(t[i0]), float(t[i1 - 1])],
         "transmission_error_p2p_urad": float(np.ptp(S["transmission_error_rad"][sl]) * 1e6),
         "wheel_speed_fluctuation": float(np.ptp(w2[sl]) / n2) if n2 > 0 else float("nan"),

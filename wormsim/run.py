@@ -4,19 +4,20 @@ report.png, recording.rrd and summary.json atomically (wormsim.output)."""
 from __future__ import annotations
 
 import importlib
+import sys
 import time
 from pathlib import Path
 from types import ModuleType
 
 import numpy as np
 
-from wormsim import interrupt, prewarm
+from wormsim import interrupt, outputs, prewarm
 from wormsim.errors import ScenarioError, SimulationError
 from wormsim.output import ResultDir
 from wormsim.progress import Progress
 from wormsim.result import Result
 from wormsim.run_warnings import run_warnings
-from wormsim.scenario import Scenario
+from wormsim.scenario import Scenario, ignored_inputs
 from wormsim.validate import validate_geometry
 
 # fidelity level -> its package, which exports simulate(scenario, progress) -> Result, write_report(result, path) and
@@ -33,20 +34,48 @@ def model_module(name: str) -> ModuleType:
 
 
 def simulate(scenario: Scenario, progress: Progress | None = None) -> Result:
-    """Simulate only (no files): for tests and the benchmark. The summary carries `warnings` (wormsim.run_warnings)."""
+    """Simulate `scenario` at its level (`scenario.model`) and return the Result; writes no files.
+
+    Args:
+        scenario: a validated Scenario (load_scenario, or Scenario.model_validate of a dict).
+        progress: an optional wormsim.progress.Progress bar (None: silent).
+
+    Returns:
+        Result: `summary` (the keys of docs/outputs.md without the run's status / wall-time keys), `series` (numpy
+        arrays on `series["t_s"]` in s; units in the names: `_rad`, `_rpm`, `_nm`, `_n`, `_m`, ...), `steps`,
+        `sim_time_s`; `summary["warnings"]` lists results that need care (wormsim.run_warnings). Forces follow
+        the sign convention of docs/outputs.md.
+
+    Raises:
+        ScenarioError: input found invalid on the way (exit 2 at the CLI), e.g. impossible gear geometry.
+        SimulationError: the simulation failed, with a diagnosis (diverged, teeth jumped, locked...; exit 3).
+    """
     res = model_module(scenario.model).simulate(scenario, progress=progress)
     res.summary["warnings"] = run_warnings(res)
     return res
 
 
 def run_scenario(scenario: Scenario, out_dir: str | Path, progress: bool | None = None) -> dict:
-    """Simulate and write DIR/{summary.json, timeseries.npz, report.png, recording.rrd}.
+    """Simulate `scenario` and write out_dir/{summary.json, timeseries.npz, report.png, recording.rrd}, as
+    `wormsim run` does.
 
-    Returns the summary. Raises SimulationError / ScenarioError after writing a "failed" summary (which replaces
-    an earlier result); an interrupt (KeyboardInterrupt, SIGTERM via the CLI) leaves DIR as it was
-    (wormsim.output).
+    Args:
+        scenario: a validated Scenario.
+        out_dir: the result folder (created; files replaced atomically; one writer at a time).
+        progress: True / False shows / hides the progress bar; None shows it on a terminal.
+
+    Returns:
+        dict: the summary as written to summary.json: `status` "ok", `message`, `model`, `scenario`, `wall_time_s`
+        [s], `sim_time_s` [s], `steps`, the level's keys and `ignored_inputs` (docs/outputs.md has every key with
+        its unit).
+
+    Raises:
+        ScenarioError: invalid input, or out_dir cannot be written (exit 2); a "failed" summary.json is written.
+        SimulationError: the simulation failed (exit 3); a "failed" summary.json with the diagnosis is written.
+        KeyboardInterrupt: Ctrl-C / SIGTERM; out_dir is left as it was.
     """
     validate_geometry(scenario)  # the checks `wormsim check` makes, before anything is written
+    ignored = ignored_inputs(scenario)
     mod = model_module(scenario.model)
     rd = ResultDir(out_dir)
     base = {"model": scenario.model, "scenario": scenario.name}
@@ -110,6 +139,13 @@ def run_scenario(scenario: Scenario, out_dir: str | Path, progress: bool | None 
         "sim_time_s": res.sim_time_s,
         "steps": res.steps,
         **res.summary,
+        "ignored_inputs": ignored,
     }
+    missing = outputs.undocumented(summary)
+    if missing:  # every key has its entry in wormsim.outputs (docs/outputs.md); never written silently
+        print(f"wormsim: summary keys without an entry in docs/outputs.md: {', '.join(missing)}", file=sys.stderr)
     rd.commit(summary)
+    # never silence: what the level does not use is said after the run (a failed run prints its error alone)
+    for line in ignored:
+        print(f"wormsim: {line}", file=sys.stderr)
     return summary

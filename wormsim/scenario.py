@@ -11,6 +11,7 @@ naming the field (dotted path), the value given and what is allowed; the CLI map
 
 from __future__ import annotations
 
+import difflib
 import json
 import re
 from pathlib import Path
@@ -21,14 +22,28 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_valida
 
 
 class ScenarioError(ValueError):
-    """Invalid input: the message names the field, the value and what is allowed (exit code 2)."""
+    """Invalid input: the message names the field, the value and what is allowed (exit code 2 at the CLI)."""
 
 
 class _Strict(BaseModel):
-    # allow_inf_nan=False: every float field refuses .inf / .nan (YAML reads `.inf` as a float)
-    model_config = ConfigDict(extra="forbid", validate_default=True, allow_inf_nan=False)
+    """allow_inf_nan=False: every float field refuses .inf / .nan (YAML reads `.inf` as a float).
+    validate_assignment: `sc.gear.axial_module_mm = -3` is refused at the assignment (ScenarioError, one line), as
+    the same value in a file is."""
+
+    model_config = ConfigDict(extra="forbid", validate_default=True, allow_inf_nan=False, validate_assignment=True)
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        before, fields_set = dict(self.__dict__), set(self.__pydantic_fields_set__)
+        try:
+            super().__setattr__(name, value)
+        except ValidationError as err:  # a cross-field rule fails after the field was set: put the block back
+            self.__dict__.clear()
+            self.__dict__.update(before)
+            object.__setattr__(self, "__pydantic_fields_set__", fields_set)
+            raise ScenarioError(format_validation_error(err, type(self).__name__.lower(), type(self))) from None
 
 
+MODULE_MIN_MM = 0.05  # the finest worm gears have modules of a few tenths of a millimetre
 PositiveFloat = Annotated[float, Field(gt=0)]
 NonNegFloat = Annotated[float, Field(ge=0)]
 FrictionGroup = Literal["I", "II", "III"]
@@ -40,14 +55,20 @@ FrictionGroup = Literal["I", "II", "III"]
 class Gear(_Strict):
     """Worm gear data (DIN 3975 / ISO 1122 names). Exactly one module and one of lead angle / q."""
 
-    profile: Literal["ZI", "ZA"] = Field(
-        "ZI", description="ZI: involute helicoid (seed 003); ZA: straight-sided axial profile"
+    profile: Literal["ZA", "ZN", "ZI", "ZK", "ZC"] = Field(
+        "ZI",
+        description=(
+            "flank form (DIN 3975): ZI involute helicoid (seed 003); ZA straight in the axial section; ZN straight in "
+            "the normal section; ZK disc with straight sides; ZC disc with a convex arc (Cavex); docs/flank_forms.md"
+        ),
     )
     hand: Literal["right", "left"] = Field("right", description="thread hand of the worm")
     worm_starts: int = Field(1, ge=1, le=8, description="z1")
     wheel_teeth: int = Field(..., ge=10, le=200, description="z2")
-    normal_module_mm: float | None = Field(None, gt=0, le=50)
-    axial_module_mm: float | None = Field(None, gt=0, le=50)
+    normal_module_mm: float | None = Field(
+        None, ge=MODULE_MIN_MM, le=50, description="m_n; below 0.05 mm is no gear (a value in metres gets a hint)"
+    )
+    axial_module_mm: float | None = Field(None, ge=MODULE_MIN_MM, le=50, description="m_x (DIN 3975: m)")
     normal_pressure_angle_deg: float = Field(20.0, ge=5, le=30)
     lead_angle_deg: float | None = Field(None, gt=0, lt=45, description="gamma at the worm reference diameter")
     diameter_quotient: float | None = Field(None, gt=0, le=40, description="q = d1 / m_axial")
@@ -72,27 +93,54 @@ class Gear(_Strict):
     )
     addendum_coef: float = Field(1.0, gt=0, le=1.5, description="h_a / m_axial")
     dedendum_coef: float = Field(1.2, gt=0, le=2.0, description="h_f / m_axial")
+    zn_section: Literal["thread", "space"] = Field(
+        "thread", description="ZN: the straight line in the normal section of the thread (ZN1) or of the space (ZN2)"
+    )
+    tool_diameter_mm: float | None = Field(
+        None, gt=0, le=2000, description="ZK, ZC: disc / grinding wheel diameter; default 100 (docs/flank_forms.md)"
+    )
+    profile_radius_mm: float | None = Field(
+        None, gt=0, le=2000, description="ZC: the tool's arc profile radius; default 5.5 m_axial (docs/flank_forms.md)"
+    )
 
     @model_validator(mode="after")
     def _one_of(self) -> "Gear":
-        if (self.normal_module_mm is None) == (self.axial_module_mm is None):
-            raise ValueError("give exactly one of normal_module_mm / axial_module_mm")
-        if (self.lead_angle_deg is None) == (self.diameter_quotient is None):
-            raise ValueError("give exactly one of lead_angle_deg / diameter_quotient")
+        for a, b in (("normal_module_mm", "axial_module_mm"), ("lead_angle_deg", "diameter_quotient")):
+            va, vb = getattr(self, a), getattr(self, b)
+            if (va is None) == (vb is None):
+                given = f"both given ({a} = {va:g}, {b} = {vb:g})" if va is not None else "neither given"
+                raise ValueError(f"give exactly one of {a} / {b}: {given}")
         if self.dedendum_coef <= self.addendum_coef:
             raise ValueError("dedendum_coef must exceed addendum_coef (root clearance)")
+        module = self.normal_module_mm if self.normal_module_mm is not None else self.axial_module_mm
+        if self.face_width_mm is not None and module is not None and self.face_width_mm < module:
+            raise ValueError(
+                f"gear.face_width_mm = {self.face_width_mm:g}: narrower than one module ({module:g} mm); allowed: "
+                f"face_width_mm >= the module{unit_hint('face_width_mm', self.face_width_mm)}"
+            )
         return self
 
 
 class Material(_Strict):
+    """One part's material: a given material names all three keys; a part left out takes the default of the
+    materials block (steel worm, bronze wheel)."""
+
     youngs_modulus_gpa: float = Field(..., gt=0, le=1000)
     poisson_ratio: float = Field(..., ge=0, lt=0.5)
     density_kg_m3: float = Field(..., gt=0, le=25000)
 
 
 class Materials(_Strict):
-    worm: Material = Material(youngs_modulus_gpa=210, poisson_ratio=0.3, density_kg_m3=7850)
-    wheel: Material = Material(youngs_modulus_gpa=100, poisson_ratio=0.34, density_kg_m3=8800)
+    """Optional block: left out, or a part left out, takes these defaults (steel worm on a bronze wheel)."""
+
+    worm: Material = Field(
+        Material(youngs_modulus_gpa=210, poisson_ratio=0.3, density_kg_m3=7850),
+        description="default steel: 210 GPa, 0.3, 7850 kg/m^3",
+    )
+    wheel: Material = Field(
+        Material(youngs_modulus_gpa=100, poisson_ratio=0.34, density_kg_m3=8800),
+        description="default tin bronze: 100 GPa, 0.34, 8800 kg/m^3",
+    )
 
 
 # ----------------------------------------------------------------------------- contact, drive, load
@@ -214,6 +262,13 @@ class Simulation(_Strict):
     mesh_stiffness_samples: int = Field(
         64, ge=8, le=4096, description="torsional: k(theta) samples per mesh cycle (tooth contact analysis)"
     )
+    backdrive_probe: bool = Field(
+        False,
+        description=(
+            "contact3d, worm driving: after the run, a second run of duration_s with the wheel speed-driven and the "
+            "worm loaded, measuring self-locking and the back-driving efficiency (summary backdrive_measured_*)"
+        ),
+    )
     mass_scaling: Annotated[float, Field(ge=1, le=1e8)] | Literal["auto"] = Field(
         1.0,
         description=(
@@ -287,7 +342,7 @@ class Wedge(_Strict):
         if self.friction is not None and self.friction_group is not None and "friction_group" in self.model_fields_set:
             raise ValueError("give one of friction_group / friction")
         if self.friction is not None:
-            self.friction_group = None
+            object.__setattr__(self, "friction_group", None)  # not a user assignment: no re-validation
         return self
 
 
@@ -295,7 +350,7 @@ class Wedge(_Strict):
 
 
 class Errors(_Strict):
-    """Assembly errors and manufacturing deviations of the gear pair (issue 12), every key 0 by default.
+    """Assembly errors and manufacturing deviations of the gear pair, every key 0 by default.
     Their geometry, limits and signs: meshgen.displaced and docs/errors.md. The limits that depend on the gear
     (backlash, tooth depth, face width, threaded length) are checked against the derived geometry (exit 2)."""
 
@@ -353,26 +408,97 @@ class Errors(_Strict):
         )
 
 
+# ----------------------------------------------------------------------------- shafts on bearings
+
+
+class ShaftSupport(_Strict):
+    """One shaft on two bearings (wormsim.contact3d.shafts): positions, stiffnesses, the worm's bending."""
+
+    bearings_mm: list[Annotated[float, Field(ge=-10000, le=10000)]] = Field(
+        ...,
+        min_length=2,
+        max_length=2,
+        description="the two bearing centres along the shaft axis, from the mesh point (one each side: [-l1, l2])",
+    )
+    locating_bearing: int = Field(0, ge=0, le=1, description="index of the bearing that takes the axial force")
+    radial_stiffness_n_per_um: float | None = Field(
+        None, gt=0, le=1e6, description="radial stiffness of each bearing; omitted = rigid"
+    )
+    axial_stiffness_n_per_um: float | None = Field(
+        None, gt=0, le=1e6, description="axial stiffness of the locating bearing; omitted = rigid"
+    )
+    bending: bool = Field(
+        False, description="worm: the shaft bends between the bearings (root-diameter section, worm material)"
+    )
+
+    @model_validator(mode="after")
+    def _straddle(self) -> "ShaftSupport":
+        b0, b1 = self.bearings_mm
+        if not b0 < 0 < b1:
+            raise ValueError(
+                f"bearings_mm = {self.bearings_mm}: one bearing each side of the mesh point; allowed: "
+                f"bearings_mm[0] < 0 < bearings_mm[1] (mm along the shaft axis)"
+            )
+        return self
+
+
+class Shafts(_Strict):
+    """The worm and the wheel on compliant bearings, the worm shaft bending (absent: rigid hinges)."""
+
+    worm: ShaftSupport | None = None
+    wheel: ShaftSupport | None = None
+
+    @model_validator(mode="after")
+    def _wheel_rigid_section(self) -> "Shafts":
+        if self.wheel is not None and self.wheel.bending:
+            raise ValueError(
+                "shafts.wheel.bending = true: only the worm shaft bends (the wheel's shaft section is not given); "
+                "allowed: shafts.wheel.bending = false"
+            )
+        return self
+
+
 # ----------------------------------------------------------------------------- scenario
 
 
 class Scenario(_Strict):
+    """A validated scenario (the YAML file as Python objects; units in the key names, docs/scenario.md).
+
+    Blocks: `gear`, `materials`, `contact`, `drive`, `load`, `simulation`, `errors` (gear levels) and `wedge` (seed
+    000's reduced model). Build one with load_scenario(path) or Scenario.model_validate(dict); change one with
+    attribute assignment (validated) or `sc.model_copy(update=...)` (not validated: prefer load_scenario's
+    overrides).
+    """
+
     name: str = Field(..., pattern=r"^[a-z0-9_-]+$", description="case name, used in outputs")
     description: str = Field("", description="free text")
     model: Literal["contact3d", "torsional", "wedge"] = Field(
         "contact3d", description="fidelity level: 3D tooth contact (MuJoCo), 2-DOF torsional, or 1-DOF wedge (seed 000)"
     )
     gear: Gear | None = None
-    materials: Materials = Materials()
+    materials: Materials = Field(
+        Materials(), description="optional: steel worm on a bronze wheel when left out (defaults in the block)"
+    )
     contact: Contact = Contact()
     drive: Drive | None = None
     load: Load = Load()
     simulation: Simulation = Simulation()
     wedge: Wedge | None = None
     errors: Errors = Errors()
+    shafts: Shafts | None = None
 
     @model_validator(mode="after")
     def _blocks(self) -> "Scenario":
+        if self.shafts is not None and (self.model != "contact3d" or self.contact.geometry != "flanks"):
+            raise ValueError(
+                "shafts: the shafts on bearings are modelled by contact3d with contact.geometry flanks; allowed: "
+                "model contact3d with contact.geometry flanks, or no shafts: block"
+            )
+        if self.shafts is not None and self.simulation.mass_scaling != 1:
+            raise ValueError(
+                f"simulation.mass_scaling = {self.simulation.mass_scaling}: the shafts' masses and bearing modes are "
+                f"not scaled; allowed: simulation.mass_scaling = 1 with a shafts: block"
+            )
         if self.model != "contact3d" and self.simulation.mass_scaling != 1:
             raise ValueError(
                 f"simulation.mass_scaling = {self.simulation.mass_scaling}: only model contact3d scales "
@@ -385,9 +511,17 @@ class Scenario(_Strict):
                 "not on the contacts found on the exact flanks; allowed: simulation.speculative = false with "
                 "contact.geometry flanks, or contact.geometry pieces"
             )
+        if self.simulation.backdrive_probe and (
+            self.model != "contact3d" or self.drive is None or self.drive.on != "worm"
+        ):
+            raise ValueError(
+                "simulation.backdrive_probe = true: measures back-driving after a forward contact3d run; allowed: "
+                "model contact3d with drive.on worm (a run with drive.on wheel measures it itself; torsional and "
+                "wedge state it from rho' and gamma)"
+            )
         if self.model == "wedge":
             if self.wedge is None:
-                raise ValueError("model: wedge needs a wedge: block")
+                _derivable_wedge(self)
             if not self.errors.is_zero():
                 raise ValueError(
                     "errors: the wedge model has no gear geometry to displace; use model: torsional or "
@@ -401,6 +535,88 @@ class Scenario(_Strict):
             if self.drive.on == self.load.on:
                 raise ValueError("drive.on and load.on must name different shafts")
         return self
+
+
+def _derivable_wedge(sc: "Scenario") -> None:
+    """model: wedge without a wedge: block derives the reduced model from gear:, drive:, load: (wormsim.wedge.derive):
+    the worm driven at a speed, the load a torque on the wheel."""
+    if sc.gear is None or sc.drive is None:
+        missing = " and ".join(b for b, v in (("gear:", sc.gear), ("drive:", sc.drive)) if v is None)
+        raise ValueError(
+            f"model: wedge needs a wedge: block (seed 000's reduced model) or gear: and drive: blocks to derive it "
+            f"from; {missing} missing"
+        )
+    if sc.drive.on != "worm" or sc.drive.speed_rpm is None or sc.drive.speed_rpm <= 0:
+        raise ValueError(
+            f"model: wedge derived from gear: drives the worm at a speed (its motor is a Kloss curve on the worm); "
+            f"given drive.on = {sc.drive.on}"
+            + (f", drive.torque_nm = {sc.drive.torque_nm:g}" if sc.drive.torque_nm is not None else "")
+            + (f", drive.speed_rpm = {sc.drive.speed_rpm:g}" if sc.drive.speed_rpm is not None else "")
+            + "; allowed: drive.on worm with drive.speed_rpm > 0, or model torsional / contact3d"
+        )
+    if sc.load.on != "wheel":
+        raise ValueError("model: wedge derived from gear: loads the wheel; allowed: load.on wheel")
+
+
+def ignored_inputs(sc: Scenario) -> list[str]:
+    """The blocks and keys the user gave that the scenario's level does not use, one line each (wormsim.run prints
+    them on stderr and writes them to summary.json `ignored_inputs`)."""
+    given = sc.model_fields_set
+    out = []
+    if sc.model == "wedge" and sc.wedge is not None:
+        blocks = [b for b in ("gear", "drive", "load", "contact", "materials") if b in given]
+        if blocks:
+            out.append(
+                f"{', '.join(b + ':' for b in blocks)} ignored: the wedge: block gives the whole reduced model "
+                "(remove wedge: to derive it from gear:, drive:, load:)"
+            )
+    elif sc.model == "wedge":
+        rigid = [f"contact.{k}" for k in WEDGE_IGNORES_CONTACT if k in sc.contact.model_fields_set]
+        if sc.gear is not None and "backlash_mm" in sc.gear.model_fields_set:
+            rigid.append("gear.backlash_mm")
+        if rigid:
+            out.append(f"{', '.join(rigid)} ignored: the wedge is rigid and without backlash")
+        if sc.drive is not None and sc.drive.ramp_s > 0:
+            out.append(
+                f"drive.ramp_s = {sc.drive.ramp_s:g} ignored: the derived wedge starts its Kloss motor curve at once"
+            )
+    elif sc.wedge is not None:
+        out.append(f"wedge: ignored: model {sc.model} uses gear:, drive:, load:")
+    if sc.model != "wedge" or sc.wedge is None:
+        by_level: dict[tuple[str, ...], list[str]] = {}
+        for k, levels in LEVEL_KEYS.items():
+            block, key = k.split(".")
+            reported = sc.model == "wedge" and block == "contact"  # named above with the rigid wedge
+            if sc.model not in levels and not reported and key in getattr(sc, block).model_fields_set:
+                by_level.setdefault(levels, []).append(k)
+        for levels, keys in by_level.items():
+            out.append(f"{', '.join(keys)} ignored: used by model {' / '.join(levels)} only")
+    return out
+
+
+# keys only some levels use (given at another level, the run names them)
+LEVEL_KEYS: dict[str, tuple[str, ...]] = {
+    "contact.geometry": ("contact3d",),
+    "contact.slices": ("contact3d",),
+    "contact.flank_contacts": ("contact3d",),
+    "contact.exponent": ("contact3d",),
+    "simulation.resolution": ("contact3d",),
+    "simulation.integrator": ("contact3d",),
+    "simulation.speculative": ("contact3d",),
+    "simulation.record_every": ("contact3d",),
+    "simulation.mesh_stiffness_samples": ("torsional",),
+}
+
+
+WEDGE_IGNORES_CONTACT = (
+    "stiffness_n_per_m",
+    "exponent",
+    "damping_n_s_per_m",
+    "penetration_depth_m",
+    "geometry",
+    "slices",
+    "flank_contacts",
+)
 
 
 # ----------------------------------------------------------------------------- loading
@@ -538,9 +754,9 @@ def _field_info(loc: tuple):
     return info
 
 
-def _allowed_range(loc: tuple) -> str | None:
+def _allowed_range(loc: tuple, root: type[BaseModel] | None = None) -> str | None:
     """'allowed: 0 < x <= 50' from the field's numeric bounds, for messages about numbers."""
-    info = _field_info(loc)
+    info = _field_info(loc) if root is None else root.model_fields.get(str(loc[-1])) if len(loc) == 1 else None
     if info is None:
         return None
     lo = hi = None
@@ -570,7 +786,47 @@ NUMBER_ERRORS = (
 )
 
 
-def format_validation_error(err: ValidationError, source: str = "scenario") -> str:
+# the millimetre sizes of a gear, none of which is below 0.1 mm in a real worm gear (a backlash or a deviation may be)
+SIZE_KEYS_MM = ("normal_module_mm", "axial_module_mm", "face_width_mm", "worm_length_mm", "tool_diameter_mm")
+
+
+def unit_hint(key: str, value: Any) -> str:
+    """'; ... looks like metres' for a gear size in millimetres (SIZE_KEYS_MM) given below 0.1 (0.003 for a 3 mm
+    module), else ''."""
+    if key not in SIZE_KEYS_MM or isinstance(value, bool) or not isinstance(value, int | float):
+        return ""
+    if 0 < abs(value) < 0.1:
+        return f"; {key} is in millimetres: {value:g} looks like metres ({value * 1000:g} mm?)"
+    return ""
+
+
+def _did_you_mean(loc: tuple) -> str:
+    """' (did you mean 'wheel_teeth'?)' for a misspelt key: the closest field names of its block (difflib)."""
+    parent = loc[:-1]
+    if parent:
+        info = _field_info(parent)
+        model = _block_model(info.annotation) if info is not None else None
+    else:
+        model = Scenario
+    if model is None or not isinstance(loc[-1], str):
+        return ""
+    close = difflib.get_close_matches(loc[-1], list(model.model_fields), n=2, cutoff=0.6)
+    return f" (did you mean {' or '.join(repr(c) for c in close)}?)" if close else ""
+
+
+def _block_model(ann) -> type[BaseModel] | None:
+    import types
+    import typing
+
+    for cand in (
+        typing.get_args(ann) if isinstance(ann, types.UnionType) or typing.get_origin(ann) is typing.Union else (ann,)
+    ):
+        if isinstance(cand, type) and issubclass(cand, BaseModel):
+            return cand
+    return None
+
+
+def format_validation_error(err: ValidationError, source: str = "scenario", root: type[BaseModel] | None = None) -> str:
     """One line per problem: `source: field = value: what is allowed`; at most MAX_PROBLEMS lines, then a count."""
     lines = []
     errors = err.errors(include_url=False)
@@ -578,12 +834,16 @@ def format_validation_error(err: ValidationError, source: str = "scenario") -> s
         field = _abbrev(_fmt_loc(e["loc"]) or "(top level)", 2 * MAX_SHOWN).strip('"')
         msg = e["msg"].removeprefix("Value error, ")
         if e["type"] == "extra_forbidden":
-            lines.append(f"{source}: unknown key '{field}' (not in the schema; see `wormsim schema`)")
+            lines.append(f"{source}: unknown key '{field}'{_did_you_mean(e['loc'])} (see docs/scenario.md)")
         elif e["type"] == "missing":
             lines.append(f"{source}: missing required field '{field}'")
         else:
-            rng = _allowed_range(e["loc"]) if e["type"] in NUMBER_ERRORS else None
-            lines.append(f"{source}: {field} = {_abbrev(e.get('input'))}: {msg}" + (f"; {rng}" if rng else ""))
+            rng = _allowed_range(e["loc"], root) if e["type"] in NUMBER_ERRORS else None
+            hint = unit_hint(str(e["loc"][-1]), e.get("input")) if e["loc"] else ""
+            if msg.startswith(f"{field}."):  # a block's cross-field rule that names its own key and value
+                lines.append(f"{source}: {msg}")
+                continue
+            lines.append(f"{source}: {field} = {_abbrev(e.get('input'))}: {msg}" + (f"; {rng}" if rng else "") + hint)
     if len(errors) > MAX_PROBLEMS:
         lines.append(f"{source}: ... and {len(errors) - MAX_PROBLEMS} more problems")
     return "\n".join(lines)
@@ -633,6 +893,21 @@ def scenario_from_dict(data: Any, source: str = "scenario", overrides: list[str]
 
 
 def load_scenario(path: str | Path, overrides: list[str] | None = None) -> Scenario:
+    """Read and validate a scenario YAML file (docs/scenario.md has every key, its unit and default).
+
+    Args:
+        path: the scenario file (YAML, UTF-8, at most 256 kB).
+        overrides: `--set` style "dotted.key=VALUE" strings applied before validation, e.g.
+            ["model=torsional", "gear.wheel_teeth=41", "simulation.duration_s=0.1"]; VALUE is read as YAML.
+
+    Returns:
+        Scenario: the validated model; its blocks validate on assignment (`sc.gear.axial_module_mm = -3` raises
+        ScenarioError and leaves the block as it was).
+
+    Raises:
+        ScenarioError: the file is missing or unreadable, or a value is invalid; the message names the field, the
+            value and what is allowed, one line per problem (exit 2 at the CLI).
+    """
     path = Path(path)
     if not path.is_file():
         raise ScenarioError(f"{path}: no such scenario file")

@@ -16,6 +16,7 @@ from wormsim import scenario as S
 BLOCKS = [
     ("(top level)", S.Scenario),
     ("gear", S.Gear),
+    ("materials", S.Materials),
     ("materials.worm / materials.wheel", S.Material),
     ("contact", S.Contact),
     ("drive", S.Drive),
@@ -84,7 +85,10 @@ def markdown() -> str:
         "`gear.lead_angle_deg` / `gear.diameter_quotient`; `gear.dedendum_coef` > `gear.addendum_coef`; one of",
         "`contact.friction` / `contact.friction_group` / `contact.friction_static` + `contact.friction_dynamic`",
         "(dynamic <= static); exactly one of `drive.speed_rpm` / `drive.torque_nm`; `drive.on` != `load.on`;",
-        "`model: wedge` needs a `wedge:` block, the other models need `gear:` and `drive:`.",
+        "the gear models need `gear:` and `drive:`; `model: wedge` takes a `wedge:` block (seed 000's reduced",
+        "model) or, without one, derives it from `gear:`, `drive:` (the worm at `drive.speed_rpm` > 0) and `load:`",
+        '(on the wheel) (docs/wedge.md, "Derived from gear:"). Blocks and keys a level does not use are named on',
+        "stderr and in summary.json `ignored_inputs`.",
         "",
     ]
     return "\n".join(lines)

@@ -118,7 +118,7 @@ def speedups(records: list[dict], key: str = "wall_s_per_sim_s", name: str = "sp
 
 
 def speedups_equal_accuracy(records: list[dict], key: str = "wall_s_per_sim_s") -> dict:
-    """Flanks against pieces at equal or better accuracy (issue 13), per scenario and resolution level, from one bench
+    """Flanks against pieces at equal or better accuracy, per scenario and resolution level, from one bench
     run's records (their `error` against the scenario's converged reference, every key of ERROR_LABELS) and cost
     `key` (whole simulate() or the stepping loop per simulated second). Two readings:
     vs_default_pieces: the pieces record at its default step (timestep_factor 1) against the cheapest flanks record

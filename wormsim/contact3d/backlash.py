@@ -35,7 +35,7 @@ import mujoco
 import numpy as np
 
 from meshgen.geometry import GearGeometry
-from wormsim.contact3d.window import repose_window
+from wormsim.contact3d.slots import repose_window
 from wormsim.scenario import ScenarioError
 from wormsim.units import MM
 

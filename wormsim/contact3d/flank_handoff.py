@@ -81,7 +81,7 @@ def _fill_add(
     """Writes the per-contact fields of records 0..n-1 (rec: the buffer as float64 rows, at address base, size bytes
     each; off: the offsets of dist, pos, frame, solref, solreffriction, friction in float64 units): dist = -depth,
     solref (and, where friction_ref, solreffriction) scaled by the contact's share of its slice (direct solref: -k,
-    -b); where scale_friction (one contact per tooth flank, wormsim.contact3d.flank_merge), the sliding friction
+    -b); where scale_friction (one contact per tooth flank, wormsim.tooth.merge), the sliding friction
     mu fscale[i] and solreffriction scaled by weight fscale; then mj_addContact (at address fn) on each. Returns how
     many were added (it stops when the arena is full, where MuJoCo has warned with mjWARN_CONTACTFULL)."""
     o0, o1, o2, o3, o4, o5 = off[0], off[1], off[2], off[3], off[4], off[5]

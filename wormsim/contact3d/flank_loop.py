@@ -1,11 +1,11 @@
-"""The exact-flank step loop compiled (issue 13): the steps of one record interval of wormsim.contact3d.runner in one
+"""The exact-flank step loop compiled: the steps of one record interval of wormsim.contact3d.runner in one
 numba call, MuJoCo's C stage functions called by address.
 
 Each step does what the runner's Python loop did with `FlankContacts.step` (wormsim.contact3d.flank_step), in the
 same order and with the same floating-point operations, so the results are bit-identical
 (tests/test_flank_loop.py): the drive and load commands into d.ctrl, the shaft speeds read, then `split_step`'s stages
 (mj_checkPos, mj_checkVel, mj_fwdKinematics, mj_makeM, mj_factorM, mj_collision; the flank contacts: the window
-update of FlankContacts.window, with assembly errors flank_pose.set_pose, flanks.find_packed (find_contacts with
+update of FlankContacts.window, with assembly errors flank_pose.set_pose, kernel.find_packed (find_contacts with
 its memo, slice_weights, contact_frames), flank_handoff._fill_add; mj_makeConstraint, mj_island, mj_transmission,
 mj_projectConstraint, mj_sensorPos, mj_fwdVelocity, mj_sensorVel, mj_step2), then the runner's per-step sums
 (actuator torques, shaft powers T w, the contact sensor's count, force and moment, the peak |F_x|).
@@ -17,7 +17,7 @@ exhausted) is not turned into a Python exception here. MuJoCo's warnings (d.warn
 runner's guards read them after each interval.
 
 `sample` is the runner's per-sample work on the flank contacts in one compiled call: flank_step.flank_contact_details
-(forces, points, teeth touching, largest penetration), flank_outputs.PatternLog.record (the contact pattern's rows),
+(forces, points, teeth touching, largest penetration), hertz.PatternLog.record (the contact pattern's rows),
 contact_sums.radial_and_radius, and the points stored into the run's arrays.
 
 Both take their per-run arrays as one table of addresses and shapes (`run_table`, `sample_table`: numba's unboxing of
@@ -40,10 +40,10 @@ from numba.extending import intrinsic
 
 from wormsim.contact3d.contact_sums import radial_and_radius, radius_mean
 from wormsim.contact3d.flank_handoff import _MJ_ADD_CONTACT, _fill_add, _library
-from wormsim.contact3d.flank_outputs import _rows
-from wormsim.contact3d.flank_pose import set_pose
 from wormsim.contact3d.flank_step import _contact_forces
-from wormsim.contact3d.flanks import find_packed
+from wormsim.tooth.hertz import _rows
+from wormsim.tooth.kernel import find_packed
+from wormsim.tooth.pose import set_pose
 
 STAGES_BEFORE = ("mj_checkPos", "mj_checkVel", "mj_fwdKinematics", "mj_makeM", "mj_factorM", "mj_collision")
 STAGES_AFTER = (
@@ -95,7 +95,7 @@ def run_interval(fns, m_addr, d_addr, cmd, load, j0, j1, mjd, iv, fv, state, ker
     fv = (tooth 0's angle, pitch angle, margin, taper, friction coefficient); state = (the window's centre tooth, the
     last step's contact count); kern = FlankContacts.kernel's buffers (fb, ib; flanks.PackedKernel) and ks (the
     window's teeth, a view of ib); params = the kernel's P (a view of fb); out = the kernel's (pos, depth, weight,
-    frame, mfric), the merged ones with one contact per tooth flank (FlankContacts.handed, flank_merge); hand =
+    frame, mfric), the merged ones with one contact per tooth flank (FlankContacts.handed, wormsim.tooth.merge); hand =
     (records, field offsets, solref, solreffriction).
     acc (N_ACC) receives the sums over the steps: worm and wheel actuator torque, worm and wheel power, contact count,
     F_x, F_y, F_z, M_z about the wheel axis, the peak |F_x|. Returns the number of contacts MuJoCo did not take
@@ -127,7 +127,7 @@ def run_interval(fns, m_addr, d_addr, cmd, load, j0, j1, mjd, iv, fv, state, ker
             state[0] = cw
         n = find_packed(fb, ib, th1, th2, margin0, taper)
         state[1] = n
-        nh = ib[7] if ib[6] != 0 else n  # one contact per tooth flank (flank_merge): out holds the merged ones
+        nh = ib[7] if ib[6] != 0 else n  # one contact per tooth flank (wormsim.tooth.merge): out holds the merged ones
         if nh:
             k = min(nh, rec.shape[0])
             added = _fill_add(
@@ -231,7 +231,7 @@ TABLE = (
     ("i8", 1),  # 21 the stage addresses
     ("i8", 1),  # 22 iv
     ("f8", 1),  # 23 fv
-    ("f8", 1),  # 24 the merged contacts' friction scale (flank_merge: mfric)
+    ("f8", 1),  # 24 the merged contacts' friction scale (wormsim.tooth.merge: mfric)
 )
 
 

@@ -1,12 +1,12 @@
-"""The exact-flank runner's record intervals compiled together (issue 13): one numba call runs many samples, each
+"""The exact-flank runner's record intervals compiled together: one numba call runs many samples, each
 `flank_loop.run_table` (the interval's steps) and then the runner's per-sample work of wormsim.contact3d.runner, so
 the per-sample Python (~45-60 us a sample: dispatch, guards, the series column) is paid once per call.
 
 Per sample, in the runner's order and with its floating-point operations (bit-identical series, pattern and radius
 logs, contact points: tests/test_flank_samples.py): the steps; the state read from d (shaft angles and speeds,
-d.time); the runner's _Guards.state checks (non-finite state or MuJoCo's bad-qacc warning, overspeed, teeth jumped);
+d.time); the runner's Guards.state checks (non-finite state or MuJoCo's bad-qacc warning, overspeed, teeth jumped);
 mu from the friction law (wormsim.friction.friction_coefficient_scalar's three forms); flank_loop.sample_flanks; the
-penetration and lock checks of _Guards.contact; the series column (runner.SERIES order).
+penetration and lock checks of Guards.contact; the series column (series.SERIES order).
 
 Anything else hands the sample back to the runner's Python path, after its steps and before any of its per-sample
 work: a guard that would act (it raises or keeps state: a stuck drive, the friction guard's next check), a friction
@@ -16,27 +16,28 @@ MuJoCo did not take.
 The runner then does that sample as before, so errors and their messages are the Python guards' own.
 
 d's scalar fields (time, ncon, nefc) and arena pointers (contact, efc_force) are read at their byte offsets in
-mjData, found once per process on a small model (`mjdata_offsets`: sentinel values and pointers searched in the
-struct, each match unique, checked against the binding). Where that fails the runner keeps the per-sample path.
+mjData, from MuJoCo's declared layout and checked once per process (wormsim.contact3d.mjdata_layout: an unknown
+layout raises, naming the MuJoCo version).
 """
 
 from __future__ import annotations
 
-import ctypes
 import math
 
-import mujoco
 import numba
 import numpy as np
 from numba import types
 from numba.extending import intrinsic
 
 from wormsim.contact3d.flank_loop import _f1, _f64_at, _i1, _i64_at, run_table, sample_table
-from wormsim.contact3d.flank_merge import split_forces
+from wormsim.contact3d.friction_law import mu_at, mu_params
+from wormsim.contact3d.guards import state_event
+from wormsim.contact3d.mjdata_layout import mjdata_offsets
+from wormsim.contact3d.series import column
+from wormsim.tooth.merge import split_forces
 
 ENABLED = True  # the runner's switch (tests compare against the per-sample path)
 ADR_CAP = 4096  # contacts per step the compiled sample reads (more: the sample goes to the Python path)
-SCAN_BYTES = 1 << 16  # how far past d.warning the scalar fields and pointers are searched
 
 # io: what run_samples hands back
 IO_NEXT, IO_PENDING, IO_TURN_MAX, IO_PM, IO_RM, IO_DROPPED = range(6)
@@ -86,108 +87,14 @@ def _i32_at(typingctx, addr):
     return sig, codegen
 
 
-_OFFSETS: np.ndarray | None = None
-
-
-def _find(raw: bytes, key: bytes, base: int, last_of_two: bool = False) -> int:
-    """base + where key is in raw, 8-aligned and unique (last_of_two: the second of exactly two)."""
-    k = raw.find(key)
-    if k >= 0 and last_of_two:
-        k2 = raw.find(key, k + 1)
-        k = k2 if k2 >= 0 else k
-    if k < 0 or raw.find(key, k + 1) >= 0 or (base + k) % 8:
-        return -1
-    return base + k
-
-
-def mjdata_offsets() -> np.ndarray | None:
-    """Byte offsets in mjData of (time, ncon, nefc, contact pointer, efc_force pointer, warning[BADQACC].number), then
-    mjContact's size and its efc_address field's offset, found on a box resting on a plane (module docstring); None
-    where a search is not unique or does not check."""
-    global _OFFSETS
-    if _OFFSETS is not None:
-        return _OFFSETS if _OFFSETS[0] >= 0 else None
-    m = mujoco.MjModel.from_xml_string(
-        "<mujoco><worldbody><geom type='plane' size='1 1 .1'/><body pos='0 0 .099'><freejoint/>"
-        "<geom type='box' size='.1 .1 .1'/></body></worldbody></mujoco>"
-    )
-    d = mujoco.MjData(m)
-    mujoco.mj_forward(m, d)
-    out = np.full(8, -1, dtype=np.int64)
-    try:
-        if d.ncon < 1 or d.nefc < 1:
-            raise LookupError
-        wn = np.asarray(d.warning.number)
-        w0 = wn.ctypes.data - d._address  # warning[0].number
-        d.time = 1.2345678901234567e-300
-        raw = ctypes.string_at(d._address + w0, SCAN_BYTES)
-        t_off = _find(raw, np.float64(d.time).tobytes(), w0)
-        con = np.asarray(d.contact.dist).ctypes.data  # dist is mjContact's first field
-        c_off = _find(raw, np.int64(con).tobytes(), w0, last_of_two=True)  # d->arena holds it too, declared first
-        e_off = _find(raw, np.int64(np.asarray(d.efc_force).ctypes.data).tobytes(), w0)
-        # ncon .. nefc are the ints after warning[] and timer[] (mjdata.h): the first int32 pair equal to ncon with
-        # nefc 16 bytes on, before time
-        n_off = -1
-        for k in range(w0 + 8 * len(wn), t_off, 4):
-            if ctypes.c_int.from_address(d._address + k).value == d.ncon and (
-                ctypes.c_int.from_address(d._address + k + 16).value == d.nefc
-            ):
-                n_off = k
-                break
-        b_off = w0 + 8 * int(mujoco.mjtWarning.mjWARN_BADQACC)
-        dist = np.asarray(d.contact.dist)
-        size = dist.strides[0]  # one mjContact record
-        a_off = np.asarray(d.contact.efc_address).ctypes.data - con
-        out[:] = (t_off, n_off, n_off + 16, c_off, e_off, b_off, size, a_off)
-        if min(out) < 0:
-            raise LookupError
-        # check: other values read back through the offsets
-        d.time = 0.25
-        mujoco.mj_step(m, d)
-        a = d._address
-        o = [int(x) for x in out]
-        ok = (
-            ctypes.c_double.from_address(a + o[0]).value == d.time
-            and ctypes.c_int.from_address(a + o[1]).value == d.ncon
-            and ctypes.c_int.from_address(a + o[2]).value == d.nefc
-            and ctypes.c_int64.from_address(a + o[3]).value == np.asarray(d.contact.dist).ctypes.data
-            and ctypes.c_int64.from_address(a + o[4]).value == np.asarray(d.efc_force).ctypes.data
-            and ctypes.c_int.from_address(a + o[5]).value == d.warning[mujoco.mjtWarning.mjWARN_BADQACC].number
-            and ctypes.c_int.from_address(np.asarray(d.contact.dist).ctypes.data + o[6] * (d.ncon - 1) + o[7]).value
-            == d.contact.efc_address[d.ncon - 1]
-        )
-        if not ok:
-            raise LookupError
-    except LookupError:
-        out[:] = -1
-    _OFFSETS = out
-    return out if out[0] >= 0 else None
-
-
-@numba.njit(cache=True, inline="always")
-def _friction(vs, g):
-    """wormsim.friction.friction_coefficient_scalar at the sliding speed vs, with its operations."""
-    kind = g[11]
-    if kind == 0.0:
-        return g[12]
-    if kind == 1.0:  # units.step(abs(vs), 0.0, static, v_t, dynamic)
-        t, h0, t1, h1 = abs(vs), g[12], g[13], g[14]
-        if t1 <= 0.0:
-            return h1 if t >= 0.0 else h0
-        s = (t - 0.0) / (t1 - 0.0)
-        s = 0.0 if s < 0.0 else (1.0 if s > 1.0 else s)
-        return h0 + (h1 - h0) * s * s * (3.0 - 2.0 * s)
-    return math.tan(g[28] / (g[12] * abs(vs) ** g[13] + g[14]))  # tan(DEG / (a |Vs|^b + c))
-
-
 @numba.njit(cache=True, nogil=True)
 def run_samples(T, Ts, m_addr, d_addr, cmd, load, i0, i1, o0, rec, S, g, off, frame, pos, adr, pat_buf, r_buf, io, mrg):
     """Samples i0..i1-1 (module docstring); sample i's steps are o0 + (i - i0) rec .. + rec of cmd and load.
-    T, Ts: flank_loop's run and sample tables; S the series (runner.SERIES rows); g the parameters (G_NAMES); off
-    mjdata_offsets; frame, pos the kernel's contacts; adr (ADR_CAP) work room; pat_buf, r_buf the pattern's and the
-    radius log's rows; io: IO_* (io[IO_PM], io[IO_RM] the logs' rows used on entry); mrg: with one contact per tooth
-    flank (merge) the kernel's (grp, share, mfric, mwrap) and the per-slice rows' room (FlankContacts.slice_rows),
-    else None."""
+    T, Ts: flank_loop's run and sample tables; S the series (series.SERIES rows); g the parameters (G_NAMES); off
+    the checked mjData offsets (wormsim.contact3d.mjdata_layout); frame, pos the kernel's contacts; adr (ADR_CAP) work
+    room; pat_buf, r_buf the pattern's and the radius log's rows; io: IO_* (io[IO_PM], io[IO_RM] the logs' rows used
+    on entry); mrg: with one contact per tooth flank (merge) the kernel's (grp, share, mfric, mwrap) and the per-slice
+    rows' room (FlankContacts.slice_rows), else None."""
     acc = _f1(T, 20)
     state = numba.carray(_i64_at(T[19, 0]), (T[19, 1],))
     qpos, qvel = _f1(T, 2), _f1(T, 1)
@@ -218,25 +125,17 @@ def run_samples(T, Ts, m_addr, d_addr, cmd, load, i0, i1, o0, rec, S, g, off, fr
         io[IO_DROPPED] = dropped
         if dropped:
             return
-        t1, t2, p1, p2, nc = acc[0], acc[1], acc[2], acc[3], acc[4]
-        fx, fy, fz, mz, fpk = acc[5], acc[6], acc[7], acc[8], acc[9]
         cmd_i = cmd[o + rec - 1]
         th1, th2 = qpos[qa1], qpos[qa2]
         w1, w2 = qvel[dof1], qvel[dof2]
         t = tptr[0]
-        # _Guards.state
-        if not math.isfinite(th1 + th2 + w1 + w2) or bptr[0] != 0:
-            return
-        turn = abs(w1) * dt
-        if turn > turn_lim:
-            return
-        te = th2 - direction * th1 / ratio
-        if abs(te) > jump_rad:
+        event, te, turn = state_event(th1, th2, w1, w2, bptr[0], dt, turn_lim, direction, ratio, jump_rad)
+        if event != 0:  # Guards.state raises: the Python path
             return
         if t > g[8]:  # the friction guard's next check
             return
         vs = abs(w1) * g[9] / g[10]
-        mu = _friction(vs, g)
+        mu = mu_at(vs, g[11], g[12], g[13], g[14], g[28])
         if mu != mu_now:  # FlankContacts.set_friction: the records' friction, where the cone's dimension stays
             if (mu > 0.0) != (mu_now > 0.0):
                 return
@@ -249,7 +148,7 @@ def run_samples(T, Ts, m_addr, d_addr, cmd, load, i0, i1, o0, rec, S, g, off, fr
                 recs[r, o5 + 1] = mu
             mu_now = mu
             g[16] = mu
-        # the sample's contacts: d.contact's efc addresses, the largest penetration (_Guards.contact's first check)
+        # the sample's contacts: d.contact's efc addresses, the largest penetration (Guards.contact's first check)
         ncon = nptr[0]
         n_fc = state[1]
         if ncon > adr.shape[0] or pm + n_fc > pat_buf.shape[0] or rm + n_fc > r_buf.shape[0]:
@@ -317,32 +216,8 @@ def run_samples(T, Ts, m_addr, d_addr, cmd, load, i0, i1, o0, rec, S, g, off, fr
             )
         turn_max = max(turn_max, turn)
         r_c = wr / W if W > 0 else math.nan
-        rpm = g[17]
-        col = (
-            t,
-            th1,
-            th2,
-            w1 / rpm,
-            w2 / rpm,
-            t1 / rec,
-            t2 / rec,
-            cmd_i,
-            fx / rec,
-            -fy / rec,
-            fz / rec,
-            nc / rec,
-            float(nteeth),
-            pen2,
-            mu,
-            te,
-            mz / rec,
-            p1 / rec,
-            p2 / rec,
-            fpk,
-            fr,
-            r_c,
-            0.0,
-        )
+        sums = (acc[0], acc[1], acc[2], acc[3], acc[4], acc[5], acc[6], acc[7], acc[8], acc[9])
+        col = column(t, th1, th2, w1, w2, cmd_i, sums, rec, nteeth, pen2, mu, te, fr, r_c, g[17])
         for k in range(len(col)):
             S[k, i] = col[k]
         io[IO_PENDING] = 0.0
@@ -357,39 +232,25 @@ class FlankSamples:
 
     def __init__(self, loop, guards, scenario, bm, worm_is_drive: bool, rec: int, series: np.ndarray):
         from wormsim import gear_theory as gt
-        from wormsim.contact3d.runner import JUMP_PITCH, MAX_WORM_TURN_PER_STEP_RAD, OVERSPEED_GUARD
-        from wormsim.friction import GROUPS, friction_coefficient
-        from wormsim.units import DEG, RPM
+        from wormsim.units import RPM
 
-        fc, geo, c = loop.fc, bm.geometry, scenario.contact
+        fc, geo = loop.fc, bm.geometry
         self.loop, self.fc, self.guards, self.rec, self.S = loop, fc, guards, rec, series
-        offs = mjdata_offsets()
-        self.ok = offs is not None
-        if offs is None:
-            return
-        self.off = offs
+        self.off = mjdata_offsets()
         g = np.zeros(len(G_NAMES))
         g[G["dt"]] = guards.dt
         g[G["direction"]] = bm.direction
         g[G["ratio"]] = geo.ratio
-        g[G["overspeed_turn"]] = OVERSPEED_GUARD * MAX_WORM_TURN_PER_STEP_RAD
-        g[G["jump_rad"]] = JUMP_PITCH * guards.pitch_angle
+        g[G["overspeed_turn"]] = guards.turn_lim
+        g[G["jump_rad"]] = guards.jump_rad
         g[G["pen_lim"]] = guards.pen_lim
         g[G["lock_start"]] = guards.lock_start
         g[G["lock_fraction"]] = gt.LOCK_SPEED_FRACTION
         g[G["r1"]] = geo.r1
         g[G["cos_gamma"]] = math.cos(geo.gamma)
-        if c.friction_group is not None:
-            g[G["mu_kind"]] = 2.0
-            g[G["mu_a"]], g[G["mu_b"]], g[G["mu_c"]] = GROUPS[c.friction_group]
-        elif c.friction is None and c.friction_static is None:
-            g[G["mu_a"]] = float(friction_coefficient(c, 0.0))
-        elif c.friction is not None:
-            g[G["mu_a"]] = float(c.friction)
-        else:
-            g[G["mu_kind"]] = 1.0
-            g[G["mu_a"]], g[G["mu_b"]], g[G["mu_c"]] = c.friction_static, c.transition_velocity_m_s, c.friction_dynamic
-        g[G["deg"]] = DEG
+        kind, a, b, c_, deg = mu_params(scenario.contact)
+        g[G["mu_kind"]], g[G["mu_a"]], g[G["mu_b"]], g[G["mu_c"]] = kind, a, b, c_
+        g[G["deg"]] = deg
         g[G["rpm"]] = RPM
         g[G["a"]] = geo.a
         g[G["speed_driven"]] = float(guards.speed_driven)
@@ -403,9 +264,8 @@ class FlankSamples:
         self._store: tuple = ()
 
     def usable(self) -> bool:
-        """The compiled samples apply: offsets found, rigid poses, every contact MuJoCo's so far."""
-        fc = self.fc
-        return ENABLED and self.ok and not fc.displaced and self.loop.dropped == 0
+        """The compiled samples apply: rigid poses, every contact MuJoCo's so far."""
+        return ENABLED and not self.fc.displaced and self.loop.dropped == 0
 
     def run(self, cmd, load, i0: int, i1: int, o0: int, pattern, rlog) -> tuple[int, bool]:
         """Samples i0..i1-1 (run_samples); returns (the next sample, whether its steps are done and its per-sample

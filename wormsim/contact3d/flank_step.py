@@ -1,4 +1,4 @@
-"""MuJoCo's step split so that contacts found on the exact flanks (wormsim.contact3d.flanks) enter its constraint
+"""MuJoCo's step split so that contacts found on the exact flanks (wormsim.tooth.kernel) enter its constraint
 solver.
 
 mj_step (MuJoCo 4.0.0, engine_forward.c) is mj_checkPos, mj_checkVel, mj_forward, mj_checkAcc, integrate, and
@@ -30,30 +30,26 @@ import numba
 import numpy as np
 
 from wormsim.contact3d.flank_handoff import ContactBuffer
-from wormsim.contact3d.flank_merge import split_forces
-from wormsim.contact3d.flanks import (
-    MARGIN_PITCH,
-    TAPER_SHARE,
-    PackedKernel,
-    find_packed,
-    flank_grid,
-)
+from wormsim.tooth.grid import flank_grid
+from wormsim.tooth.kernel import MARGIN_PITCH, TAPER_SHARE, PackedKernel, find_packed
+from wormsim.tooth.merge import split_forces
 
 
 class FlankContacts:
     """The flank contacts of one model: the grid, the window, the template contact and the step."""
 
     def __init__(self, bm, slices: int, merge: bool | None = None):
-        """merge: one MuJoCo contact per tooth flank (wormsim.contact3d.flank_merge; contact.flank_contacts tooth);
+        """merge: one MuJoCo contact per tooth flank (wormsim.tooth.merge; contact.flank_contacts tooth);
         None: from the model's scenario (bm.meta's flank_contacts)."""
         g = bm.geometry
         self.merge = bm.meta.get("flank_contacts", "slice") == "tooth" if merge is None else bool(merge)
         m = bm.model
         self.bm = bm
-        self.grid = flank_grid(g, slices)
+        plan_grid = bm.plan.grid if getattr(bm, "plan", None) is not None else None
+        self.grid = plan_grid if plan_grid is not None and plan_grid.slices == slices else flank_grid(g, slices)
         self.pitch = 2 * math.pi / g.z2
         self.margin0 = MARGIN_PITCH * self.pitch + g.backlash / (2 * g.r2)
-        self.taper_rad = TAPER_SHARE * self.margin0  # of the error-free window (flanks.find_contacts)
+        self.taper_rad = TAPER_SHARE * self.margin0  # of the error-free window (wormsim.tooth.kernel.find_contacts)
         W = bm.window_teeth
         cap = 2 * W * slices
         self.pos = np.zeros((cap, 3))
@@ -61,7 +57,7 @@ class FlankContacts:
         self.depth = np.zeros(cap)
         self.meta = np.zeros((cap, 4))
         self.line = np.zeros((cap, 2))
-        self.weight = np.zeros(cap)  # each contact's share of its slice (flanks.slice_weights)
+        self.weight = np.zeros(cap)  # each contact's share of its slice (wormsim.tooth.kernel.slice_weights)
         self.slices = slices
         self.frame = np.zeros((cap, 9))
         self.n = 0
@@ -69,8 +65,9 @@ class FlankContacts:
         self.qa2 = int(m.jnt_qposadr[m.dof_jntid[bm.wheel_dof]])
         self._c = None
         self.ks = np.zeros(W, dtype=np.int64)
-        gw = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, "worm_visual")
-        gg = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, "wheel_visual")
+        worm_geom, wheel_geom = bm.meta.get("flank_geoms", ("worm_visual", "wheel_visual"))  # wormsim.pair: prefixed
+        gw = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, worm_geom)
+        gg = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, wheel_geom)
         self.geoms = (gw, gg)
         law = bm.law
         t = mujoco.MjContact()
@@ -93,21 +90,23 @@ class FlankContacts:
         self.buffer = None
         self.set_friction(float(m.geom_friction[gw, 0]))
         self.buffer = ContactBuffer(m, t, cap)  # the bulk hand-off (wormsim.contact3d.flank_handoff)
-        # errors: (issue 12): the kernel gets the displaced bodies' poses each step (wormsim.contact3d.flank_pose)
+        # with errors: the kernel gets the displaced bodies' poses each step (wormsim.tooth.pose)
         self.params = self.grid.params
         dev = getattr(bm, "deviations", None)
-        self.displaced = dev is not None and not dev.is_zero()
+        # poses_from_data: bodies that move on their own (wormsim.contact3d.shafts, wormsim.pair), margin_rad theirs
+        self.displaced = (dev is not None and not dev.is_zero()) or bool(bm.meta.get("poses_from_data"))
         if self.displaced:
-            from wormsim.contact3d import flank_pose
+            from wormsim.tooth import pose as flank_pose
 
             shift = bm.tooth_shift_rad if bm.tooth_shift_rad is not None else np.zeros(g.z2)
             self.params = flank_pose.displaced_params(self.grid.params, np.asarray(shift, dtype=float))
-            self.margin0 += flank_pose.error_margin_rad(g, self.grid, dev)
+            self.margin0 += flank_pose.error_margin_rad(g, self.grid, dev) if dev is not None else 0.0
+            self.margin0 += float(bm.meta.get("margin_rad", 0.0))
             self._set_pose = flank_pose.set_pose
         self._pack()
 
     def _pack(self) -> None:
-        """The kernel's arrays, memo included, in two buffers: one compiled call per step (flanks.find_packed);
+        """The kernel's arrays, memo included, in two buffers: one compiled call per step (kernel.find_packed);
         again when self.params was replaced."""
         k = self.kernel = PackedKernel(
             self.grid, self.params, len(self.depth), len(self.ks), self.bm.geometry.z2, self.merge
@@ -116,8 +115,8 @@ class FlankContacts:
         self.pos, self.nrm, self.depth, self.meta, self.line = k.pos, k.nrm, k.depth, k.meta, k.line
         self.weight, self.frame, self.ks, self.params = k.weight, k.frame, k.ks, k.P
         self.memo = (k.memo, k.memo_consts)  # find_contacts' open-slice memo
-        k.axes[:] = self._hinges()  # the merge's moment arms (flank_merge)
-        # what is handed to MuJoCo: the slice contacts, or one per tooth flank (flank_merge)
+        k.axes[:] = self._hinges()  # the merge's moment arms (wormsim.tooth.merge)
+        # what is handed to MuJoCo: the slice contacts, or one per tooth flank (wormsim.tooth.merge)
         self.handed = (k.mdepth, k.mpos, k.mframe, k.mweight) if self.merge else (k.depth, k.pos, k.frame, k.weight)
         self._adr = np.zeros(len(k.depth), dtype=np.int64)  # slice_rows' per-slice rows (merge)
         self._efc = np.zeros(3 * len(k.depth))
@@ -129,7 +128,9 @@ class FlankContacts:
         d = mujoco.MjData(m)
         mujoco.mj_kinematics(m, d)
         j1, j2 = m.dof_jntid[bm.worm_dof], m.dof_jntid[bm.wheel_dof]
-        ratio = float(self.grid.params[12])  # the conjugate motion: theta2 = ratio theta1 (flanks._find_contacts)
+        ratio = float(
+            self.grid.params[12]
+        )  # the conjugate motion: theta2 = ratio theta1 (wormsim.tooth.kernel._find_contacts)
         return np.concatenate([d.xanchor[j1], d.xaxis[j1], d.xanchor[j2], d.xaxis[j2], [ratio]])
 
     def n_handed(self) -> int:
@@ -139,7 +140,7 @@ class FlankContacts:
     def slice_rows(self, d: mujoco.MjData):
         """Per slice contact (the kernel's last fc.n): (efc_address, efc_force, frame, pos, cone3) to read its
         constraint force from, as d.contact's last fc.n entries give it; with merge, the merged contacts' forces split
-        over their slices (flank_merge.split_forces: efc_address into the returned efc_force, three rows each)."""
+        over their slices (merge.split_forces: efc_address into the returned efc_force, three rows each)."""
         dim3 = self.template.dim == 3
         if not self.merge:
             n = min(self.n, d.ncon)
@@ -173,7 +174,7 @@ class FlankContacts:
         return self.ks
 
     def find(self, d: mujoco.MjData) -> int:
-        """Run the kernel at the current positions (flanks.find_packed: find_contacts with its memo, slice_weights,
+        """Run the kernel at the current positions (kernel.find_packed: find_contacts with its memo, slice_weights,
         contact_frames); returns the number of contacts."""
         q = d.qpos  # one view (each d.qpos builds one: ~1 us)
         th1, th2 = q[self.qa1], q[self.qa2]
@@ -215,7 +216,7 @@ class FlankContacts:
         # each contact's stiffness and damping scaled by its share of its slice (direct solref: -k, -b)
         c.solref[k0:k1] = np.multiply.outer(weight[: k1 - k0], self.solref)
         wf = weight[: k1 - k0]
-        if self.merge:  # friction mu / c_w and its damping by W (wormsim.contact3d.flank_merge)
+        if self.merge:  # friction mu / c_w and its damping by W (wormsim.tooth.merge)
             fs = self.kernel.mfric[: k1 - k0]
             wf = wf * fs
             c.friction[k0:k1, 0] = c.friction[k0:k1, 1] = self.mu * fs
@@ -261,7 +262,7 @@ def split_forward(m: mujoco.MjModel, d: mujoco.MjData, add_contacts) -> None:
 
 
 def flank_contact_details(fc: FlankContacts, d: mujoco.MjData):
-    """As wormsim.contact3d.runner.contact_details for flank contacts: (n teeth touching, max penetration, points in
+    """As wormsim.contact3d.sources.contact_details for flank contacts: (n teeth touching, max penetration, points in
     the frame of wheel tooth 0, forces on the wheel (world), points (world)). The kernel's contacts are d.contact's
     last fc.n entries; the force on the wheel (geom 2) is the elliptic-cone rows turned into the world frame
     (`_contact_forces`, compiled: this runs at every sample)."""
@@ -284,8 +285,8 @@ def flank_contact_details(fc: FlankContacts, d: mujoco.MjData):
         out,
     )
     p0, F, pw = out[0, :m], out[1, :m], out[2, :m]
-    if fc.displaced:  # via the displaced wheel body's frame (wormsim.contact3d.flank_pose)
-        from wormsim.contact3d.flank_pose import tooth_shift_of, wheel_body_points
+    if fc.displaced:  # via the displaced wheel body's frame (wormsim.tooth.pose)
+        from wormsim.tooth.pose import tooth_shift_of, wheel_body_points
 
         adr = np.asarray(adr_all)
         ks = fc.meta[:n, 0][adr >= 0]

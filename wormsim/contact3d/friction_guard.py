@@ -27,6 +27,7 @@ import mujoco
 import numba
 
 from wormsim import gear_theory as gt
+from wormsim.contact3d.diagnosis import locked_error
 from wormsim.errors import SimulationError
 from wormsim.friction import friction_coefficient
 from wormsim.units import rad_s_to_rpm, rpm_to_rad_s
@@ -102,10 +103,8 @@ def friction_error(
     t: float, cos: float, fn: float, w1: float, w2: float, f_nominal: float, bm, scenario, hold_s: float = HOLD_S
 ) -> SimulationError:
     """Friction against the slip: where the wheel drives a pair that is self-locking at standstill, the drive is
-    locked (wormsim.contact3d.runner.locked_error's diagnosis, with what was measured); otherwise the load is
+    locked (wormsim.contact3d.diagnosis.locked_error's diagnosis, with what was measured); otherwise the load is
     beyond what the friction rows were sized for."""
-    from wormsim.contact3d.runner import locked_error
-
     geo = bm.geometry
     law = bm.law
     ratio = fn / f_nominal if f_nominal > 0 else math.inf

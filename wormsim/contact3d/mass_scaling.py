@@ -1,4 +1,4 @@
-"""Mass scaling for quasi-static contact3d runs (`simulation.mass_scaling`, issue 13).
+"""Mass scaling for quasi-static contact3d runs (`simulation.mass_scaling`).
 
 Explicit FE codes add inertia to quasi-static runs and check that the kinetic energy stays a small part of the work
 (Abaqus Analysis User's Guide 6.14, "Mass scaling" and "Quasi-static analysis": kinetic energy a small fraction,

@@ -33,22 +33,23 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from meshgen import assembly
+from meshgen import assembly, wheel
 from meshgen.cache import cached
 from meshgen.displaced import Deviations, wheel_mount, worm_mount
 from meshgen.geometry import GearGeometry
 from meshgen.kinematic_tca import KinematicTCA
 from meshgen.pieces import GearSet
 from wormsim import gear_theory as gt
-from wormsim.contact3d import mass_scaling
+from wormsim.contact3d import mass_scaling, shafts
 from wormsim.contact3d.backlash import check_backlash, check_conjugate_interference
 from wormsim.contact3d.law import ContactLaw, contact_law, friction_damping_n_s_per_m, friction_impratio
 from wormsim.contact3d.mass_scaling import ScalingCheck
 from wormsim.contact3d.timestep import choose_timestep
-from wormsim.contact3d.window import slot_quat, window_size, window_teeth_at
 from wormsim.friction import friction_coefficient
-from wormsim.geometry import derive, displaced_pair, gear_set
+from wormsim.geometry import derive, displaced_pair, gear_set, solid_set
 from wormsim.scenario import Scenario, ScenarioError
+from wormsim.tooth.grid import SLICES_MASS_SCALED, FlankGrid, default_slices, flank_grid
+from wormsim.tooth.window import slot_quat, window_size, window_teeth_at
 from wormsim.units import rpm_to_rad_s
 
 TEMPLATE = files("wormsim.models") / "worm_pair.xml"  # models/, shipped as package data
@@ -90,6 +91,7 @@ class BuiltModel:
     tooth_shift_rad: np.ndarray | None = None  # (z2,) pitch deviations f_k / r2 (errors:, meshgen.displaced)
     kinematic_tca: KinematicTCA | None = None  # of the displaced pair (errors: only)
     deviations: Deviations | None = None  # the errors: block in SI (None for the perfect pair)
+    plan: Prepared | None = None  # what the build was derived from (prepare), handed down to the run
 
 
 @dataclass(frozen=True)
@@ -107,7 +109,9 @@ class Inertias:
 
 @dataclass(frozen=True)
 class Prepared:
-    """What is known before the model is built: geometry, pieces, inertias and the contact law."""
+    """The run's plan, derived once from the scenario before the model is built and handed down: geometry, pieces,
+    inertias, the contact law, the flank grid, the drive and load commands and the working loads the law and the
+    guards are sized for (the timestep and the window follow in BuiltModel)."""
 
     geometry: GearGeometry
     pieces: GearSet
@@ -116,6 +120,12 @@ class Prepared:
     inv_mass_worm: float  # arm1^2 / (I1 + J1): the worm's share of A_hat
     inv_mass_wheel: float  # arm2^2 / (I2 + J2)
     scaling: ScalingCheck | None = None  # simulation.mass_scaling: the factor used and its checks (inertias x it)
+    normal_force_n: float = 0.0  # nominal_normal_force_n: the whole mesh's normal force at the working load
+    commands: gt.Commands | None = None  # the drive and load commands over time (gear_theory.commands)
+    grid: FlankGrid | None = None  # contact.geometry flanks: the flank grid of law.contacts_per_pair slices
+
+
+Plan = Prepared
 
 
 # ----------------------------------------------------------------------------- geometry helpers
@@ -198,14 +208,11 @@ def expected_direction(scenario: Scenario, geo: GearGeometry) -> int:
     return geo.hand
 
 
-def flank_slices(scenario: Scenario) -> int:
-    """contact.geometry flanks: slices across the face (contact.slices, else flanks.default_slices)."""
-    from meshgen.geometry import derive
-    from wormsim.contact3d.flanks import default_slices
-
+def flank_slices(scenario: Scenario, geo: GearGeometry | None = None) -> int:
+    """contact.geometry flanks: slices across the face (contact.slices, else wormsim.tooth.grid.default_slices)."""
     if scenario.contact.slices:
         return int(scenario.contact.slices)
-    return default_slices(derive(scenario.gear), scenario.simulation.resolution)
+    return default_slices(geo if geo is not None else derive(scenario.gear), scenario.simulation.resolution)
 
 
 def _slabs_per_flank(gs: GearSet) -> int:
@@ -217,12 +224,8 @@ def _slabs_per_flank(gs: GearSet) -> int:
     return len(set(zs))
 
 
-def _tooth0_angle(gs: GearSet) -> float:
-    """Angle of tooth 0's centre (mean of its pieces' centroids) in the wheel frame (cached: _on_gear_set)."""
-    return _on_gear_set(gs, "tooth0_angle", _pieces_angle, gs.wheel_tooth_pieces)
-
-
 def _pieces_angle(pieces) -> float:
+    """Angle of the pieces' mean centroid in the wheel frame (tests: tooth 0's pieces sit on wheel.tooth_angle)."""
     c = np.mean([p.centroid for p in pieces], axis=0)
     return math.atan2(c[1], c[0])
 
@@ -244,14 +247,15 @@ def prepare(scenario: Scenario, gs: GearSet | None = None) -> Prepared:
     everything the timestep and the model need, without compiling anything."""
     if scenario.gear is None or scenario.drive is None:
         raise ScenarioError("model: contact3d needs gear: and drive: blocks")
-    geo, gs = (derive(scenario.gear), gs) if gs is not None else gear_set(scenario)
+    flanks = scenario.contact.geometry == "flanks"  # the flank contacts need the solid meshes only, no pieces
+    geo, gs = (derive(scenario.gear), gs) if gs is not None else (solid_set if flanks else gear_set)(scenario)
     ine = shaft_inertias(scenario, geo, gs)
     arm1, arm2 = gt.mesh_arms_m(geo.r1, geo.r2, geo.alpha_n, geo.gamma)
     # driven-machine inertia J on the loaded shaft (joint armature) belongs to that shaft's effective mass
     I1 = ine.worm_inertia_kg_m2 + ine.worm_load_inertia_kg_m2
     I2 = ine.wheel_inertia_kg_m2 + ine.wheel_load_inertia_kg_m2
     # n_ref: the pieces across the face width, or with contact.geometry flanks the flank contacts' slices
-    slabs = flank_slices(scenario) if scenario.contact.geometry == "flanks" else max(1, _slabs_per_flank(gs))
+    slabs = flank_slices(scenario, geo) if scenario.contact.geometry == "flanks" else max(1, _slabs_per_flank(gs))
     # simulation.mass_scaling (wormsim.contact3d.mass_scaling): every inertia x S before the law takes them
     law1 = contact_law(scenario.contact, scenario.materials, geo.face_width, slabs, arm1**2 / I1 + arm2**2 / I2)
     scaling = mass_scaling.resolve(
@@ -267,18 +271,17 @@ def prepare(scenario: Scenario, gs: GearSet | None = None) -> Prepared:
         segments_per_turn=0 if scenario.contact.geometry == "flanks" else gs.resolution.worm_segments_per_turn or 0,
     )
     S = scaling.factor
-    if S != 1:
-        ine = Inertias(*(S * v for v in astuple(ine)))
-        if scenario.contact.geometry == "flanks" and not scenario.contact.slices:
-            from wormsim.contact3d.flanks import SLICES_MASS_SCALED
-
-            slabs = min(slabs, SLICES_MASS_SCALED)  # a scaled run keeps means only (flanks.SLICES_MASS_SCALED)
     a1, a2 = arm1**2 / (S * I1), arm2**2 / (S * I2)
-    law = contact_law(scenario.contact, scenario.materials, geo.face_width, slabs, a1 + a2)
+    law = law1
+    if S != 1:  # the law again with the scaled inertias
+        ine = Inertias(*(S * v for v in astuple(ine)))
+        if flanks and not scenario.contact.slices:
+            slabs = min(slabs, SLICES_MASS_SCALED)  # a scaled run keeps means only (tooth.grid.SLICES_MASS_SCALED)
+        law = contact_law(scenario.contact, scenario.materials, geo.face_width, slabs, a1 + a2)
     mu0 = float(friction_coefficient(scenario.contact, 0.0))
     mu_max = max(mu0, float(friction_coefficient(scenario.contact, 1.0)))
     f_n = nominal_normal_force_n(scenario, geo)
-    if scenario.contact.geometry == "flanks":  # the flank contacts' own friction-row damping, law (4)
+    if flanks:  # the flank contacts' own friction-row damping, law (4)
         law = replace(
             law,
             friction_damping_n_s_per_m=friction_damping_n_s_per_m(
@@ -286,7 +289,9 @@ def prepare(scenario: Scenario, gs: GearSet | None = None) -> Prepared:
             ),
         )
     law = replace(law, impratio=friction_impratio(law, mu_max, f_n, scenario.contact.transition_velocity_m_s))
-    return Prepared(geo, gs, ine, law, a1, a2, scaling)
+    grid = flank_grid(geo, law.contacts_per_pair) if flanks else None
+    cmds = gt.commands(scenario, expected_direction(scenario, geo))
+    return Prepared(geo, gs, ine, law, a1, a2, scaling, f_n, cmds, grid)
 
 
 # ----------------------------------------------------------------------------- build
@@ -320,13 +325,14 @@ def build_model(
         else (timestep_s, "given to build_model")
     )
 
-    pair = displaced_pair(scenario.errors, geo)  # errors: (issue 12), None for the perfect pair
+    pair = displaced_pair(scenario.errors, geo)  # the errors: block; None for the perfect pair
     dev, kin = pair if pair is not None else (None, None)
     shift = dev.tooth_angle_shift(geo, np.arange(geo.z2)) if dev is not None and any(dev.tooth_shift) else None
 
     spec = mujoco.MjSpec.from_file(str(TEMPLATE))
     spec.modelname = scenario.name
     _place_bodies(spec, geo, p.inertias, dev)
+    sups = shafts.mount(spec, scenario, geo) if scenario.shafts is not None else None  # bearings, bending
     worm_names, slot_names, W = _add_geoms(
         spec, geo, gs, law, float(friction_coefficient(scenario.contact, 0.0)), window_teeth, shift, flanks
     )
@@ -356,6 +362,8 @@ def build_model(
     meta["load_inertia_kg_m2"] = scenario.load.inertia_kg_m2
     meta["mass_scaling"] = p.scaling.factor
     meta["mass_scaling_check"] = p.scaling
+    if sups is not None:  # the shafts' joints (wormsim.contact3d.shafts): the kernel takes the poses from the data
+        meta.update(shafts.model_meta(model, sups, p.normal_force_n, geo, h))
     meta["shaft_inertias_kg_m2"] = (
         ine.worm_inertia_kg_m2 + ine.worm_load_inertia_kg_m2,
         ine.wheel_inertia_kg_m2 + ine.wheel_load_inertia_kg_m2,
@@ -384,7 +392,7 @@ def build_model(
         wheel_slot_geoms=slot_geoms,
         slot_bodies=slot_bodies,
         window_teeth=W,
-        tooth0_angle_rad=_tooth0_angle(gs),
+        tooth0_angle_rad=wheel.tooth_angle(geo, 0),
         direction=expected_direction(scenario, geo),
         drive_sign=drive_sign,
         pieces=gs,
@@ -394,11 +402,12 @@ def build_model(
         tooth_shift_rad=shift,
         kinematic_tca=kin,
         deviations=dev,
+        plan=p,
     )
     if check_backlash_vs_pieces:
         # the model itself at the rigid-conjugate pose (wormsim.contact3d.backlash.check_conjugate_interference): exit 2
         meta["conjugate_interference_m"] = check_conjugate_interference(
-            bm, scenario.simulation.resolution, nominal_normal_force_n(scenario, geo)
+            bm, scenario.simulation.resolution, p.normal_force_n
         )
     return bm
 
@@ -429,7 +438,7 @@ def _place_bodies(spec: mujoco.MjSpec, geo: GearGeometry, ine: Inertias, dev: De
 
 
 def _place_displaced(spec: mujoco.MjSpec, geo: GearGeometry, dev: Deviations) -> None:
-    """Assembly errors (issue 12): move and tilt the bodies and put each hinge on its axis of rotation, off the part's
+    """Assembly errors: move and tilt the bodies and put each hinge on its axis of rotation, off the part's
     own axis by the runout, as meshgen.displaced (1), (2) gives them: body -> assembly = M Rz(theta) E, i.e. the body
     at M E and the hinge at E^-1's origin in the body frame."""
     for part, (M, E) in (("worm", worm_mount(geo, dev)), ("wheel", wheel_mount(geo, dev))):
@@ -487,12 +496,12 @@ def _add_geoms(
         g.name = g.meshname = f"worm_piece_{i}"
         set_contact(g)
         worm_names.append(g.name)
-    for j, piece in enumerate(gs.wheel_tooth_pieces):
+    for j, piece in enumerate([] if flanks else gs.wheel_tooth_pieces):
         _add_mesh(spec, f"tooth_piece_{j}", piece)
     W = window_size(geo) if window_teeth is None else int(min(max(window_teeth, 1), geo.z2))
     n_pieces = 0 if flanks else len(gs.wheel_tooth_pieces)
     slot_names = [[""] * n_pieces for _ in range(W)]
-    for k in window_teeth_at(0.0, geo.z2, W, _tooth0_angle(gs)):
+    for k in window_teeth_at(0.0, geo.z2, W, wheel.tooth_angle(geo, 0)):
         s = int(k % W)
         sb = wheel_b.add_body()
         sb.name = f"slot{s}"

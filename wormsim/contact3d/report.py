@@ -9,8 +9,8 @@ recording.rrd (wormsim.recording layout): /series/* time series on the sim_time 
 wheel meshes under /assembly/worm and /assembly/wheel moved by their 4x4 transforms; contact points
 (/assembly/contacts/points) and force arrows on the wheel (/assembly/contacts/forces, 1 mm per
 `ARROW_N_PER_MM` newtons) at up to MAX_FRAMES instants. With exact flanks: the steady-window contact
-pattern on every wheel tooth, coloured by pressure (/assembly/wheel/contact_pattern, flank_outputs.log_pattern),
-and in report.png the pattern as a band on the wheel flank coloured by pressure (flank_outputs.draw_pattern).
+pattern on every wheel tooth, coloured by pressure (/assembly/wheel/contact_pattern, wormsim.tooth.hertz.log_pattern),
+and in report.png the pattern as a band on the wheel flank coloured by pressure (wormsim.tooth.hertz.draw_pattern).
 """
 
 from __future__ import annotations
@@ -140,8 +140,8 @@ def write_report(result: Result, path) -> None:
     a = ax[1, 1]
     P = result.extra.get("points_tooth0")
     F = result.extra.get("forces_world")
-    if "flank_pattern" in result.extra:  # exact flanks: the loaded band coloured by pressure (flank_outputs)
-        from wormsim.contact3d.flank_outputs import draw_pattern
+    if "flank_pattern" in result.extra:  # exact flanks: the loaded band coloured by pressure (wormsim.tooth.hertz)
+        from wormsim.tooth.hertz import draw_pattern
 
         draw_pattern(a, fig, result.extra["flank_pattern"], result.extra["built"].geometry, s)
     elif P is not None and sl.any():
@@ -151,7 +151,7 @@ def write_report(result: Result, path) -> None:
         r = np.hypot(p[ok, 0], p[ok, 1]) * 1e3
         sc = a.scatter(p[ok, 2] * 1e3, r, c=f[ok], s=3, cmap="viridis")
         fig.colorbar(sc, ax=a, label="contact force [N]")
-        from wormsim.contact3d.flank_outputs import draw_tooth_outline
+        from wormsim.tooth.hertz import draw_tooth_outline
 
         draw_tooth_outline(a, geo)
         a.set_xlim(-0.6 * geo.face_width * 1e3, 1.15 * geo.face_width * 1e3)
@@ -185,7 +185,7 @@ def write_recording(result: Result, path) -> None:
         log_transforms(rec, "assembly/worm", t[idx], Tw)
         log_transforms(rec, "assembly/wheel", t[idx], Tg)
         if "flank_pattern" in result.extra:  # exact flanks: the loaded pattern on the wheel, coloured by pressure
-            from wormsim.contact3d.flank_outputs import log_pattern
+            from wormsim.tooth.hertz import log_pattern
 
             log_pattern(rec, "assembly/wheel/contact_pattern", result.extra["flank_pattern"], geo)
         P, F = result.extra["points_world"], result.extra["forces_world"]

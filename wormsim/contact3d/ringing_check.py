@@ -1,4 +1,4 @@
-"""Ringing above the contact's stable limit: a run that oscillates to its end with no other guard firing (issue 13).
+"""Ringing above the contact's stable limit: a run that oscillates to its end with no other guard firing.
 
 Above ContactLaw.stable_limit_s the explicit contact spring-damper can ring at the step frequency without running
 away: the state stays finite, the transmission error stays within half a pitch, the penetration within 0.4 m_x, and

@@ -1,30 +1,19 @@
 """contact3d runner: steps the MuJoCo model of wormsim.contact3d.mjcf, reads the tooth forces, guards the run.
 
-`simulate(scenario, progress) -> Result` (the interface of wormsim.run). The loop steps the model one step at a
-time (the drive and load commands follow their STEP ramps at each step's midpoint) and, at every step, adds up
-the model's contact sensor (worm against the wheel's subtree, reduce="netforce": the resultant tooth force on the
-wheel, its point and moment) and the shaft powers T w. Every `record_every` steps it stores one sample whose
-forces, moment, contact count, torques and powers are the MEANS over those steps (a box-car filter: the contact
-vibration at 10-80 kHz does not alias into the meshing band, and the box's nulls at multiples of the sampling
-rate cancel exactly what would fold onto 0 Hz), and whose angles and speeds are the values at its end. Then it
+`simulate(scenario, progress) -> Result` (the interface of wormsim.run). `run_model` makes the guards
+(wormsim.contact3d.guards), the contact source (wormsim.contact3d.sources: the exact flanks or the convex pieces,
+behind one interface) and the series array (wormsim.contact3d.series), then `_loop` runs the record intervals:
+each interval's steps (the drive and load commands at each step's midpoint; the source sums the actuator torques,
+the shaft powers T w and the contact sensor's resultant on the wheel over the steps), then per sample the state,
+the guards' checks, mu(Vs) at the sliding speed Vs = |omega1| r1 / cos(gamma) (wormsim.contact3d.friction_law), the
+source's contact outputs (teeth touching, largest penetration, contact points in tooth 0's frame, the radial force on
+the line of centres and the contact radius) and one series column: forces, moment, contact count, torques and powers
+are the MEANS over the interval (a box-car: the 10-80 kHz contact vibration does not alias into the meshing band),
+angles and speeds the values at its end. A flank source with compiled samples (wormsim.contact3d.flank_samples) runs
+whole stretches of samples in one call and hands back the samples whose guards act or whose services are due.
 
-- re-poses the wheel's collision window by whole pitches (wormsim.contact3d.window.repose_window),
-- sets the friction coefficient mu(Vs) from the sliding speed Vs = |omega1| r1 / cos(gamma),
-- resolves the mean resultant on the wheel in the wheel's directions at the pitch point on the line of centres
-  (DIN 3975 F_t2, F_r2, F_a2; seed 001's x/y components): tangential, radial (outward), axial; the contact
-  torque M_z apart (wheel_contact_torque_nm); and takes, at the sample instant, the number of wheel teeth
-  touching, the largest penetration and the contact points in the frame of wheel tooth 0 (for the contact
-  pattern), from the contacts' elliptic-cone rows (what mj_contactForce returns, contact_details),
-- checks the guards: non-finite state or MuJoCo's bad-qacc warning (divergence), penetration beyond
-  `penetration_limit_m`, the transmission error passing half a pitch (teeth jumped; divergence when the
-  timestep is above the contact's stable limit), a speed-driven drive stuck below half its command (locked;
-  self-locking named when the wheel drives), the worm turning more than 1.25 x MAX_WORM_TURN_PER_STEP_RAD per
-  step (overspeed: its pieces would tunnel through the wheel's), the sliding contacts' friction turned away from
-  their slip (wormsim.contact3d.friction_guard); after the loop, above the stable limit, an exact-flank mesh that rang
-  to the end (wormsim.contact3d.ringing_check). Each raises its subclass of SimulationError
-  (wormsim.errors) with what to change (diverged_error, jump_error, locked_error, overspeed_error, penetration_error;
-  docs/contact3d.md "Failure modes and guards").
-
+After the loop: the summary (wormsim.contact3d.metrics), the source's own keys (the flanks' contact pattern and
+pressure), the mass-scaling check and, above the stable limit, the ringing check (wormsim.contact3d.ringing_check).
 The timestep is the model's, chosen before it was built (wormsim.contact3d.timestep.choose_timestep).
 """
 
@@ -40,34 +29,23 @@ from wormsim import gear_theory as gt
 from wormsim import prewarm
 from wormsim.contact3d import jit_warmup, mass_scaling
 from wormsim.contact3d.contact_sums import RadiusLog
+from wormsim.contact3d.diagnosis import diverged_error
+from wormsim.contact3d.friction_law import mu_of, mu_params
+from wormsim.contact3d.guards import Guards
 from wormsim.contact3d.metrics import contact3d_summary
 from wormsim.contact3d.mjcf import BuiltModel, build_model
 from wormsim.contact3d.ringing_check import ringing
-from wormsim.contact3d.timestep import (
-    MAX_WORM_TURN_PER_STEP_RAD,
-    OVERSPEED_GUARD,
-    default_timestep,
-    speed_timestep_limit_s,
-)
-from wormsim.contact3d.window import repose_window
-from wormsim.errors import (
-    DivergedError,
-    LockedError,
-    OverspeedError,
-    PenetrationError,
-    SimulationError,
-    TeethJumpedError,
-)
-from wormsim.friction import friction_coefficient, friction_coefficient_scalar, friction_mode
+from wormsim.contact3d.series import SERIES, column
+from wormsim.contact3d.shafts import ShaftLog
+from wormsim.contact3d.sources import FlankSource, PieceSource
+from wormsim.friction import friction_mode
 from wormsim.result import Result
 from wormsim.scenario import Scenario
-from wormsim.units import rad_s_to_rpm
+from wormsim.units import RPM
 
 MAX_POINTS = 48  # contact points kept per sample (for the pattern and the recording)
 TARGET_SAMPLES = 20000  # automatic record_every aims at about this many samples per run (each the mean
 # over its interval, so decimation does not alias the contact vibration)
-_ROWS3 = np.arange(3)  # the normal and two tangent rows of an elliptic-cone contact
-JUMP_PITCH = 0.5  # transmission error (in pitches) that counts as teeth jumping
 
 
 def _record_every(scenario: Scenario, dt: float, n_steps: int, scaled: bool = False) -> int:
@@ -77,285 +55,67 @@ def _record_every(scenario: Scenario, dt: float, n_steps: int, scaled: bool = Fa
     return max(1, n_steps // (mass_scaling.SCALED_SAMPLES if scaled else TARGET_SAMPLES))
 
 
-def contact_details(bm: BuiltModel, d: mujoco.MjData, window_ks: np.ndarray):
-    """The contacts one by one (the resultant comes from the contact sensor): (n_teeth touching, max penetration,
-    points in the frame of wheel tooth 0 (n, 3), forces on the wheel (n, 3) world, points (n, 3) world). Forces are
-    the elliptic-cone rows (normal, two tangents: what mj_contactForce returns) turned into the world frame."""
-    n = d.ncon
-    if n == 0:
-        z = np.zeros((0, 3))
-        return 0, 0.0, z, z, z
-    con = d.contact
-    adr = np.asarray(con.efc_address[:n])
-    ok = adr >= 0
-    geom = np.asarray(con.geom[:n])[ok]
-    adr = adr[ok]
-    frame = np.asarray(con.frame[:n])[ok].reshape(-1, 3, 3)
-    pos = np.asarray(con.pos[:n])[ok]
-    dist = np.asarray(con.dist[:n])[ok]
-    f = d.efc_force[adr[:, None] + _ROWS3]
-    F = np.einsum("ni,nij->nj", f, frame)  # force on geom2, world frame
-    wheel_is_2 = bm.model.geom_bodyid[geom[:, 1]] != bm.worm_body
-    F = np.where(wheel_is_2[:, None], F, -F)  # force on the wheel
-    wheel_geom = np.where(wheel_is_2, geom[:, 1], geom[:, 0])
-    # tooth index of each contact: slot -> tooth in the current window
-    W = bm.window_teeth
-    slots = _slot_lookup(bm)[wheel_geom]
-    tooth_of_slot = np.zeros(W, dtype=int)
-    tooth_of_slot[np.asarray(window_ks) % W] = window_ks
-    ks = tooth_of_slot[slots]
-    # contact points in tooth-0 frame: undo wheel rotation and tooth angle
-    th2 = float(d.qpos[bm.model.jnt_qposadr[bm.model.dof_jntid[bm.wheel_dof]]])
-    ang = -(th2 + 2 * math.pi * ks / bm.geometry.z2)
-    c, s = np.cos(ang), np.sin(ang)
-    p0 = np.stack([c * pos[:, 0] - s * pos[:, 1], s * pos[:, 0] + c * pos[:, 1], pos[:, 2]], axis=1)
-    pen = float(max(0.0, -dist.min())) if len(dist) else 0.0
-    return int(np.unique(ks).size), pen, p0, F, pos
-
-
-def diverged_error(t: float, dt: float, bm: BuiltModel, what: str) -> SimulationError:
-    """Divergence diagnosis. Above the explicit stability limit of the contact spring-damper with three pairs in
-    parallel (ContactLaw.stable_timestep_s: h < 2/omega (sqrt(1 + zeta^2) - zeta)) the cure is the timestep: the
-    message names the limit and wormsim's default (wormsim.contact3d.timestep.default_timestep, 0.4 x the limit
-    rounded down to 1-2-5). Within the limit the blow-up comes from a command step the light shafts cannot follow."""
-    lim = bm.law.stable_limit_s
-    h0 = default_timestep(bm.law)
-    if dt > lim:
-        return DivergedError(
-            f"diverged at t = {t:.4g} s ({what}): timestep {dt:.3g} s is above the contact's stable limit "
-            f"{lim:.3g} s (contact stiffness {bm.law.pair_stiffness_n_per_m:.3g} N/m per tooth pair); set "
-            f"simulation.timestep_s <= {h0:.3g} s (the default for this contact: leave it unset) or lower "
-            f"contact.stiffness_n_per_m"
-        )
-    return DivergedError(
-        f"diverged at t = {t:.4g} s ({what}) at timestep {dt:.3g} s, within the contact's stable limit {lim:.3g} s: "
-        f"a torque or speed step the light shafts cannot follow; lengthen drive.ramp_s / load.ramp_s, lower "
-        f"load.torque_nm"
-    )
-
-
-def jump_error(t: float, te_pitch: float, dt: float, bm: BuiltModel, scenario: Scenario) -> SimulationError:
-    """Transmission error beyond half a pitch. Above the stable timestep this is the integration running away
-    (reported as divergence: a stiffer contact would make it worse); within it the teeth really passed each
-    other: the load overpowers the mesh. With contact.geometry flanks (the working flanks only: no tips, edges or
-    roots) the jump itself is not modelled, and the message says so."""
-    lim = bm.law.stable_limit_s
-    if dt > lim:
-        return diverged_error(t, dt, bm, f"the transmission error ran away to {te_pitch:.2f} pitch")
-    flanks_note = (
-        "; contact.geometry flanks models the working flanks only (no tips or edges), so the jump itself is not "
-        "simulated: contact.geometry pieces models it"
-        if bm.meta.get("contact_geometry") == "flanks"
-        else ""
-    )
-    return TeethJumpedError(
-        f"teeth jumped a pitch at t = {t:.4g} s (transmission error {te_pitch:.2f} pitch) at timestep {dt:.3g} s, "
-        f"within the contact's stable limit {lim:.3g} s: the load overpowers the mesh (load {scenario.load.torque_nm} "
-        f"N m over {scenario.load.ramp_s} s, contact stiffness {bm.law.pair_stiffness_n_per_m:.3g} N/m per tooth "
-        f"pair); lower load.torque_nm or lengthen load.ramp_s, or raise contact.stiffness_n_per_m (with a smaller "
-        f"simulation.timestep_s){flanks_note}"
-    )
-
-
-def overspeed_error(t: float, w1: float, dt: float) -> SimulationError:
-    """The worm turns more than OVERSPEED_GUARD x MAX_WORM_TURN_PER_STEP_RAD per step (a torque drive running away,
-    or a timestep set past the speed check): its pieces would pass through the wheel's between steps."""
-    lim = speed_timestep_limit_s(abs(w1))
-    return OverspeedError(
-        f"worm overspeed at t = {t:.4g} s: the worm turns {rad_s_to_rpm(abs(w1)):.0f} rpm, {abs(w1) * dt:.3g} rad per "
-        f"step of {dt:.3g} s, beyond the {MAX_WORM_TURN_PER_STEP_RAD} rad contact3d resolves (the thread passes "
-        f"through the wheel's teeth between steps); set simulation.timestep_s <= {lim:.3g} s (or leave it unset for "
-        f"a speed-driven worm), or lower the drive (drive.speed_rpm / drive.torque_nm); simulation.speculative does "
-        f"not prevent it (measured: it tunnels sooner, docs/stability_speed.md)"
-    )
-
-
-def locked_error(t: float, w_drive: float, w_cmd: float, bm: BuiltModel, scenario: Scenario) -> SimulationError:
-    """A speed-driven drive held below half its command. When the wheel drives and the pair is self-locking at
-    standstill, rho' = atan(mu_static / cos alpha_n) >= gamma (DIN 3975: back-driving efficiency
-    tan(gamma - rho') / tan(gamma) <= 0), the diagnosis says so; otherwise the mesh is jammed."""
-    geo = bm.geometry
-    head = (
-        f"the drive locked at t = {t:.4g} s: the {scenario.drive.on} turns at {rad_s_to_rpm(w_drive):.3g} rpm "
-        f"against a command of {rad_s_to_rpm(w_cmd):.3g} rpm"
-    )
-    mu0 = float(friction_coefficient(scenario.contact, 0.0))
-    rho = gt.virtual_friction_angle_rad(mu0, geo.alpha_n)
-    if scenario.drive.on == "wheel" and rho >= geo.gamma:
-        mu_max = math.tan(geo.gamma) * math.cos(geo.alpha_n)
-        return LockedError(
-            f"{head}: the pair is self-locking (rho' = atan(mu / cos alpha_n) = {math.degrees(rho):.2f} deg at "
-            f"standstill friction mu = {mu0:.3g} >= lead angle gamma = {math.degrees(geo.gamma):.2f} deg), so the "
-            f"wheel cannot turn the worm; drive the worm (drive.on=worm, load.on=wheel), or, to back-drive, lower "
-            f"the friction below mu = tan(gamma) cos(alpha_n) = {mu_max:.3g} or raise gear.lead_angle_deg above "
-            f"{math.degrees(rho):.2f} deg"
-        )
-    return LockedError(
-        f"{head}: the mesh is jammed; check gear.backlash_mm, the load torque {scenario.load.torque_nm} N m "
-        f"against what the drive can deliver, and the friction"
-    )
-
-
-def penetration_error(t: float, pen: float, pen_lim: float, dt: float, bm: BuiltModel) -> SimulationError:
-    """Penetration beyond gear_theory.penetration_limit_m (0.4 m_x): the teeth are about to skip."""
-    return PenetrationError(
-        f"penetration {pen * 1e6:.1f} um at t = {t:.4g} s exceeds the tolerance {pen_lim * 1e6:.1f} um "
-        f"(0.4 m_x): contact too soft for the load or timestep {dt:.3g} s too large (stable limit "
-        f"~{bm.law.stable_limit_s:.2g} s); raise contact.stiffness_n_per_m, lower simulation.timestep_s or lower "
-        f"load.torque_nm"
-    )
-
-
-_SLOT_CACHE: dict[int, np.ndarray] = {}
-
-
-def _slot_lookup(bm: BuiltModel) -> np.ndarray:
-    key = id(bm)
-    if key not in _SLOT_CACHE:
-        lut = np.full(bm.model.ngeom, -1, dtype=int)
-        for s, row in enumerate(bm.wheel_slot_geoms):
-            lut[row] = s
-        _SLOT_CACHE.clear()
-        _SLOT_CACHE[key] = lut
-    return _SLOT_CACHE[key]
-
-
-SERIES = (
-    "t_s",
-    "worm_angle_rad",
-    "wheel_angle_rad",
-    "worm_speed_rpm",
-    "wheel_speed_rpm",
-    "worm_torque_nm",
-    "wheel_torque_nm",
-    "drive_command",
-    "tangential_force_n",
-    "radial_force_n",
-    "axial_force_n",
-    "contacts",
-    "teeth_in_contact",
-    "max_penetration_m",
-    "friction_coefficient",
-    "transmission_error_rad",
-    "wheel_contact_torque_nm",
-    "worm_power_w",
-    "wheel_power_w",
-    "tangential_force_abs_max_n",
-    "radial_force_line_of_centres_n",
-    "worm_contact_radius_m",
-    "efficiency_theory_at_contact_radius",
-)
-
-
-class _Guards:
-    """The checks after every record interval (module docstring); each raises its SimulationError subclass."""
-
-    def __init__(self, bm: BuiltModel, scenario: Scenario, dt: float, rec: int):
-        self.bm, self.scenario, self.dt = bm, scenario, dt
-        geo = bm.geometry
-        self.pen_lim = gt.penetration_limit_m(geo.m_x)
-        self.pitch_angle = 2 * math.pi / geo.z2
-        self.lock_start = gt.lock_check_start_s(scenario)
-        self.lock_hold = max(gt.LOCK_HOLD_S, 20 * rec * dt)
-        self.speed_driven = scenario.drive.speed_rpm is not None
-        self.locked_since: float | None = None
-        self.turn_max = 0.0
-        # sliding contacts' friction against their slip (wormsim.contact3d.friction_guard)
-        from wormsim.contact3d.friction_guard import FrictionGuard
-        from wormsim.contact3d.mjcf import nominal_normal_force_n
-
-        self.friction = FrictionGuard(scenario, bm, nominal_normal_force_n(scenario, geo), rec * dt)
-
-    def state(self, d: mujoco.MjData, t: float, th1: float, th2: float, w1: float, w2: float) -> float:
-        """Divergence, overspeed, teeth jumped, friction against the slip; returns the transmission error (rad)."""
-        bm, dt = self.bm, self.dt
-        if not math.isfinite(th1 + th2 + w1 + w2) or d.warning[mujoco.mjtWarning.mjWARN_BADQACC].number:
-            raise diverged_error(t, dt, bm, "non-finite state or huge acceleration (MuJoCo's bad-qacc warning)")
-        turn = abs(w1) * dt
-        self.turn_max = max(self.turn_max, turn)
-        if turn > OVERSPEED_GUARD * MAX_WORM_TURN_PER_STEP_RAD:
-            if dt > bm.law.stable_limit_s:
-                raise diverged_error(t, dt, bm, f"the worm ran away to {rad_s_to_rpm(abs(w1)):.0f} rpm")
-            raise overspeed_error(t, w1, dt)
-        te = th2 - bm.direction * th1 / bm.geometry.ratio
-        if abs(te) > JUMP_PITCH * self.pitch_angle:
-            raise jump_error(t, te / self.pitch_angle, dt, bm, self.scenario)
-        self.friction.check(d, t, w1, w2)
-        return te
-
-    def contact(self, t: float, pen: float, w_drive: float, cmd: float) -> None:
-        """Penetration beyond the limit; a speed-driven drive stuck below half its command (locked)."""
-        if pen > self.pen_lim:
-            raise penetration_error(t, pen, self.pen_lim, self.dt, self.bm)
-        if self.speed_driven and t > self.lock_start:
-            if gt.drive_stuck(w_drive, cmd):
-                self.locked_since = t if self.locked_since is None else self.locked_since
-                if t - self.locked_since > self.lock_hold:
-                    raise locked_error(t, w_drive, cmd, self.bm, self.scenario)
-            else:
-                self.locked_since = None
-
-
 def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
     """Step the built model over simulation.duration_s at its timestep; sample, guard, summarise (module docstring)."""
     m = bm.model
     d = mujoco.MjData(m)
-    geo = bm.geometry
     dt = bm.timestep_s
     n_steps = int(round(scenario.simulation.duration_s / dt))
     rec = _record_every(scenario, dt, n_steps, bm.meta.get("mass_scaling", 1) > 1)
     n_rec = n_steps // rec
-    qa_worm = int(m.jnt_qposadr[m.dof_jntid[bm.worm_dof]])
-    qa_wheel = int(m.jnt_qposadr[m.dof_jntid[bm.wheel_dof]])
-    coll = np.concatenate([bm.worm_geoms, bm.wheel_slot_geoms.ravel()])
-    guards = _Guards(bm, scenario, dt, rec)
-
+    guards = Guards(bm, scenario, dt, rec)
     S_all = np.zeros((len(SERIES), n_rec))  # one column per sample, written at once
     S = dict(zip(SERIES, S_all))
-    pts = np.full((n_rec, MAX_POINTS, 3), np.nan, dtype=np.float32)
-    pts_world = np.full((n_rec, MAX_POINTS, 3), np.nan, dtype=np.float32)
-    forces = np.full((n_rec, MAX_POINTS, 3), np.nan, dtype=np.float32)
-    store = (pts, forces, pts_world)
+    store = tuple(np.full((n_rec, MAX_POINTS, 3), np.nan, dtype=np.float32) for _ in range(3))  # p0, F, world p
     rlog = RadiusLog()  # the contacts' radii and weights: the efficiency at the contact radius (contact_sums)
-
-    fc = pattern = loop = None
-    if bm.meta.get("contact_geometry") == "flanks":
-        # contacts found on the exact flanks and added between collision and constraints (wormsim.contact3d.flank_step)
-        from wormsim.contact3d.flank_outputs import PatternLog
-        from wormsim.contact3d.flank_step import FlankContacts, flank_contact_details, split_forward
-
-        fc = FlankContacts(bm, bm.law.contacts_per_pair)
-        pattern = PatternLog(fc, gt.effective_modulus_pa(scenario.materials))  # contact pattern and stress
-        split_forward(m, d, fc.add)
-        window = None
-        step_fn = fc.step
-    else:
-        window = repose_window(bm, 0.0)
-        mujoco.mj_forward(m, d)
-        step_fn = mujoco.mj_step
-    t_wall = time.perf_counter()
     worm_is_drive = scenario.drive.on == "worm"
-    sd, act, qv, qp, ctrl = d.sensordata, d.actuator_force, d.qvel, d.qpos, d.ctrl
     s0 = int(m.sensor_adr[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SENSOR, "mesh_force")])
-    ia_drv, ia_load, dof1, dof2 = bm.drive_actuator, bm.load_actuator, bm.worm_dof, bm.wheel_dof
-    # worm / wheel actuator on each shaft: (drive, load) or (load, drive)
-    a1, a2 = (ia_drv, ia_load) if worm_is_drive else (ia_load, ia_drv)
-    mu_of = friction_coefficient_scalar(scenario.contact)
-    mu_set = None
-    if fc is not None:  # the record interval's steps compiled (wormsim.contact3d.flank_loop)
-        from wormsim.contact3d.flank_loop import FlankLoop
-
-        loop = FlankLoop(fc, d, ia_drv, ia_load, a1, a2, s0)
-    # the commands at each step's midpoint, evaluated for blocks of about 4096 steps at once
-    cmds = gt.commands(scenario, bm.direction)
-    block = max(1, 4096 // rec)
-    fast = None
-    if loop is not None:  # whole stretches of samples in one compiled call (wormsim.contact3d.flank_samples)
-        from wormsim.contact3d.flank_samples import FlankSamples
-
-        fast = FlankSamples(loop, guards, scenario, bm, worm_is_drive, rec, S_all)
-        fast.bind(store)
+    ia_drv, ia_load = bm.drive_actuator, bm.load_actuator
+    a1, a2 = (ia_drv, ia_load) if worm_is_drive else (ia_load, ia_drv)  # the worm's and the wheel's actuator
+    io = (ia_drv, ia_load, a1, a2, s0)
+    flanks = bm.meta.get("contact_geometry") == "flanks"
+    src = FlankSource(bm, d, io, scenario, guards, rec, S_all, store) if flanks else PieceSource(bm, d, io)
+    slog = ShaftLog(m, bm.meta["shafts"], n_rec) if "shafts" in bm.meta else None  # wormsim.contact3d.shafts
+    t_wall = time.perf_counter()
     prewarm.loop_started()  # the writers' warm-up thread goes now, beside the GIL-free loop (wormsim.prewarm)
+    _loop(src, bm, scenario, d, guards, S_all, rlog, store, rec, progress, slog)
+    force_signs(S, bm.geometry.hand)  # into docs/outputs.md's convention
+    S["efficiency_theory_at_contact_radius"][:] = rlog.efficiency(S["friction_coefficient"], bm.geometry, worm_is_drive)
+    wall = time.perf_counter() - t_wall
+    summary = _run_summary(
+        S, scenario, bm, rec, guards.turn_max, len(src.coll), 1e6 * wall / max(n_rec * rec, 1), flanks=flanks
+    )
+    extra = {"points_tooth0": store[0], "points_world": store[2], "forces_world": store[1], "built": bm}
+    src.finish(S, summary, extra)
+    if slog is not None:  # the shafts' deflections and bearing forces
+        S.update(slog.series())
+        summary.update(slog.summary(S["t_s"], summary["steady_window_s"]))
+    summary.update(mass_scaling.run_summary(S, scenario, bm.meta, summary))  # and the ringing guard (exit 3)
+    rang = ringing(S, summary, dt, bm.law.stable_limit_s) if flanks else None  # flanks (ringing_check)
+    if rang is not None:
+        raise diverged_error(rang[0], dt, bm, rang[1])
+    if bm.kinematic_tca is not None:  # errors: the displaced exact flanks' kinematic TE and play
+        kin = bm.kinematic_tca.summary(bm.geometry, gt.working_flank(scenario, bm.geometry.hand))
+        summary.update({k: v for k, v in kin.items() if not k.startswith("contact_pattern")})
+    return Result(
+        model="contact3d", summary=summary, series=S, steps=n_rec * rec, sim_time_s=float(d.time), extra=extra
+    )
+
+
+def _loop(src, bm: BuiltModel, scenario: Scenario, d, guards, S_all, rlog, store, rec: int, progress, slog) -> None:
+    """The samples: each record interval's steps (the compiled stretch of samples where the source has one), then
+    the state, the guards, mu(Vs), the source's contact outputs, the shafts' log (slog, None without `shafts:`) and
+    the series column."""
+    m, geo, dt = bm.model, bm.geometry, bm.timestep_s
+    n_rec = S_all.shape[1]
+    qa_worm = int(m.jnt_qposadr[m.dof_jntid[bm.worm_dof]])
+    qa_wheel = int(m.jnt_qposadr[m.dof_jntid[bm.wheel_dof]])
+    qp, qv = d.qpos, d.qvel
+    worm_is_drive = scenario.drive.on == "worm"
+    mu_p = mu_params(scenario.contact)
+    cmds = bm.plan.commands  # the commands at each step's midpoint, for blocks of about 4096 steps at once
+    block = max(1, 4096 // rec)
+    fast = src.fast
     i = 0
     while i < n_rec:
         if i % block == 0:
@@ -363,116 +123,44 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
             cmd_arr, load_arr = cmds.drive(t_blk), cmds.load(t_blk)
             cmd_blk, load_blk = cmd_arr.tolist(), load_arr.tolist()
         o = (i % block) * rec
-        fx = fy = fz = mz = nc = t1 = t2 = p1 = p2 = fpk = 0.0
         if fast is not None and fast.usable():
-            i_next, pending = fast.run(cmd_arr, load_arr, i, min(n_rec, i - i % block + block), o, pattern, rlog)
+            i_next, pending = fast.run(cmd_arr, load_arr, i, min(n_rec, i - i % block + block), o, src.pattern, rlog)
             if progress is not None and i_next > i:
                 progress.update(float(S_all[0, i_next - 1]))
             i = i_next
             if not pending:  # samples done up to i_next (the block's end)
                 continue
             o = (i % block) * rec  # sample i's steps are done; its per-sample work follows in Python
-            t1, t2, p1, p2, nc, fx, fy, fz, mz, fpk = loop.acc.tolist()
-        elif loop is not None:
-            t1, t2, p1, p2, nc, fx, fy, fz, mz, fpk = loop.run(cmd_arr, load_arr, o, o + rec).tolist()
-        for j in range(o, o + rec) if loop is None else ():
-            ctrl[ia_drv] = cmd_blk[j]
-            ctrl[ia_load] = load_blk[j]
-            w1j, w2j = qv[dof1], qv[dof2]
-            step_fn(m, d)
-            # actuator forces of this step (computed at its start, with the speeds above) and the sensor's
-            # resultant (found, F (3), torque about the point (3), point (3); global frame, on the wheel)
-            q1, q2 = act[a1], act[a2]
-            t1 += q1
-            t2 += q2
-            p1 += q1 * w1j
-            p2 += q2 * w2j
-            nc += sd[s0]
-            f0, f1, f2 = sd[s0 + 1], sd[s0 + 2], sd[s0 + 3]
-            fx += f0
-            if abs(f0) > fpk:  # the per-step peak (the start-up impact is shorter than an interval)
-                fpk = abs(f0)
-            fy += f1
-            fz += f2
-            mz += sd[s0 + 6] + sd[s0 + 7] * f1 - sd[s0 + 8] * f0
+            sums = tuple(src.loop.acc.tolist())
+        elif fast is not None:
+            sums = src.steps(cmd_arr, load_arr, o, rec)
+        else:
+            sums = src.steps(cmd_blk, load_blk, o, rec)
         cmd = cmd_blk[o + rec - 1]
         th1, th2 = float(qp[qa_worm]), float(qp[qa_wheel])
-        w1, w2 = float(qv[dof1]), float(qv[dof2])
+        w1, w2 = float(qv[bm.worm_dof]), float(qv[bm.wheel_dof])
         t = float(d.time)
         te = guards.state(d, t, th1, th2, w1, w2)
-        vs = abs(w1) * geo.r1 / math.cos(geo.gamma)
-        mu = mu_of(vs)
+        mu = mu_of(abs(w1) * geo.r1 / math.cos(geo.gamma), mu_p)  # at the sliding speed Vs
         # each contact's force turned about the worm axis onto the line of centres: the radial force DIN 3975's
         # single pitch-point contact means; the force-weighted contact radius and efficiency there (contact_sums)
-        if fc is None or fc.displaced:
-            if fc is None:
-                window = repose_window(bm, th2, window)
-                if mu != mu_set:
-                    m.geom_friction[coll, 0] = mu_set = mu
-                nteeth, pen, p0, F, pw = contact_details(bm, d, window)
-            else:
-                fc.set_friction(mu)
-                nteeth, pen, p0, F, pw = flank_contact_details(fc, d)
-                pattern.record(i, d)
-            k = min(len(p0), MAX_POINTS)
-            pts[i, :k], forces[i, :k], pts_world[i, :k] = p0[:k], F[:k], pw[:k]
-            fr_lc, r_c = rlog.add(i, F, pw, geo.a)
-        else:  # compiled (wormsim.contact3d.flank_loop)
-            fc.set_friction(mu)
-            nteeth, pen, fr_lc, r_c = loop.sample(i, pattern, rlog, store)
+        nteeth, pen, fr_lc, r_c = src.sample(i, th2, mu, rlog, store)
         guards.contact(t, pen, w1 if worm_is_drive else w2, cmd)
-        # the mean resultant on the wheel resolved at the pitch point P = (0, -r2, 0) on the line of centres, in the
-        # wheel's directions there (DIN 3975 F_t2, F_r2, F_a2; seed 001 resolves ADAMS's contact force the same
-        # way): tangential e_t = +x, radial e_r = -y (outward, towards the worm), axial e_z. The contact torque M_z
-        # is kept apart: M_z / r2 equals the mean F_t, but by the wheel's torque balance it varies only through
-        # I2 alpha2 and hides the mesh
-        S_all[:, i] = (  # in SERIES order
-            t,  # t_s
-            th1,  # worm_angle_rad
-            th2,  # wheel_angle_rad
-            rad_s_to_rpm(w1),  # worm_speed_rpm
-            rad_s_to_rpm(w2),  # wheel_speed_rpm
-            t1 / rec,  # worm_torque_nm
-            t2 / rec,  # wheel_torque_nm
-            cmd,  # drive_command
-            fx / rec,  # tangential_force_n
-            -fy / rec,  # radial_force_n
-            fz / rec,  # axial_force_n
-            nc / rec,  # contacts
-            nteeth,  # teeth_in_contact
-            pen,  # max_penetration_m
-            mu,  # friction_coefficient
-            te,  # transmission_error_rad
-            mz / rec,  # wheel_contact_torque_nm
-            p1 / rec,  # worm_power_w
-            p2 / rec,  # wheel_power_w
-            fpk,  # tangential_force_abs_max_n
-            fr_lc,  # radial_force_line_of_centres_n
-            r_c,  # worm_contact_radius_m
-            0.0,  # efficiency_theory_at_contact_radius: after the loop, from rlog
-        )
+        if slog is not None:
+            slog.record(i, d)
+        S_all[:, i] = column(t, th1, th2, w1, w2, cmd, sums, rec, nteeth, pen, mu, te, fr_lc, r_c, RPM)
         if progress is not None:
             progress.update(t)
         i += 1
-    S["efficiency_theory_at_contact_radius"][:] = rlog.efficiency(S["friction_coefficient"], geo, worm_is_drive)
-    wall = time.perf_counter() - t_wall
-    summary = _run_summary(
-        S, scenario, bm, rec, guards.turn_max, len(coll), 1e6 * wall / max(n_rec * rec, 1), flanks=fc is not None
-    )
-    extra = {"points_tooth0": pts, "points_world": pts_world, "forces_world": forces, "built": bm}
-    if pattern is not None:  # the loaded contact pattern and Hertz stress (flank_outputs)
-        summary.update(pattern.summary(S["t_s"], summary["steady_window_s"]))
-        extra["flank_pattern"] = pattern.grid(S["t_s"], summary["steady_window_s"])
-    summary.update(mass_scaling.run_summary(S, scenario, bm.meta, summary))  # and the ringing guard (exit 3)
-    rang = ringing(S, summary, dt, bm.law.stable_limit_s) if fc is not None else None  # flanks (ringing_check)
-    if rang is not None:
-        raise diverged_error(rang[0], dt, bm, rang[1])
-    if bm.kinematic_tca is not None:  # errors: the displaced exact flanks' kinematic TE and play (issue 12)
-        kin = bm.kinematic_tca.summary(bm.geometry, gt.working_flank(scenario, bm.geometry.hand))
-        summary.update({k: v for k, v in kin.items() if not k.startswith("contact_pattern")})
-    return Result(
-        model="contact3d", summary=summary, series=S, steps=n_rec * rec, sim_time_s=float(d.time), extra=extra
-    )
+
+
+def force_signs(S: dict, hand: int) -> None:
+    """The samples' forces (e_t = +x, e_r = -y outward, e_z) into the sign convention of docs/outputs.md
+    (wormsim.outputs.FORCE_SIGNS), in place: radial positive towards the wheel axis (separating), axial along
+    -hand e_z (F_a2 = F_t2 tan(gamma + rho') with its sign, as at torsional)."""
+    S["radial_force_n"] *= -1.0
+    S["radial_force_line_of_centres_n"] *= -1.0
+    S["axial_force_n"] *= -float(hand)
 
 
 def _run_summary(
@@ -524,4 +212,9 @@ def simulate(scenario: Scenario, progress=None) -> Result:
     bm = build_model(scenario)
     if progress is not None and scenario.simulation.mass_scaling != 1:
         progress.note(mass_scaling.note(bm.meta["mass_scaling_check"], scenario.simulation.mass_scaling, bm.timestep_s))
-    return run_model(bm, scenario, progress)
+    res = run_model(bm, scenario, progress)
+    if scenario.simulation.backdrive_probe:  # a second run with the wheel driving (wormsim.contact3d.backdrive)
+        from wormsim.contact3d.backdrive import probe
+
+        res.summary.update(probe(scenario, res.summary, simulate))
+    return res

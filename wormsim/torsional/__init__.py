@@ -1,8 +1,9 @@
 """torsional: 2 DOF, worm and wheel rotations coupled by a mesh force element with k(theta) from a tooth contact
-analysis of the exact flanks. mesh_stiffness.py (TCA), dynamics.py (equations, integration, summary), report.py.
+analysis of the exact flanks (wormsim.tooth.mesh_stiffness, wormsim.tooth's kernel for the loaded TCA). dynamics.py
+(equations, integration, summary), loaded_tca.py, report.py.
 
-The package's entry points load on first use (PEP 562), so that importing mesh_stiffness alone (contact3d's default
-slice count, flanks.default_slices) does not import dynamics' scipy.integrate (~2.5 s)."""
+The package's entry points load on first use (PEP 562): importing the package does not import dynamics'
+scipy.integrate (~2.5 s)."""
 
 from __future__ import annotations
 

@@ -14,7 +14,7 @@ worm pushes in forward drive (side +1) touches for e > g and the opposite flank 
 in between, no force. (With assembly errors, `errors:`, the gaps are the kinematic TCA's g_side(theta1) and the
 elastic torque is the loaded TCA's table of the displaced flanks, wormsim.torsional.loaded_tca; docs/errors.md 5a.)
 The penetration along the line of action is delta = arm0 (|e| - g), arm0 = r2 cos(alpha_n)
-cos(gamma) (wormsim.torsional.mesh_stiffness: k(theta1) is computed there, once, from the generated flanks).
+cos(gamma) (wormsim.tooth.mesh_stiffness: k(theta1) is computed there, once, from the generated flanks).
 
 Mesh torque on the wheel (ADAMS IMPACT form with e = 1, damping blended in over the penetration depth d_max
 like IMPACT's STEP, never pulling):
@@ -86,7 +86,7 @@ from wormsim.geometry import derive, displaced_pair
 from wormsim.metrics import dominant_frequency, drive_summary, mean_speeds_rpm, window_of
 from wormsim.result import Result
 from wormsim.scenario import Scenario
-from wormsim.torsional.mesh_stiffness import MeshStiffness, mesh_stiffness, per_length_stiffness
+from wormsim.tooth.mesh_stiffness import MeshStiffness, mesh_stiffness, per_length_stiffness
 from wormsim.units import rad_s_to_rpm, step
 
 CHORD_ITER = 4  # backward Euler: Newton iterations that reuse the first Jacobian of a step
@@ -99,12 +99,7 @@ SIGN_VELOCITY_FRACTION = 0.1  # v_s / v_t: friction-direction regularisation (mo
 def inertias(scenario: Scenario, g: GearGeometry) -> tuple[float, float]:
     """(I1, I2) in kg m^2: solid cylinders (module docstring), plus the driven-machine inertia
     load.inertia_kg_m2 on the loaded shaft (rigid on it, as contact3d's joint armature)."""
-    mats = scenario.materials
-    m1 = mats.worm.density_kg_m3 * math.pi * g.r1**2 * g.worm_length
-    m2 = mats.wheel.density_kg_m3 * math.pi * g.r2**2 * g.face_width
-    j = scenario.load.inertia_kg_m2
-    j1, j2 = (j, 0.0) if scenario.load.on == "worm" else (0.0, j)
-    return 0.5 * m1 * g.r1**2 + j1, 0.5 * m2 * g.r2**2 + j2
+    return gt.shaft_inertias_kg_m2(scenario, g.r1, g.worm_length, g.r2, g.face_width)
 
 
 class _TorqueTable:
@@ -144,7 +139,7 @@ class _Mesh:
         self.g, self.ms = g, ms
         self.hz = g.hand * g.z1 / g.z2
         self.gap = g.backlash / (2 * g.r2)
-        # assembly errors (issue 12): the gaps of the displaced flanks from the kinematic TCA, per side, as tables
+        # assembly errors: the gaps of the displaced flanks from the kinematic TCA, per side, as tables
         # over its period of worm angle (meshgen.kinematic_tca); None: the perfect pair's constant gap
         self.kin = kin
         if kin is not None:
@@ -418,7 +413,7 @@ def simulate(scenario: Scenario, progress=None, method: str = "implicit") -> Res
     kin = pair[1] if pair is not None else None
     ltca, t_lt = None, 0.0
     if pair is not None:
-        from wormsim.torsional.loaded_tca import loaded_tca  # imports contact3d's kernel: only with errors
+        from wormsim.torsional.loaded_tca import loaded_tca  # only with errors
 
         t_lt = time.perf_counter()
         t2w = gt.working_wheel_torque_nm(scenario, g.ratio)

@@ -1,14 +1,14 @@
-"""Loaded tooth contact analysis (LTCA) of a displaced worm gear pair for the torsional level (issue 12): the mesh
+"""Loaded tooth contact analysis (LTCA) of a displaced worm gear pair for the torsional level: the mesh
 torque on the wheel as a table T_side(theta1, x) over the worm angle and the wheel's lag past the first touch.
 
 Geometry and contact law are contact3d's exact-flank ones, evaluated statically, without MuJoCo:
-the wheel flanks of wormsim.contact3d.flanks (tooth 0's grid of S slices across the face, every wheel tooth rotated by
+the wheel flanks of wormsim.tooth.grid (tooth 0's grid of S slices across the face, every wheel tooth rotated by
 2 pi k / z2 plus its pitch deviation), placed with the worm by meshgen.displaced (1), (2) exactly as
-wormsim.contact3d.flank_pose passes MuJoCo's body poses to the kernel (X_g = wheel body -> assembly, A = worm body at
+wormsim.tooth.pose passes MuJoCo's body poses to the kernel (X_g = wheel body -> assembly, A = worm body at
 theta1 turned back by theta1); `find_contacts` and `slice_weights` give, per (tooth, flank, slice), the depth delta_i
 of the displaced flanks' interpenetration, its unit normal n_i (worm -> wheel) and the share w_i of the slice that the
 contact line covers. Each contact carries contact3d's linear spring k_c w_i delta_i, k_c = K / S
-(wormsim.contact3d.law, n_ref = S; K = k' b2 with wormsim.torsional.mesh_stiffness's k'), so the torque about the
+(wormsim.contact3d.law, n_ref = S; K = k' b2 with wormsim.tooth.mesh_stiffness's k'), so the torque about the
 wheel's axis of rotation (direction a and point o of M_g in meshgen.displaced (2)) is
 
     T(theta1, theta2) = sum_i k_c w_i delta_i ((p_i - o) x n_i) . a.                                         (1)
@@ -38,12 +38,17 @@ import numpy as np
 from meshgen import assembly, displaced
 from meshgen.cache import cached
 from meshgen.geometry import GearGeometry
-from wormsim.contact3d import flank_pose, flanks
-from wormsim.contact3d.flanks import MARGIN_PITCH, TAPER_SHARE, find_contacts, flank_grid, slice_weights
 from wormsim.errors import SimulationError
+from wormsim.tooth import gap as tooth_gap
+from wormsim.tooth import grid as tooth_grid
+from wormsim.tooth import kernel as tooth_kernel
+from wormsim.tooth import pose as flank_pose
+from wormsim.tooth.grid import flank_grid
+from wormsim.tooth.kernel import MARGIN_PITCH, TAPER_SHARE, find_contacts, slice_weights
 
 CODE_VERSION = "ltca-3"
-SLICES = 32  # slices across the face (contact3d's default for the seat motor; flanks.default_slices)
+KERNEL_MODULES = (tooth_gap, tooth_grid, tooth_kernel, flank_pose)  # their source keys the cache
+SLICES = 32  # slices across the face (contact3d's default for the seat motor; wormsim.tooth.grid.default_slices)
 SAMPLES_PER_MESH = 32  # worm angles per mesh cycle
 X_POINTS = 17  # wheel lag grid points from 0 to the range's end
 X_BELOW = 4  # and below 0 (the flank kernel touches up to ~35 urad before the kinematic TCA's g: screw jack)
@@ -74,7 +79,7 @@ class LoadedTCA:
 
 
 def _poses(g: GearGeometry, dev: displaced.Deviations, th1: float, th2: float, P: np.ndarray):
-    """Write X_g and A (wormsim.contact3d.flank_pose) into P; returns (o, a) of the wheel's axis of rotation."""
+    """Write X_g and A (wormsim.tooth.pose) into P; returns (o, a) of the wheel's axis of rotation."""
     Xg = displaced.wheel_to_assembly(g, dev, th2)
     A = displaced.worm_to_assembly(g, dev, th1) @ assembly._rz(-th1)
     P[flank_pose.WHEEL : flank_pose.WHEEL + 12] = Xg[:3, :].ravel()
@@ -97,7 +102,7 @@ class Evaluator:
         self.depth, self.meta, self.line = np.zeros(cap), np.zeros((cap, 4)), np.zeros((cap, 2))
         self.weight = np.zeros(cap)
         self.margin = MARGIN_PITCH * 2 * math.pi / g.z2 + g.backlash / (2 * g.r2)
-        self.taper_rad = TAPER_SHARE * self.margin  # of the error-free window (flanks.find_contacts)
+        self.taper_rad = TAPER_SHARE * self.margin  # of the error-free window (wormsim.tooth.kernel.find_contacts)
         self.slices = slices
         self.n = 0
         if dev is None or dev.is_zero():
@@ -204,7 +209,7 @@ def loaded_tca(g, dev, kin, k_pair_n_per_m, working_torque_nm, k_theta_guess_nm_
         "kg": k_theta_guess_nm_per_rad,
         "grid": (SLICES, SAMPLES_PER_MESH, X_POINTS, X_BELOW, X_MAX_FACTOR),
         "v": CODE_VERSION,
-        "kernel": hashlib.sha256((inspect.getsource(flanks) + inspect.getsource(flank_pose)).encode()).hexdigest(),
+        "kernel": hashlib.sha256("".join(inspect.getsource(m) for m in KERNEL_MODULES).encode()).hexdigest(),
     }
     return cached(
         "ltca",

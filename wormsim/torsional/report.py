@@ -19,7 +19,7 @@ from wormsim.report_header import (
     warning_text,
 )
 from wormsim.result import Result
-from wormsim.torsional.mesh_stiffness import MeshStiffness
+from wormsim.tooth.mesh_stiffness import MeshStiffness
 
 # ----------------------------------------------------------------------------- report, recording
 

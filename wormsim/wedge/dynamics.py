@@ -60,7 +60,7 @@ from scipy.integrate import solve_ivp, trapezoid
 
 from wormsim import gear_theory as gt
 from wormsim.errors import SimulationError
-from wormsim.friction import rho_rad
+from wormsim.friction import friction_coefficient, rho_rad
 from wormsim.result import Result
 from wormsim.units import DEG, step
 
@@ -94,6 +94,11 @@ class WedgeParams:
     v0_m_s: float
     duration_s: float
     rtol: float
+    # derived from gear: (wormsim.wedge.derive): the contact's friction law mu(Vs) and rho' = atan(mu / cos alpha_n),
+    # the friction angle of the gear levels; None: seed 000's rho(Vs) of `group` / `friction` (rho = atan(mu))
+    contact: object | None = None
+    cos_alpha_n: float = 1.0
+    method: str = "DOP853"  # solve_ivp method; the derived motor curve is stiff (Radau)
 
 
 def params_from_scenario(scenario) -> WedgeParams:
@@ -140,7 +145,10 @@ def load_force_n(t_s, p: WedgeParams):
 
 
 def rho_of_speed(v1_m_s, p: WedgeParams):
-    """rho(Vs), Vs = |x1'| / cos(gamma) (seed 000)."""
+    """rho(Vs), Vs = |x1'| / cos(gamma) (seed 000); derived from gear: rho' = atan(mu(Vs) / cos alpha_n)."""
+    if p.contact is not None:
+        mu = friction_coefficient(p.contact, np.abs(v1_m_s) / math.cos(p.gamma_rad))
+        return gt.virtual_friction_angle_rad(mu, math.acos(p.cos_alpha_n))
     return rho_rad(np.abs(v1_m_s) / math.cos(p.gamma_rad), p.group, p.friction)
 
 
@@ -271,9 +279,16 @@ def _segment_times(grid: np.ndarray, t0: float, t1: float, extra=()) -> np.ndarr
 
 
 def simulate(scenario, progress=None) -> Result:
-    """Integrate the wedge model of `scenario` (model: wedge) and return series and summary."""
+    """Integrate the wedge model of `scenario` (model: wedge) and return series and summary: from its wedge: block,
+    or derived from gear:, drive:, load: when it has none (wormsim.wedge.derive)."""
+    if scenario.wedge is None:
+        from wormsim.wedge import derive
+
+        return derive.simulate_derived(scenario, progress)
     p = params_from_scenario(scenario)
-    return simulate_params(p, progress=progress, name=scenario.name)
+    res = simulate_params(p, progress=progress, name=scenario.name)
+    res.summary["wedge_source"] = "wedge: block (seed 000: rho = atan(mu), forces reduced to the pitch radii)"
+    return res
 
 
 def simulate_params(p: WedgeParams, progress=None, name: str = "wedge") -> Result:
@@ -361,7 +376,7 @@ def simulate_params(p: WedgeParams, progress=None, name: str = "wedge") -> Resul
             events.append(ev_stop)
 
         sol = solve_ivp(
-            rhs, (t, t_end), [x, v], method="DOP853", rtol=p.rtol, atol=atol, events=events, dense_output=True
+            rhs, (t, t_end), [x, v], method=p.method, rtol=p.rtol, atol=atol, events=events, dense_output=True
         )
         if sol.status < 0:
             raise SimulationError(f"the integrator failed at t = {t:.6g} s: {sol.message}")
@@ -469,8 +484,7 @@ def _assemble(segs: list[dict], p: WedgeParams, steps: int, name: str) -> Result
         **_summary_efficiencies(g, rho_ss, rho0),
         "rho_steady_deg": rho_ss / DEG,
         "rho_static_deg": rho0 / DEG,
-        "lead_angle_deg": g / DEG,
-        "self_locking": bool(rho0 > g),
+        **gt.backdrive_keys(g, rho0, rho_ss),
         "stalled": bool(np.max(np.abs(x1)) == 0.0),
         "locked_at_end": bool(code[-1] == 0),
         "x1_end_m": float(x1[-1]),

@@ -1,26 +1,14 @@
-"""The wheel's active collision window: only the W tooth slots nearest the line of centres carry collision pieces,
-re-posed by whole pitches as the wheel turns (tooth k lives in slot k mod W), so the cost does not grow with z2."""
+"""The wheel's mesh window: the W teeth nearest the line of centres, the only ones the contact looks at (and, in the
+MuJoCo model, the W tooth slots re-posed by whole pitches as the wheel turns: tooth k lives in slot k mod W), so the
+cost does not grow with z2."""
 
 from __future__ import annotations
 
 import math
-from typing import Protocol
 
-import mujoco
 import numpy as np
 
 from meshgen.geometry import GearGeometry
-
-
-class Windowed(Protocol):
-    """What re-posing needs of a built model (wormsim.contact3d.mjcf.BuiltModel has it)."""
-
-    model: mujoco.MjModel
-    geometry: GearGeometry
-    window_teeth: int
-    tooth0_angle_rad: float
-    slot_bodies: np.ndarray
-    tooth_shift_rad: np.ndarray | None  # (z2,) pitch deviations f_k / r2 (errors:), None for the perfect pair
 
 
 def window_size(geo: GearGeometry) -> int:
@@ -46,16 +34,3 @@ def slot_quat(k: int, z2: int, tooth_shift_rad: np.ndarray | None = None) -> lis
     if tooth_shift_rad is not None:
         ang += tooth_shift_rad[k % z2]
     return [math.cos(ang / 2), 0, 0, math.sin(ang / 2)]
-
-
-def repose_window(bm: Windowed, theta2: float, current: np.ndarray | None = None) -> np.ndarray:
-    """Place the window slots on the W teeth nearest the line of centres; returns the tooth indices."""
-    ks = window_teeth_at(theta2, bm.geometry.z2, bm.window_teeth, bm.tooth0_angle_rad)
-    if current is not None and np.array_equal(ks, current):
-        return current
-    m = bm.model
-    for k in ks:
-        if current is not None and k in current:
-            continue
-        m.body_quat[bm.slot_bodies[int(k % bm.window_teeth)]] = slot_quat(int(k), bm.geometry.z2, bm.tooth_shift_rad)
-    return ks

@@ -1,7 +1,7 @@
-"""Contact pattern and Hertz contact stress from the exact-flank contacts (`contact.geometry: flanks`; issue 13).
+"""Contact pattern and Hertz contact stress from the exact-flank contacts (`contact.geometry: flanks`).
 
 Geometry, once per gear and slice count (`flank_curvature`, cached in process), on the kernel's grid
-(wormsim.contact3d.flanks.flank_grid: flank sigma, slice j, profile point i): at each active point, the wheel flank
+(wormsim.tooth.kernel.flank_grid: flank sigma, slice j, profile point i): at each active point, the wheel flank
 and the worm thread in the rigid conjugate pose at which that point is on the contact line (wheel angle c, the
 point's conjugate angle; worm angle c / (hand z1 / z2); the unshifted space-0 flank, i.e. without backlash). There
 the gap function G (meshgen.worm.thread_gap of the wheel flank point: the normal distance to the worm thread) is a
@@ -17,7 +17,7 @@ lambda_max = 1 / rho'. The slice's contact-line length inside the slice (width b
 
     L = s (b2 / S) / |t . e_z|,   capped at the active profile length of the slice                            (2)
 
-(s the contact's share of its slice, wormsim.contact3d.flanks.slice_weights: 1 inside the line, less at its ends).
+(s the contact's share of its slice, wormsim.tooth.kernel.slice_weights: 1 inside the line, less at its ends).
 
 Hertz line contact (Johnson eq. 4.45; DIN 3996 and ISO/TS 14521 use the same p_H for line contact):
 
@@ -45,13 +45,12 @@ import functools
 import math
 from dataclasses import dataclass
 
-import mujoco
 import numba
 import numpy as np
 
 from meshgen import wheel, worm
 from meshgen.geometry import GearGeometry
-from wormsim.contact3d.flanks import N_PROFILE, flank_grid
+from wormsim.tooth.grid import N_PROFILE, flank_grid
 
 H_STEP_MX = 0.02  # finite-difference step of (1), in axial modules
 EXTENT_LOAD_SHARE = 0.95  # contact_pattern_extent_face_mm: the face span holding this share of the load
@@ -181,7 +180,7 @@ def _lerp_rows(a, sg, j, f):
 @numba.njit(cache=True)
 def _rows(i, adr, efc_force, meta, weight, inv_rho, line_len, e_star, out, m):
     """Appends (i, sigma, j, f, F_n, p_H (3)) per contact with a constraint row to out (float32) from row m. The
-    contact carries the share weight[c] of its slice (flanks.slice_weights), so its line is weight[c] x L long."""
+    contact carries the share weight[c] of its slice (kernel.slice_weights), so its line is weight[c] x L long."""
     for c in range(adr.shape[0]):
         if adr[c] < 0 or weight[c] <= 0.0:
             continue
@@ -209,7 +208,7 @@ class PatternLog:
         self.buf = np.zeros((4096, 6), dtype=np.float32)  # 24 bytes per contact and sample
         self.m = 0
 
-    def record(self, i: int, d: mujoco.MjData) -> None:
+    def record(self, i: int, d) -> None:
         """The kernel's contacts (d.contact's last fc.n entries) at sample i: (i, sigma, j, f, F_n, p_H);
         p_H by (3) (in `_rows`, compiled: the same formula as hertz_line_pressure_pa)."""
         fc = self.fc

@@ -1,73 +1,41 @@
-"""Exact-flank tooth contact of contact3d (`contact.geometry: flanks`): the geometry kernel.
+"""The exact-flank contact kernel: per step, the contacts of the window teeth with the worm, one per (tooth, flank,
+slice), their slice weights and contact frames, packed in one compiled call (`find_packed`).
 
-Per gear, once (`flank_grid`, cached in process): the wheel's generated flanks of tooth 0 on a grid of S SLICES
-across the face (zeta_j = slice centres, zeta across the face, 0 at the mid-plane) by N_PROFILE points along the
-profile (rho from the worm tip's reach, or the wheel root, to the wheel tip: the active zone of
-wormsim.torsional.mesh_stiffness), from meshgen.wheel.tooth_flanks / space_flank (the envelope; no equation repeated
-here). Flank A of tooth 0 is psi_+ of tooth space 0 (it faces -psi), flank B is psi_- of space 1; backlash applied.
-With each point goes its conjugate wheel angle c = beta - psi (mesh_stiffness (1)): tooth k's flank point touches
-the conjugate worm at wheel angle theta2 = c - 2 pi (k + sigma) / z2 (sigma = 0 flank A, 1 flank B). Points cut by
-the hob tip edge (root fillet, not conjugate) are left out: exact flanks carry the working flanks only.
-
-Each step (`find_contacts`, numba): for every wheel tooth k of the mesh window and both flanks, and for every slice
-whose conjugate angles come within `margin` of the current wheel angle, the kernel starts at the profile point whose
-conjugate angle is nearest (bisection) and descends along the profile to the gap's minimum, so a step costs about three
-points per slice. A point of tooth k at wheel
-angle theta2 sits in the assembly at (rho cos b, rho sin b, zeta), b = psi + theta2 + 2 pi k / z2, and in the
-static worm frame (meshgen.assembly: x_s = y + a, y_s = -z, z_s = -x) at radius r and angle phi. Its signed
-normal distance from the worm thread is the closed form of meshgen.worm.thread_gap (equations (1), (2) there):
-
-    u = wrap(z_s - p (phi - theta1), p_x),   G = (|u| - H(r)) / |grad G|,
-    grad G = sign(u) (e_z - (p / r) e_phi) - H'(r) e_r,                                              (1)
-
-negative inside the thread, valid for r_f1 <= r <= r_a1 and |z_s| <= b1 / 2; the kernel evaluates it past these
-bounds too (the flank extended, worm_gap_ext) and, where the minimum lies outside, takes the worm's edge on the wheel
-flank (where the excess crosses zero), so contacts enter and leave at zero depth (docs/contact3d.md). In each slice
-the deepest point along the profile is refined by the parabola through it and its two neighbours (the gap across a
-contact line is quadratic; blended with the next parabola towards its vertex, and at the active profile's end the one
-through the end and its two inner neighbours, so the line's depth and point are continuous in the mesh angle),
-giving ONE contact per (tooth, flank, slice): depth delta = -G_min, normal
+For every wheel tooth k of the mesh window and both flanks, and for every slice of the flank grid
+(wormsim.tooth.grid) whose conjugate angles come within `margin` of the current wheel angle, `find_contacts` starts at
+the profile point whose conjugate angle is nearest (bisection) and descends along the profile to the worm gap's
+minimum (wormsim.tooth.gap), so a step costs about three points per slice. A point of tooth k at wheel angle theta2
+sits in the assembly at (rho cos b, rho sin b, zeta), b = psi + theta2 + 2 pi k / z2; with assembly errors it goes
+through the body poses (wormsim.tooth.pose). Where the gap's minimum lies past the worm's tip, root or end faces, the
+kernel takes the worm's edge on the wheel flank (where the excess crosses zero), so contacts enter and leave at zero
+depth. In each slice the deepest point along the profile is refined by the parabola through it and its two
+neighbours (the gap across a contact line is quadratic; blended with the next parabola towards its vertex, and at
+the active profile's end the one through the end and its two inner neighbours, so the line's depth and point are
+continuous in the mesh angle), giving ONE contact per (tooth, flank, slice): depth delta = -G_min, normal
 n = grad G / |grad G| in the assembly frame (from the worm into the wheel: the force on the wheel is along +n),
 position = the wheel point moved delta / 2 along n (MuJoCo's midpoint). A tooth pair whose contact line spans the face
 thus gives S contacts of stiffness K / S each (wormsim.contact3d.law, n_ref = S): the slice method of gear dynamics;
 slice_weights scales each by the share of its slice the contact line covers (the line's end interpolated with the
-excess's own slope across the face at the line's point, _face_slope). Where the
-line's point lies past the wheel's active profile, the contact is the profile's end (the wheel's tip edge, or the
-end at the worm tip's reach) pressed into the worm flank, its depth the gap there; its depth fades linearly to zero
-over the outer TAPER_SHARE of the candidate window, so that it leaves at zero load also where the flanks are still
-pressed together at the window's edge (seat motor: 30 um deep, 0.1 pitch past the profile's end).
-
-The kernel repeats the worm's H(r) (meshgen.worm.half_thickness, ZI/ZA) in compiled form; tests/test_flank_contact.py
-pins the kernel's distance to meshgen.worm.thread_gap.
+excess's own slope across the face at the line's point, _face_slope). Where the line's point lies past the wheel's
+active profile, the contact is the profile's end (the wheel's tip edge, or the end at the worm tip's reach) pressed
+into the worm flank, its depth the gap there; its depth fades linearly to zero over the outer TAPER_SHARE of the
+candidate window, so that it leaves at zero load also where the flanks are still pressed together at the window's
+edge (seat motor: 30 um deep, 0.1 pitch past the profile's end). With `merge`, the contacts of one tooth flank are
+also merged into one (wormsim.tooth.merge).
 """
 
 from __future__ import annotations
 
-import functools
-import hashlib
 import math
-import sys
-from dataclasses import asdict, dataclass
 
 import numba
 import numpy as np
 
-from meshgen import wheel, worm
-from meshgen.cache import cached
-from meshgen.geometry import GearGeometry
-from wormsim.contact3d.flank_merge import merge_flanks
-from wormsim.contact3d.flank_pose import N_WORM_PARAMS, static_dir_to_world, to_static, tooth_angle
+from wormsim.tooth.gap import _wrap, worm_gap_ext
+from wormsim.tooth.grid import FlankGrid
+from wormsim.tooth.merge import merge_flanks
+from wormsim.tooth.pose import N_WORM_PARAMS, static_dir_to_world, to_static, tooth_angle
 
-N_PROFILE = 64  # points along the profile per slice (the parabola refines between them)
-SLICES_COARSE = 8  # simulation.resolution coarse: a quick look (not converged; docs/contact3d.md)
-SLICE_SHARE = 0.2  # medium and fine: a slice's stiffness K / S at most this share of the mesh stiffness's p2p
-SLICES_STEP = 8  # the count rounded up to a multiple of this
-SLICES_TCA_SAMPLES = 128  # worm angles per mesh cycle of the TCA that gives the fluctuation
-# Default slices of a mass-scaled run, at most: mass scaling keeps the means and loses the fluctuation
-# (docs/contact3d.md, "Mass scaling"), which default_slices sizes the slices for; the means converge from 16 (seat
-# motor 20 s at S = 5000, 16 / 32 slices: efficiency 0.61286 / 0.61279, F_t mean 1289.160 / 1289.169 N; 105 / 196
-# us per step)
-SLICES_MASS_SCALED = 16
 TAPER_SHARE = 0.5  # outer share of the candidate margin over which an edge contact's depth fades to zero
 MARGIN_PITCH = 0.10  # candidate points: conjugate angle within this fraction of a pitch (plus the backlash
 # angle and the transmission error, find_contacts' margin) of the wheel angle
@@ -78,187 +46,12 @@ INSIDE_SHARE = 0.5 * (1.0 + 1e-3)  # line points deeper inside than this x the s
 # slope (its |change| across a slice is at most the slice width; 1e-3 is far above the slope's round-off)
 
 
-def default_slices(g: GearGeometry, resolution: str) -> int:
-    """Slices across the face when contact.slices is not given. Each slice switches a stiffness of up to K / S as the
-    contact line's end crosses it, and rings the contact mode; the slicing resolves the mesh stiffness's own change
-    over a mesh cycle once K / S is small against it:
-
-        S = SLICES_STEP ceil(k_mean / (SLICE_SHARE k_p2p) / SLICES_STEP),
-
-    k_p2p / k_mean the fluctuation of the zero-load TCA's k(theta) (wormsim.torsional.mesh_stiffness, both flank
-    sides, the smaller). Measured (docs/contact3d.md, "Default slice count"): seat motor 0.177 -> 32 slices (16 were
-    not converged), screw jack 0.376 -> 16, involute_41 0.267 -> 24. Coarse: SLICES_COARSE."""
-    if resolution == "coarse":
-        return SLICES_COARSE
-    from wormsim.torsional.mesh_stiffness import mesh_stiffness
-
-    ms = mesh_stiffness(g, 1.0, "slices", SLICES_TCA_SAMPLES)
-    share = min(float(np.ptp(k) / np.mean(k)) for k in (ms.k_mesh_fwd_n_per_m, ms.k_mesh_rev_n_per_m))
-    return int(SLICES_STEP * math.ceil(1.0 / (SLICE_SHARE * max(share, 1e-3)) / SLICES_STEP))
-
-
-@dataclass(frozen=True)
-class FlankGrid:
-    """Tooth 0's two active flanks on (slice, profile) grids; wheel frame, SI."""
-
-    slices: int
-    zeta: np.ndarray  # (S,) slice centres
-    rho: np.ndarray  # (S, N) radius of the profile points
-    psi: np.ndarray  # (2, S, N) polar angle (flank A, flank B), nan where not an active flank point
-    xy: np.ndarray  # (2, S, N, 2) the points' (x, y) in the wheel frame (rho cos psi, rho sin psi)
-    c: np.ndarray  # (2, S, N) conjugate wheel angle, nan where not active
-    c_range: np.ndarray  # (2, S, 2) min and max of c per flank and slice (whole slices are skipped by it)
-    span: np.ndarray  # (2, S, 2) first and last active profile index per flank and slice (c is monotone
-    # between them; -1, -1 where a slice has none)
-    params: np.ndarray  # worm scalars for the kernel (worm_params)
-
-
-def worm_params(g: GearGeometry) -> np.ndarray:
-    """Scalars of meshgen.worm's closed form, in the order the kernel reads them."""
-    zi = 1.0 if g.profile == "ZI" else 0.0
-    t1 = math.sqrt(max(g.r1**2 / g.r_b**2 - 1.0, 0.0)) if zi else 0.0
-    return np.array(
-        [
-            g.p,
-            g.p_x,
-            g.r_f1,
-            g.r_a1,
-            g.worm_length / 2,
-            zi,
-            g.r_b,
-            math.tan(g.alpha_x),
-            t1 - math.atan(t1),
-            g.r1,
-            g.a,
-            2 * math.pi / g.z2,
-            g.hand * g.z1 / g.z2,
-        ],
-        dtype=float,
-    )
-
-
-@functools.lru_cache(maxsize=16)
-def flank_grid(g: GearGeometry, slices: int, n_profile: int = N_PROFILE) -> FlankGrid:
-    """The grids of the module docstring (meshgen.wheel's envelope, both flanks of tooth 0); in process and on disk
-    (meshgen.cache, keyed by the geometry, the grid size and the source of the modules that compute the grid)."""
-    parts = {"g": asdict(g), "slices": slices, "n_profile": n_profile, "code": _grid_code_hash()}
-    return cached("flankgrid", parts, lambda: _flank_grid(g, slices, n_profile))
-
-
-@functools.cache
-def _grid_code_hash() -> str:
-    """SHA-256 of the source that determines flank_grid's result (this module, the trim, the pose, the window and
-    meshgen's geometry, worm and wheel)."""
-    import inspect
-
-    from meshgen import geometry as mg
-    from wormsim.contact3d import flank_pose, flank_trim, window
-
-    mods = (sys.modules[__name__], flank_trim, flank_pose, window, mg, worm, wheel)
-    return hashlib.sha256("".join(inspect.getsource(m) for m in mods).encode()).hexdigest()
-
-
-def _flank_grid(g: GearGeometry, slices: int, n_profile: int) -> FlankGrid:
-    bw = g.face_width
-    zeta = -bw / 2 + (np.arange(slices) + 0.5) * bw / slices
-    lo = np.maximum(g.a - np.sqrt(np.maximum(g.r_a1**2 - zeta**2, 0.0)), wheel.root_rho(g, zeta))
-    hi = wheel.tip_rho(g, zeta)
-    s = np.linspace(0.0, 1.0, n_profile)
-    R = lo[:, None] + (hi - lo)[:, None] * s[None, :]
-    Z = np.broadcast_to(zeta[:, None], R.shape)
-    dj = g.backlash / (2 * g.r2)
-    pitch = 2 * math.pi / g.z2
-    psi = np.full((2,) + R.shape, np.nan)
-    c = np.full((2,) + R.shape, np.nan)
-    for i, side in enumerate((+1, -1)):
-        sol = wheel.space_flank(g, R, Z, side)
-        ok = sol.interior & (hi > lo)[:, None]
-        ok &= ~_cut_by_worm(g, R, sol.psi, zeta)
-        # flank A: psi_+ of space 0 + dj; flank B: psi_- of space 0 + pitch - dj (meshgen.wheel.tooth_flanks);
-        # c is the conjugate angle of the unshifted space-0 flank (flank B's tooth space is 1: sigma in find_contacts)
-        shift = dj if side > 0 else pitch - dj
-        psi[i] = np.where(ok, sol.psi + shift, np.nan)
-        c[i] = np.where(ok, sol.beta - sol.psi, np.nan)
-    with np.errstate(all="ignore"):
-        rng = np.stack([np.nanmin(c, axis=2), np.nanmax(c, axis=2)], axis=-1)
-    rng = np.where(np.isfinite(rng), rng, np.array([np.inf, -np.inf]))
-    xy = np.stack([R * np.cos(psi), R * np.sin(psi)], axis=-1)
-    act = np.isfinite(c)
-    first = np.where(act.any(axis=2), np.argmax(act, axis=2), -1)
-    last = np.where(act.any(axis=2), n_profile - 1 - np.argmax(act[:, :, ::-1], axis=2), -1)
-    span = np.stack([first, last], axis=-1).astype(np.int64)
-    return FlankGrid(
-        slices=slices, zeta=zeta, rho=R, psi=psi, xy=xy, c=c, c_range=rng, span=span, params=worm_params(g)
-    )
-
-
-def _cut_by_worm(g: GearGeometry, R: np.ndarray, psi0: np.ndarray, zeta: np.ndarray) -> np.ndarray:
-    """Envelope points of tooth space 0 that the conjugate worm cuts into (wormsim.contact3d.flank_trim)."""
-    from wormsim.contact3d.flank_trim import cut_points
-    from wormsim.contact3d.window import window_size
-
-    xy = np.stack([R * np.cos(psi0), R * np.sin(psi0)], axis=-1)[None]
-    return cut_points(xy, zeta, worm_params(g), float(window_size(g)))[0]
-
-
-@numba.njit(cache=True, inline="always")
-def _half_thickness(r, P):
-    """meshgen.worm.half_thickness and its derivative dH/dr (ZI equation (2), ZA straight)."""
-    p, p_x, r1 = P[0], P[1], P[9]
-    if P[5] > 0.5:
-        r_b = P[6]
-        x = r * r / (r_b * r_b) - 1.0
-        t = math.sqrt(x) if x > 0.0 else 0.0
-        ap = abs(p)
-        return p_x / 4 - ap * ((t - math.atan(t)) - P[8]), -ap * t / r
-    return p_x / 4 - (r - r1) * P[7], -P[7]
-
-
-@numba.njit(cache=True, inline="always")
-def _wrap(x, period):
-    """x wrapped to [-period / 2, period / 2): Python's (x + period / 2) % period - period / 2 with floor, inlined
-    (numba's float % calls a helper around fmod: 15 % of the kernel's time); equal to it within an ulp of x."""
-    w = x + 0.5 * period
-    return w - period * math.floor(w / period) - 0.5 * period
-
-
-@numba.njit(cache=True, inline="always")
-def worm_gap_ext(xs, ys, zs, theta1, P, out):
-    """Signed normal distance (1) of a static-worm-frame point from the thread flank extended past the worm's tip,
-    root and end faces, the unit gradient (static worm frame) in out[0:3], and the excess (m) by which the point is
-    outside the threaded region: max(r - r_a1, r_f1 - r, |z_s| - b1/2) (<= 0 inside). Returns (gap, excess)."""
-    r = math.sqrt(xs * xs + ys * ys)
-    ex = max(r - P[3], P[2] - r, abs(zs) - P[4])
-    p, p_x = P[0], P[1]
-    phi = math.atan2(ys, xs)
-    u = _wrap(zs - p * (phi - theta1), p_x)
-    H, dH = _half_thickness(r, P)
-    sg = 1.0 if u >= 0.0 else -1.0
-    ir = 1.0 / r
-    cp, sp = xs * ir, ys * ir
-    # grad G = sg (e_z - p/r e_phi) - H' e_r, e_r = (c, s, 0), e_phi = (-s, c, 0)
-    gx = sg * (p * ir) * sp - dH * cp
-    gy = -sg * (p * ir) * cp - dH * sp
-    gz = sg
-    inrm = 1.0 / math.sqrt(gx * gx + gy * gy + gz * gz)
-    out[0], out[1], out[2] = gx * inrm, gy * inrm, gz * inrm
-    return (abs(u) - H) * inrm, ex
-
-
-@numba.njit(cache=True)
-def worm_gap(xs, ys, zs, theta1, P, out):
-    """Signed normal distance (1) of a static-worm-frame point and the unit gradient (static worm frame) in out[0:3].
-    Returns +inf where there is no thread (r outside [r_f1, r_a1] or |z_s| > b1/2)."""
-    gv, ex = worm_gap_ext(xs, ys, zs, theta1, P, out)
-    return np.inf if ex > 0.0 else gv
-
-
 @numba.njit(cache=True, inline="always")
 def _eval(x0, y0, zeta, ca, sa, theta1, P, out):
     """Extended gap and excess (worm_gap_ext) of the wheel point (x0, y0, zeta) turned by the angle (cos ca, sin sa)
     about z (assembly frame), and the turned point in out[3:6]. With a displaced pose in P
-    (wormsim.contact3d.flank_pose) the turned point is in the wheel body's frame and goes through the poses instead
-    (flank_pose.to_static)."""
+    (wormsim.tooth.pose) the turned point is in the wheel body's frame and goes through the poses instead
+    (pose.to_static)."""
     x, y = ca * x0 - sa * y0, sa * x0 + ca * y0
     if P.shape[0] > N_WORM_PARAMS:
         xs, ys, zs = to_static(x, y, zeta, P, out)
@@ -369,7 +162,7 @@ def _find_contacts(xy, c, c_range, span, zeta, ks, theta1, theta2, margin, taper
         ang = theta2 + pitch * k
         dk = 0.0
         if P.shape[0] > N_WORM_PARAMS:
-            ang, dk = tooth_angle(k, P)  # wheel body frame, pitch deviation dk (flank_pose)
+            ang, dk = tooth_angle(k, P)  # wheel body frame, pitch deviation dk (wormsim.tooth.pose)
         ca, sa = math.cos(ang), math.sin(ang)
         for sg in range(2):
             target = _wrap(theta2 + pitch * (k + sg) + dk, 2 * math.pi)
@@ -402,7 +195,7 @@ def _find_contacts(xy, c, c_range, span, zeta, ks, theta1, theta2, margin, taper
                 while b - a > 1:
                     mid = (a + b) // 2
                     cm = c[sg, j, mid]
-                    if cm != cm:  # a point trimmed inside the row (flank_trim): scan the row instead
+                    if cm != cm:  # a point trimmed inside the row (wormsim.tooth.trim): scan the row instead
                         a = -1
                         break
                     if (cm < target) == inc:
@@ -643,7 +436,18 @@ def contact_frames(nrm, n, frame):
 
 _F_FIELDS = ("xy", "c", "c_range", "zeta", "P", "pos", "nrm", "depth", "meta", "line", "weight", "frame", "memo")
 _F_FIELDS += ("memo_consts", "tmp", "gaps", "exc", "pts", "nrs")
-_F_FIELDS += ("mpos", "mnrm", "mdepth", "mweight", "mframe", "grp", "share", "mfric", "mwrap", "axes")  # flank_merge
+_F_FIELDS += (
+    "mpos",
+    "mnrm",
+    "mdepth",
+    "mweight",
+    "mframe",
+    "grp",
+    "share",
+    "mfric",
+    "mwrap",
+    "axes",
+)  # wormsim.tooth.merge
 _I_HEADER = 8  # S, N, cap, len(P), W, z2, merge (one contact per tooth flank), merged contacts
 
 
@@ -661,7 +465,7 @@ class PackedKernel:
     numba's dispatch costs ~0.25 us per array argument (the three calls with their 28 arrays and find_contacts' work
     allocation cost ~9 us of Python per step). The fields are numpy views of the buffers (pos, nrm, depth, meta, line,
     weight, frame, P, memo, span, ks: write ks and P in place). merge: also one contact per tooth flank
-    (wormsim.contact3d.flank_merge: mpos, mnrm, mdepth, mweight, mframe, mfric, mwrap, their number in ib[7];
+    (wormsim.tooth.merge: mpos, mnrm, mdepth, mweight, mframe, mfric, mwrap, their number in ib[7];
     grp, share; axes: the hinges, set by the caller)."""
 
     def __init__(self, grid: FlankGrid, P: np.ndarray, cap: int, W: int, z2: int, merge: bool = False):
@@ -776,13 +580,8 @@ def find_packed(fb, ib, theta1, theta2, margin, taper_rad):
     )
     n = slice_weights(meta, line, n, S, pos, nrm, depth, weight)
     contact_frames(nrm, n, frame)
-    if ib[6]:  # one contact per tooth flank (flank_merge)
+    if ib[6]:  # one contact per tooth flank (wormsim.tooth.merge)
         nm = merge_flanks(meta, n, pos, nrm, depth, weight, grp, share, mpos, mnrm, mdepth, mweight, mfric, mwrap, axes)
         ib[7] = nm
         contact_frames(mnrm, nm, mframe)
     return n
-
-
-def gap_reference(g: GearGeometry, pts_static: np.ndarray, theta1: float) -> np.ndarray:
-    """meshgen.worm.thread_gap on static-worm-frame points (the reference the kernel is tested against)."""
-    return worm.thread_gap(g, pts_static, theta1)

@@ -1,8 +1,8 @@
-"""One MuJoCo contact per tooth flank (`contact.flank_contacts: tooth`; issue 13): the slice contacts of one tooth
+"""One MuJoCo contact per tooth flank (`contact.flank_contacts: tooth`): the slice contacts of one tooth
 flank (same tooth, same side: meta[:, 0:2], contiguous in the kernel's order) handed to MuJoCo as one contact.
 
 The contact law is a linear spring per contact whose stiffness is scaled by the contact's share w_i of its slice
-(wormsim.contact3d.law (1); flanks.slice_weights; flank_handoff._fill_add scales solref by w). With a_i = w_i d_i:
+(wormsim.contact3d.law (1); kernel.slice_weights; flank_handoff._fill_add scales solref by w). With a_i = w_i d_i:
 
     depth = sum a_i / W,   W = sum w_i,   pos = sum a_i p_i / sum a_i  (the spring forces' centroid),
     normal = sum a_i n_i / |sum a_i n_i|,   c_w = |sum a_i n_i| / sum a_i,
@@ -101,7 +101,7 @@ def split_forces(adr, efc_force, k0, cone3, grp, share, mfric, mwrap, n, adr_out
     entry k0 + grp[c], constraint rows from adr[k0 + grp[c]]; normal and, with cone3, the two tangent rows) in its own
     frame as slice c's rows in slice c's own frame: normal x share[c] / c_w (the slices' spring forces sum to the
     merged normal force / c_w), friction x share[c] / (c_w mfric) (a slice's own mu). efc_out[3c:3c+3], adr_out[c]
-    = 3c (-1 where the merged contact has no rows). The frames (flanks.contact_frames) turn with the normal about the
+    = 3c (-1 where the merged contact has no rows). The frames (kernel.contact_frames) turn with the normal about the
     worm axis, so a slice's friction keeps its direction relative to its own normal."""
     for c in range(n):
         g = int(grp[c])

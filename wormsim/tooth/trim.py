@@ -1,4 +1,4 @@
-"""Trim of the exact-flank grid (wormsim.contact3d.flanks.flank_grid): flank points that the conjugate worm would
+"""Trim of the exact-flank grid (wormsim.tooth.kernel.flank_grid): flank points that the conjugate worm would
 cut into are not on the generated wheel flank.
 
 meshgen.wheel.space_flank takes each flank point as the envelope maximum over the hob positions found by a grid
@@ -7,8 +7,8 @@ near the wheel tip of flank B) some points lie up to 29 um inside the thread at 
 have removed them, yet the kernel took them as flank and met them as a 76 um deep contact against the 47 um of the
 conjugate pose (docs/contact3d.md, "Variety"). Checked here directly: each backlash-free grid point is turned with
 the wheel through the whole mesh window at the conjugate worm angle (theta1 = theta2 z2 / (hand z1)) and its signed
-distance from the thread (the kernel's closed form, flanks.worm_gap) is taken at every position; a point whose least
-distance is below -TRIM_TOL_M is cut away (nan), like the hob-tip-cut root points.
+distance from the thread (wormsim.tooth.gap.worm_gap) is taken at every position; a point whose least distance
+is below -TRIM_TOL_M is cut away (nan), like the hob-tip-cut root points.
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ import math
 import numba
 import numpy as np
 
-from wormsim.contact3d.flanks import worm_gap
+from wormsim.tooth.gap import worm_gap
 
 TRIM_TOL_M = 5e-8  # generated points: least distance >= 0 (measured); cut points: -1 to -29 um
 POSITIONS_PER_PITCH = 64  # wheel positions per pitch in the sweep

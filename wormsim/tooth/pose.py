@@ -1,5 +1,5 @@
-"""Exact-flank contact with assembly errors (issue 12 on contact3d's `contact.geometry: flanks`): the poses of the
-displaced worm and wheel, as MuJoCo places them, for the kernel (wormsim.contact3d.flanks.find_contacts).
+"""Exact-flank contact with assembly errors (contact3d's `contact.geometry: flanks`): the poses of the
+displaced worm and wheel, as MuJoCo places them, for the kernel (wormsim.tooth.kernel.find_contacts).
 
 Without errors the kernel maps a wheel point of tooth k into the static worm frame by the nominal assembly: turn by
 theta2 + 2 pi k / z2 about z, then (x_s, y_s, z_s) = (y + a, -zeta, -x) (meshgen.assembly). With errors the bodies sit
@@ -33,7 +33,9 @@ import math
 import numba
 import numpy as np
 
-N_WORM_PARAMS = 13  # len(wormsim.contact3d.flanks.worm_params(g)): the nominal kernel's P
+from meshgen.worm_forms_jit import TABLE_LEN
+
+N_WORM_PARAMS = 13 + TABLE_LEN  # len(wormsim.tooth.kernel.worm_params(g)): the nominal kernel's P
 WHEEL = N_WORM_PARAMS  # offsets into the displaced P (module docstring)
 WORM = WHEEL + 12
 SHIFT = WORM + 12
@@ -42,7 +44,7 @@ SHIFT = WORM + 12
 def displaced_params(worm_p: np.ndarray, tooth_shift_rad: np.ndarray) -> np.ndarray:
     """The kernel's P with room for the poses (module docstring); set_pose fills them each step."""
     if worm_p.shape[0] != N_WORM_PARAMS:
-        raise ValueError("flank_pose: worm_params changed length; update N_WORM_PARAMS")
+        raise ValueError("wormsim.tooth.pose: worm_params changed length; update N_WORM_PARAMS")
     P = np.zeros(SHIFT + len(tooth_shift_rad))
     P[:N_WORM_PARAMS] = worm_p
     P[SHIFT:] = tooth_shift_rad

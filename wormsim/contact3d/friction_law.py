@@ -1,0 +1,53 @@
+"""The friction law mu(Vs) in compiled form, the one the runs use (Python sample loop and compiled samples alike):
+wormsim.friction.friction_coefficient_scalar's three forms with its operations, on five parameters (`mu_params`)."""
+
+from __future__ import annotations
+
+import math
+
+import numba
+
+from wormsim.friction import GROUPS, friction_coefficient
+from wormsim.units import DEG
+
+CONSTANT, STEP, GROUP = 0.0, 1.0, 2.0  # mu_params' kind
+
+
+def mu_params(contact) -> tuple[float, float, float, float, float]:
+    """(kind, a, b, c, deg) of the scenario's contact block: constant mu = a; STEP(|Vs|, 0, a = static, b = v_t,
+    c = dynamic); friction group tan(deg / (a |Vs|^b + c)) (seed 000's rho(Vs), wormsim/friction.py)."""
+    if contact.friction_group is not None:
+        a, b, c = GROUPS[contact.friction_group]
+        return GROUP, float(a), float(b), float(c), DEG
+    if contact.friction is None and contact.friction_static is None:
+        return CONSTANT, float(friction_coefficient(contact, 0.0)), 0.0, 0.0, DEG
+    if contact.friction is not None:
+        return CONSTANT, float(contact.friction), 0.0, 0.0, DEG
+    return (
+        STEP,
+        float(contact.friction_static),
+        float(contact.transition_velocity_m_s),
+        float(contact.friction_dynamic),
+        DEG,
+    )
+
+
+@numba.njit(cache=True, inline="always")
+def mu_at(vs, kind, a, b, c, deg):
+    """mu at the sliding speed vs (mu_params' forms; STEP is wormsim.units.step(|vs|, 0, a, b, c))."""
+    if kind == CONSTANT:
+        return a
+    if kind == STEP:
+        t, h0, t1, h1 = abs(vs), a, b, c
+        if t1 <= 0.0:
+            return h1 if t >= 0.0 else h0
+        s = (t - 0.0) / (t1 - 0.0)
+        s = 0.0 if s < 0.0 else (1.0 if s > 1.0 else s)
+        return h0 + (h1 - h0) * s * s * (3.0 - 2.0 * s)
+    return math.tan(deg / (a * abs(vs) ** b + c))
+
+
+@numba.njit(cache=True)
+def mu_of(vs, p):
+    """mu_at with the parameters as one tuple (the Python sample loop's call)."""
+    return mu_at(vs, p[0], p[1], p[2], p[3], p[4])

@@ -1,0 +1,97 @@
+"""The run's guards (docs/contact3d.md, "Failure modes and guards"): after every record interval, non-finite state or
+MuJoCo's bad-qacc warning (divergence), the worm turning more than OVERSPEED_GUARD x MAX_WORM_TURN_PER_STEP_RAD per
+step (overspeed), the transmission error passing JUMP_PITCH of a pitch (teeth jumped), the sliding contacts'
+friction against their slip (wormsim.contact3d.friction_guard), penetration beyond gear_theory.penetration_limit_m,
+and a speed-driven drive stuck below half its command (locked). Each raises its SimulationError subclass
+(wormsim.errors) with what to change; the messages are built in wormsim.contact3d.diagnosis."""
+
+from __future__ import annotations
+
+import math
+
+import mujoco
+import numba
+
+from wormsim import gear_theory as gt
+from wormsim.contact3d.diagnosis import (
+    JUMP_PITCH,
+    diverged_error,
+    jump_error,
+    locked_error,
+    overspeed_error,
+    penetration_error,
+)
+from wormsim.contact3d.friction_guard import FrictionGuard
+from wormsim.contact3d.mjcf import BuiltModel
+from wormsim.contact3d.timestep import MAX_WORM_TURN_PER_STEP_RAD, OVERSPEED_GUARD
+from wormsim.scenario import Scenario
+from wormsim.units import rad_s_to_rpm
+
+DIVERGED, OVERSPEED, JUMPED = 1, 2, 3  # state_event's codes (0: none)
+
+
+@numba.njit(cache=True, inline="always")
+def state_event(th1, th2, w1, w2, badqacc, dt, turn_lim, direction, ratio, jump_rad):
+    """The state checks of a sample, in order: DIVERGED (non-finite state or MuJoCo's bad-qacc warning count
+    badqacc), OVERSPEED (the worm's turn per step |w1| dt beyond turn_lim), JUMPED (the transmission error
+    th2 - direction th1 / ratio beyond jump_rad), 0 when none fires; with (the TE, the turn). Guards.state and the
+    compiled samples (wormsim.contact3d.flank_samples) both decide by it."""
+    if not math.isfinite(th1 + th2 + w1 + w2) or badqacc != 0:
+        return DIVERGED, 0.0, 0.0
+    turn = abs(w1) * dt
+    if turn > turn_lim:
+        return OVERSPEED, 0.0, turn
+    te = th2 - direction * th1 / ratio
+    if abs(te) > jump_rad:
+        return JUMPED, te, turn
+    return 0, te, turn
+
+
+class Guards:
+    """The checks after every record interval (module docstring); each raises its SimulationError subclass."""
+
+    def __init__(self, bm: BuiltModel, scenario: Scenario, dt: float, rec: int):
+        self.bm, self.scenario, self.dt = bm, scenario, dt
+        geo = bm.geometry
+        self.pen_lim = gt.penetration_limit_m(geo.m_x)
+        self.pitch_angle = 2 * math.pi / geo.z2
+        self.turn_lim = OVERSPEED_GUARD * MAX_WORM_TURN_PER_STEP_RAD
+        self.jump_rad = JUMP_PITCH * self.pitch_angle
+        self.lock_start = gt.lock_check_start_s(scenario)
+        self.lock_hold = max(gt.LOCK_HOLD_S, 20 * rec * dt)
+        self.speed_driven = scenario.drive.speed_rpm is not None
+        self.locked_since: float | None = None
+        self.turn_max = 0.0
+        # sliding contacts' friction against their slip (wormsim.contact3d.friction_guard)
+        self.friction = FrictionGuard(scenario, bm, bm.plan.normal_force_n, rec * dt)
+
+    def state(self, d: mujoco.MjData, t: float, th1: float, th2: float, w1: float, w2: float) -> float:
+        """Divergence, overspeed, teeth jumped, friction against the slip; returns the transmission error (rad)."""
+        bm, dt = self.bm, self.dt
+        badqacc = d.warning[mujoco.mjtWarning.mjWARN_BADQACC].number
+        code, te, turn = state_event(
+            th1, th2, w1, w2, badqacc, dt, self.turn_lim, float(bm.direction), bm.geometry.ratio, self.jump_rad
+        )
+        if code == DIVERGED:
+            raise diverged_error(t, dt, bm, "non-finite state or huge acceleration (MuJoCo's bad-qacc warning)")
+        self.turn_max = max(self.turn_max, turn)
+        if code == OVERSPEED:
+            if dt > bm.law.stable_limit_s:
+                raise diverged_error(t, dt, bm, f"the worm ran away to {rad_s_to_rpm(abs(w1)):.0f} rpm")
+            raise overspeed_error(t, w1, dt)
+        if code == JUMPED:
+            raise jump_error(t, te / self.pitch_angle, dt, bm, self.scenario)
+        self.friction.check(d, t, w1, w2)
+        return te
+
+    def contact(self, t: float, pen: float, w_drive: float, cmd: float) -> None:
+        """Penetration beyond the limit; a speed-driven drive stuck below half its command (locked)."""
+        if pen > self.pen_lim:
+            raise penetration_error(t, pen, self.pen_lim, self.dt, self.bm)
+        if self.speed_driven and t > self.lock_start:
+            if gt.drive_stuck(w_drive, cmd):
+                self.locked_since = t if self.locked_since is None else self.locked_since
+                if t - self.locked_since > self.lock_hold:
+                    raise locked_error(t, w_drive, cmd, self.bm, self.scenario)
+            else:
+                self.locked_since = None

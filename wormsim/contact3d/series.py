@@ -1,0 +1,71 @@
+"""The run's time series: their names in row order (SERIES, the layout of the series array) and one sample's column
+(`column`), compiled once and called by the Python sample loop (wormsim.contact3d.runner) and by the compiled one
+(wormsim.contact3d.flank_samples) alike.
+
+The interval's mean resultant on the wheel is resolved at the pitch point P = (0, -r2, 0) on the line of centres, in
+the wheel's directions there (DIN 3975 F_t2, F_r2, F_a2; seed 001 resolves ADAMS's contact force the same way):
+tangential e_t = +x, radial e_r = -y (outward, towards the worm), axial e_z. The contact torque M_z is kept apart:
+M_z / r2 equals the mean F_t, but by the wheel's torque balance it varies only through I2 alpha2 and hides the mesh."""
+
+from __future__ import annotations
+
+import numba
+
+SERIES = (
+    "t_s",
+    "worm_angle_rad",
+    "wheel_angle_rad",
+    "worm_speed_rpm",
+    "wheel_speed_rpm",
+    "worm_torque_nm",
+    "wheel_torque_nm",
+    "drive_command",
+    "tangential_force_n",
+    "radial_force_n",
+    "axial_force_n",
+    "contacts",
+    "teeth_in_contact",
+    "max_penetration_m",
+    "friction_coefficient",
+    "transmission_error_rad",
+    "wheel_contact_torque_nm",
+    "worm_power_w",
+    "wheel_power_w",
+    "tangential_force_abs_max_n",
+    "radial_force_line_of_centres_n",
+    "worm_contact_radius_m",
+    "efficiency_theory_at_contact_radius",
+)
+
+
+@numba.njit(cache=True)
+def column(t, th1, th2, w1, w2, cmd, sums, rec, nteeth, pen, mu, te, fr_lc, r_c, rpm):
+    """One sample's column in SERIES order: the state at the interval's end, the interval's per-step sums
+    sums = (T1, T2, P1, P2, contacts, F_x, F_y, F_z, M_z, |F_x| peak) over its rec steps as means, and the sample's
+    contact outputs; rpm = (rad/s) per rpm. The efficiency at the contact radius is filled after the run."""
+    t1, t2, p1, p2, nc, fx, fy, fz, mz, fpk = sums
+    return (
+        t,  # t_s
+        th1,  # worm_angle_rad
+        th2,  # wheel_angle_rad
+        w1 / rpm,  # worm_speed_rpm
+        w2 / rpm,  # wheel_speed_rpm
+        t1 / rec,  # worm_torque_nm
+        t2 / rec,  # wheel_torque_nm
+        cmd,  # drive_command
+        fx / rec,  # tangential_force_n
+        -fy / rec,  # radial_force_n
+        fz / rec,  # axial_force_n
+        nc / rec,  # contacts
+        float(nteeth),  # teeth_in_contact
+        pen,  # max_penetration_m
+        mu,  # friction_coefficient
+        te,  # transmission_error_rad
+        mz / rec,  # wheel_contact_torque_nm
+        p1 / rec,  # worm_power_w
+        p2 / rec,  # wheel_power_w
+        fpk,  # tangential_force_abs_max_n
+        fr_lc,  # radial_force_line_of_centres_n
+        r_c,  # worm_contact_radius_m
+        0.0,  # efficiency_theory_at_contact_radius
+    )

@@ -1,0 +1,187 @@
+"""The contact sources of a contact3d run, behind one interface the runner drives (wormsim.contact3d.runner):
+
+    steps(cmd, load, o, rec) -> (T1, T2, P1, P2, contacts, F_x, F_y, F_z, M_z, |F_x| peak) summed over rec steps,
+    sample(i, th2, mu, rlog, store) -> (teeth touching, largest penetration, F_r at the line of centres, contact
+                                        radius), with row i of store (points in tooth 0's frame, forces, points),
+    fast: the compiled record intervals (wormsim.contact3d.flank_samples) where the source has them, else None,
+    finish(S, summary, extra): the source's own summary keys and outputs after the loop.
+
+PieceSource: the convex collision pieces in MuJoCo's own collision (contact.geometry pieces), stepped by mj_step.
+FlankSource: the exact flanks (contact.geometry flanks, wormsim.tooth's kernel) handed to MuJoCo between collision and
+constraints, stepped by the compiled loop (wormsim.contact3d.flank_loop)."""
+
+from __future__ import annotations
+
+import functools
+import math
+
+import mujoco
+import numpy as np
+
+from wormsim import gear_theory as gt
+from wormsim.contact3d.mjcf import BuiltModel
+from wormsim.contact3d.slots import repose_window
+
+_ROWS3 = np.arange(3)  # the normal and two tangent rows of an elliptic-cone contact
+
+
+class PieceSource:
+    """contact.geometry pieces: MuJoCo's collision of the convex pieces, the wheel's window re-posed per sample."""
+
+    fast = None
+
+    def __init__(self, bm: BuiltModel, d: mujoco.MjData, io: tuple):
+        """io = (drive actuator, load actuator, worm actuator, wheel actuator, contact sensor address)."""
+        self.bm, self.m, self.d = bm, bm.model, d
+        self.io = io
+        self.coll = np.concatenate([bm.worm_geoms, bm.wheel_slot_geoms.ravel()])
+        self.window = repose_window(bm, 0.0)
+        self.mu_set: float | None = None
+        mujoco.mj_forward(self.m, d)
+
+    def steps(self, cmd_blk: list, load_blk: list, o: int, rec: int) -> tuple:
+        """Steps o..o+rec-1 of the block's commands one mj_step each; the per-step sums of the module docstring
+        (the actuator forces of each step, computed at its start with the speeds read before it; the contact
+        sensor's resultant: found, F (3), torque about the point (3), point (3); global frame, on the wheel)."""
+        m, d, bm = self.m, self.d, self.bm
+        ia_drv, ia_load, a1, a2, s0 = self.io
+        sd, act, qv, ctrl = d.sensordata, d.actuator_force, d.qvel, d.ctrl
+        dof1, dof2 = bm.worm_dof, bm.wheel_dof
+        fx = fy = fz = mz = nc = t1 = t2 = p1 = p2 = fpk = 0.0
+        for j in range(o, o + rec):
+            ctrl[ia_drv] = cmd_blk[j]
+            ctrl[ia_load] = load_blk[j]
+            w1j, w2j = qv[dof1], qv[dof2]
+            mujoco.mj_step(m, d)
+            q1, q2 = act[a1], act[a2]
+            t1 += q1
+            t2 += q2
+            p1 += q1 * w1j
+            p2 += q2 * w2j
+            nc += sd[s0]
+            f0, f1, f2 = sd[s0 + 1], sd[s0 + 2], sd[s0 + 3]
+            fx += f0
+            if abs(f0) > fpk:  # the per-step peak (the start-up impact is shorter than an interval)
+                fpk = abs(f0)
+            fy += f1
+            fz += f2
+            mz += sd[s0 + 6] + sd[s0 + 7] * f1 - sd[s0 + 8] * f0
+        return t1, t2, p1, p2, nc, fx, fy, fz, mz, fpk
+
+    def sample(self, i: int, th2: float, mu: float, rlog, store: tuple) -> tuple:
+        """Re-pose the window, set mu on the pieces, read the contacts (contact_details)."""
+        bm = self.bm
+        self.window = repose_window(bm, th2, self.window)
+        if mu != self.mu_set:
+            self.m.geom_friction[self.coll, 0] = self.mu_set = mu
+        nteeth, pen, p0, F, pw = contact_details(bm, self.d, self.window)
+        fr_lc, r_c = _store_points(i, p0, F, pw, rlog, store, bm.geometry.a)
+        return nteeth, pen, fr_lc, r_c
+
+    def finish(self, S: dict, summary: dict, extra: dict) -> None:
+        """Nothing of its own."""
+
+
+class FlankSource:
+    """contact.geometry flanks: the exact-flank contacts (wormsim.contact3d.flank_step) in the compiled step loop,
+    the contact pattern and Hertz pressure logged per sample (wormsim.tooth.hertz)."""
+
+    def __init__(self, bm: BuiltModel, d: mujoco.MjData, io: tuple, scenario, guards, rec: int, S_all, store):
+        from wormsim.contact3d.flank_loop import FlankLoop
+        from wormsim.contact3d.flank_samples import FlankSamples
+        from wormsim.contact3d.flank_step import FlankContacts, split_forward
+        from wormsim.tooth.hertz import PatternLog
+
+        self.bm, self.d = bm, d
+        self.fc = fc = FlankContacts(bm, bm.law.contacts_per_pair)
+        self.pattern = PatternLog(fc, gt.effective_modulus_pa(scenario.materials))
+        split_forward(bm.model, d, fc.add)
+        self.coll = np.zeros(0, dtype=int)
+        self.loop = FlankLoop(fc, d, *io)
+        self.fast = FlankSamples(self.loop, guards, scenario, bm, scenario.drive.on == "worm", rec, S_all)
+        self.fast.bind(store)
+
+    def steps(self, cmd_arr: np.ndarray, load_arr: np.ndarray, o: int, rec: int) -> tuple:
+        """Steps o..o+rec-1 in one compiled call (FlankLoop.run); its sums."""
+        return tuple(self.loop.run(cmd_arr, load_arr, o, o + rec).tolist())
+
+    def sample(self, i: int, th2: float, mu: float, rlog, store: tuple) -> tuple:
+        """Set mu on the flank contacts; read them (compiled: FlankLoop.sample; with assembly errors
+        flank_contact_details and the pattern's rows)."""
+        fc = self.fc
+        fc.set_friction(mu)
+        if not fc.displaced:
+            return self.loop.sample(i, self.pattern, rlog, store)
+        from wormsim.contact3d.flank_step import flank_contact_details
+
+        nteeth, pen, p0, F, pw = flank_contact_details(fc, self.d)
+        self.pattern.record(i, self.d)
+        fr_lc, r_c = _store_points(i, p0, F, pw, rlog, store, self.bm.geometry.a)
+        return nteeth, pen, fr_lc, r_c
+
+    def finish(self, S: dict, summary: dict, extra: dict) -> None:
+        """The loaded contact pattern and Hertz stress over the steady window (wormsim.tooth.hertz)."""
+        summary.update(self.pattern.summary(S["t_s"], summary["steady_window_s"]))
+        extra["flank_pattern"] = self.pattern.grid(S["t_s"], summary["steady_window_s"])
+
+
+def _store_points(i: int, p0, F, pw, rlog, store: tuple, a: float) -> tuple[float, float]:
+    """Row i of store (up to its width) and the radius log's rows; returns (F_r at the line of centres, radius)."""
+    pts, forces, pts_world = store
+    k = min(len(p0), pts.shape[1])
+    pts[i, :k], forces[i, :k], pts_world[i, :k] = p0[:k], F[:k], pw[:k]
+    return rlog.add(i, F, pw, a)
+
+
+def contact_details(bm: BuiltModel, d: mujoco.MjData, window_ks: np.ndarray):
+    """The contacts one by one (the resultant comes from the contact sensor): (n_teeth touching, max penetration,
+    points in the frame of wheel tooth 0 (n, 3), forces on the wheel (n, 3) world, points (n, 3) world). Forces are
+    the elliptic-cone rows (normal, two tangents: what mj_contactForce returns) turned into the world frame."""
+    n = d.ncon
+    if n == 0:
+        z = np.zeros((0, 3))
+        return 0, 0.0, z, z, z
+    con = d.contact
+    adr = np.asarray(con.efc_address[:n])
+    ok = adr >= 0
+    geom = np.asarray(con.geom[:n])[ok]
+    adr = adr[ok]
+    frame = np.asarray(con.frame[:n])[ok].reshape(-1, 3, 3)
+    pos = np.asarray(con.pos[:n])[ok]
+    dist = np.asarray(con.dist[:n])[ok]
+    f = d.efc_force[adr[:, None] + _ROWS3]
+    F = np.einsum("ni,nij->nj", f, frame)  # force on geom2, world frame
+    wheel_is_2 = bm.model.geom_bodyid[geom[:, 1]] != bm.worm_body
+    F = np.where(wheel_is_2[:, None], F, -F)  # force on the wheel
+    wheel_geom = np.where(wheel_is_2, geom[:, 1], geom[:, 0])
+    # tooth index of each contact: slot -> tooth in the current window
+    W = bm.window_teeth
+    slots = slot_lookup(bm)[wheel_geom]
+    tooth_of_slot = np.zeros(W, dtype=int)
+    tooth_of_slot[np.asarray(window_ks) % W] = window_ks
+    ks = tooth_of_slot[slots]
+    # contact points in tooth-0 frame: undo wheel rotation and tooth angle
+    th2 = float(d.qpos[bm.model.jnt_qposadr[bm.model.dof_jntid[bm.wheel_dof]]])
+    ang = -(th2 + 2 * math.pi * ks / bm.geometry.z2)
+    c, s = np.cos(ang), np.sin(ang)
+    p0 = np.stack([c * pos[:, 0] - s * pos[:, 1], s * pos[:, 0] + c * pos[:, 1], pos[:, 2]], axis=1)
+    pen = float(max(0.0, -dist.min())) if len(dist) else 0.0
+    return int(np.unique(ks).size), pen, p0, F, pos
+
+
+def slot_lookup(bm: BuiltModel) -> np.ndarray:
+    """Geom id -> window slot of the wheel's collision geoms (-1 elsewhere), computed once per model layout."""
+    rows = np.ascontiguousarray(bm.wheel_slot_geoms, dtype=np.int64)
+    return _slot_table(int(bm.model.ngeom), rows.shape, rows.tobytes())
+
+
+@functools.lru_cache(maxsize=8)
+def _slot_table(ngeom: int, shape: tuple[int, ...], slot_geoms: bytes) -> np.ndarray:
+    """The lookup of slot_lookup, keyed by its content: the model's geom count and the slots' geom ids (a sweep
+    that runs several scenarios in one process gets each model's own table)."""
+    rows = np.frombuffer(slot_geoms, dtype=np.int64).reshape(shape)
+    lut = np.full(ngeom, -1, dtype=int)
+    for s, row in enumerate(rows):
+        lut[row] = s
+    lut.flags.writeable = False
+    return lut

@@ -1,0 +1,108 @@
+"""The worm gap: the signed normal distance of a point from the worm thread, in compiled form (numba), for the
+contact kernel (wormsim.tooth.kernel) and the trim (wormsim.tooth.trim).
+
+A point in the static worm frame (meshgen.assembly: x_s = y + a, y_s = -z, z_s = -x) at radius r and angle phi has the
+closed form of meshgen.worm.thread_gap (equations (1), (2) there):
+
+    u = wrap(z_s - p (phi - theta1), p_x),   G = (|u| - H(r)) / |grad G|,
+    grad G = sign(u) (e_z - (p / r) e_phi) - H'(r) e_r,                                              (1)
+
+negative inside the thread, valid for r_f1 <= r <= r_a1 and |z_s| <= b1 / 2; worm_gap_ext evaluates it past these
+bounds too (the flank extended) and returns the excess by which the point lies outside. The module repeats the
+worm's H(r) (meshgen.worm.half_thickness, ZI/ZA); tests/test_flank_contact.py pins it to meshgen.worm.thread_gap.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+
+from meshgen import worm, worm_forms, worm_forms_jit
+from meshgen.geometry import GearGeometry
+
+
+def worm_params(g: GearGeometry) -> np.ndarray:
+    """Scalars of meshgen.worm's closed form, in the order the kernel reads them."""
+    zi = 1.0 if g.profile == "ZI" else 2.0 if g.profile in worm_forms.TABLE_FORMS else 0.0
+    t1 = math.sqrt(max(g.r1**2 / g.r_b**2 - 1.0, 0.0)) if zi == 1.0 else 0.0
+    table = worm_forms.form_table(g).params() if zi == 2.0 else np.zeros(worm_forms_jit.TABLE_LEN)
+    head = np.array(
+        [
+            g.p,
+            g.p_x,
+            g.r_f1,
+            g.r_a1,
+            g.worm_length / 2,
+            zi,
+            g.r_b,
+            math.tan(g.alpha_x),
+            t1 - math.atan(t1),
+            g.r1,
+            g.a,
+            2 * math.pi / g.z2,
+            g.hand * g.z1 / g.z2,
+        ],
+        dtype=float,
+    )
+    return np.concatenate([head, table])  # ZN, ZK, ZC: H(r)'s table at P[13:] (meshgen.worm_forms_jit)
+
+
+@numba.njit(cache=True, inline="always")
+def _half_thickness(r, P):
+    """meshgen.worm.half_thickness and its derivative dH/dr (ZI equation (2), ZA straight; ZN, ZK, ZC the table)."""
+    p, p_x, r1 = P[0], P[1], P[9]
+    if P[5] > 1.5:
+        return worm_forms_jit.half_thickness(r, P, 13)
+    if P[5] > 0.5:
+        r_b = P[6]
+        x = r * r / (r_b * r_b) - 1.0
+        t = math.sqrt(x) if x > 0.0 else 0.0
+        ap = abs(p)
+        return p_x / 4 - ap * ((t - math.atan(t)) - P[8]), -ap * t / r
+    return p_x / 4 - (r - r1) * P[7], -P[7]
+
+
+@numba.njit(cache=True, inline="always")
+def _wrap(x, period):
+    """x wrapped to [-period / 2, period / 2): Python's (x + period / 2) % period - period / 2 with floor, inlined
+    (numba's float % calls a helper around fmod: 15 % of the kernel's time); equal to it within an ulp of x."""
+    w = x + 0.5 * period
+    return w - period * math.floor(w / period) - 0.5 * period
+
+
+@numba.njit(cache=True, inline="always")
+def worm_gap_ext(xs, ys, zs, theta1, P, out):
+    """Signed normal distance (1) of a static-worm-frame point from the thread flank extended past the worm's tip,
+    root and end faces, the unit gradient (static worm frame) in out[0:3], and the excess (m) by which the point is
+    outside the threaded region: max(r - r_a1, r_f1 - r, |z_s| - b1/2) (<= 0 inside). Returns (gap, excess)."""
+    r = math.sqrt(xs * xs + ys * ys)
+    ex = max(r - P[3], P[2] - r, abs(zs) - P[4])
+    p, p_x = P[0], P[1]
+    phi = math.atan2(ys, xs)
+    u = _wrap(zs - p * (phi - theta1), p_x)
+    H, dH = _half_thickness(r, P)
+    sg = 1.0 if u >= 0.0 else -1.0
+    ir = 1.0 / r
+    cp, sp = xs * ir, ys * ir
+    # grad G = sg (e_z - p/r e_phi) - H' e_r, e_r = (c, s, 0), e_phi = (-s, c, 0)
+    gx = sg * (p * ir) * sp - dH * cp
+    gy = -sg * (p * ir) * cp - dH * sp
+    gz = sg
+    inrm = 1.0 / math.sqrt(gx * gx + gy * gy + gz * gz)
+    out[0], out[1], out[2] = gx * inrm, gy * inrm, gz * inrm
+    return (abs(u) - H) * inrm, ex
+
+
+@numba.njit(cache=True)
+def worm_gap(xs, ys, zs, theta1, P, out):
+    """Signed normal distance (1) of a static-worm-frame point and the unit gradient (static worm frame) in out[0:3].
+    Returns +inf where there is no thread (r outside [r_f1, r_a1] or |z_s| > b1/2)."""
+    gv, ex = worm_gap_ext(xs, ys, zs, theta1, P, out)
+    return np.inf if ex > 0.0 else gv
+
+
+def gap_reference(g: GearGeometry, pts_static: np.ndarray, theta1: float) -> np.ndarray:
+    """meshgen.worm.thread_gap on static-worm-frame points (the reference the kernel is tested against)."""
+    return worm.thread_gap(g, pts_static, theta1)
