@@ -14,15 +14,12 @@ radial 20 N/um, axial 10 N/um; its POM wheel on a steel pin, bushings 16 mm apar
 from __future__ import annotations
 
 import argparse
-import datetime
 import json
-import os
-import platform
-import subprocess
 import sys
 from pathlib import Path
 
 from wormsim.contact3d.runner import simulate
+from wormsim.provenance import provenance
 from wormsim.scenario import Scenario, load_scenario
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -104,14 +101,10 @@ def main(argv: list[str] | None = None) -> None:
                 row.update({k: s.get(k) for k in KEYS})
                 rows.append(row)
                 print(json.dumps(row), flush=True)
-    commit = subprocess.run(["git", "rev-parse", "HEAD"], cwd=ROOT, capture_output=True, text=True).stdout.strip()
     doc = {
-        "provenance": {
-            "command": " ".join(["python", "sweeps/shafts_study.py", *(argv if argv is not None else sys.argv[1:])]),
-            "commit": commit,
-            "date": datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds"),
-            "machine": {"node": platform.node(), "cpus": os.cpu_count(), "python": platform.python_version()},
-        },
+        "provenance": provenance(
+            " ".join(["python", "sweeps/shafts_study.py", *(argv if argv is not None else sys.argv[1:])])
+        ),
         "runs": {k: {"set": v["set"], "shafts": v["shafts"], "loads_nm": v["loads_nm"]} for k, v in RUNS.items()},
         "rows": rows,
     }

@@ -119,8 +119,10 @@ def _balance(s: dict, S: dict) -> None:
     def mean(key: str) -> float:
         return float(np.mean(S[key][sl]))
 
-    # the force on the wheel in the assembly frame (runner: tangential +x, radial -y, axial +z)
-    F = np.array([mean("tangential_force_n"), -mean("radial_force_n"), mean("axial_force_n")])
+    # the force on the wheel in the assembly frame from the series' signs (docs/outputs.md: tangential +x, radial
+    # positive towards the wheel axis = +y, axial along -hand z; a right-hand worm here)
+    hand = 1.0
+    F = np.array([mean("tangential_force_n"), mean("radial_force_n"), -hand * mean("axial_force_n")])
     assert s["worm_bearing_axial_mean_n"] == pytest.approx(s["tangential_force_mean_n"], rel=0.03)
     assert s["wheel_bearing_axial_mean_n"] == pytest.approx(s["axial_force_mean_n"], rel=0.03)
     # worm: the bearings' forces on the shaft balance the mesh force on the worm (-F) across its axis (worm frame)

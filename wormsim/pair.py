@@ -358,10 +358,11 @@ class WormPair:
     def mesh_forces(self, data: mujoco.MjData) -> tuple[float, float, float]:
         """(ft, fr, fa) [N]: the resultant of the pair's tooth forces on the wheel at the last step (the contact
         forces of the constraint solve: normal and two friction rows of each flank contact), resolved in the pair's
-        assembly frame as it sits in the parent body now: tangential +x (the wheel's positive sense at the pitch
-        point on the line of centres), radial -y (outward, towards the worm), axial +z (the wheel axis). The
-        contact3d series' convention (tangential_force_n, radial_force_n, axial_force_n); the summary's
-        *_force_mean_n are the magnitudes of their means."""
+        assembly frame as it sits in the parent body now, in the sign convention of docs/outputs.md
+        (wormsim.outputs.FORCE_SIGNS, as contact3d's series tangential_force_n, radial_force_n, axial_force_n):
+        tangential along +x (the wheel's positive sense at the pitch point on the line of centres), radial positive
+        towards the wheel axis (+y, the separating force), axial along -hand z (F_a2 = F_t2 tan(gamma + rho') with
+        its sign); the summary's *_force_mean_n are the magnitudes of their means."""
         b = self._bound()
         F = np.zeros(3)
         con = data.contact
@@ -374,7 +375,7 @@ class WormPair:
             F = np.einsum("ni,nij->j", f, fr)  # on geom 2, the wheel
         R = data.xmat[b.parent_body].reshape(3, 3) @ b.R0  # the assembly frame in the world
         x, y, z = R.T @ F
-        return float(x), float(-y), float(z)
+        return float(x), float(y), float(-self.geometry.hand * z)
 
 
 def _check_options(pair: WormPair, model: mujoco.MjModel) -> None:
