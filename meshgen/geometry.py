@@ -32,15 +32,14 @@ import math
 from dataclasses import asdict, dataclass
 from typing import Literal, Protocol
 
+from meshgen import worm_forms
+from meshgen.errors import GeometryError
+from meshgen.worm_forms import DEFAULT_PROFILE_RADIUS_MODULES, DEFAULT_TOOL_DIAMETER_MM
+
 # meshgen reads gear data in the units of its field names (mm, deg) and works in SI: these are its conversions
 # (the simulator's are in wormsim.units; meshgen imports nothing from wormsim)
 MM = 1e-3  # m per mm
 DEG = math.pi / 180.0  # rad per deg
-
-
-class GeometryError(ValueError):
-    """Gear data that cannot be made (pointed or undercut teeth, a too wide face...). The message names the field
-    of the gear data (as in a scenario's `gear:` block, e.g. gear.backlash_mm) and what is allowed."""
 
 
 class GearData(Protocol):
@@ -168,8 +167,6 @@ class GearGeometry:
         return out
 
 
-DEFAULT_TOOL_DIAMETER_MM = 100.0  # ZK, ZC disc (meshgen.worm_forms, docs/flank_forms.md)
-DEFAULT_PROFILE_RADIUS_MODULES = 5.5  # ZC tool arc radius / m_x (meshgen.worm_forms, docs/flank_forms.md)
 Q_MAX = 40.0  # largest diameter quotient (the schema's bound on gear.diameter_quotient)
 WORM_LENGTH_MAX = 4.0  # threaded length at most 4 x the mesh zone (the default length)
 
@@ -305,8 +302,6 @@ def derive(gear: GearData) -> GearGeometry:
         wheel_tooth_thickness=s2,
         ratio=z2 / z1,
     )
-    from meshgen import worm_forms  # the flank form's tool (it imports this module)
-
     if g.profile in worm_forms.TABLE_FORMS:
         worm_forms.form_table(g)  # GeometryError here where the tool cannot generate the flank
     return g

@@ -70,11 +70,17 @@ from __future__ import annotations
 import functools
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.polynomial import chebyshev as C
 
-from meshgen.geometry import DEFAULT_PROFILE_RADIUS_MODULES, DEFAULT_TOOL_DIAMETER_MM, GearGeometry, GeometryError
+from meshgen.errors import GeometryError
+
+Gear = Any  # a meshgen.geometry.GearGeometry (not imported: meshgen.geometry imports this module)
+
+DEFAULT_TOOL_DIAMETER_MM = 100.0  # ZK, ZC disc (docs/flank_forms.md)
+DEFAULT_PROFILE_RADIUS_MODULES = 5.5  # ZC tool arc radius / m_x (docs/flank_forms.md)
 
 N_CHEB = 40  # Chebyshev terms of the H(r) table
 TABLE_TOL_M = 1e-9  # the table's largest allowed deviation from the exact H(r) (form_table's check)
@@ -89,13 +95,13 @@ __all__ = [
 ]
 
 
-def _geom(g: GearGeometry):
+def _geom(g: Gear):
     ap = abs(g.p)
     L = math.hypot(g.r1, ap)
     return ap, ap / L, g.r1 / L
 
 
-def _normal_line_u(g: GearGeometry, r, sigma0: float, slope: float):
+def _normal_line_u(g: Gear, r, sigma0: float, slope: float):
     """u(r) on the helicoid swept by the normal-section line sigma = sigma0 + slope (x - r1) (equations (1), (2))."""
     ap, s, c = _geom(g)
     r = np.asarray(r, float)
@@ -112,7 +118,7 @@ def _normal_line_u(g: GearGeometry, r, sigma0: float, slope: float):
     return sg * c + ap * np.arctan(sg * s / x)
 
 
-def _tool_profile(g: GearGeometry, rho, w0: float):
+def _tool_profile(g: Gear, rho, w0: float):
     """W_t(rho) and dW_t/drho of the ZK / ZC tool (equation (3))."""
     Rt = g.tool_diameter / 2
     if g.profile == "ZK":
@@ -126,7 +132,7 @@ def _tool_profile(g: GearGeometry, rho, w0: float):
     return wc + q, -d / q
 
 
-def _tool_point(g: GearGeometry, rho, theta, w0: float):
+def _tool_point(g: Gear, rho, theta, w0: float):
     """X(rho, theta) of equation (3) and dX/drho."""
     _, s, c = _geom(g)
     cx = g.r1 + g.tool_diameter / 2
@@ -137,7 +143,7 @@ def _tool_point(g: GearGeometry, rho, theta, w0: float):
     return X, dX
 
 
-def _u_on_cylinder(g: GearGeometry, r, theta, w0: float):
+def _u_on_cylinder(g: Gear, r, theta, w0: float):
     """u of the tool point at angle theta on the worm cylinder r (rho by Newton on r(X)^2 = r^2); nan where none."""
     ap, _, _ = _geom(g)
     Rt = g.tool_diameter / 2
@@ -158,7 +164,7 @@ def _u_on_cylinder(g: GearGeometry, r, theta, w0: float):
     return np.where(ok, u, np.nan)
 
 
-def tool_tip_radius(g: GearGeometry) -> float:
+def tool_tip_radius(g: Gear) -> float:
     """The disc's tip radius: R_t + (r1 - r_lo) + 1.5 m_x, 1.5 m_x past the depth of the table's range (module
     docstring; at a large lead angle the contact at r_lo lies off the disc's mid-plane, further out on the disc). The
     disc exists only up to it; an unbounded disc would reach round a slender worm's axis and cut it on the far side."""
@@ -166,7 +172,7 @@ def tool_tip_radius(g: GearGeometry) -> float:
     return g.tool_diameter / 2 + (g.r1 - lo) + 1.5 * g.m_x
 
 
-def _space_half_width_tool(g: GearGeometry, r, w0: float, n_grid: int = 41, n_newton: int = 12):
+def _space_half_width_tool(g: Gear, r, w0: float, n_grid: int = 41, n_newton: int = 12):
     """W(r) of equation (4) for the ZK / ZC disc: grid search over theta, then Newton on du/dtheta = 0."""
     r = np.atleast_1d(np.asarray(r, float))
     Rt = g.tool_diameter / 2
@@ -189,16 +195,16 @@ def _space_half_width_tool(g: GearGeometry, r, w0: float, n_grid: int = 41, n_ne
     return _u_on_cylinder(g, r, th, w0)
 
 
-def _space_half_width_normal(g: GearGeometry, r, sigma0: float):
+def _space_half_width_normal(g: Gear, r, sigma0: float):
     return _normal_line_u(g, r, sigma0, +math.tan(g.alpha_n))
 
 
-def exact_half_thickness(g: GearGeometry, r) -> np.ndarray:
+def exact_half_thickness(g: Gear, r) -> np.ndarray:
     """H(r) of the ZN / ZK / ZC flank by equations (2)-(4), the tool set for H(r1) = p_x / 4 (module docstring)."""
     return _exact(g, np.atleast_1d(np.asarray(r, float)), tool_setting(g))
 
 
-def _exact(g: GearGeometry, r, k0: float):
+def _exact(g: Gear, r, k0: float):
     if g.profile == "ZN" and g.zn_section == "thread":
         return _normal_line_u(g, r, k0, -math.tan(g.alpha_n))
     if g.profile == "ZN":
@@ -207,7 +213,7 @@ def _exact(g: GearGeometry, r, k0: float):
 
 
 @functools.lru_cache(maxsize=64)
-def tool_setting(g: GearGeometry) -> float:
+def tool_setting(g: Gear) -> float:
     """sigma_0 (ZN) or w_0 (ZK, ZC) with H(r1) = p_x / 4 (secant iteration from the normal thickness p_x cos / 4)."""
     _check_tool(g)
     _, _, c = _geom(g)
@@ -227,7 +233,7 @@ def tool_setting(g: GearGeometry) -> float:
     return k1
 
 
-def _check_tool(g: GearGeometry) -> None:
+def _check_tool(g: Gear) -> None:
     """The disc must reach over the table's range of depth (module docstring): R_t > depth, and for ZC the arc must
     cover it, rho_c (1 - sin alpha_n) >= 1.5 (h_f + 0.1 m_x) (its tangent turns radial at the arc's end)."""
     if g.profile not in ("ZK", "ZC"):
@@ -273,14 +279,14 @@ class FormTable:
         return np.concatenate([[self.r_lo, self.r_hi], self.coef])
 
 
-def table_range(g: GearGeometry) -> tuple[float, float]:
+def table_range(g: Gear) -> tuple[float, float]:
     """[r1 - h_f - 0.1 m_x, r1 + h_f + 0.1 m_x]: the worm root to past the hob's tip (module docstring)."""
     d = g.h_f + 0.1 * g.m_x
     return g.r1 - d, g.r1 + d
 
 
 @functools.lru_cache(maxsize=64)
-def form_table(g: GearGeometry) -> FormTable:
+def form_table(g: Gear) -> FormTable:
     """The H(r) table of a ZN / ZK / ZC worm (exact values at the Chebyshev points of the range)."""
     lo, hi = table_range(g)
     k = np.arange(N_CHEB)

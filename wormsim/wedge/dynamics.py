@@ -279,12 +279,8 @@ def _segment_times(grid: np.ndarray, t0: float, t1: float, extra=()) -> np.ndarr
 
 
 def simulate(scenario, progress=None) -> Result:
-    """Integrate the wedge model of `scenario` (model: wedge) and return series and summary: from its wedge: block,
-    or derived from gear:, drive:, load: when it has none (wormsim.wedge.derive)."""
-    if scenario.wedge is None:
-        from wormsim.wedge import derive
-
-        return derive.simulate_derived(scenario, progress)
+    """Integrate the wedge model of `scenario`'s wedge: block (seed 000's valve case) and return series and
+    summary; a scenario without one goes to wormsim.wedge.derive (wormsim.wedge.level picks)."""
     p = params_from_scenario(scenario)
     res = simulate_params(p, progress=progress, name=scenario.name)
     res.summary["wedge_source"] = "wedge: block (seed 000: rho = atan(mu), forces reduced to the pitch radii)"
