@@ -709,6 +709,108 @@ def cli_wall_table(name: str = "cli_wall") -> str:
     return _table(["command", "wall time of each run", "machine (load)"], [row]) + "\n" + _source(name)
 
 
+def shafts_study_table(name: str = "shafts_study") -> str:
+    """sweeps/shafts_study.py: each drive at several loads, rigid hinges against its shafts on bearings
+    (docs/multibody.md)."""
+
+    def f(x, spec: str) -> str:
+        if x is None:
+            return "-"
+        if isinstance(x, list):
+            return ", ".join(spec.format(v) for v in x)
+        return spec.format(x)
+
+    rows = []
+    for r in load(name)["rows"]:
+        rows.append(
+            [
+                r["scenario"],
+                f"{r['load_nm']:g}",
+                r["shafts"],
+                f"{r['transmission_error_p2p_urad']:.1f}",
+                f"{r['contact_pattern_centroid_face_mm']:.2f}",
+                f(r["worm_deflection_mesh_um"], "{:.2f}"),
+                f(r["wheel_deflection_mesh_um"], "{:.2f}"),
+                f(r["worm_bearing_radial_mean_n"], "{:.0f}"),
+                f(r["worm_bearing_axial_mean_n"], "{:.0f}"),
+                f(r["wheel_bearing_radial_mean_n"], "{:.0f}"),
+                f(r["wheel_bearing_axial_mean_n"], "{:.0f}"),
+                f"{r['efficiency']:.4f}",
+            ]
+        )
+    head = ["scenario", "load [N m]", "shafts", "TE p2p [urad]", "pattern centroid [mm]", "worm defl. [um]"]
+    head += ["wheel defl. [um]", "worm bearings radial [N]", "worm axial [N]", "wheel bearings radial [N]"]
+    head += ["wheel axial [N]", "efficiency"]
+    return _table(head, rows) + "\n" + _source(name)
+
+
+def _flank_forms_runs(name: str):
+    """(gear, form, label, contact3d summary, torsional k(theta), refusal) of each run of the flank-form study."""
+    r = load(name)
+    for gear, forms in r["results"].items():
+        for form, run in forms.items():
+            rho = next((s.split("=")[1] for s in run.get("set", []) if s.startswith("gear.profile_radius_mm=")), None)
+            label = form + (f" (rho_c {rho} mm)" if rho else "")
+            yield gear, form, label, run.get("contact3d"), run.get("torsional"), run.get("refused")
+
+
+def flank_forms_table(name: str = "flank_forms") -> str:
+    """sweeps/flank_forms_study.py: every worm flank form at contact3d (exact flanks) and torsional's TCA."""
+    rows = []
+    for gear, _, label, c, t, refused in _flank_forms_runs(name):
+        g = gear.replace("_", " ")
+        if refused:
+            rows.append([g, label, f"refused: {refused.split(': ', 1)[-1].split(';')[0]}", "", "", "", ""])
+            continue
+        eff, th = c["efficiency"], c["efficiency_theory_at_contact_radius"]
+        k = [t[f"mesh_stiffness_{s}_n_per_m"] / 1e6 for s in ("mean", "min", "max")]
+        rows.append(
+            [
+                g,
+                label,
+                f"{c['contact_pressure_max_mpa']:.0f} / {c['contact_pressure_mean_mpa']:.0f}",
+                f"{eff:.4f} / {th:.4f} ({(eff / th - 1) * 100:+.2f} %)",
+                f"{c['tangential_force_p2p_n']:.2f}",
+                f"{c['transmission_error_p2p_urad']:.1f}",
+                " / ".join(f"{x:.0f}" for x in k),
+            ]
+        )
+    head = ["gear", "form", "p_H max / mean (MPa)", "efficiency / theory at contact radius", "F_t p2p (N)"]
+    head += ["TE p2p (urad)", "mesh stiffness mean / min / max (N/um)"]
+    return _table(head, rows) + "\n" + _source(name)
+
+
+def flank_forms_checks_table(name: str = "flank_forms") -> str:
+    """The flank-form study's runs against the closed forms: the range over the forms each gear can make."""
+    by_gear: dict[str, list[dict]] = {}
+    for gear, _, _, c, _, refused in _flank_forms_runs(name):
+        if not refused:
+            by_gear.setdefault(gear, []).append(c)
+
+    def span(vals: list[float], spec: str) -> str:
+        lo, hi = spec.format(min(vals)), spec.format(max(vals))
+        return lo if lo == hi else f"{lo} to {hi}"
+
+    gears = list(by_gear)
+    cells: dict[str, list[str]] = {
+        "ratio": [],
+        "F_t mean": [],
+        "efficiency against theory at the contact radius": [],
+        "meshing frequency (z1 n1 / 60)": [],
+    }
+    for gear in gears:
+        cs = by_gear[gear]
+        cells["ratio"].append(span([c["ratio"] for c in cs], "{:.6f}"))
+        cells["F_t mean"].append(span([c["tangential_force_mean_n"] for c in cs], "{:.2f}") + " N")
+        dev = [(c["efficiency"] / c["efficiency_theory_at_contact_radius"] - 1) * 100 for c in cs]
+        cells["efficiency against theory at the contact radius"].append(span(dev, "{:+.2f}") + " %")
+        fm = [c["mesh_frequency_hz"] for c in cs]
+        th = [c["mesh_frequency_theory_hz"] for c in cs]
+        cells["meshing frequency (z1 n1 / 60)"].append(f"{span(fm, '{:.4f}')} ({span(th, '{:.4f}')}) Hz")
+    rows = [[k, *v] for k, v in cells.items()]
+    return _table(["check", *(g.replace("_", " ") for g in gears)], rows) + "\n" + _source(name)
+
+
 TABLES: dict[str, Callable[[], str]] = {
     "torsional_seeds": torsional_seeds_table,
     "torsional_samples": torsional_samples_table,
@@ -727,6 +829,9 @@ TABLES: dict[str, Callable[[], str]] = {
     "wedge_seed000": wedge_seed000_table,
     "mass_scaling": mass_scaling_table,
     "cli_wall": cli_wall_table,
+    "shafts_study": shafts_study_table,
+    "flank_forms": flank_forms_table,
+    "flank_forms_checks": flank_forms_checks_table,
     "piece_error": piece_error_table,
     "backlash_min": backlash_min_table,
     "sweep_screw_jack_stiffness": sweep_screw_jack_stiffness_table,
