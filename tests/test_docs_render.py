@@ -21,6 +21,13 @@ def test_rendered_blocks_equal_their_records(path):
     assert dr.render_text(text) == text, f"{path.name}: a rendered block differs from its record (run `make docs`)"
 
 
+def test_decision_records_are_history_not_rendered():
+    """docs/decisions/ keeps each decision with its numbers as measured then: outside the rendered pages."""
+    files = dr.markdown_files()
+    assert all(p.parent.name != "decisions" for p in files)
+    assert (ROOT / "docs" / "contact3d.md") in files
+
+
 def test_every_block_names_a_registered_table():
     names = {n for p in dr.markdown_files() for n in dr.blocks(p.read_text())}
     assert names, "no rendered block in README.md or docs/*.md"

@@ -933,7 +933,8 @@ def render_text(text: str) -> str:
 
 
 def markdown_files() -> list[Path]:
-    """README.md and docs/*.md."""
+    """README.md and docs/*.md; not docs/decisions/, whose records are history with their deciding numbers as
+    measured at the time."""
     return [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
 
 
