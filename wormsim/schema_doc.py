@@ -24,6 +24,7 @@ BLOCKS = [
     ("wedge", S.Wedge),
     ("wedge.motor", S.WedgeMotor),
     ("wedge.load", S.WedgeLoad),
+    ("rating", S.Rating),
 ]
 
 
