@@ -390,9 +390,15 @@ class Rating(_Strict):
         le=100000,
         description="worm bearing distance l1 + l2, mesh point midway; default 2 x the worm threaded length",
     )
+    root_stress_limit_mpa: float | None = Field(
+        None,
+        gt=0,
+        le=10000,
+        description="permissible max principal root stress for safety_root_sim (no public value for the table's materials)",
+    )
     fe_positions: int = Field(6, ge=1, le=64, description="FE root stress: mesh positions over one mesh cycle")
     fe_mesh_size_mm: float | None = Field(
-        None, gt=0, le=1000, description="FE root stress: element size at the fillet; default m_x / 4"
+        None, gt=0, le=1000, description="FE root stress: largest element size; default m_x / 1.5"
     )
 
 
