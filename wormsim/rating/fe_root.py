@@ -317,6 +317,7 @@ def contact_loads(g: GearGeometry, side: int, t2_nm: float, positions: int) -> l
             for ln in gen.lines(theta2 + k * pitch):
                 if len(ln) < 2:
                     continue
+                ln = np.asarray(ln)
                 j, i = ln[:, 0], ln[:, 1]
                 P = ms._bilinear(fld.xyz, i, j)
                 A = ms._bilinear(fld.arm, i, j)
