@@ -193,3 +193,39 @@ def test_validity_warning_above_25_m_s():
     r = rate(_niemann(wheel_material="CuSn12Ni2", worm_speed_rpm=8000))
     assert r["sliding_speed_m_s"] > 25
     assert any("25 m/s" in w for w in r["warnings"])
+
+
+def test_summary_keys_with_a_simulated_pressure():
+    """The contact3d summary's rating keys (wormsim.rating.summary): the method-B keys, and safety_pitting_sim =
+    sigma_HG / (simulated mean Hertz pressure x sqrt(K_A))."""
+    from wormsim.rating.summary import SIM_KEYS, pitting_limit_mpa, rating_before_run, summary_keys
+
+    sc = _niemann(wheel_material="CuSn12Ni2", application_factor=1.44)
+    rating = rating_before_run(sc)
+    assert rating is not None
+    keys = summary_keys(sc, rating, {"contact_pressure_mean_mpa": 250.0})
+    assert set(RATING_KEYS) | set(SIM_KEYS) <= set(keys)
+    assert keys["safety_pitting_sim"] == pytest.approx(pitting_limit_mpa(rating) / (250.0 * 1.2))
+    assert keys["safety_root_sim"] is None  # root_stress: none
+    nan = summary_keys(sc, rating, {"contact_pressure_mean_mpa": float("nan")})
+    assert nan["safety_pitting_sim"] is None
+
+
+def test_run_with_bad_rating_input_exits_2_before_any_work(tmp_path, capsys):
+    code = cli.main(
+        [
+            "run",
+            str(SCENARIOS / "screw_jack.yaml"),
+            "--out",
+            str(tmp_path),
+            "--no-progress",
+            "--set",
+            "drive.speed_rpm=null",
+            "--set",
+            "drive.torque_nm=1",
+            "--set",
+            "rating.life_h=1000",
+        ]
+    )
+    assert code == 2 and "rating.worm_speed_rpm" in capsys.readouterr().err
+    assert not (tmp_path / "summary.json").exists()

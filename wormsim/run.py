@@ -44,6 +44,12 @@ def run_scenario(scenario: Scenario, out_dir: str | Path, progress: bool | None 
     (wormsim.output).
     """
     validate_geometry(scenario)  # the checks `wormsim check` makes, before anything is written
+    rating = None
+    if scenario.rating is not None:  # `rating:` at contact3d (wormsim.rating.summary): input errors exit 2 before work
+        from wormsim.rating.summary import rating_before_run
+        from wormsim.rating.summary import summary_keys as rating_summary_keys
+
+        rating = rating_before_run(scenario)
     mod = model_module(scenario.model)
     rd = ResultDir(out_dir)
     base = {"model": scenario.model, "scenario": scenario.name}
@@ -56,6 +62,7 @@ def run_scenario(scenario: Scenario, out_dir: str | Path, progress: bool | None 
         ) as bar:
             res = mod.simulate(scenario, progress=bar)
         wall = time.perf_counter() - t0
+        rated = {} if rating is None else rating_summary_keys(scenario, rating, res.summary)
         warm.release()
         np.savez_compressed(rd.path("timeseries.npz"), **res.series)
         warm.join()
@@ -106,6 +113,7 @@ def run_scenario(scenario: Scenario, out_dir: str | Path, progress: bool | None 
         "sim_time_s": res.sim_time_s,
         "steps": res.steps,
         **res.summary,
+        **rated,
     }
     rd.commit(summary)
     return summary

@@ -38,6 +38,8 @@ FILLET_COEF = 0.38  # rho_fP / m: ISO 53 profile A root radius of the basic rack
 RIM_DEPTH_MX = 2.5  # rim below the throat root circle, in axial modules (model extent, clamped there)
 ROOT_BAND_MX = 0.35  # root band: element centroids within this many m_x above the root torus radius
 FLANK_DENSE = 48  # flank points per section before resampling
+SURFACE_DENSITY = 2  # sampling of the outline sections that gmsh re-meshes (the geometry; the element size is apart)
+LOAD_EXCLUSION_MX = 0.25  # elements within this many m_x of a contact sample are not root elements at that position
 _VERBOSE = False  # gmsh's messages on the terminal (debugging)
 
 
@@ -361,7 +363,7 @@ def tooth_mesh(g: GearGeometry, density: int = 1, size_m: float | None = None, u
     size = size_m if size_m is not None else g.m_x / (1.5 * density)
 
     def build() -> ToothMesh:
-        V, F = tooth_surface(g, 2 * density)
+        V, F = tooth_surface(g, SURFACE_DENSITY)
         P, T = tet_mesh(V, F, size)
         return ToothMesh(P, T, g.r_f2 - RIM_DEPTH_MX * g.m_x)
 
@@ -415,9 +417,10 @@ def root_stress_cases(
     # the loaded vertices: the surface vertices nearest to each contact sample (3 per sample, equal shares)
     surf = np.unique(_boundary_faces(T))
     tree = cKDTree(P[surf])
-    loads = []
+    loads, samples = [], []
     for t2 in torques_nm:
         for pts, frc in contact_loads(g, side, t2, positions):
+            samples.append(pts)
             if len(pts) == 0:
                 loads.append((np.zeros(0, dtype=np.int64), np.zeros((0, 3))))
                 continue
@@ -428,10 +431,17 @@ def root_stress_cases(
     rho_c = np.hypot(c[:, 0], c[:, 1])
     root_c = wheel.root_rho(g, c[:, 2])
     band = (rho_c <= root_c + ROOT_BAND_MX * g.m_x) & (rho_c >= root_c - ROOT_BAND_MX * g.m_x)
+    # the point loads' own local stress is not root stress: elements near a contact sample are left out there
+    near = np.zeros((len(samples), int(band.sum())), dtype=bool)
+    for i, pts in enumerate(samples):
+        if len(pts):
+            dist, _ = cKDTree(pts).query(c[band])
+            near[i] = dist < LOAD_EXCLUSION_MX * g.m_x
     out = []
     for k in range(len(torques_nm)):
-        stress = sol.stress[k * positions : (k + 1) * positions][:, band]  # (positions, n_band, 3, 3)
-        s1v = max_principal(stress)
+        cases = slice(k * positions, (k + 1) * positions)
+        stress = sol.stress[cases][:, band]  # (positions, n_band, 3, 3)
+        s1v = np.where(near[cases], -np.inf, max_principal(stress))
         per_pos = s1v.max(axis=1)
         ipos, iel = np.unravel_index(int(np.argmax(s1v)), s1v.shape)
         # the history at the critical element along the peak's principal direction; out of mesh it is 0
