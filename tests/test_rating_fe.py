@@ -69,10 +69,6 @@ def _screw_jack():
     return sc, derive(sc.gear)
 
 
-# a coarse mesh for `make test` (a few thousand tetrahedra): 2 axial modules
-COARSE_M = 2.0 * 2.5e-3
-
-
 @pytest.fixture(scope="module")
 def fe_cache(tmp_path_factory):
     return tmp_path_factory.mktemp("fe-cache")
@@ -81,7 +77,7 @@ def fe_cache(tmp_path_factory):
 def test_root_stress_is_linear_in_the_load(fe_cache, monkeypatch):
     monkeypatch.setenv("WORMSIM_CACHE", str(fe_cache))
     sc, g = _screw_jack()
-    one, two = fe_root.root_stress_cases(g, 130e9, 0.25, 1, [12.0, 24.0], 2, size_m=COARSE_M)
+    one, two = fe_root.root_stress_cases(g, 130e9, 0.25, 1, [12.0, 24.0], 2, density=1)
     assert one["root_stress_max_mpa"] > 0
     assert two["root_stress_max_mpa"] == pytest.approx(2 * one["root_stress_max_mpa"], rel=1e-6)
     assert two["position_mm"] == pytest.approx(one["position_mm"])
@@ -125,7 +121,7 @@ def test_rate_fe_writes_the_root_stress(tmp_path, fe_cache, monkeypatch, capsys)
             str(tmp_path / "out"),
             "--fe",
             "--set",
-            f"rating.fe_mesh_size_mm={COARSE_M * 1e3}",
+            "rating.fe_mesh_density=1",
             "--set",
             "rating.fe_positions=2",
             "--set",

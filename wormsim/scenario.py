@@ -397,8 +397,11 @@ class Rating(_Strict):
         description="permissible max principal root stress for safety_root_sim (no public value for the table's materials)",
     )
     fe_positions: int = Field(6, ge=1, le=64, description="FE root stress: mesh positions over one mesh cycle")
-    fe_mesh_size_mm: float | None = Field(
-        None, gt=0, le=1000, description="FE root stress: largest element size; default m_x / 1.5"
+    fe_mesh_density: int = Field(
+        2,
+        ge=1,
+        le=4,
+        description="FE root stress: mesh density d (elements 1.5 m_x / d, fillet rho_f / d; 1 coarse, 2 default)",
     )
 
 

@@ -36,12 +36,14 @@ from meshgen import wheel
 from meshgen.cache import cached
 from meshgen.geometry import GearGeometry
 
-CODE_VERSION = "fe-root-2"
+CODE_VERSION = "fe-root-3"
 FILLET_COEF = 0.38  # rho_fP / m: ISO 53 profile A root radius of the basic rack
 RIM_DEPTH_MX = 2.5  # rim below the throat root circle, in axial modules (model extent, clamped there)
 ROOT_BAND_MX = 0.35  # root band: element centroids within this many m_x above the root torus radius
 FLANK_DENSE = 48  # flank points per section before resampling
 SURFACE_DENSITY = 2  # sampling of the outline sections that gmsh re-meshes (the geometry; the element size is apart)
+CURVATURE_ELEMENTS = 4  # elements per full turn of a curved surface at density 1 (the default density 2: 8)
+LOAD_RADIUS_MX = 0.25  # radius of the patch over which a contact sample's force is spread (surface vertices)
 LOAD_EXCLUSION_MX = 0.25  # elements within this many m_x of a contact sample are not root elements at that position
 EDGE_EXCLUSION_MX = 0.5  # nor elements within this many m_x of the wheel's end faces (module docstring)
 _VERBOSE = False  # gmsh's messages on the terminal (debugging)
@@ -164,9 +166,12 @@ def tooth_surface(g: GearGeometry, density: int = 1) -> tuple[np.ndarray, np.nda
     return V, F
 
 
-def tet_mesh(V: np.ndarray, F: np.ndarray, size_m: float) -> tuple[np.ndarray, np.ndarray]:
+def tet_mesh(
+    V: np.ndarray, F: np.ndarray, size_m: float, min_size_m: float, curvature: int
+) -> tuple[np.ndarray, np.ndarray]:
     """Tetrahedra (gmsh) inside the closed surface (V, F): the surface is classified into patches at sharp edges
-    (40 deg), re-parametrised and re-meshed at `size_m`, then the volume is meshed: (points (n, 3), tets (m, 4))."""
+    (40 deg), re-parametrised and re-meshed at `size_m` (refined on curvature, `curvature` elements per 2 pi of a
+    curve's turn, down to min_size_m: the root fillet), then the volume is meshed: (points (n, 3), tets (m, 4))."""
     import gmsh
 
     gmsh.initialize(["-noenv"], readConfigFiles=False)
@@ -184,8 +189,8 @@ def tet_mesh(V: np.ndarray, F: np.ndarray, size_m: float) -> tuple[np.ndarray, n
         gmsh.model.geo.addVolume([loop])
         gmsh.model.geo.synchronize()
         gmsh.option.setNumber("Mesh.MeshSizeMax", size_m * 1e3)
-        gmsh.option.setNumber("Mesh.MeshSizeMin", size_m * 1e3 / 4)
-        gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 8)
+        gmsh.option.setNumber("Mesh.MeshSizeMin", min_size_m * 1e3)
+        gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", curvature)
         gmsh.model.mesh.generate(3)
         tags, xyz, _ = gmsh.model.mesh.getNodes()
         _, _, conn = gmsh.model.mesh.getElements(3)
@@ -359,16 +364,19 @@ class ToothMesh:
     r_in: float
 
 
-def tooth_mesh(g: GearGeometry, density: int = 1, size_m: float | None = None, use_cache: bool = True) -> ToothMesh:
-    """The tetrahedral mesh of the one-tooth sector (element size size_m, default m_x / (1.5 density)), cached by
-    geometry (meshgen.cache)."""
+def tooth_mesh(g: GearGeometry, density: int = 2, size_m: float | None = None, use_cache: bool = True) -> ToothMesh:
+    """The tetrahedral mesh of the one-tooth sector, cached by geometry (meshgen.cache). `density` d sets the element
+    sizes together (d = 2 is the default, d = 1 and 2 are an h / (h/2) pair): largest 1.5 m_x / d (or size_m),
+    smallest FILLET_COEF m_x / d (the fillet radius over d), CURVATURE_ELEMENTS d per full turn of a curved surface."""
     from dataclasses import asdict
 
-    size = size_m if size_m is not None else g.m_x / (1.5 * density)
+    size = size_m if size_m is not None else 1.5 * g.m_x / density
+    min_size = min(FILLET_COEF * g.m_x / density, size)
+    curvature = CURVATURE_ELEMENTS * density
 
     def build() -> ToothMesh:
         V, F = tooth_surface(g, SURFACE_DENSITY)
-        P, T = tet_mesh(V, F, size)
+        P, T = tet_mesh(V, F, size, min_size, curvature)
         return ToothMesh(P, T, g.r_f2 - RIM_DEPTH_MX * g.m_x)
 
     parts = {"geometry": asdict(g), "density": density, "size_m": size, "code": CODE_VERSION}
@@ -382,7 +390,7 @@ def root_stress(
     side: int,
     t2_nm: float,
     positions: int,
-    density: int = 1,
+    density: int = 2,
     size_m: float | None = None,
     use_cache: bool = True,
 ) -> dict:
@@ -398,7 +406,7 @@ def root_stress_cases(
     side: int,
     torques_nm: list[float],
     positions: int,
-    density: int = 1,
+    density: int = 2,
     size_m: float | None = None,
     use_cache: bool = True,
 ) -> list[dict]:
@@ -418,7 +426,7 @@ def root_stress_cases(
         on_side = below & ((np.abs(psi - s0) * rho < tol) | (np.abs(psi - s1) * rho < tol))
         return (rho < tm.r_in + tol) | on_side
 
-    # the loaded vertices: the surface vertices nearest to each contact sample (3 per sample, equal shares)
+    # each contact sample's force spread over the surface vertices within LOAD_RADIUS_MX (a load patch of fixed size)
     surf = np.unique(_boundary_faces(T))
     tree = cKDTree(P[surf])
     loads, samples = [], []
@@ -428,8 +436,7 @@ def root_stress_cases(
             if len(pts) == 0:
                 loads.append((np.zeros(0, dtype=np.int64), np.zeros((0, 3))))
                 continue
-            _, nn = tree.query(pts, k=3)
-            loads.append((surf[nn].ravel(), np.repeat(frc / 3.0, 3, axis=0)))
+            loads.append(_spread(tree, surf, pts, frc, LOAD_RADIUS_MX * g.m_x))
     sol = solve_elastic(P, T, e_pa, nu, fixed, loads)
     c = sol.centroids
     rho_c = np.hypot(c[:, 0], c[:, 1])
@@ -471,6 +478,23 @@ def root_stress_cases(
     return out
 
 
+def _spread(tree, surf: np.ndarray, pts: np.ndarray, frc: np.ndarray, radius: float):
+    """(vertices, forces): each force shared by the surface vertices within `radius` of its point, weights 1 - d/R
+    (the nearest 3 where none is that close), so the load patch keeps its size when the mesh is refined."""
+    verts, forces = [], []
+    for p, f, near in zip(pts, frc, tree.query_ball_point(pts, radius)):
+        if len(near) < 3:
+            _, near = tree.query(p, k=3)
+            w = np.ones(3)
+        else:
+            d = np.linalg.norm(tree.data[near] - p, axis=1)
+            w = 1.0 - d / radius
+        near = np.asarray(near)
+        verts.append(surf[near])
+        forces.append(np.outer(w / w.sum(), f))
+    return np.concatenate(verts), np.concatenate(forces)
+
+
 def _boundary_faces(T: np.ndarray) -> np.ndarray:
     """Triangles that belong to one tetrahedron only."""
     f = np.concatenate([T[:, [0, 1, 2]], T[:, [0, 1, 3]], T[:, [0, 2, 3]], T[:, [1, 2, 3]]])
@@ -495,11 +519,10 @@ def add_fe_root_stress(scenario, result: dict) -> dict:
     g = derive(scenario.gear)
     side = gear_theory.working_flank(scenario, g.hand)
     t2 = result["inputs"]["wheel_torque_rated_nm"]
-    size = r.fe_mesh_size_mm * 1e-3 if r.fe_mesh_size_mm is not None else None
     t0 = time.perf_counter()
     fe = root_stress(
         g, scenario.materials.wheel.youngs_modulus_gpa * 1e9, scenario.materials.wheel.poisson_ratio, side, t2,
-        r.fe_positions, size_m=size,
+        r.fe_positions, density=r.fe_mesh_density,
     )  # fmt: skip
     fe["wall_time_s"] = time.perf_counter() - t0
     result["fe_root"] = fe
