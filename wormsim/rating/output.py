@@ -59,10 +59,11 @@ def markdown(result: dict, scenario_name: str) -> str:
         lines += [
             "## FE root stress (wheel tooth)",
             "",
-            f"Max principal stress at the fillet {_fmt(result.get('root_stress_max_mpa'))} MPa at "
-            f"{_fmt(fe.get('position_mm'))} mm (wheel frame), range over the mesh cycle "
-            f"{_fmt(result.get('root_stress_range_mpa'))} MPa; {fe.get('elements')} tetrahedra, "
-            f"{fe.get('positions')} mesh positions.",
+            f"Max principal stress at the root {_fmt(result.get('root_stress_max_mpa'))} MPa at "
+            f"({', '.join(f'{v:.1f}' for v in fe.get('position_mm', []))}) mm (wheel frame: x, y, z along the wheel "
+            f"axis), range over the tooth's engagement {_fmt(result.get('root_stress_range_mpa'))} MPa; "
+            f"{fe.get('elements')} tetrahedra (mesh density {fe.get('density')}), {fe.get('positions')} positions; "
+            "not mesh-converged within 5 % (docs/rating.md, 'FE root stress').",
             "",
         ]
     lines += ["## Inputs", "", "| input | value |", "| --- | --- |"]
