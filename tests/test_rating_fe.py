@@ -97,9 +97,9 @@ def test_contact_loads_carry_the_tooth_share_of_the_torque():
     strict=True,
     reason=(
         "not mesh-converged: root_stress_max_mpa 10.05 (density 1, 4178 tets) vs 11.78 MPa (density 2, the default, "
-        "20192 tets), +17 %; per position +17 % / +14 % / -8 % (10.05 / 8.46 / 9.95 vs 11.78 / 9.65 / 9.13 MPa): "
-        "the peak sits at the fillet near the tooth's entry, 0.7 m_x from the end face; density 4 (the default's h/2, "
-        "~160 000 tets) was not affordable on the shared 2-core machine"
+        "20192 tets), +17 %; per position +17 % / +14 % / -8 % (10.05 / 8.46 / 9.95 vs 11.78 / 9.65 / 9.13 MPa); "
+        "density 3 (55240 tets) gives 15.26 / 10.05 / 10.57 MPa: the peak at the tooth's entry, 0.7 m_x from the "
+        "wheel's end face, keeps growing as at a stress singularity where the root meets the end face"
     ),
 )
 def test_root_stress_mesh_convergence():
