@@ -21,8 +21,9 @@ Model:
 * Output: the largest first principal stress over the elements in the root band (centroid within
   ROOT_BAND_MX axial modules of the root torus radius), its position, and its range over the positions. Left out:
   elements within LOAD_EXCLUSION_MX of a contact sample at that position (the point loads' own stress), and within
-  EDGE_EXCLUSION_MX of the wheel's end faces, where the contact lines end on the free edge and the point-load model
-  does not converge (h vs h/2 on the screw jack: +30 % there, with the peak jumping between the two end faces).
+  EDGE_EXCLUSION_MX of the wheel's end faces, where the contact lines end on the free edge and the stress does not
+  converge with the mesh. Just inside that band the peak still grows with refinement (docs/rating.md, 'FE root
+  stress'): the value is not mesh-converged.
 """
 
 from __future__ import annotations
