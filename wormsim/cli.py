@@ -1,4 +1,4 @@
-"""`wormsim` console script (INTERFACE.md): run, mesh, model, bench, sweep, schema, check, init.
+"""`wormsim` console script (INTERFACE.md): run, mesh, model, bench, sweep, rate, schema, check, init.
 
 Exit codes: 0 ok, 2 invalid input or an output path that cannot be written (the message names the field or
 the path), 3 the simulation failed (with a diagnosis), 130 / 143 interrupted by SIGINT (Ctrl-C) / SIGTERM
@@ -90,6 +90,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--workers", type=int, help="local workers (default: one per core); with --scheduler: wait for them")
     p.add_argument("--keep-runs", action="store_true", help="also write each point's result folder into DIR/runs/")
     p.add_argument("--no-progress", action="store_true", help="no progress bar or progress lines")
+    p = sub.add_parser("rate", help="load-capacity rating (ISO/TS 14521 method B, AGMA 6034): rating.json, rating.md")
+    _add_scenario_args(p)
+    p.add_argument("--fe", action="store_true", help="add the FE root stress of the wheel tooth (rating.root_stress)")
     p = sub.add_parser("schema", help="print the scenario JSON schema (for editors)")
     p.add_argument("--out", help="write to this file instead of stdout")
     p = sub.add_parser("check", help="validate a scenario and print it with defaults filled in")
@@ -179,6 +182,12 @@ def _cmd_sweep(args) -> int:
     return EXIT_OK
 
 
+def _cmd_rate(args) -> int:
+    from wormsim.rating.cmd import rate_command
+
+    return rate_command(args.scenario, args.out, args.overrides, fe=args.fe)
+
+
 def _cmd_schema(args) -> int:
     from wormsim.output import check_writable_file, write_text_atomic
 
@@ -215,6 +224,7 @@ COMMANDS = {
     "model": _cmd_model,
     "bench": _cmd_bench,
     "sweep": _cmd_sweep,
+    "rate": _cmd_rate,
     "schema": _cmd_schema,
     "check": _cmd_check,
     "init": _cmd_init,

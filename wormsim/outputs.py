@@ -56,8 +56,8 @@ KEYS: dict[str, Key] = {
         "list",
         ALL,
         "results that need care, one line each (also on stderr and in report.png's header): a tangential-force "
-        "fluctuation above half its mean, contact force outside the wheel flanks (wormsim.run_warnings); empty "
-        "when none",
+        "fluctuation above half its mean, contact force outside the wheel flanks (wormsim.run_warnings); with "
+        "`rating:`, the rating's validity warnings follow; empty when none",
     ),
     "ignored_inputs": Key(
         "list",
@@ -128,6 +128,40 @@ KEYS: dict[str, Key] = {
     "wheel_bearing_radial_max_n": Key("list", C, "shafts: the wheel bearings' largest radial forces [N]"),
     "wheel_bearing_axial_mean_n": Key("N", C, "shafts: the wheel's locating bearing's axial force, |mean|"),
     "wheel_bearing_axial_max_n": Key("N", C, "shafts: the wheel's locating bearing's largest axial force"),
+    "contact_stress_mean_iso_mpa": Key(
+        "MPa", C, "rating: ISO/TS 14521 method B mean contact stress sigma_Hm with p_m* (docs/rating.md)"
+    ),
+    "friction_iso": Key("-", C, "rating: mean tooth friction mu_zm = mu_0T Y_S Y_G Y_W Y_R (ISO/TS 14521 method B)"),
+    "efficiency_iso": Key("-", C, "rating: the mesh efficiency of method B from friction_iso, worm driving"),
+    "sliding_speed_m_s": Key("m/s", C, "rating: sliding speed v_g at the reference diameter"),
+    "safety_pitting": Key("-", C, "rating: pitting safety S_H (method B)"),
+    "safety_wear": Key("-", C, "rating: wear safety S_W (given only with rating.wear_intensity)"),
+    "safety_root": Key("-", C, "rating: tooth root safety S_F from tau_F (method B)"),
+    "safety_deflection": Key("-", C, "rating: worm deflection safety S_delta = 0.04 sqrt(m_x) / delta_m"),
+    "safety_temperature": Key("-", C, "rating: temperature safety S_T (sump temperature limit over oil_temperature_c)"),
+    "oil_temperature_c": Key("degC", C, "rating: sump temperature at the rated load (splash lubrication)"),
+    "agma_rated_tangential_force_n": Key(
+        "N", C, "rating: AGMA 6034 rated tangential force W_t = C_s D_m^0.8 F_e C_m C_v"
+    ),
+    "agma_friction": Key("-", C, "rating: AGMA 6034 friction coefficient at the sliding speed"),
+    "agma_efficiency": Key("-", C, "rating: AGMA 6034 efficiency, worm driving"),
+    "sources": Key("list", C, "rating: the public sources of the rating's formulas and tables"),
+    "root_stress_max_mpa": Key(
+        "MPa",
+        C,
+        "rating.root_stress fe: the largest max principal stress at the wheel tooth's root fillet over the positions",
+    ),
+    "root_stress_range_mpa": Key(
+        "MPa", C, "rating.root_stress fe: the range of the root stress over the mesh cycle (fatigue)"
+    ),
+    "safety_pitting_sim": Key(
+        "-", C, "rating: sigma_HG over the simulated mean Hertz pressure times sqrt(K_A) (method C)"
+    ),
+    "safety_root_sim": Key(
+        "-",
+        C,
+        "rating.root_stress fe: the root stress limit over root_stress_max_mpa (needs rating.root_stress_limit_mpa)",
+    ),
     "backdrive_measured_self_locking": Key(
         "bool",
         C,

@@ -76,6 +76,12 @@ def run_scenario(scenario: Scenario, out_dir: str | Path, progress: bool | None 
     """
     validate_geometry(scenario)  # the checks `wormsim check` makes, before anything is written
     ignored = ignored_inputs(scenario)
+    rating = None
+    if scenario.rating is not None:  # `rating:` at contact3d (wormsim.rating.summary): input errors exit 2 before work
+        from wormsim.rating.summary import rating_before_run
+        from wormsim.rating.summary import summary_keys as rating_summary_keys
+
+        rating = rating_before_run(scenario)
     mod = model_module(scenario.model)
     rd = ResultDir(out_dir)
     base = {"model": scenario.model, "scenario": scenario.name}
@@ -89,6 +95,7 @@ def run_scenario(scenario: Scenario, out_dir: str | Path, progress: bool | None 
             res = mod.simulate(scenario, progress=bar)
         wall = time.perf_counter() - t0
         res.summary["warnings"] = run_warnings(res)  # results to read with care (F_t p2p, off-flank contacts)
+        rated = {} if rating is None else rating_summary_keys(scenario, rating, res.summary)
         warm.release()
         np.savez_compressed(rd.path("timeseries.npz"), **res.series)
         warm.join()
@@ -140,6 +147,7 @@ def run_scenario(scenario: Scenario, out_dir: str | Path, progress: bool | None 
         "steps": res.steps,
         **res.summary,
         "ignored_inputs": ignored,
+        **rated,
     }
     missing = outputs.undocumented(summary)
     if missing:  # every key has its entry in wormsim.outputs (docs/outputs.md); never written silently

@@ -458,6 +458,58 @@ class Shafts(_Strict):
         return self
 
 
+# ----------------------------------------------------------------------------- rating (wormsim.rating, docs/rating.md)
+
+
+class Rating(_Strict):
+    """Load-capacity rating (`wormsim rate`, and the contact3d summary when given). Every key optional; the formulas,
+    tables and their sources: docs/rating.md."""
+
+    life_h: float = Field(25000.0, gt=0, le=1e6, description="required life L_h (ISO/TS 14521 reference 25000 h)")
+    application_factor: float = Field(1.0, ge=1, le=4, description="K_A: the nominal wheel torque times this")
+    lubricant: Literal["mineral", "pao", "peg"] = Field("mineral", description="oil base: friction, Z_oil, theta_Slim")
+    oil_viscosity_40_mm2_s: float = Field(320.0, gt=0, le=10000, description="ISO VG of the oil (reported)")
+    wheel_material: Literal["CuSn12Ni2", "CuSn12", "CuAl10Fe5Ni5", "GJS-400", "GJL-250", "POM"] | None = Field(
+        None,
+        description=(
+            "wheel material (table with sources: docs/rating.md); default POM when materials.wheel has E <= 10 GPa, "
+            "else CuSn12Ni2 (with a warning)"
+        ),
+    )
+    wheel_casting: Literal["sand", "chilled", "centrifugal"] = Field("sand", description="AGMA C_s casting method")
+    ambient_c: float = Field(20.0, ge=-60, le=80, description="ambient temperature theta_0")
+    roughness_worm_um: float = Field(0.5, gt=0, le=10, description="worm flank Ra1 (friction factor Y_R)")
+    root_stress: Literal["none", "fe"] = Field("none", description="fe: FE root stress of the wheel tooth")
+    worm_speed_rpm: float | None = Field(
+        None, gt=0, le=100000, description="rated worm speed n1; default |drive speed| (needed for a torque drive)"
+    )
+    wear_intensity: float | None = Field(
+        None,
+        gt=0,
+        le=1e-3,
+        description="J_W (wear intensity; its DIN 3996 table is not public): safety_wear is given only with it",
+    )
+    worm_bearing_span_mm: float | None = Field(
+        None,
+        gt=0,
+        le=100000,
+        description="worm bearing distance l1 + l2, mesh point midway; default 2 x the worm threaded length",
+    )
+    root_stress_limit_mpa: float | None = Field(
+        None,
+        gt=0,
+        le=10000,
+        description="permissible max principal root stress for safety_root_sim (no public value for the table's materials)",
+    )
+    fe_positions: int = Field(6, ge=1, le=64, description="FE root stress: mesh positions over one mesh cycle")
+    fe_mesh_density: int = Field(
+        2,
+        ge=1,
+        le=4,
+        description="FE root stress: mesh density d (elements 1.5 m_x / d, fillet rho_f / d; 1 coarse, 2 default)",
+    )
+
+
 # ----------------------------------------------------------------------------- scenario
 
 
@@ -486,6 +538,7 @@ class Scenario(_Strict):
     wedge: Wedge | None = None
     errors: Errors = Errors()
     shafts: Shafts | None = None
+    rating: Rating | None = None
 
     @model_validator(mode="after")
     def _blocks(self) -> "Scenario":

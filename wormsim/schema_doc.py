@@ -25,6 +25,7 @@ BLOCKS = [
     ("wedge", S.Wedge),
     ("wedge.motor", S.WedgeMotor),
     ("wedge.load", S.WedgeLoad),
+    ("rating", S.Rating),
 ]
 
 

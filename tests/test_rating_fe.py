@@ -1,0 +1,135 @@
+"""FE root stress (wormsim.rating.fe_root): the solver against a closed form, linearity in the load, the h vs h/2
+mesh convergence on a seed (long), and `wormsim rate --fe`."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+from conftest import SCENARIOS
+
+from wormsim import cli
+from wormsim.geometry import derive
+from wormsim.rating import fe_root
+from wormsim.scenario import load_scenario
+
+
+def _box(lx: float, ly: float, lz: float, size: float) -> tuple[np.ndarray, np.ndarray]:
+    import gmsh
+
+    gmsh.initialize(["-noenv"], readConfigFiles=False)
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.model.occ.addBox(0, 0, 0, lx, ly, lz)
+        gmsh.model.occ.synchronize()
+        gmsh.option.setNumber("Mesh.MeshSizeMax", size)
+        gmsh.option.setNumber("Mesh.MeshSizeMin", size)
+        gmsh.model.mesh.generate(3)
+        tags, xyz, _ = gmsh.model.mesh.getNodes()
+        _, _, conn = gmsh.model.mesh.getElements(3)
+    finally:
+        gmsh.finalize()
+    P = np.asarray(xyz).reshape(-1, 3)
+    order = np.empty(int(tags.max()) + 1, dtype=np.int64)
+    order[np.asarray(tags, dtype=np.int64)] = np.arange(len(tags))
+    return P, order[np.asarray(conn[0], dtype=np.int64).reshape(-1, 4)]
+
+
+def test_cantilever_against_beam_theory():
+    """A clamped steel bar 100 x 10 x 10 mm with an end load of 100 N: Euler-Bernoulli bending stress
+    sigma_xx = F (L - x) y / I (I = b h^3 / 12) at the element centroids of the middle fifth (Saint-Venant: away from
+    the clamp and the load), and tip deflection F L^3 / (3 E I) (+ the shear term F L / (k G A), k = 5/6)."""
+    L, h, b, F, E, nu = 0.1, 0.01, 0.01, 100.0, 210e9, 0.3
+    P, T = _box(L, h, b, 3.4e-3)
+    used = np.unique(T)
+    remap = -np.ones(len(P), dtype=np.int64)
+    remap[used] = np.arange(len(used))
+    P, T = P[used], remap[T]
+    tip = np.where(P[:, 0] > L - 1e-9)[0]
+    forces = np.zeros((len(tip), 3))
+    forces[:, 1] = -F / len(tip)
+    sol = fe_root.solve_elastic(P, T, E, nu, lambda x: x[0] < 1e-9, [(tip, forces)])
+    I = b * h**3 / 12
+    c = sol.centroids
+    mid = (c[:, 0] > 0.4 * L) & (c[:, 0] < 0.6 * L)
+    beam = -F * (L - c[mid, 0]) * (c[mid, 1] - h / 2) / I * -1.0  # tension on top (y = h) under a downward load
+    fe = sol.stress[0][mid, 0, 0]
+    smax = F * 0.5 * L * (h / 2) / I
+    assert np.max(np.abs(fe - beam)) / smax < 0.03
+    g_mod = E / (2 * (1 + nu))
+    delta = F * L**3 / (3 * E * I) + F * L / (5 / 6 * g_mod * b * h)
+    uy_tip = -sol.displacement[0][tip, 1].mean()
+    assert uy_tip == pytest.approx(delta, rel=0.03)
+
+
+def _screw_jack():
+    sc = load_scenario(SCENARIOS / "screw_jack.yaml")
+    return sc, derive(sc.gear)
+
+
+@pytest.fixture(scope="module")
+def fe_cache(tmp_path_factory):
+    return tmp_path_factory.mktemp("fe-cache")
+
+
+def test_root_stress_is_linear_in_the_load(fe_cache, monkeypatch):
+    monkeypatch.setenv("WORMSIM_CACHE", str(fe_cache))
+    sc, g = _screw_jack()
+    one, two = fe_root.root_stress_cases(g, 130e9, 0.25, 1, [12.0, 24.0], 2, density=1)
+    assert one["root_stress_max_mpa"] > 0
+    assert two["root_stress_max_mpa"] == pytest.approx(2 * one["root_stress_max_mpa"], rel=1e-6)
+    assert two["position_mm"] == pytest.approx(one["position_mm"])
+
+
+def test_contact_loads_carry_the_tooth_share_of_the_torque():
+    """The forces on the FE tooth: their torque about the wheel axis is the tooth's share of T2 (at most T2), and
+    summed over the teeth in contact the load law gives T2 back (the share per tooth from the same lines)."""
+    sc, g = _screw_jack()
+    for pts, frc in fe_root.contact_loads(g, 1, 12.0, 6):
+        torque = float(np.sum(np.cross(pts, frc)[:, 2]))
+        assert 0 < abs(torque) <= 12.0 * (1 + 1e-9)
+
+
+@pytest.mark.long
+@pytest.mark.xfail(
+    strict=True,
+    reason=(
+        "not mesh-converged: root_stress_max_mpa 10.05 (density 1, 4178 tets) vs 11.78 MPa (density 2, the default, "
+        "20192 tets), +17 %; per position +17 % / +14 % / -8 % (10.05 / 8.46 / 9.95 vs 11.78 / 9.65 / 9.13 MPa); "
+        "density 3 (55240 tets) gives 15.26 / 10.05 / 10.57 MPa: the peak at the tooth's entry, 0.7 m_x from the "
+        "wheel's end face, keeps growing as at a stress singularity where the root meets the end face"
+    ),
+)
+def test_root_stress_mesh_convergence():
+    """h vs h/2 on the screw jack (mesh density 1 and 2, 3 positions): the max root stress within 5 %."""
+    sc, g = _screw_jack()
+    h = fe_root.root_stress(g, 130e9, 0.25, 1, 12.0, 3, density=1)
+    h2 = fe_root.root_stress(g, 130e9, 0.25, 1, 12.0, 3, density=2)
+    assert h2["root_stress_max_mpa"] == pytest.approx(h["root_stress_max_mpa"], rel=0.05)
+
+
+def test_rate_fe_writes_the_root_stress(tmp_path, fe_cache, monkeypatch, capsys):
+    monkeypatch.setenv("WORMSIM_CACHE", str(fe_cache))
+    code = cli.main(
+        [
+            "rate",
+            str(SCENARIOS / "screw_jack.yaml"),
+            "--out",
+            str(tmp_path / "out"),
+            "--fe",
+            "--set",
+            "rating.fe_mesh_density=1",
+            "--set",
+            "rating.fe_positions=2",
+            "--set",
+            "rating.root_stress_limit_mpa=60",
+        ]
+    )
+    assert code == 0
+    out = json.loads((tmp_path / "out" / "rating.json").read_text())
+    assert out["root_stress_max_mpa"] > 0 and out["root_stress_range_mpa"] > 0
+    assert out["safety_root_sim"] == pytest.approx(60 / out["root_stress_max_mpa"])
+    assert math.isfinite(out["fe_root"]["position_mm"][0])
+    assert "FE root stress" in (tmp_path / "out" / "rating.md").read_text()

@@ -1,0 +1,543 @@
+"""FE tooth-root stress of the wheel from the simulated contact (ISO/TS 14521 calls this kind of analysis method C).
+
+Model:
+* Solid: one wheel tooth with its rim, from meshgen's exact wheel geometry (meshgen.wheel: the flanks of tooth 0,
+  the tip on the throat torus, the root on the root torus), every face-width section's outline from the middle of
+  the space before the tooth to the middle of the space after it, down to a rim of RIM_DEPTH_MX axial modules below
+  the wheel's throat root circle. meshgen's wheel has a sharp corner between flank and root, where linear elasticity
+  has no finite stress: each section's corner is rounded with the root radius of the ISO 53 basic rack profile A,
+  rho_fP = 0.38 m (FILLET_COEF; ISO 53:1998 profile A, as any gear program lists it, e.g. the KISSsoft report cited in
+  wormsim.rating.materials). The sections are lofted into one watertight triangulated surface.
+* Mesh: gmsh (tetrahedra inside the given surface triangulation); the element size is set by the surface sampling
+  (`density`: 1 coarse, 2 the h/2 mesh).
+* Solver: scikit-fem, quadratic tetrahedra, isotropic linear elasticity (wheel E, nu of materials.wheel); the rim's
+  cut faces (the two space-middle planes below the root and the inner face) are clamped.
+* Load: the contact lines of the loaded tooth contact analysis of the torsional level
+  (wormsim.tooth.mesh_stiffness: the contour lines of the conjugate-contact field on the flank) with that
+  analysis's load law: a line element ds carries k' arm ds of the mesh's deflection, so the normal force per length
+  is q = T2 arm / sum over all teeth in contact of the integral of arm^2 ds, frictionless, along the flank normal.
+  Sampled at `positions` wheel angles evenly over the tooth's whole engagement (entry to exit), the share of the
+  teeth in contact at each from the same lines.
+* Output: the largest first principal stress over the elements in the root band (centroid within
+  ROOT_BAND_MX axial modules of the root torus radius), its position, and its range over the positions. Left out:
+  elements within LOAD_EXCLUSION_MX of a contact sample at that position (the point loads' own stress), and within
+  EDGE_EXCLUSION_MX of the wheel's end faces, where the contact lines end on the free edge and the stress does not
+  converge with the mesh. Just inside that band the peak still grows with refinement (docs/rating.md, 'FE root
+  stress'): the value is not mesh-converged.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from meshgen import wheel
+from meshgen.cache import cached
+from meshgen.geometry import GearGeometry
+
+CODE_VERSION = "fe-root-3"
+FILLET_COEF = 0.38  # rho_fP / m: ISO 53 profile A root radius of the basic rack
+RIM_DEPTH_MX = 2.5  # rim below the throat root circle, in axial modules (model extent, clamped there)
+ROOT_BAND_MX = 0.35  # root band: element centroids within this many m_x above the root torus radius
+FLANK_DENSE = 48  # flank points per section before resampling
+SURFACE_DENSITY = 2  # sampling of the outline sections that gmsh re-meshes (the geometry; the element size is apart)
+CURVATURE_ELEMENTS = 4  # elements per full turn of a curved surface at density 1 (the default density 2: 8)
+LOAD_RADIUS_MX = 0.25  # radius of the patch over which a contact sample's force is spread (surface vertices)
+LOAD_EXCLUSION_MX = 0.25  # elements within this many m_x of a contact sample are not root elements at that position
+EDGE_EXCLUSION_MX = 0.5  # nor elements within this many m_x of the wheel's end faces (module docstring)
+_VERBOSE = False  # gmsh's messages on the terminal (debugging)
+
+
+# ----------------------------------------------------------------------------- geometry
+
+
+def _resample(poly: np.ndarray, n: int) -> np.ndarray:
+    """n points evenly by arc length along a polyline (first and last kept)."""
+    seg = np.linalg.norm(np.diff(poly, axis=0), axis=1)
+    s = np.concatenate([[0.0], np.cumsum(seg)])
+    t = np.linspace(0.0, s[-1], n)
+    return np.stack([np.interp(t, s, poly[:, k]) for k in range(poly.shape[1])], axis=-1)
+
+
+def _arc(r: float, a0: float, a1: float, n: int) -> np.ndarray:
+    t = np.linspace(a0, a1, n)
+    return np.stack([r * np.cos(t), r * np.sin(t)], axis=-1)
+
+
+def _fillet(corner: np.ndarray, toward_root: np.ndarray, toward_flank: np.ndarray, radius: float, n: int):
+    """n points of the circular arc of `radius` tangent to the two rays from `corner` (unit directions), from the
+    root-side tangent point to the flank-side one; and the distance of the tangent points from the corner."""
+    u1, u2 = toward_root / np.linalg.norm(toward_root), toward_flank / np.linalg.norm(toward_flank)
+    theta = math.acos(float(np.clip(u1 @ u2, -1.0, 1.0)))
+    t = radius / math.tan(theta / 2)
+    bis = (u1 + u2) / np.linalg.norm(u1 + u2)
+    centre = corner + bis * radius / math.sin(theta / 2)
+    p1, p2 = corner + t * u1, corner + t * u2
+    a1 = math.atan2(*(p1 - centre)[::-1])
+    a2 = math.atan2(*(p2 - centre)[::-1])
+    da = (a2 - a1 + math.pi) % (2 * math.pi) - math.pi
+    ang = a1 + np.linspace(0.0, da, n)
+    return centre + radius * np.stack([np.cos(ang), np.sin(ang)], axis=-1), t
+
+
+@dataclass(frozen=True)
+class Counts:
+    zeta: int
+    root: int
+    fillet: int
+    flank: int
+    tip: int
+    radial: int
+    inner: int
+
+    @staticmethod
+    def at(density: int) -> Counts:
+        d = density
+        return Counts(zeta=6 * d + 1, root=2 * d + 1, fillet=3 * d + 1, flank=6 * d + 1, tip=2 * d + 1, radial=3 * d,
+                      inner=4 * d + 1)  # fmt: skip
+
+
+def space_middles(g: GearGeometry, zeta):
+    """Polar angles of the middles of space 0 and space 1 at the root, at axial position(s) zeta (the teeth are
+    helical: these turn across the face)."""
+    pitch = 2 * math.pi / g.z2
+    zeta = np.asarray(zeta, float)
+    lo = wheel.root_rho(g, zeta)
+    pa, pb = wheel.tooth_flanks(g, lo, zeta)
+    return 0.5 * (pa + pb - pitch), 0.5 * (pa + pb + pitch)
+
+
+def section_outline(g: GearGeometry, zeta: float, c: Counts) -> np.ndarray:
+    """Closed outline (N, 2) of tooth 0 with its rim in the wheel section at axial position zeta, counter-clockwise,
+    N the same for every zeta (module docstring)."""
+    lo = float(wheel.root_rho(g, zeta))
+    hi = float(wheel.tip_rho(g, zeta))
+    rho = np.linspace(lo, hi, FLANK_DENSE)
+    pa, pb = wheel.tooth_flanks(g, rho, np.full_like(rho, zeta))
+    A = np.stack([rho * np.cos(pa), rho * np.sin(pa)], -1)  # flank a, root -> tip
+    B = np.stack([rho * np.cos(pb), rho * np.sin(pb)], -1)  # flank b, root -> tip
+    r_f = FILLET_COEF * g.m_x
+    s0, s1 = space_middles(g, zeta)
+    tan_a = np.array([math.sin(pa[0]), -math.cos(pa[0])])  # root circle tangent at A's root, towards space 0
+    fa, ta = _fillet(A[0], tan_a, A[1] - A[0], r_f, c.fillet)
+    tan_b = np.array([-math.sin(pb[0]), math.cos(pb[0])])  # towards space 1
+    fb, tb = _fillet(B[0], tan_b, B[1] - B[0], r_f, c.fillet)
+    # flanks from their fillet tangent point to the tip
+    sa = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(A, axis=0), axis=1))])
+    sb = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(B, axis=0), axis=1))])
+    flank_a = _resample(np.concatenate([fa[-1:], A[sa > ta]]), c.flank)
+    flank_b = _resample(np.concatenate([fb[-1:], B[sb > tb]]), c.flank)
+    root_a = _arc(lo, s0, math.atan2(fa[0, 1], fa[0, 0]), c.root)
+    root_b = _arc(lo, math.atan2(fb[0, 1], fb[0, 0]), s1, c.root)
+    tip = _arc(hi, pa[-1], pb[-1], c.tip)
+    r_in = g.r_f2 - RIM_DEPTH_MX * g.m_x
+    down = np.linspace(lo, r_in, c.radial + 1)[1:-1]
+    side_b = np.stack([down * math.cos(s1), down * math.sin(s1)], -1)
+    inner = _arc(r_in, s1, s0, c.inner)
+    side_a = np.stack([down[::-1] * math.cos(s0), down[::-1] * math.sin(s0)], -1)
+    return np.concatenate(
+        [root_a, fa[1:], flank_a[1:], tip[1:-1], flank_b[::-1], fb[::-1][1:], root_b[1:], side_b, inner, side_a]
+    )
+
+
+def tooth_surface(g: GearGeometry, density: int = 1) -> tuple[np.ndarray, np.ndarray]:
+    """Watertight triangulated surface (vertices (n, 3) in m, faces (m, 3), outward) of the one-tooth sector."""
+    import manifold3d as mf
+
+    c = Counts.at(density)
+    zetas = np.linspace(-g.face_width / 2, g.face_width / 2, c.zeta)
+    secs = np.stack([section_outline(g, z, c) for z in zetas])  # (nz, N, 2)
+    nz, N = secs.shape[:2]
+    V = np.concatenate([secs.reshape(-1, 2), np.repeat(zetas, N)[:, None]], axis=1)
+    idx = np.arange(nz * N).reshape(nz, N)
+    I = np.concatenate([idx, idx[:, :1]], axis=1)
+    a, b, cc, d = I[:-1, :-1], I[1:, :-1], I[1:, 1:], I[:-1, 1:]
+    faces = [np.stack([a, cc, b], -1).reshape(-1, 3), np.stack([a, d, cc], -1).reshape(-1, 3)]
+    for row, up in ((0, False), (nz - 1, True)):
+        tri = np.asarray(mf.triangulate([secs[row]]), dtype=np.int64)
+        t = idx[row][tri]
+        faces.append(t if up else t[:, ::-1])
+    F = np.concatenate(faces)
+    # orient outward: positive signed volume
+    vol = np.einsum("ij,ij->i", V[F[:, 0]], np.cross(V[F[:, 1]], V[F[:, 2]])).sum() / 6.0
+    if vol < 0:
+        F = F[:, ::-1]
+    return V, F
+
+
+def tet_mesh(
+    V: np.ndarray, F: np.ndarray, size_m: float, min_size_m: float, curvature: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """Tetrahedra (gmsh) inside the closed surface (V, F): the surface is classified into patches at sharp edges
+    (40 deg), re-parametrised and re-meshed at `size_m` (refined on curvature, `curvature` elements per 2 pi of a
+    curve's turn, down to min_size_m: the root fillet), then the volume is meshed: (points (n, 3), tets (m, 4))."""
+    import gmsh
+
+    gmsh.initialize(["-noenv"], readConfigFiles=False)
+    try:
+        gmsh.option.setNumber("General.Terminal", 1 if _VERBOSE else 0)
+        gmsh.option.setNumber("General.NumThreads", 1)
+        gmsh.model.add("tooth")
+        s = gmsh.model.addDiscreteEntity(2)
+        gmsh.model.mesh.addNodes(2, s, list(range(1, len(V) + 1)), (V * 1e3).ravel().tolist())  # mm
+        gmsh.model.mesh.addElementsByType(s, 2, [], (F.ravel() + 1).tolist())
+        gmsh.model.mesh.classifySurfaces(math.radians(40), True, True, math.pi)
+        gmsh.model.mesh.createGeometry()
+        surfs = [e[1] for e in gmsh.model.getEntities(2)]
+        loop = gmsh.model.geo.addSurfaceLoop(surfs)
+        gmsh.model.geo.addVolume([loop])
+        gmsh.model.geo.synchronize()
+        gmsh.option.setNumber("Mesh.MeshSizeMax", size_m * 1e3)
+        gmsh.option.setNumber("Mesh.MeshSizeMin", min_size_m * 1e3)
+        gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", curvature)
+        gmsh.model.mesh.generate(3)
+        tags, xyz, _ = gmsh.model.mesh.getNodes()
+        _, _, conn = gmsh.model.mesh.getElements(3)
+        P = np.asarray(xyz).reshape(-1, 3) / 1e3
+        order = np.empty(int(tags.max()) + 1, dtype=np.int64)
+        order[np.asarray(tags, dtype=np.int64)] = np.arange(len(tags))
+        T = order[np.asarray(conn[0], dtype=np.int64).reshape(-1, 4)]
+    finally:
+        gmsh.finalize()
+    used = np.unique(T)
+    remap = -np.ones(len(P), dtype=np.int64)
+    remap[used] = np.arange(len(used))
+    return P[used], remap[T]
+
+
+# ----------------------------------------------------------------------------- solver
+
+
+@dataclass(frozen=True)
+class Solution:
+    stress: np.ndarray  # (n_load, m, 3, 3) element-centroid stress, Pa
+    centroids: np.ndarray  # (m, 3)
+    displacement: np.ndarray  # (n_load, n_nodes, 3) at the mesh vertices
+
+
+def solve_elastic(
+    points: np.ndarray,
+    tets: np.ndarray,
+    e_pa: float,
+    nu: float,
+    fixed_facet,
+    loads: list[tuple[np.ndarray, np.ndarray]],
+) -> Solution:
+    """Linear elasticity on quadratic tetrahedra (scikit-fem). fixed_facet(x) -> bool mask of boundary-facet
+    midpoints (3, k) that are clamped; loads: per load case (vertex indices (k,), forces (k, 3) N) at mesh vertices."""
+    from skfem import Basis, ElementTetP2, ElementVector, MeshTet, asm
+    from skfem.models.elasticity import lame_parameters, linear_elasticity
+
+    mesh = MeshTet(points.T.copy(), tets.T.copy()).oriented()
+    ib = Basis(mesh, ElementVector(ElementTetP2()), intorder=2)
+    lam, mu = lame_parameters(e_pa, nu)
+    K = asm(linear_elasticity(lam, mu), ib).tocsc()
+    fixed = ib.get_dofs(lambda x: fixed_facet(x)).all()
+    free = np.setdiff1d(np.arange(ib.N), fixed)
+    Kff = K[free][:, free].tocsr()
+    solve = _solver(Kff, ib.doflocs, free)
+    us, stresses = [], []
+    for verts, forces in loads:
+        f = np.zeros(ib.N)
+        for d in range(3):
+            np.add.at(f, ib.nodal_dofs[d, verts], forces[:, d])
+        u = np.zeros(ib.N)
+        u[free] = solve(f[free])
+        ui = ib.interpolate(u)
+        grad = ui.grad.mean(axis=-1)  # (3, 3, m) mean over quadrature points: the centroid value of a P2 strain
+        eps = 0.5 * (grad + grad.transpose(1, 0, 2))
+        tr = np.trace(eps)
+        sig = 2 * mu * eps + lam * tr[None, None, :] * np.eye(3)[:, :, None]
+        stresses.append(np.moveaxis(sig, -1, 0))
+        us.append(u[ib.nodal_dofs].T)
+    cent = mesh.p[:, mesh.t].mean(axis=1).T
+    return Solution(stress=np.array(stresses), centroids=cent, displacement=np.array(us))
+
+
+DIRECT_DOFS_MAX = 30000  # above this, algebraic multigrid (pyamg) with conjugate gradients instead of SuperLU
+CG_RTOL = 1e-8  # relative residual; the stresses change by < 1e-5 relative below it (measured on involute_41)
+
+
+def _solver(Kff, doflocs: np.ndarray, free: np.ndarray):
+    """x = solve(b) for the clamped stiffness matrix: SuperLU for small systems, else pyamg's smoothed aggregation
+    with the rigid-body modes as near-null space, as the preconditioner of conjugate gradients."""
+    import scipy.sparse.linalg as spla
+
+    if Kff.shape[0] <= DIRECT_DOFS_MAX:
+        lu = spla.splu(Kff.tocsc())
+        return lu.solve
+    import pyamg
+
+    # rigid-body modes at the free dofs (dof k of the vector basis is component k % 3 in skfem's interleaving)
+    n = doflocs.shape[1]
+    x = doflocs[:, free]
+    comp = free % 3
+    B = np.zeros((len(free), 6))
+    for d in range(3):
+        B[comp == d, d] = 1.0
+    # rotations: e_d x r
+    B[comp == 0, 3], B[comp == 1, 3] = -x[1, comp == 0], x[0, comp == 1]
+    B[comp == 1, 4], B[comp == 2, 4] = -x[2, comp == 1], x[1, comp == 2]
+    B[comp == 2, 5], B[comp == 0, 5] = -x[0, comp == 2], x[2, comp == 0]
+    del n
+    ml = pyamg.smoothed_aggregation_solver(Kff, B=B, max_coarse=500)
+
+    def solve(b):
+        return ml.solve(b, tol=CG_RTOL, accel="cg", maxiter=500)
+
+    return solve
+
+
+def max_principal(stress: np.ndarray) -> np.ndarray:
+    """First principal stress of (..., 3, 3) symmetric tensors."""
+    return np.linalg.eigvalsh(stress)[..., -1]
+
+
+# ----------------------------------------------------------------------------- contact load (torsional LTCA lines)
+
+
+def contact_loads(g: GearGeometry, side: int, t2_nm: float, positions: int) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Per position over tooth 0's engagement: (points (k, 3) m on tooth 0's working flank, forces (k, 3) N on the
+    wheel), from the contact lines and load law of the torsional TCA (module docstring)."""
+    import contourpy
+
+    from wormsim.tooth import mesh_stiffness as ms
+
+    fld = ms._flank_field(g, side)
+    gen = contourpy.contour_generator(z=fld.c, name="serial", corner_mask=True)
+    pitch = 2 * math.pi / g.z2
+    dj = g.backlash / (2 * g.r2)
+    rot = dj if side > 0 else pitch - dj  # the field's flank -> tooth 0's working flank (meshgen.wheel.tooth_flanks)
+    cr, sr = math.cos(rot), math.sin(rot)
+    Rz = np.array([[cr, -sr, 0.0], [sr, cr, 0.0], [0.0, 0.0, 1.0]])
+    zeta = np.linspace(-g.face_width / 2, g.face_width / 2, fld.xyz.shape[0])
+    s = np.linspace(0.0, 1.0, fld.xyz.shape[1])
+    dz = np.gradient(fld.xyz, zeta, axis=0)
+    dsv = np.gradient(fld.xyz, s, axis=1)
+    normal = np.cross(dz, dsv)
+    normal /= np.linalg.norm(normal, axis=-1, keepdims=True)
+    cmin, cmax = float(fld.c.min()), float(fld.c.max())
+    psi_c = wheel.tooth_angle(g, 0)
+    levels = cmin + (cmax - cmin) * (np.arange(positions) + 0.5) / positions
+    out = []
+    for theta2 in levels:
+        total = 0.0
+        mine: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = []
+        for k in range(math.ceil((cmin - theta2) / pitch), math.floor((cmax - theta2) / pitch) + 1):
+            for ln in gen.lines(theta2 + k * pitch):
+                if len(ln) < 2:
+                    continue
+                ln = np.asarray(ln)
+                j, i = ln[:, 0], ln[:, 1]
+                P = ms._bilinear(fld.xyz, i, j)
+                A = ms._bilinear(fld.arm, i, j)
+                n = ms._bilinear(normal, i, j)
+                ds = np.linalg.norm(np.diff(P, axis=0), axis=1)
+                total += float(np.sum(0.5 * (A[1:] ** 2 + A[:-1] ** 2) * ds))
+                if k == 0:
+                    Pm, Am, nm = 0.5 * (P[1:] + P[:-1]), 0.5 * (A[1:] + A[:-1]), 0.5 * (n[1:] + n[:-1])
+                    mine.append((Pm, Am, nm, ds))
+        pts, frc = [np.zeros((0, 3))], [np.zeros((0, 3))]
+        for Pm, Am, nm, ds in mine:
+            q = t2_nm * Am / total  # N per m of line
+            Pw = Pm @ Rz.T
+            nw = nm @ Rz.T
+            nw /= np.linalg.norm(nw, axis=1, keepdims=True)
+            psi = np.arctan2(Pw[:, 1], Pw[:, 0])
+            e_psi = np.stack([-np.sin(psi), np.cos(psi), np.zeros_like(psi)], -1)
+            into = np.sign(psi_c - psi)  # into tooth 0's material
+            nw *= np.where(np.einsum("ij,ij->i", nw, e_psi) * into < 0, -1.0, 1.0)[:, None]
+            pts.append(Pw)
+            frc.append(nw * (q * ds)[:, None])
+        out.append((np.concatenate(pts), np.concatenate(frc)))
+    return out
+
+
+# ----------------------------------------------------------------------------- the root stress
+
+
+@dataclass(frozen=True)
+class ToothMesh:
+    points: np.ndarray
+    tets: np.ndarray
+    r_in: float
+
+
+def tooth_mesh(g: GearGeometry, density: int = 2, size_m: float | None = None, use_cache: bool = True) -> ToothMesh:
+    """The tetrahedral mesh of the one-tooth sector, cached by geometry (meshgen.cache). `density` d sets the element
+    sizes together (d = 2 is the default, d = 1 and 2 are an h / (h/2) pair): largest 1.5 m_x / d (or size_m),
+    smallest FILLET_COEF m_x / d (the fillet radius over d), CURVATURE_ELEMENTS d per full turn of a curved surface."""
+    from dataclasses import asdict
+
+    size = size_m if size_m is not None else 1.5 * g.m_x / density
+    min_size = min(FILLET_COEF * g.m_x / density, size)
+    curvature = CURVATURE_ELEMENTS * density
+
+    def build() -> ToothMesh:
+        V, F = tooth_surface(g, SURFACE_DENSITY)
+        P, T = tet_mesh(V, F, size, min_size, curvature)
+        return ToothMesh(P, T, g.r_f2 - RIM_DEPTH_MX * g.m_x)
+
+    parts = {"geometry": asdict(g), "density": density, "size_m": size, "code": CODE_VERSION}
+    return cached("fe-tooth", parts, build, use_cache=use_cache)
+
+
+def root_stress(
+    g: GearGeometry,
+    e_pa: float,
+    nu: float,
+    side: int,
+    t2_nm: float,
+    positions: int,
+    density: int = 2,
+    size_m: float | None = None,
+    use_cache: bool = True,
+) -> dict:
+    """FE root stress of the wheel tooth over its engagement at wheel torque t2_nm (module docstring): a dict with
+    root_stress_max_mpa, root_stress_range_mpa, the position (mm, wheel frame) and the per-position maxima."""
+    return root_stress_cases(g, e_pa, nu, side, [t2_nm], positions, density, size_m, use_cache)[0]
+
+
+def root_stress_cases(
+    g: GearGeometry,
+    e_pa: float,
+    nu: float,
+    side: int,
+    torques_nm: list[float],
+    positions: int,
+    density: int = 2,
+    size_m: float | None = None,
+    use_cache: bool = True,
+) -> list[dict]:
+    """root_stress at several torques with one mesh and one stiffness matrix."""
+    from scipy.spatial import cKDTree
+
+    tm = tooth_mesh(g, density, size_m, use_cache)
+    P, T = tm.points, tm.tets
+    tol = 1e-3 * g.m_x
+
+    def fixed(x):
+        """The rim's cut faces: the inner face and the two space-middle faces below the root."""
+        rho = np.hypot(x[0], x[1])
+        psi = np.arctan2(x[1], x[0])
+        s0, s1 = space_middles(g, x[2])
+        below = rho < wheel.root_rho(g, x[2]) - tol
+        on_side = below & ((np.abs(psi - s0) * rho < tol) | (np.abs(psi - s1) * rho < tol))
+        return (rho < tm.r_in + tol) | on_side
+
+    # each contact sample's force spread over the surface vertices within LOAD_RADIUS_MX (a load patch of fixed size)
+    surf = np.unique(_boundary_faces(T))
+    tree = cKDTree(P[surf])
+    loads, samples = [], []
+    for t2 in torques_nm:
+        for pts, frc in contact_loads(g, side, t2, positions):
+            samples.append(pts)
+            if len(pts) == 0:
+                loads.append((np.zeros(0, dtype=np.int64), np.zeros((0, 3))))
+                continue
+            loads.append(_spread(tree, surf, pts, frc, LOAD_RADIUS_MX * g.m_x))
+    sol = solve_elastic(P, T, e_pa, nu, fixed, loads)
+    c = sol.centroids
+    rho_c = np.hypot(c[:, 0], c[:, 1])
+    root_c = wheel.root_rho(g, c[:, 2])
+    band = (rho_c <= root_c + ROOT_BAND_MX * g.m_x) & (rho_c >= root_c - ROOT_BAND_MX * g.m_x)
+    band &= np.abs(c[:, 2]) <= g.face_width / 2 - EDGE_EXCLUSION_MX * g.m_x
+    # the point loads' own local stress is not root stress: elements near a contact sample are left out there
+    near = np.zeros((len(samples), int(band.sum())), dtype=bool)
+    for i, pts in enumerate(samples):
+        if len(pts):
+            dist, _ = cKDTree(pts).query(c[band])
+            near[i] = dist < LOAD_EXCLUSION_MX * g.m_x
+    out = []
+    for k in range(len(torques_nm)):
+        cases = slice(k * positions, (k + 1) * positions)
+        stress = sol.stress[cases][:, band]  # (positions, n_band, 3, 3)
+        s1v = np.where(near[cases], -np.inf, max_principal(stress))
+        per_pos = s1v.max(axis=1)
+        ipos, iel = np.unravel_index(int(np.argmax(s1v)), s1v.shape)
+        # the history at the critical element along the peak's principal direction; out of mesh it is 0
+        w, v = np.linalg.eigh(stress[ipos, iel])
+        n = v[:, -1]
+        hist = np.einsum("i,pij,j->p", n, stress[:, iel], n)
+        out.append(
+            {
+                "root_stress_max_mpa": float(s1v.max() / 1e6),
+                "root_stress_range_mpa": float((hist.max() - min(hist.min(), 0.0)) / 1e6),
+                "position_mm": [float(x * 1e3) for x in c[band][iel]],
+                "position_index": int(ipos),
+                "per_position_mpa": [float(x / 1e6) for x in per_pos],
+                "critical_history_mpa": [float(x / 1e6) for x in hist],
+                "elements": int(len(T)),
+                "nodes": int(len(P)),
+                "positions": int(positions),
+                "density": int(density),
+                "fillet_radius_mm": FILLET_COEF * g.m_x * 1e3,
+            }
+        )
+    return out
+
+
+def _spread(tree, surf: np.ndarray, pts: np.ndarray, frc: np.ndarray, radius: float):
+    """(vertices, forces): each force shared by the surface vertices within `radius` of its point, weights 1 - d/R
+    (the nearest 3 where none is that close), so the load patch keeps its size when the mesh is refined."""
+    verts, forces = [], []
+    for p, f, near in zip(pts, frc, tree.query_ball_point(pts, radius)):
+        if len(near) < 3:
+            _, near = tree.query(p, k=3)
+            w = np.ones(3)
+        else:
+            d = np.linalg.norm(tree.data[near] - p, axis=1)
+            w = 1.0 - d / radius
+        near = np.asarray(near)
+        verts.append(surf[near])
+        forces.append(np.outer(w / w.sum(), f))
+    return np.concatenate(verts), np.concatenate(forces)
+
+
+def _boundary_faces(T: np.ndarray) -> np.ndarray:
+    """Triangles that belong to one tetrahedron only."""
+    f = np.concatenate([T[:, [0, 1, 2]], T[:, [0, 1, 3]], T[:, [0, 2, 3]], T[:, [1, 2, 3]]])
+    fs = np.sort(f, axis=1)
+    _, inv, cnt = np.unique(fs, axis=0, return_inverse=True, return_counts=True)
+    return f[cnt[inv.ravel()] == 1]
+
+
+# ----------------------------------------------------------------------------- the rating's use
+
+
+def add_fe_root_stress(scenario, result: dict) -> dict:
+    """root_stress_max_mpa, root_stress_range_mpa, safety_root_sim (and `fe_root`, the details) into a rating result
+    of wormsim.rating.rate: the wheel of materials.wheel (E, nu) at the rated torque K_A T2 on the working flank."""
+    import time
+
+    from wormsim import gear_theory
+    from wormsim.geometry import derive
+    from wormsim.rating.rate import rating_inputs
+
+    r = rating_inputs(scenario)
+    g = derive(scenario.gear)
+    side = gear_theory.working_flank(scenario, g.hand)
+    t2 = result["inputs"]["wheel_torque_rated_nm"]
+    t0 = time.perf_counter()
+    fe = root_stress(
+        g, scenario.materials.wheel.youngs_modulus_gpa * 1e9, scenario.materials.wheel.poisson_ratio, side, t2,
+        r.fe_positions, density=r.fe_mesh_density,
+    )  # fmt: skip
+    fe["wall_time_s"] = time.perf_counter() - t0
+    result["fe_root"] = fe
+    result["root_stress_max_mpa"] = fe["root_stress_max_mpa"]
+    result["root_stress_range_mpa"] = fe["root_stress_range_mpa"]
+    if r.root_stress_limit_mpa is not None:
+        result["safety_root_sim"] = r.root_stress_limit_mpa / fe["root_stress_max_mpa"]
+    else:
+        result["safety_root_sim"] = None
+        result["warnings"].append(
+            "safety_root_sim not given: no public bending-fatigue limit of the wheel materials as a max principal "
+            "stress; give rating.root_stress_limit_mpa"
+        )
+    src = "FE root stress: gmsh + scikit-fem on meshgen's wheel tooth, loaded by the torsional TCA's contact lines"
+    if src not in result["sources"]:
+        result["sources"].append(src)
+    return result
