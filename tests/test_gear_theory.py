@@ -82,6 +82,7 @@ def test_din_3975_force_components():
 
 def test_working_wheel_torque_of_the_seat_motor(scenario_dir):
     sc = load_scenario(scenario_dir / "seat_motor.yaml")
+    # load.torque_nm 24 of scenarios/seat_motor.yaml
     assert gt.working_wheel_torque_nm(sc, 53.0) == 24.0  # the load on the wheel
     on_worm = sc.model_copy(update={"load": sc.load.model_copy(update={"on": "worm", "torque_nm": 0.5})})
     assert gt.working_wheel_torque_nm(on_worm, 53.0) == pytest.approx(26.5)  # 0.5 N m x ratio 53
@@ -93,12 +94,14 @@ def test_commands_follow_adams_step_and_the_load_resists(scenario_dir):
     w = 36 * 2 * math.pi / 60
     assert c.drive(0.0) == 0.0 and c.drive(0.3) == pytest.approx(w) and c.drive(1.0) == pytest.approx(w)
     assert c.drive(0.15) == pytest.approx(w / 2)  # STEP is half way at mid-ramp
+    # load.torque_nm 24 of scenarios/seat_motor.yaml, reached at the end of its 0.3 s ramp
     assert c.load(0.3) == pytest.approx(-24.0)  # resists the positive motion
     assert gt.commands(sc, direction=-1).load(0.3) == pytest.approx(24.0)
     t = np.array([0.0, 0.075, 0.15, 0.3])
     # STEP: s^2 (3 - 2 s) at s = 0.25 -> 0.15625; float and array paths agree exactly
     assert c.drive(t)[1] == pytest.approx(0.15625 * w)
     assert list(c.drive(t)) == [c.drive(float(x)) for x in t]
+    # ramp_s 0.3 of scenarios/seat_motor.yaml; + LOCK_SETTLE_S 0.02 of wormsim/gear_theory.py
     assert gt.ramps_end_s(sc) == 0.3 and gt.lock_check_start_s(sc) == pytest.approx(0.32)
 
 
@@ -107,6 +110,7 @@ def test_servo_gain_gives_the_speed_droop_at_the_expected_torque(scenario_dir):
     g, an, mu, i = 4.79 * DEG, 10 * DEG, 0.05, 53.0
     eta = gt.efficiency_theory(g, an, mu)
     t_exp = gt.expected_drive_torque_nm(sc, i, g, an, mu)
+    # T1 = T2 / (i eta): power balance with the theory efficiency; 24 N m of scenarios/seat_motor.yaml
     assert t_exp == pytest.approx(24.0 / i / eta)
     kv = gt.servo_gain_nm_s(sc, i, g, an, mu)
     w = 36 * 2 * math.pi / 60
@@ -122,6 +126,7 @@ def test_guards_penetration_limit_and_stuck_drive():
     assert list(gt.drive_stuck(np.array([0.1, 0.9]), np.array([1.0, 1.0]))) == [True, False]
 
 
+# 1-2-5 series: the largest of {1, 2, 5} x 10^k not above h (definition of round_down_125)
 @pytest.mark.parametrize(
     "h, expected",
     [

@@ -72,6 +72,7 @@ def test_screw_jack_at_30x_speed_gets_a_safe_timestep_and_keeps_the_physics():
     assert sc.simulation.timestep_s is None
     res = simulate(sc)
     s = res.summary
+    # 0.035 rad / (40000 rpm = 4189 rad/s) = 8.4e-6 s, round_down_125 -> 5e-6 s (runner rule, docstring)
     assert s["timestep_s"] == 5e-6
     assert s["timestep_s"] < 0.4 * s["timestep_stable_limit_s"]  # the speed, not the contact, set it
     assert s["timestep_source"].startswith("worm speed: 40000 rpm"), s["timestep_source"]
@@ -95,15 +96,18 @@ def test_a_scenario_timestep_too_large_for_the_speed_is_refused_with_its_allowed
     seed = _jack(1330, 0.01, "simulation.timestep_s=1e-5")
     bm = build_model(seed)
     h, src = choose_timestep(seed, bm.geometry, bm.law)
+    # the scenario's own simulation.timestep_s=1e-5 (input echoed back)
     assert h == 1e-5 and src == "scenario"
     # unset: the contact's default (1e-5 s for the screw jack), the speed does not bind
     h, src = choose_timestep(_jack(1330, 0.01), bm.geometry, bm.law)
+    # the contact's default timestep for the screw jack (1e-5 s, docstring above)
     assert h == 1e-5 and src.startswith("default"), src
     # a speed-driven wheel: the worm turns ratio x faster (2000 x 24 = 48000 rpm -> 0.035 / 5027 rad/s = 7e-6 -> 5e-6)
     wheel = load_scenario(
         JACK, COARSE + ["drive.on=wheel", "drive.speed_rpm=2000", "load.on=worm", "load.torque_nm=0.1"]
     )
     h, src = choose_timestep(wheel, bm.geometry, bm.law)
+    # 0.035 rad / (48000 rpm = 5027 rad/s) = 7e-6 s, round_down_125 -> 5e-6 s
     assert h == 5e-6 and src.startswith("worm speed: 48000 rpm"), (h, src)
     # above the contact's stable limit (2.53e-5 s) the divergence guard speaks first (it names that limit)
     assert choose_timestep(_jack(26600, 0.01, "simulation.timestep_s=5e-5"), bm.geometry, bm.law) == (5e-5, "scenario")
@@ -183,8 +187,10 @@ def test_speculative_contacts_tunnel_sooner_beyond_the_speed_limit(monkeypatch):
         return run_model(bm, sc)
 
     plain = run(66500, 1e-5)
+    # 66500 rpm x 2 pi / 60 x 1e-5 s = 0.0696 rad per step (kinematics); ratio 24 = z2 / z1 of the screw jack
     assert plain.summary["worm_turn_per_step_max_rad"] == pytest.approx(0.0696, rel=0.02)
     assert abs(plain.summary["ratio"] / 24 - 1) < 1e-3, plain.summary["ratio"]
+    # 20 um / 200 um: bounds around the measured 9-11 um / 1685 um of the docstring (regression values of this code)
     assert plain.series["max_penetration_m"].max() < 20e-6
     try:
         spec = run(66500, 1e-5, "simulation.speculative=true")
@@ -255,6 +261,7 @@ def test_startup_impact_step_against_ramp(
     for s in (step, ramp):
         assert abs(s["ratio"] / s["ratio_theory"] - 1) < 1e-3, s["ratio"]
         assert 0 < s["startup_time_s"] == pytest.approx(s["steady_window_s"][0])
+        # 100 um: bound above the measured 15.3 / 64 um of the docstring (this code's runs), below the 281-1000 um guards
         assert s["startup_penetration_max_um"] < 100
     peak = step["startup_tangential_force_peak_n"]
     assert peak > over_mean * step["tangential_force_mean_n"], (peak, step["tangential_force_mean_n"])
@@ -272,6 +279,7 @@ def test_startup_peak_is_per_step_whatever_record_every():
     measured with pieces, before flanks were the default)."""
     s1, _ = _start(JACK, 6650, 0.04, 0)
     s100, series = _start(JACK, 6650, 0.04, 0, record_every=100)
+    # the record_every input echoed back
     assert s100["record_every"] == 100
     peak = s100["startup_tangential_force_peak_n"]
     assert peak == pytest.approx(s1["startup_tangential_force_peak_n"], rel=0.1)

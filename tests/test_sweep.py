@@ -59,6 +59,7 @@ def test_expand_grid_zip_random_in_order():
         }
     )
     pts = expand(spec)
+    # grid 2 x 3, zip 2 (side by side), random n 2: the product of the axes' lengths
     assert len(pts) == 2 * 3 * 2 * 2
     assert pts[0] == {"a.b": 1, "c.d": 0.0, "e.f": 10, "g.h": 30, "i.j": pts[0]["i.j"]}
     assert [p["c.d"] for p in pts[:12:4]] == [0.0, 0.5, 1.0]  # the last axes vary fastest
@@ -66,6 +67,7 @@ def test_expand_grid_zip_random_in_order():
     assert pts == expand(spec)  # the seed fixes the draws
     assert all(0.0 <= p["i.j"] <= 1.0 for p in pts)
     log = SweepFile.model_validate({"name": "t", "base": "x", "grid": {"a": {"logspace": [1.0e2, 1.0e4, 3]}}})
+    # logspace [1e2, 1e4, 3] = 10^2, 10^3, 10^4 (numpy.logspace)
     assert [p["a"] for p in expand(log)] == pytest.approx([100.0, 1000.0, 10000.0])
 
 
@@ -76,7 +78,9 @@ def test_points_are_validated_and_hashed():
         {"contact.stiffness_n_per_m": 6.0e8, "load.torque_nm": 12},
         {"contact.stiffness_n_per_m": 4.39e8, "load.torque_nm": 30000},
     ]
+    # the set: block of tests/assets/sweep_torsional.yaml (inputs echoed back)
     assert all(p.scenario.model == "torsional" and p.scenario.simulation.duration_s == 0.12 for p in sw.points)
+    # zip value 2 of tests/assets/sweep_torsional.yaml
     assert sw.points[1].scenario.contact.stiffness_n_per_m == 6.0e8
     assert len({p.scenario_hash for p in sw.points}) == 3
     assert load_sweep(SWEEP).points[0].scenario_hash == sw.points[0].scenario_hash
@@ -155,12 +159,15 @@ def test_local_cluster_two_workers_with_a_failing_point(local_run):
         assert float(r["tangential_force_mean_n"]) == pytest.approx(400.0, rel=1e-4)
         assert float(r["contact.stiffness_n_per_m"]) in (2.0e8, 6.0e8)
     doc = json.loads((out / "sweep.json").read_text())
+    # the --workers 2 of local_run (input echoed back)
     assert doc["cluster"]["kind"].startswith("LocalCluster") and doc["cluster"]["workers"] == 2
     assert doc["cluster"]["threads"] == 2
     assert [p["status"] for p in doc["points"]] == ["ok", "ok", "failed"]
+    # zip value 2 of tests/assets/sweep_torsional.yaml
     assert doc["points"][1]["scenario"]["contact"]["stiffness_n_per_m"] == 6.0e8
     assert doc["sweep"]["name"] == "test_torsional" and doc["machine"]["cpu_count"] >= 1
     assert len({p["timing"]["worker"] for p in doc["points"]}) == 2  # both workers took points
+    # 10 kB: a bound for a rendered figure rather than an empty file, not a measured value
     assert (out / "sweep.png").stat().st_size > 10_000
     assert not (out / "runs").exists()  # per-point folders only with --keep-runs
 
@@ -291,6 +298,7 @@ def test_resume_after_ctrl_c_skips_finished_points(tmp_path, capsys):
     assert [int(r["point"]) for r in rows] == list(range(6)) and all(r["status"] == "ok" for r in rows)
     for r in first:  # the finished points were not run again
         assert rows[int(r["point"])]["wall_time_s"] == r["wall_time_s"]
+    # linspace [1000, 1500, 6] of the sweep above (numpy.linspace)
     assert [float(r["drive.speed_rpm"]) for r in rows] == pytest.approx([1000, 1100, 1200, 1300, 1400, 1500])
     # a third run has nothing to do and starts no cluster
     assert cli.main(["sweep", str(sweep), "--out", str(out), "--no-progress"]) == 0
@@ -345,4 +353,5 @@ def test_sweep_png_plain_tick_labels(tmp_path, monkeypatch):
     for a in axes:
         assert a.yaxis.get_offset_text().get_text() == "" and a.xaxis.get_offset_text().get_text() == ""
         lo, hi = a.get_ylim()
+        # MIN_REL_SPAN = 0.01 of wormsim/sweep/plot.py (less 1e-4 for rounding)
         assert hi - lo >= 0.0099 * abs(0.5 * (lo + hi))

@@ -48,6 +48,7 @@ def test_motor_force_at_rest_is_the_kloss_value():
     # Kloss (seed 000): F = 2 F_k / (s / s_k + s_k / s), slip s = 1 at rest, s_k = (7.85 - 6.5) / 7.85 = 0.17197:
     # 2 x 2178 / (1 / 0.17197 + 0.17197) = 727.6 N
     assert wedge.motor_force_n(0.0, p) == pytest.approx(727.6, abs=0.1)
+    # F_k = 2178 N at Vmax 6.5 m/s, synchronous 7.85 m/s: the Kloss parameters of scenarios/mov_1.yaml (seed 000)
     assert wedge.motor_force_n(6.5, p) == pytest.approx(2178.0, rel=1e-12)  # peak at Vmax
     assert wedge.motor_force_n(7.85, p) == 0.0  # synchronous speed
     assert wedge.motor_force_n(8.0, p) < 0  # generator above it
@@ -194,6 +195,7 @@ def test_load_reversal_timeline_tractive_locked_inverse():
     # breakaway where the static limit is reached: F1(0) / |F2| = tan(g - rho)
     assert -wedge.load_force_n(t_break, p) == pytest.approx(F1_REST / math.tan(G - math.atan(0.05)), rel=1e-9)
     # the stop happened before that, with the drive stalled beyond its peak force: |F2| tan(g + rho) > Fmax
+    # 2178 N: the Kloss peak force F_k of the motor (seed 000, scenarios/mov_1.yaml)
     assert -wedge.load_force_n(t_lock, p) * math.tan(G + math.atan(0.05)) > 2178
     assert s["v1_m_s"][-1] < 0 and np.all(s["v1_m_s"][s["regime_code"] == 0] == 0)
 
@@ -276,6 +278,7 @@ def test_kd_uses_the_rated_forces():
     res = run_wedge(load={"force_n": -10000.0, "start_s": 0.1, "ramp_s": 0.02})
     p, sm = params(res), res.summary
     rho_n = wedge.rho_of_speed(7.59, p)
+    # Ft1 = nominal_force_n 990 N, Vs_n 7.59 m/s: wedge defaults (wormsim/scenario.py), seed 000 MOV (M_n / R1)
     assert sm["Ft1_n"] == 990.0
     assert sm["Ft2_n"] == pytest.approx(990.0 / math.tan(G + rho_n), rel=1e-12)
     assert sm["Kd1"] == pytest.approx(abs(sm["S1_peak_n"]) / 990.0, rel=1e-12)
@@ -312,6 +315,7 @@ def test_early_seat_stalls_and_locks_with_s1_at_the_static_wedge_limit():
     t_stop = sm["regime_timeline"][1]["start_s"]
     assert sm["S1_peak_time_s"] == pytest.approx(t_stop, abs=1e-9)
     # just before the stop x1' -> 0, rho -> rho(0): S1 = psi1(rho0) S2 with S2 = F2 - m2 tan g x1''
+    # m1 11.8 kg, m2 100 kg, F2 -15000 N, rho(0) = 1 / 0.088 deg (group III): scenarios/mov_3_early_seat.yaml, seed 000
     rho0 = math.radians(1 / 0.088)
     a = (F1_REST - (-15000.0) * -math.tan(G + rho0)) / (11.8 + 100 * math.tan(G + rho0) * math.tan(G))
     assert sm["S1_peak_n"] == pytest.approx(F1_REST - 11.8 * a, rel=1e-6)
@@ -329,6 +333,7 @@ def test_every_mov_scenario_runs_and_writes_all_files(path, tmp_path):
     assert set(on_disk["regimes"]) <= {"tractive", "inverse", "locked"}
     with np.load(tmp_path / "timeseries.npz") as ts:
         assert {"t_s", "x1_m", "v1_m_s", "S1_n", "S2_n", "F1_n", "F2_n", "regime_code"} <= set(ts.files)
+        # simulation.duration_s 0.3 of every scenarios/mov_*.yaml (input echoed back)
         assert ts["t_s"][-1] == pytest.approx(0.3)
     assert {"/series/S1_n", "/series/S2_n", "/series/v1_m_s"} <= recorded_entities(tmp_path / "recording.rrd")
     assert (tmp_path / "report.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
