@@ -12,6 +12,7 @@ def test_relative_errors_only_where_defined():
         {"ratio": 53.053, "efficiency": 0.6, "mesh_frequency_hz": None},
         {"ratio": 53.0, "efficiency": 0.0, "mesh_frequency_hz": 0.6},
     )
+    # (53.053 - 53.0) / 53.0 = 0.001 (the definition, by hand)
     assert abs(e["ratio"] - 0.001) < 1e-12
     assert e["efficiency"] is None and e["mesh_frequency_hz"] is None
     assert set(e) == set(ERROR_KEYS)
@@ -126,6 +127,7 @@ def test_speedup_of_flanks_over_pieces_pairs_equal_level_and_step_factor():
         rec("flanks", "fine", 1.0, 20.0),
     ]
     assert speedups(recs) == {"s": {"medium": 12.0}}
+    # 120 / 10 and 60 / 6: pieces' over flanks' wall_s_per_sim_s of the records above (by hand)
     assert recs[1]["speedup_vs_pieces"] == 12.0 and recs[3]["speedup_vs_pieces"] == 10.0
     assert "speedup_vs_pieces" not in recs[4]  # no pieces run of that level: no speed-up claimed
 
@@ -145,6 +147,7 @@ def test_loop_speedup_uses_the_stepping_loop_wall_time_of_the_same_records():
         }
 
     recs = [rec("pieces", 120.0, 110.0), rec("flanks", 15.0, 5.0)]
+    # 120 / 15 and 110 / 5 of the records above (by hand)
     assert speedups(recs) == {"s": {"medium": 8.0}}
     assert speedups(recs, "loop_wall_s_per_sim_s", "loop_speedup_vs_pieces") == {"s": {"medium": 22.0}}
     assert recs[1]["speedup_vs_pieces"] == 8.0 and recs[1]["loop_speedup_vs_pieces"] == 22.0
@@ -185,9 +188,11 @@ def test_speedup_at_equal_or_better_accuracy_takes_the_cheapest_flanks_run_at_le
     ]
     got = speedups_equal_accuracy(recs)["s"]["medium"]
     d, c = got["vs_default_pieces"], got["vs_cheapest_pieces"]
+    # 100 / 5 and 50 / 5 of the records above: the cheapest flanks run no worse in any error key (by hand)
     assert d["speedup"] == 20.0 and d["pieces_timestep_factor"] == 1.0 and d["flanks_timestep_factor"] == 2.0
     assert c["speedup"] == 10.0 and c["pieces_timestep_factor"] == 2.0 and c["flanks_timestep_factor"] == 2.0
     recs[3]["error"]["efficiency"] = 1e-3  # now as accurate: it is taken
+    # 100 / 2: the cheapest flanks run is now taken (by hand)
     assert speedups_equal_accuracy(recs)["s"]["medium"]["vs_default_pieces"]["speedup"] == 50.0
 
 
@@ -201,6 +206,7 @@ def test_speedup_at_equal_accuracy_needs_every_error_key_on_both_sides():
     recs[0]["error"]["mesh_frequency_hz"] = None
     assert speedups_equal_accuracy(recs)["s"]["medium"]["vs_default_pieces"] is None
     recs[0]["error"]["mesh_frequency_hz"] = 1e-5
+    # 100 / 10 of the two records (by hand)
     assert speedups_equal_accuracy(recs)["s"]["medium"]["vs_default_pieces"]["speedup"] == 10.0
 
 
