@@ -62,6 +62,7 @@ def _rho_deg(mu: float, alpha_n_deg: float) -> float:
 def test_self_locking_pair_with_speed_driven_wheel_stops_locked_through_the_cli(tmp_path, capsys, geometry):
     """mu = 0.2: rho' = 12.0 deg > gamma = 5.71 deg, the wheel cannot turn the worm. Exit 3, a failed summary.json
     naming the self-locking and what to change, and nothing else left in DIR. For each contact.geometry."""
+    # gamma = atan(z1 / q) = atan(1 / 10) = 5.71 deg for the screw jack (scenarios/screw_jack.yaml)
     assert _rho_deg(0.2, 20.0) > 5.71
     out = tmp_path / "locked"
     args = ["run", str(JACK), "--out", str(out), "--no-progress"]
@@ -80,6 +81,7 @@ def test_self_locking_pair_with_speed_driven_wheel_stops_locked_through_the_cli(
     # the numbers it states: rho' at the friction given and the lead angle of the screw jack (q = 10)
     rho = float(re.search(r"rho' = .*? = ([0-9.]+) deg", msg).group(1))
     gamma = float(re.search(r"lead angle gamma = ([0-9.]+) deg", msg).group(1))
+    # gamma = atan(z1 / q) = atan(1 / 10) = 5.71 deg (scenarios/screw_jack.yaml)
     assert rho == pytest.approx(_rho_deg(0.2, 20.0), abs=0.01) and gamma == pytest.approx(5.71, abs=0.01)
     # the friction below which back-driving works: mu < tan(gamma) cos(alpha_n)
     mu_max = float(re.search(r"below mu = tan\(gamma\) cos\(alpha_n\) = ([0-9.]+)", msg).group(1))
@@ -120,6 +122,7 @@ def test_valid_back_driven_run_trips_no_guard():
     sc = load_scenario(JACK, WHEEL_DRIVEN + ["contact.friction=0.02", LOCK_DURATION])
     res = simulate(sc)
     bm = res.extra["built"]
+    # LOCK_DURATION above: the run reaches its simulation.duration_s (input echoed back)
     assert res.sim_time_s == pytest.approx(0.085, abs=1e-4)
     # ratio from the shaft angles over the last 0.05 s (the summary's mean-speed ratio has about one 22 Hz mesh
     # period in so short a window)
@@ -127,11 +130,12 @@ def test_valid_back_driven_run_trips_no_guard():
     i = int((t < t[-1] - 0.05).sum())
     d1 = res.series["worm_angle_rad"][-1] - res.series["worm_angle_rad"][i]
     d2 = res.series["wheel_angle_rad"][-1] - res.series["wheel_angle_rad"][i]
+    # 24 = z2 / z1 of scenarios/screw_jack.yaml (kinematics)
     assert abs(d1 / d2) == pytest.approx(24.0, rel=1e-3)
     assert max(res.series["max_penetration_m"]) < penetration_limit_m(bm.geometry.m_x)
     te_pitch = abs(res.series["transmission_error_rad"]).max() / (2 * math.pi / bm.geometry.z2)
     assert te_pitch < JUMP_PITCH
-    # the worm really turned at the kinematic speed after the ramp
+    # the worm really turned at the kinematic speed after the ramp: 55 rpm (WHEEL_DRIVEN) x z2 / z1 = 24, half as bound
     assert abs(res.series["worm_speed_rpm"][-1]) > 0.5 * 55 * 24
 
 
@@ -198,6 +202,7 @@ def test_bad_qacc_at_a_stable_timestep_names_the_command_step_and_its_cure():
     assert classify_failure(exc.value) == "diverged" and "bad-qacc" in msg, msg
     assert "within the contact's stable limit" in msg and "drive.ramp_s" in msg and "load.ramp_s" in msg
     res = simulate(load_scenario(DEMO, base + ["load.ramp_s=0.002", "drive.ramp_s=0.002"]))
+    # simulation.duration_s 0.004 of base (the run reaches its end)
     assert res.sim_time_s == pytest.approx(0.004, abs=1e-5)
 
 
@@ -234,6 +239,7 @@ def test_stability_edge_records_the_last_stable_timestep_and_the_failure():
     ):
         assert k in rec, k
     h0 = rec["default_timestep_s"]
+    # round_down_125(DEFAULT_FRACTION x stable limit) for the seat motor demo: this code's value, no independent source
     assert h0 == pytest.approx(5e-6) and h0 < rec["stable_limit_s"] < 4 * h0
     first, second = rec["runs"]
     assert first["status"] == "ok" and first["drift"] == {"ratio_angles": 0.0, "tangential_force_mean_n": 0.0}
@@ -290,9 +296,11 @@ def test_friction_alignment_reads_one_for_a_box_sliding_on_a_plane():
     for _ in range(200):  # settle onto the plane
         mujoco.mj_step(m, d)
     cos, ft, fn = friction_alignment(d, 1e-3)
+    # f_n = m g = 1 kg x 9.81 m/s^2 (statics of the box at rest)
     assert cos == 1.0 and ft == 0.0 and fn == pytest.approx(9.81, rel=0.02)
     d.qvel[0] = 1.0
     for _ in range(5):
         mujoco.mj_step(m, d)
     cos, ft, fn = friction_alignment(d, 1e-3)
+    # Coulomb: |f_t| = mu f_n with mu 0.5 of the MJCF above
     assert cos == pytest.approx(1.0, abs=1e-3) and ft == pytest.approx(0.5 * fn, rel=0.01), (cos, ft, fn)

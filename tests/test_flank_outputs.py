@@ -91,6 +91,7 @@ def test_relative_curvature_at_the_pitch_point_is_the_mid_plane_rack_and_gear(na
     sol = wheel.space_flank(g, np.array([g.r2]), np.array([0.0]), +1)
     k, tz, _ = FO.curvature_at(g, np.array([0.0]), np.array([g.r2]), sol.beta - sol.psi, +1)
     assert abs(1 / k[0] / (g.r2 * math.sin(g.alpha_x)) - 1) < 0.01, (1 / k[0], g.r2 * math.sin(g.alpha_x))
+    # 1: the contact line runs along the face (unit tangent's z component; docstring, DIN 3975 geometry)
     assert tz[0] > 0.99
 
 
@@ -198,6 +199,7 @@ def test_extent_is_the_face_span_holding_95_percent_of_the_load():
         T[:, 2], T[:, 4] = slices, loads
         return T
 
+    # 0.95 quantile rule of contact_pattern_extent_face_mm on an even load: 0.95 b2 (by hand)
     assert log.extent_face_m(rows(np.arange(16), np.ones(16))) == pytest.approx(0.95 * g.face_width, rel=1e-12)
     assert log.extent_face_m(rows([5], [3.0])) == pytest.approx(0.95 * w, rel=1e-12)
     # half the load in slice 0, half in slice 15: 2.5 % lies 0.05 w into slice 0, 97.5 % 0.95 w into slice 15
@@ -221,6 +223,7 @@ def test_pressure_maximum_skips_contacts_entering_or_leaving_the_line():
     )
     log.table = lambda: T
     s = log.summary(np.array([0.0, 1.0]), (0.0, 1.0))
+    # row 2 of T (320 MPa at zeta 0.7 mm, rho 28.9 mm): row 1's 1e-4 N is below PRESSURE_MIN_FORCE_SHARE (by hand)
     assert s["contact_pressure_max_mpa"] == pytest.approx(320.0)
     assert s["contact_pressure_max_face_mm"] == pytest.approx(0.7) and s[
         "contact_pressure_max_radius_mm"
@@ -228,4 +231,5 @@ def test_pressure_maximum_skips_contacts_entering_or_leaving_the_line():
     fn, p = T[:, 4], T[:, 5]
     assert s["contact_pressure_mean_mpa"] == pytest.approx((fn * p).sum() / fn.sum() * 1e-6, rel=1e-12)
     T[1, 4] = 0.5  # 2.3 % of the mean: counted
+    # row 1's 2.0e9 Pa once its F_n counts (by hand from T)
     assert log.summary(np.array([0.0, 1.0]), (0.0, 1.0))["contact_pressure_max_mpa"] == pytest.approx(2000.0)

@@ -171,6 +171,7 @@ def test_self_locking_worm_creeps():
     free = _wheel_torque_worm_free(0.0)
     w_locked = abs(locked.series["worm_speed_rpm"][-1])
     w_free = abs(free.series["worm_speed_rpm"][-1])
+    # 100 rpm: bound below the measured frictionless speed; 1e-2: the creep criterion of the docstring
     assert w_free > 100.0
     assert w_locked < 0.01 * w_free
 
@@ -226,6 +227,7 @@ def test_mesh_stiffness_mean_in_expected_range(name):
     g, kp, src, ms = _ms(name)
     K_pair = kp * g.face_width
     ratio = ms.k_mesh_fwd_n_per_m.mean() / K_pair
+    # 1-4 pair stiffnesses for 2-4 teeth on diagonal contact lines (docstring estimate); teeth 2-5 likewise
     assert 1.0 < ratio < 4.0
     assert ms.k_mesh_fwd_n_per_m.mean() == pytest.approx(K_pair * ms.length_fwd_m.mean() / g.face_width, rel=0.2)
     assert 2 <= ms.teeth_fwd.min() and ms.teeth_fwd.max() <= 5
@@ -290,6 +292,7 @@ def test_driven_machine_inertia_adds_to_the_loaded_shaft():
     g = derive(base.gear)
     i1, i2 = inertias(base, g)
     j1, j2 = inertias(load_scenario(ROOT / "scenarios" / "seat_motor.yaml", ["load.inertia_kg_m2=2e-4"]), g)
+    # the load.inertia_kg_m2=2e-4 input adds to the loaded shaft only
     assert j1 == i1 and abs(j2 - i2 - 2e-4) < 1e-15
     k1, k2 = inertias(
         load_scenario(
