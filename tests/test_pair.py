@@ -167,6 +167,7 @@ def test_attach_names_and_placement():
     data = mujoco.MjData(model)
     mujoco.mj_kinematics(model, data)
     worm, wheel = (mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, n) for n in pair.body_names)
+    # the housing body's pos 1 2 3 in the MJCF above; worm at y = -a (INTERFACE.md, 'Geometry files')
     np.testing.assert_allclose(data.xpos[wheel], [1, 2, 3], atol=1e-12)
     np.testing.assert_allclose(data.xpos[worm], [1, 2 - pair.center_distance_m, 3], atol=1e-12)
     worm_axis = data.xmat[worm].reshape(3, 3)[:, 2]
@@ -196,6 +197,7 @@ def test_pair_with_shafts_on_a_compliant_housing_meshes():
     ratio = _ratio(out[0, 0, sl], out[0, 1, sl])
     ft = float(np.mean(out[0, 2, sl]))
     assert abs(ratio / pair.ratio - 1) < 1e-3, ratio
+    # 12.0 N m: the load torque given to _machine above (screw_jack.yaml); F_t = T2 / r2 (statics)
     assert abs(ft / (12.0 / pair.wheel_pitch_radius_m) - 1) < 0.02, ft
     # the worm's (rigid) locating bearing takes the worm's axial force, the wheel's tangential force (DIN 3975)
     loads = pair.shaft_loads(data)

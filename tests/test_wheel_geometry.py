@@ -192,6 +192,7 @@ def test_seed_undercut_fraction_reported():
     g = seed_geometry("seat_motor")
     frac = wheel.undercut_fraction(g)
     assert 0.3 < frac < wheel.UNDERCUT_LIMIT
+    # rack theory: involute_41 (alpha_n 20 deg, z2 41) lies above z2 < 2 h_f / sin^2 alpha: little or no undercut
     assert wheel.undercut_fraction(seed_geometry("involute_41")) < 0.1
 
 
