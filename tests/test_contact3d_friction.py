@@ -121,6 +121,7 @@ def test_load_inertia_is_the_loaded_hinge_armature_and_in_the_contact_mass():
     over = ["simulation.resolution=coarse"]
     bare = build_model(load_scenario(SCEN / "seat_motor.yaml", over))
     heavy = build_model(load_scenario(SCEN / "seat_motor.yaml", over + ["load.inertia_kg_m2=1e-4"]))
+    # the load.inertia_kg_m2 input (1e-4) on the loaded wheel hinge; 0.0 without it and on the worm
     assert bare.model.dof_armature[bare.wheel_dof] == 0.0
     assert heavy.model.dof_armature[heavy.wheel_dof] == pytest.approx(1e-4)
     assert heavy.model.dof_armature[heavy.worm_dof] == 0.0

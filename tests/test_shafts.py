@@ -66,6 +66,7 @@ def test_absent_block_builds_todays_model_and_rigid_shafts_reproduce_it():
     assert bm.model.njnt == 2
     base, _ = _run("null")
     rigid, _ = _run(RIGID)
+    # 0.0: rigid shafts (no bending joint) deflect by construction
     assert rigid["worm_deflection_mesh_um"] == 0.0 and rigid["wheel_deflection_mesh_um"] == 0.0
     for k in ("ratio", "tangential_force_mean_n", "radial_force_mean_n", "axial_force_mean_n", "efficiency"):
         assert rigid[k] == pytest.approx(base[k], rel=1e-9), k
@@ -81,8 +82,10 @@ def test_worm_bending_against_the_beam_formula_load_and_span():
     f_perp = math.hypot(s["radial_force_mean_n"], s["axial_force_mean_n"])
     assert s["worm_deflection_mesh_um"] == pytest.approx(1e6 * f_perp / k_b, rel=0.02)
     half, _ = _run(_bent(60.0), 6.0)
+    # linear beam: deflection ~ load, 12 N m / 6 N m = 2
     assert s["worm_deflection_mesh_um"] / half["worm_deflection_mesh_um"] == pytest.approx(2.0, rel=0.03)
     short, _ = _run(_bent(30.0))
+    # center-loaded beam k = 48 E I / L^3: deflection ~ L^3, (120 / 60)^3 = 8
     assert s["worm_deflection_mesh_um"] / short["worm_deflection_mesh_um"] == pytest.approx(8.0, rel=0.03)
 
 
