@@ -105,5 +105,6 @@ def test_summary_has_the_always_keys(tmp_path, monkeypatch):
     for k in ("status", "message", "model", "scenario", "wall_time_s", "sim_time_s", "steps"):
         assert k in s
     on_disk = json.loads((tmp_path / "summary.json").read_text())
+    # steps=10 of _fake_level's Result (echoed back)
     assert on_disk["scenario"] == "minimal" and on_disk["steps"] == 10
     assert np.load(tmp_path / "timeseries.npz")["x"].shape == (11,)

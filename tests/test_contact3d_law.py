@@ -28,10 +28,12 @@ def test_hertz_default_follows_seed_001_formula():
 
 def test_friction_static_to_dynamic_step():
     c = Contact(friction_static=0.08, friction_dynamic=0.05, transition_velocity_m_s=1e-3)
+    # the static / dynamic friction inputs of the Contact above (STEP end points)
     assert friction_coefficient(c, 0.0) == pytest.approx(0.08)
     assert friction_coefficient(c, 5e-4) == pytest.approx(0.065)  # STEP midpoint
     assert friction_coefficient(c, 0.5) == pytest.approx(0.05)
     g = Contact(friction_group="III")
+    # friction group III at Vs = 0: rho = 1 / (0.161 Vs^0.535 + 0.088) deg = 1 / 0.088 deg (seed 000)
     assert math.degrees(math.atan(friction_coefficient(g, 0.0))) == pytest.approx(1 / 0.088, rel=1e-6)
 
 

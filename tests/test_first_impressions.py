@@ -33,6 +33,7 @@ def test_model_xml_actuators_follow_their_controls(tmp_path):
     drive, load = m.actuator("drive").id, m.actuator("load").id
     assert not m.actuator_biasprm[:, 0].any()  # no constant bias term: the controls are the commands
     mujoco.mj_resetDataKeyframe(m, d, m.key("scenario").id)
+    # the keyframe's controls: drive.speed_rpm 600 and load.torque_nm 5 (resisting) of tests/assets/minimal_contact3d.yaml
     assert d.ctrl[drive] == pytest.approx(600.0) and d.ctrl[load] == pytest.approx(-5.0)
     worm = m.joint("worm_hinge").dofadr[0]
     wheel = m.joint("wheel_hinge").dofadr[0]
@@ -56,5 +57,6 @@ def test_model_xml_actuators_follow_their_controls(tmp_path):
     assert d.qvel[worm] * rpm == pytest.approx(300.0, rel=0.02)
     d.ctrl[load] = -10.0
     t1_double = run(0.015)
+    # the load control of -10 N m set above (echoed back by the motor actuator)
     assert d.qfrc_actuator[wheel] == pytest.approx(-10.0)
     assert t1_double / t1 == pytest.approx(2.0, rel=0.15)

@@ -79,6 +79,7 @@ def test_root_stress_is_linear_in_the_load(fe_cache, monkeypatch):
     sc, g = _screw_jack()
     one, two = fe_root.root_stress_cases(g, 130e9, 0.25, 1, [12.0, 24.0], 2, density=1)
     assert one["root_stress_max_mpa"] > 0
+    # linear elasticity: the stress scales with the load, 24 / 12 N m = 2
     assert two["root_stress_max_mpa"] == pytest.approx(2 * one["root_stress_max_mpa"], rel=1e-6)
     assert two["position_mm"] == pytest.approx(one["position_mm"])
 
@@ -89,6 +90,7 @@ def test_contact_loads_carry_the_tooth_share_of_the_torque():
     sc, g = _screw_jack()
     for pts, frc in fe_root.contact_loads(g, 1, 12.0, 6):
         torque = float(np.sum(np.cross(pts, frc)[:, 2]))
+        # 12.0 N m: the T2 passed to contact_loads above; one tooth carries at most all of it
         assert 0 < abs(torque) <= 12.0 * (1 + 1e-9)
 
 
@@ -130,6 +132,7 @@ def test_rate_fe_writes_the_root_stress(tmp_path, fe_cache, monkeypatch, capsys)
     assert code == 0
     out = json.loads((tmp_path / "out" / "rating.json").read_text())
     assert out["root_stress_max_mpa"] > 0 and out["root_stress_range_mpa"] > 0
+    # safety = limit / stress with rating.root_stress_limit_mpa=60 set above
     assert out["safety_root_sim"] == pytest.approx(60 / out["root_stress_max_mpa"])
     assert math.isfinite(out["fe_root"]["position_mm"][0])
     assert "FE root stress" in (tmp_path / "out" / "rating.md").read_text()

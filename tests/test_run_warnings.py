@@ -43,6 +43,7 @@ def test_off_flank_share_counts_tip_root_and_face_contacts():
         ]
     )
     f = np.array([[3.0, 0, 0], [0, 1.0, 0], [0, 0, 1.0], [1.0, 0, 0], [0.0, 0, 0], [np.nan] * 3])
+    # by hand: off-flank |F| (rows 2-4: 1 + 1 + 1) over all |F| (3 + 1 + 1 + 1 + 0, then + 2)
     assert W.off_flank_share(pts, f, g) == pytest.approx(3.0 / 6.0)
     f[4] = [2.0, 0, 0]
     assert W.off_flank_share(pts, f, g) == pytest.approx(3.0 / 8.0)

@@ -83,6 +83,7 @@ def test_derived_wedge_refuses_a_drive_it_cannot_model(tmp_path, capsys, sets, n
 
 def test_an_assisting_load_is_held_at_the_drive_speed_by_a_braking_motor():
     s = simulate(load_scenario(DEMO, ["model=wedge", "load.torque_nm=-5"])).summary
+    # drive.speed_rpm 1800 of scenarios/seat_motor_demo.yaml: the braking motor holds the commanded speed
     assert s["worm_speed_mean_rpm"] == pytest.approx(1800.0, rel=1e-3)
     assert s["regimes"][-1] == "inverse"
     # the worm brakes with F_t1 = F_t2 tan(gamma - rho') (DIN 3975-2, back-driving), rho' = atan(0.05 / cos 10 deg)
