@@ -40,6 +40,7 @@ def test_ringing_check_only_above_the_stable_limit_and_only_past_the_threshold()
     S, s = _synthetic(3 * 800.0, 800.0)
     assert ringing(S, s, 1e-5, 2e-5) is None  # below the limit a peak is physics (impact, rattle)
     t, what = ringing(S, s, 3e-5, 2e-5)
+    # t_s[70] = 0.07 s where _synthetic put the peak; 3 x = the peak / mean given
     assert t == pytest.approx(0.07) and "rang" in what and "3 x" in what
     S, s = _synthetic(0.99 * RING_PEAK_OVER_MEAN * 800.0, 800.0)
     assert ringing(S, s, 3e-5, 2e-5) is None
@@ -91,4 +92,5 @@ def test_pieces_are_not_checked_their_facet_impacts_peak_as_high_at_the_default_
     s = simulate(load_scenario(SCEN / "screw_jack.yaml", [*base, "simulation.timestep_s=4e-05"])).summary
     assert 4e-5 > 1.5 * s["timestep_stable_limit_s"]
     assert s["tangential_force_max_n"] > RING_PEAK_OVER_MEAN * s["tangential_force_mean_n"]
+    # 24 = z2 / z1 of scenarios/screw_jack.yaml
     assert s["ratio"] == pytest.approx(24.0, rel=1e-3)

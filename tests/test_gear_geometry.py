@@ -29,6 +29,7 @@ def test_seed_003_involute_41():
     assert math.degrees(g.gamma) == pytest.approx(6.3402, abs=1e-4)
     assert (g.d1, g.d2, g.a) == pytest.approx((0.090, 0.410, 0.250))
     assert g.throat_radius == pytest.approx(g.r1 - g.m_x) and g.root_torus_radius == pytest.approx(g.r1 + 1.2 * g.m_x)
+    # s2 = p_x / 2 - j_t (DIN 3975 tooth thickness, backlash from the wheel) with the default j_t 0.05 mm
     assert g.wheel_tooth_thickness == pytest.approx(math.pi * 0.010 / 2 - 0.05e-3)
 
 

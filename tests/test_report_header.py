@@ -64,6 +64,7 @@ def test_axes_scaled_to_the_steady_window():
     t = np.linspace(0.0, 1.0, 1001)
     speed = np.where(t < 0.1, 160.0 * t / 0.1, 100.0)
     lo, hi = RH.speed_ylim(t, [speed], (0.2, 1.0))
+    # speed_ylim's margin 0.15 over the steady 100 rpm: 0 to 115 rpm (the function's documented rule)
     assert lo == 0.0 and hi == pytest.approx(115.0)
     force = 400.0 + 5.0 * np.sin(2 * np.pi * 22 * t)
     force[20] = 12_000.0
@@ -96,5 +97,6 @@ def test_pattern_band_has_no_holes(seat_geo):
     draw_pattern(ax, fig, grid, seat_geo, {"contact_pressure_max_mpa": 300.0, "contact_pressure_mean_mpa": 300.0})
     (pc,) = [c for c in ax.collections if isinstance(c, PolyCollection)]
     assert len(pc.get_array()) == ns * 10  # cells 5..14 of every slice, the missed row 9 included
+    # the 3e8 Pa of the synthetic grid above, in MPa
     assert np.allclose(pc.get_array(), 300.0)
     plt.close(fig)

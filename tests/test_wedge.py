@@ -104,6 +104,7 @@ def test_locked_steady_state_from_rest_under_full_load():
     assert sm["regimes"] == ["locked"] and sm["stalled"] and sm["self_locking"]
     assert np.all(s["v1_m_s"] == 0) and np.all(s["x1_m"] == 0)
     np.testing.assert_allclose(s["S1_n"], F1_REST, rtol=1e-12)
+    # F2 = -5000 N of scenarios/mov_1_from_rest.yaml (seed 000 test case 1); S1 = F1(0), the Kloss force at rest
     np.testing.assert_allclose(s["S2_n"], -5000.0, rtol=1e-12)
     # why it locks: the motor's starting force is below the tractive breakaway force
     assert F1_REST < math.tan(G + math.radians(1 / 0.088)) * 5000

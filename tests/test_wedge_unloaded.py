@@ -37,6 +37,7 @@ def test_load_after_unloaded_hold_is_carried():
     sc = load_scenario(SCENARIOS / "mov_1.yaml", ["wedge.load.start_s=0.15", "simulation.duration_s=0.4"])
     sm = simulate(sc).summary
     assert sm["regimes"] in (["tractive"], ["tractive", UNLOADED, "tractive"])
+    # F2 = -5000 N of scenarios/mov_1.yaml (seed 000 test case 1); S1 = |F2| tan(g + rho) (static wedge, seed 000)
     assert sm["S2_steady_n"] == pytest.approx(-5000.0, rel=1e-3)
     g = math.radians(sc.wedge.lead_angle_deg)
     assert sm["S1_steady_n"] == pytest.approx(5000.0 * math.tan(g + math.radians(sm["rho_steady_deg"])), rel=2e-3)
