@@ -21,6 +21,7 @@ def test_fft_peak_interpolation_beats_the_bin(f_true):
 def test_fft_search_band_excludes_facet_noise():
     t = np.arange(0, 2.0, 1e-3)
     x = np.sin(2 * math.pi * 7.3 * t) + 3 * np.sin(2 * math.pi * 120 * t)
+    # the synthetic signal's own frequencies: 120 Hz strongest, 7.3 Hz below the 50 Hz band limit
     assert dominant_frequency(t, x)[0] == pytest.approx(120, abs=0.1)
     assert dominant_frequency(t, x, f_max_hz=50)[0] == pytest.approx(7.3, abs=0.05)
 
