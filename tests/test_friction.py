@@ -10,6 +10,7 @@ from wormsim.friction import GROUPS, rho_rad, rho_static_rad
 DEG = math.pi / 180
 
 
+# c of each friction group: seed 000 friction-angle table (rho = 1 / (a Vs^b + c) deg), lines I* to III*
 @pytest.mark.parametrize("group, c", [("I", 0.151), ("II", 0.140), ("III", 0.088)])
 def test_static_angle_is_one_over_c_degrees(group, c):
     assert rho_static_rad(group=group) == pytest.approx(DEG / c, rel=1e-12)
