@@ -15,6 +15,7 @@ from wormsim.result import Result
 from wormsim.scenario import load_scenario
 
 MINIMAL = ROOT / "tests" / "assets" / "minimal_contact3d.yaml"
+# exit codes asserted: 0 ok, 2 invalid input, 3 simulation failed, 130 / 143 interrupted (docs/cli.md, INTERFACE.md)
 
 
 def test_check_prints_defaults(capsys):

@@ -33,7 +33,7 @@ def test_model_xml_actuators_follow_their_controls(tmp_path):
     drive, load = m.actuator("drive").id, m.actuator("load").id
     assert not m.actuator_biasprm[:, 0].any()  # no constant bias term: the controls are the commands
     mujoco.mj_resetDataKeyframe(m, d, m.key("scenario").id)
-    # the keyframe's controls: drive.speed_rpm 600 and load.torque_nm 5 (resisting) of tests/assets/minimal_contact3d.yaml
+    # the keyframe's controls: drive.speed_rpm 600, load.torque_nm 5 resisting (tests/assets/minimal_contact3d.yaml)
     assert d.ctrl[drive] == pytest.approx(600.0) and d.ctrl[load] == pytest.approx(-5.0)
     worm = m.joint("worm_hinge").dofadr[0]
     wheel = m.joint("wheel_hinge").dofadr[0]

@@ -21,6 +21,7 @@ from wormsim.scenario import MAX_PROBLEMS, Scenario
 SEAT = ROOT / "scenarios" / "seat_motor.yaml"
 MOV = ROOT / "scenarios" / "mov_1.yaml"
 WORMSIM = Path(sys.executable).with_name("wormsim")
+# exit codes asserted: 0 ok, 2 invalid input, 3 simulation failed, 130 / 143 interrupted (docs/cli.md, INTERFACE.md)
 
 
 def _limit_memory():  # 2 GiB of address space: the billion laughs used 8 GB before the fix

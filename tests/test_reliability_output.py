@@ -21,6 +21,7 @@ from wormsim.result import Result
 
 MINIMAL = ROOT / "tests" / "assets" / "minimal_contact3d.yaml"
 MOV = ROOT / "scenarios" / "mov_1.yaml"
+# exit codes asserted: 0 ok, 2 invalid input, 3 simulation failed, 130 / 143 interrupted (docs/cli.md, INTERFACE.md)
 
 
 def _level(behaviour: str = "ok"):

@@ -19,6 +19,7 @@ from wormsim.output import RESULT_FILES
 SEAT = ROOT / "scenarios" / "seat_motor.yaml"
 WORMSIM = Path(sys.executable).with_name("wormsim")
 TORSIONAL = ["--set", "model=torsional", "--no-progress"]
+# exit codes asserted: 0 ok, 2 invalid input, 3 simulation failed, 130 / 143 interrupted (docs/cli.md, INTERFACE.md)
 
 
 def _default_sigint():

@@ -209,7 +209,7 @@ def test_torsional_lock_boundary_within_0p3_deg():
     above = _torsional_worm_speed_rpm(_friction(_mu_at(geo, +0.3)))
     below = _torsional_worm_speed_rpm(_friction(_mu_at(geo, -0.3)))
     static = _torsional_worm_speed_rpm(_friction(_mu_at(geo, +0.3), _mu_at(geo, -0.3)))
-    # free: measured 1e6 rpm frictionless (docstring); 1e-2: creep bound; 3e-2: half of tan(0.3 deg) / tan(4.79 deg) = 0.063
+    # free: 1e6 rpm measured (docstring); 1e-2: creep bound; 3e-2: half of tan(0.3 deg) / tan(4.79 deg) = 0.063
     assert free > 1e4
     assert above < 1e-2 * free
     assert below > 3e-2 * free
@@ -250,7 +250,7 @@ def test_contact3d_lock_boundary_within_0p3_deg(demo_geometry, contact3d_free_rp
     the wedge formula (contacts off the pitch point, docs/contact3d.md)."""
     above = _contact3d_worm_speed_rpm(_friction(_mu_at(demo_geometry, +0.3)))
     below = _contact3d_worm_speed_rpm(_friction(_mu_at(demo_geometry, -0.3)))
-    # free: 41 000 rpm measured (docstring); 1e-2 creep bound; 2e-2: below the measured 3.2 % run-back (this code, pieces)
+    # free: 41 000 rpm measured (docstring); 1e-2: creep bound; 2e-2: below the 3.2 % run-back this code measured
     assert contact3d_free_rpm > 1e4
     assert above < 1e-2 * contact3d_free_rpm
     assert below > 2e-2 * contact3d_free_rpm

@@ -261,7 +261,7 @@ def test_startup_impact_step_against_ramp(
     for s in (step, ramp):
         assert abs(s["ratio"] / s["ratio_theory"] - 1) < 1e-3, s["ratio"]
         assert 0 < s["startup_time_s"] == pytest.approx(s["steady_window_s"][0])
-        # 100 um: bound above the measured 15.3 / 64 um of the docstring (this code's runs), below the 281-1000 um guards
+        # 100 um: bound above the 15.3 / 64 um this code measured (docstring), below the 281-1000 um guards
         assert s["startup_penetration_max_um"] < 100
     peak = step["startup_tangential_force_peak_n"]
     assert peak > over_mean * step["tangential_force_mean_n"], (peak, step["tangential_force_mean_n"])

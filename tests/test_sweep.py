@@ -23,6 +23,7 @@ SCREW_JACK = ROOT / "scenarios" / "screw_jack.yaml"
 BIN = Path(sys.executable).parent
 # columns that hold wall-clock times: they differ between two runs of the same point
 TIMING = ("wall_time_s", "solve_wall_s", "mesh_stiffness_wall_s")
+# exit codes asserted: 0 ok, 2 invalid input, 3 simulation failed, 130 / 143 interrupted (docs/cli.md, INTERFACE.md)
 
 
 @pytest.fixture(autouse=True)

@@ -216,7 +216,7 @@ def test_zk_tends_to_zi_as_the_disc_grows(name):
     r = np.linspace(gi.r_f1, gi.r_a1, 50)
     Hi = worm.half_thickness(gi, r)
     d = [np.max(np.abs(worm.half_thickness(_g(name, profile="ZK", tool_diameter_mm=D), r) - Hi)) for D in (1e4, 1e5)]
-    # 1 / tool diameter: 10x per decade of D (Litvin & Fuentes 19.5 limit, docstring); 0.1 um bound above the measured 0.065 um
+    # ~1 / tool diameter: 10x per decade of D (Litvin & Fuentes 19.5 limit); 0.1 um: bound above the measured 0.065 um
     assert d[1] < 0.1e-6
     assert 8 < d[0] / d[1] < 12
 

@@ -120,7 +120,7 @@ def test_za_normal_pressure_angle_at_d1():
     g = gear_with("involute_41", profile="ZA", normal_pressure_angle_deg=15.0)
     for side in (-1, 1):
         fn = functools.partial(worm.flank_points, g, side=side)
-        # the normal_pressure_angle_deg=15.0 input at d1 at the pitch radius (DIN 3975: tan alpha_x = tan alpha_n / cos gamma for ZA)
+        # the normal_pressure_angle_deg=15.0 input, at the pitch radius (DIN 3975 ZA: tan a_x = tan a_n / cos gamma)
         assert _normal_pressure_angle_deg(fn, g.r1) == pytest.approx(15.0, abs=0.01)
 
 
