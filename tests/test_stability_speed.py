@@ -72,7 +72,7 @@ def test_screw_jack_at_30x_speed_gets_a_safe_timestep_and_keeps_the_physics():
     assert sc.simulation.timestep_s is None
     res = simulate(sc)
     s = res.summary
-    # 0.035 rad / (40000 rpm = 4189 rad/s) = 8.4e-6 s, round_down_125 -> 5e-6 s (runner rule, docstring)
+    # MAX_WORM_TURN_PER_STEP_RAD 0.035 / (40000 rpm = 4189 rad/s) = 8.4e-6 s, round_down_125 -> 5e-6 s
     assert s["timestep_s"] == 5e-6
     assert s["timestep_s"] < 0.4 * s["timestep_stable_limit_s"]  # the speed, not the contact, set it
     assert s["timestep_source"].startswith("worm speed: 40000 rpm"), s["timestep_source"]
@@ -100,7 +100,7 @@ def test_a_scenario_timestep_too_large_for_the_speed_is_refused_with_its_allowed
     assert h == 1e-5 and src == "scenario"
     # unset: the contact's default (1e-5 s for the screw jack), the speed does not bind
     h, src = choose_timestep(_jack(1330, 0.01), bm.geometry, bm.law)
-    # the contact's default timestep for the screw jack (1e-5 s, docstring above)
+    # round_down_125(DEFAULT_FRACTION x stable limit): this code's value for the screw jack, no independent source
     assert h == 1e-5 and src.startswith("default"), src
     # a speed-driven wheel: the worm turns ratio x faster (2000 x 24 = 48000 rpm -> 0.035 / 5027 rad/s = 7e-6 -> 5e-6)
     wheel = load_scenario(
