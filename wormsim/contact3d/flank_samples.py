@@ -30,7 +30,7 @@ from numba import types
 from numba.extending import intrinsic
 
 from wormsim.contact3d.flank_loop import _f1, _f64_at, _i1, _i64_at, run_table, sample_table
-from wormsim.contact3d.friction_law import mu_at, mu_params
+from wormsim.contact3d.friction_law import mu_at
 from wormsim.contact3d.guards import state_event
 from wormsim.contact3d.mjdata_layout import mjdata_offsets
 from wormsim.contact3d.series import column
@@ -230,7 +230,8 @@ class FlankSamples:
     """run_samples' parameters for one run (the runner's FlankLoop, guards, friction law, logs); `run` steps and
     samples a stretch of one command block."""
 
-    def __init__(self, loop, guards, scenario, bm, worm_is_drive: bool, rec: int, series: np.ndarray):
+    def __init__(self, loop, guards, bm, rec: int, series: np.ndarray):
+        """The parameters from the guards and the run's plan (bm.plan: the friction law, the drive's kind)."""
         from wormsim import gear_theory as gt
         from wormsim.units import RPM
 
@@ -248,13 +249,13 @@ class FlankSamples:
         g[G["lock_fraction"]] = gt.LOCK_SPEED_FRACTION
         g[G["r1"]] = geo.r1
         g[G["cos_gamma"]] = math.cos(geo.gamma)
-        kind, a, b, c_, deg = mu_params(scenario.contact)
+        kind, a, b, c_, deg = bm.plan.mu_params
         g[G["mu_kind"]], g[G["mu_a"]], g[G["mu_b"]], g[G["mu_c"]] = kind, a, b, c_
         g[G["deg"]] = deg
         g[G["rpm"]] = RPM
         g[G["a"]] = geo.a
         g[G["speed_driven"]] = float(guards.speed_driven)
-        g[G["worm_is_drive"]] = float(worm_is_drive)
+        g[G["worm_is_drive"]] = float(bm.plan.drive_on == "worm")
         g[G["qa1"]], g[G["qa2"]] = fc.qa1, fc.qa2
         g[G["dof1"]], g[G["dof2"]] = bm.worm_dof, bm.wheel_dof
         g[G["z2"]] = geo.z2

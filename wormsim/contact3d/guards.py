@@ -48,22 +48,25 @@ def state_event(th1, th2, w1, w2, badqacc, dt, turn_lim, direction, ratio, jump_
 
 
 class Guards:
-    """The checks after every record interval (module docstring); each raises its SimulationError subclass."""
+    """The checks after every record interval (module docstring); each raises its SimulationError subclass. What they
+    check against comes from the run's plan (bm.plan: the timestep, the drive's kind, the guards' times, the working
+    load); the scenario only completes the error messages (wormsim.contact3d.diagnosis quotes its inputs)."""
 
-    def __init__(self, bm: BuiltModel, scenario: Scenario, dt: float, rec: int):
-        self.bm, self.scenario, self.dt = bm, scenario, dt
+    def __init__(self, bm: BuiltModel, rec: int, scenario: Scenario):
+        plan = bm.plan
+        self.bm, self.scenario, self.dt = bm, scenario, plan.timestep_s
         geo = bm.geometry
         self.pen_lim = gt.penetration_limit_m(geo.m_x)
         self.pitch_angle = 2 * math.pi / geo.z2
         self.turn_lim = OVERSPEED_GUARD * MAX_WORM_TURN_PER_STEP_RAD
         self.jump_rad = JUMP_PITCH * self.pitch_angle
-        self.lock_start = gt.lock_check_start_s(scenario)
-        self.lock_hold = max(gt.LOCK_HOLD_S, 20 * rec * dt)
-        self.speed_driven = scenario.drive.speed_rpm is not None
+        self.lock_start = plan.lock_start_s
+        self.lock_hold = max(gt.LOCK_HOLD_S, 20 * rec * self.dt)
+        self.speed_driven = plan.speed_driven
         self.locked_since: float | None = None
         self.turn_max = 0.0
         # sliding contacts' friction against their slip (wormsim.contact3d.friction_guard)
-        self.friction = FrictionGuard(scenario, bm, bm.plan.normal_force_n, rec * dt)
+        self.friction = FrictionGuard(bm, rec * self.dt, scenario)
 
     def state(self, d: mujoco.MjData, t: float, th1: float, th2: float, w1: float, w2: float) -> float:
         """Divergence, overspeed, teeth jumped, friction against the slip; returns the transmission error (rad)."""

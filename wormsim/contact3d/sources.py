@@ -18,7 +18,6 @@ import math
 import mujoco
 import numpy as np
 
-from wormsim import gear_theory as gt
 from wormsim.contact3d.mjcf import BuiltModel
 from wormsim.contact3d.slots import repose_window
 
@@ -86,7 +85,7 @@ class FlankSource:
     """contact.geometry flanks: the exact-flank contacts (wormsim.contact3d.flank_step) in the compiled step loop,
     the contact pattern and Hertz pressure logged per sample (wormsim.tooth.hertz)."""
 
-    def __init__(self, bm: BuiltModel, d: mujoco.MjData, io: tuple, scenario, guards, rec: int, S_all, store):
+    def __init__(self, bm: BuiltModel, d: mujoco.MjData, io: tuple, guards, rec: int, S_all, store):
         from wormsim.contact3d.flank_loop import FlankLoop
         from wormsim.contact3d.flank_samples import FlankSamples
         from wormsim.contact3d.flank_step import FlankContacts, split_forward
@@ -94,11 +93,11 @@ class FlankSource:
 
         self.bm, self.d = bm, d
         self.fc = fc = FlankContacts(bm, bm.law.contacts_per_pair)
-        self.pattern = PatternLog(fc, gt.effective_modulus_pa(scenario.materials))
+        self.pattern = PatternLog(fc, bm.plan.e_star_pa)
         split_forward(bm.model, d, fc.add)
         self.coll = np.zeros(0, dtype=int)
         self.loop = FlankLoop(fc, d, *io)
-        self.fast = FlankSamples(self.loop, guards, scenario, bm, scenario.drive.on == "worm", rec, S_all)
+        self.fast = FlankSamples(self.loop, guards, bm, rec, S_all)
         self.fast.bind(store)
 
     def steps(self, cmd_arr: np.ndarray, load_arr: np.ndarray, o: int, rec: int) -> tuple:
