@@ -41,6 +41,7 @@ from numba.extending import intrinsic
 from wormsim.contact3d.contact_sums import radial_and_radius, radius_mean
 from wormsim.contact3d.flank_handoff import _MJ_ADD_CONTACT, _fill_add, _library
 from wormsim.contact3d.flank_step import _contact_forces
+from wormsim.contact3d.series import N_SUMS, add_step
 from wormsim.tooth.hertz import _rows
 from wormsim.tooth.kernel import find_packed
 from wormsim.tooth.pose import set_pose
@@ -57,7 +58,6 @@ STAGES_AFTER = (
     "mj_step2",
 )
 N_BEFORE = len(STAGES_BEFORE)  # the stages before the flank contacts are added
-N_ACC = 10  # the per-interval sums (`run_interval`)
 NO_WINDOW = np.iinfo(np.int64).min  # the window's first centre is not set yet
 
 
@@ -97,9 +97,8 @@ def run_interval(fns, m_addr, d_addr, cmd, load, j0, j1, mjd, iv, fv, state, ker
     window's teeth, a view of ib); params = the kernel's P (a view of fb); out = the kernel's (pos, depth, weight,
     frame, mfric), the merged ones with one contact per tooth flank (FlankContacts.handed, wormsim.tooth.merge); hand =
     (records, field offsets, solref, solreffriction).
-    acc (N_ACC) receives the sums over the steps: worm and wheel actuator torque, worm and wheel power, contact count,
-    F_x, F_y, F_z, M_z about the wheel axis, the peak |F_x|. Returns the number of contacts MuJoCo did not take
-    (arena full) summed over the steps."""
+    acc (series.SUMS) receives the sums over the steps (series.add_step). Returns the number of contacts MuJoCo did
+    not take (arena full) summed over the steps."""
     ctrl, qvel, qpos, act, sd, xpos, xmat = mjd
     ia_drv, ia_load, dof1, dof2, a1, a2, s0, qa1, qa2, worm_body, wheel_body, displaced, W, slices, size, base, fr = iv
     tooth0, pitch, margin0, taper, mu = fv
@@ -107,7 +106,7 @@ def run_interval(fns, m_addr, d_addr, cmd, load, j0, j1, mjd, iv, fv, state, ker
     pos, depth, weight, frame, fscale = out
     rec, off, solref, solreffriction = hand
     nb = N_BEFORE
-    t1 = t2 = p1 = p2 = nc = fx = fy = fz = mz = fpk = 0.0
+    acc[:] = 0.0
     dropped = 0
     for j in range(j0, j1):
         ctrl[ia_drv] = cmd[j]
@@ -153,22 +152,7 @@ def run_interval(fns, m_addr, d_addr, cmd, load, j0, j1, mjd, iv, fv, state, ker
             dropped += k - added
         for s in range(nb, fns.shape[0] - 1):
             _call_stage(fns[s], m_addr, d_addr)
-        # the runner's per-step sums (wormsim.contact3d.runner.run_model)
-        q1, q2 = act[a1], act[a2]
-        t1 += q1
-        t2 += q2
-        p1 += q1 * w1j
-        p2 += q2 * w2j
-        nc += sd[s0]
-        f0, f1, f2 = sd[s0 + 1], sd[s0 + 2], sd[s0 + 3]
-        fx += f0
-        if abs(f0) > fpk:
-            fpk = abs(f0)
-        fy += f1
-        fz += f2
-        mz += sd[s0 + 6] + sd[s0 + 7] * f1 - sd[s0 + 8] * f0
-    acc[0], acc[1], acc[2], acc[3], acc[4] = t1, t2, p1, p2, nc
-    acc[5], acc[6], acc[7], acc[8], acc[9] = fx, fy, fz, mz, fpk
+        add_step(acc, act, sd, a1, a2, s0, w1j, w2j)  # the per-step sums (wormsim.contact3d.series)
     return dropped
 
 
@@ -413,7 +397,7 @@ class FlankLoop:
         )
         self.fv = np.array([float(bm.tooth0_angle_rad), fc.pitch, fc.margin0, fc.taper_rad, 0.0])  # mu: `run`
         self.state = np.array([NO_WINDOW if fc._c is None else fc._c, fc.n], dtype=np.int64)
-        self.acc = np.zeros(N_ACC)
+        self.acc = np.zeros(N_SUMS)
         self._tables(d, buf)
         self.dropped = 0
         cap = fc.pos.shape[0]

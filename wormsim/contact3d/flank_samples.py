@@ -31,7 +31,7 @@ from numba.extending import intrinsic
 
 from wormsim.contact3d.flank_loop import _f1, _f64_at, _i1, _i64_at, run_table, sample_table
 from wormsim.contact3d.friction_law import mu_at
-from wormsim.contact3d.guards import state_event
+from wormsim.contact3d.guards import PENETRATED, RUNNING, STUCK, contact_event, state_event
 from wormsim.contact3d.mjdata_layout import mjdata_offsets
 from wormsim.contact3d.series import column
 from wormsim.tooth.merge import split_forces
@@ -160,11 +160,10 @@ def run_samples(T, Ts, m_addr, d_addr, cmd, load, i0, i1, o0, rec, S, g, off, fr
             for c in range(1, n):
                 if depth[c] > pen:
                     pen = depth[c]
-        if pen > pen_lim:
-            return
         w_drive = w1 if g[22] != 0.0 else w2
-        if g[20] != 0.0 and t > g[6] and (g[21] != 0.0 or abs(w_drive) < g[7] * abs(cmd_i)):
-            return  # the lock guard acts or keeps state: the Python path
+        event = contact_event(t, pen, pen_lim, w_drive, cmd_i, g[20] != 0.0, g[6], g[7])
+        if event == PENETRATED or event == STUCK or (event == RUNNING and g[21] != 0.0):
+            return  # Guards.contact raises, or the lock guard acts or keeps state: the Python path
         cbase = cptr[0]
         for k in range(ncon):
             adr[k] = _i32_at(cbase + k * size + o_adr)[0]

@@ -28,6 +28,7 @@ from wormsim.scenario import Scenario
 from wormsim.units import rad_s_to_rpm
 
 DIVERGED, OVERSPEED, JUMPED = 1, 2, 3  # state_event's codes (0: none)
+PENETRATED, STUCK, RUNNING = 4, 5, 6  # contact_event's codes (0: none)
 
 
 @numba.njit(cache=True, inline="always")
@@ -45,6 +46,21 @@ def state_event(th1, th2, w1, w2, badqacc, dt, turn_lim, direction, ratio, jump_
     if abs(te) > jump_rad:
         return JUMPED, te, turn
     return 0, te, turn
+
+
+@numba.njit(cache=True, inline="always")
+def contact_event(t, pen, pen_lim, w_drive, cmd, speed_driven, lock_start, lock_fraction):
+    """The contact checks of a sample, in order: PENETRATED (the largest penetration pen beyond pen_lim), then for a
+    speed-driven drive after lock_start STUCK (|w_drive| below lock_fraction of its command |cmd|:
+    gear_theory.drive_stuck) or RUNNING; 0 when the lock is not watched. Guards.contact and the compiled samples
+    (wormsim.contact3d.flank_samples) both decide by it."""
+    if pen > pen_lim:
+        return PENETRATED
+    if speed_driven and t > lock_start:
+        if abs(w_drive) < lock_fraction * abs(cmd):
+            return STUCK
+        return RUNNING
+    return 0
 
 
 class Guards:
@@ -88,13 +104,15 @@ class Guards:
         return te
 
     def contact(self, t: float, pen: float, w_drive: float, cmd: float) -> None:
-        """Penetration beyond the limit; a speed-driven drive stuck below half its command (locked)."""
-        if pen > self.pen_lim:
+        """Penetration beyond the limit; a speed-driven drive stuck below half its command (locked) for lock_hold."""
+        code = contact_event(
+            t, pen, self.pen_lim, w_drive, cmd, self.speed_driven, self.lock_start, gt.LOCK_SPEED_FRACTION
+        )
+        if code == PENETRATED:
             raise penetration_error(t, pen, self.pen_lim, self.dt, self.bm)
-        if self.speed_driven and t > self.lock_start:
-            if gt.drive_stuck(w_drive, cmd):
-                self.locked_since = t if self.locked_since is None else self.locked_since
-                if t - self.locked_since > self.lock_hold:
-                    raise locked_error(t, w_drive, cmd, self.bm, self.scenario)
-            else:
-                self.locked_since = None
+        if code == STUCK:
+            self.locked_since = t if self.locked_since is None else self.locked_since
+            if t - self.locked_since > self.lock_hold:
+                raise locked_error(t, w_drive, cmd, self.bm, self.scenario)
+        elif code == RUNNING:
+            self.locked_since = None
