@@ -29,6 +29,7 @@ about 1.3-3.5 us per stage call on the binding and 10-20 us per step on the runn
 from __future__ import annotations
 
 import ctypes
+import enum
 import math
 
 import mujoco
@@ -189,34 +190,36 @@ def _i64_at(typingctx, addr):
     return sig, codegen
 
 
-# the arrays of run_interval in FlankLoop's address table: (dtype, ndim) per row, in this order
+# the arrays of run_interval in FlankLoop's address table: (name, dtype, ndim) per row, in row order; the one
+# declaration of the table's layout (Row: the rows by name, for run_table's unpacking and FlankLoop's arrays)
 TABLE = (
-    ("f8", 1),  # 0 d.ctrl
-    ("f8", 1),  # 1 d.qvel
-    ("f8", 1),  # 2 d.qpos
-    ("f8", 1),  # 3 d.actuator_force
-    ("f8", 1),  # 4 d.sensordata
-    ("f8", 2),  # 5 d.xpos
-    ("f8", 2),  # 6 d.xmat
-    ("f8", 1),  # 7 the kernel's float buffer (flanks.PackedKernel.fb)
-    ("i8", 1),  # 8 its int buffer (ib)
-    ("i8", 1),  # 9 ks (a view of ib)
-    ("f8", 1),  # 10 params (P, a view of fb)
-    ("f8", 2),  # 11 pos
-    ("f8", 1),  # 12 depth
-    ("f8", 1),  # 13 weight
-    ("f8", 2),  # 14 frame
-    ("i8", 2),  # 15 the hand-off's records (as int64 rows; run_interval views them as float64)
-    ("i8", 1),  # 16 the records' field offsets
-    ("f8", 1),  # 17 solref
-    ("f8", 1),  # 18 solreffriction
-    ("i8", 1),  # 19 state
-    ("f8", 1),  # 20 acc
-    ("i8", 1),  # 21 the stage addresses
-    ("i8", 1),  # 22 iv
-    ("f8", 1),  # 23 fv
-    ("f8", 1),  # 24 the merged contacts' friction scale (wormsim.tooth.merge: mfric)
+    ("ctrl", "f8", 1),  # d.ctrl
+    ("qvel", "f8", 1),  # d.qvel
+    ("qpos", "f8", 1),  # d.qpos
+    ("act", "f8", 1),  # d.actuator_force
+    ("sensordata", "f8", 1),  # d.sensordata
+    ("xpos", "f8", 2),  # d.xpos
+    ("xmat", "f8", 2),  # d.xmat
+    ("fb", "f8", 1),  # the kernel's float buffer (flanks.PackedKernel.fb)
+    ("ib", "i8", 1),  # its int buffer (ib)
+    ("ks", "i8", 1),  # ks (a view of ib)
+    ("params", "f8", 1),  # params (P, a view of fb)
+    ("pos", "f8", 2),
+    ("depth", "f8", 1),
+    ("weight", "f8", 1),
+    ("frame", "f8", 2),
+    ("records", "i8", 2),  # the hand-off's records (as int64 rows; run_interval views them as float64)
+    ("rec_off", "i8", 1),  # the records' field offsets
+    ("solref", "f8", 1),
+    ("solreffriction", "f8", 1),
+    ("state", "i8", 1),
+    ("acc", "f8", 1),
+    ("stages", "i8", 1),  # the stage addresses
+    ("iv", "i8", 1),
+    ("fv", "f8", 1),
+    ("mfric", "f8", 1),  # the merged contacts' friction scale (wormsim.tooth.merge: mfric)
 )
+Row = enum.IntEnum("Row", [name for name, _, _ in TABLE], start=0)  # T[Row.qpos]: numba reads members as constants
 
 
 @numba.njit(cache=True, inline="always")
@@ -240,6 +243,11 @@ def _f4(T, k):
 
 
 @numba.njit(cache=True, inline="always")
+def _f32x3(T, k):
+    return numba.carray(_f32_at(T[k, 0]), (T[k, 1], T[k, 2], T[k, 3]))
+
+
+@numba.njit(cache=True, inline="always")
 def _i1(T, k):
     return numba.carray(_i64_at(T[k, 0]), (T[k, 1],))
 
@@ -254,18 +262,42 @@ def run_table(T, m_addr, d_addr, cmd, load, j0, j1):
     """run_interval with its arrays given by address and shape (T: one row per TABLE entry, (address, shape));
     numba unboxes one array instead of 30 per call (about 10-20 us per call saved, docs/contact3d.md). Releases the
     GIL, as MuJoCo's bindings do around mj_step: wormsim.run imports the report's libraries meanwhile."""
-    mjd = (_f1(T, 0), _f1(T, 1), _f1(T, 2), _f1(T, 3), _f1(T, 4), _f2(T, 5), _f2(T, 6))
-    kern = (_f1(T, 7), _i1(T, 8), _i1(T, 9))
-    out = (_f2(T, 11), _f1(T, 12), _f1(T, 13), _f2(T, 14), _f1(T, 24))
-    rec = numba.carray(_f64_at(T[15, 0]), (T[15, 1], T[15, 2]))  # int64 rows of the same bytes as float64
-    hand = (rec, _i1(T, 16), _f1(T, 17), _f1(T, 18))
-    v = _i1(T, 22)
+    R = Row
+    mjd = (_f1(T, R.ctrl), _f1(T, R.qvel), _f1(T, R.qpos), _f1(T, R.act), _f1(T, R.sensordata))
+    mjd2 = (_f2(T, R.xpos), _f2(T, R.xmat))
+    kern = (_f1(T, R.fb), _i1(T, R.ib), _i1(T, R.ks))
+    out = (_f2(T, R.pos), _f1(T, R.depth), _f1(T, R.weight), _f2(T, R.frame), _f1(T, R.mfric))
+    rec = _records(T)
+    hand = (rec, _i1(T, R.rec_off), _f1(T, R.solref), _f1(T, R.solreffriction))
+    v = _i1(T, R.iv)
     iv = (v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7], v[8], v[9], v[10], v[11], v[12], v[13], v[14], v[15], v[16])
-    fw = _f1(T, 23)
+    fw = _f1(T, R.fv)
     fv = (fw[0], fw[1], fw[2], fw[3], fw[4])
+    state, acc = _i1(T, R.state), _f1(T, R.acc)
     return run_interval(
-        _i1(T, 21), m_addr, d_addr, cmd, load, j0, j1, mjd, iv, fv, _i1(T, 19), kern, _f1(T, 10), out, hand, _f1(T, 20)
+        _i1(T, R.stages),
+        m_addr,
+        d_addr,
+        cmd,
+        load,
+        j0,
+        j1,
+        mjd + mjd2,
+        iv,
+        fv,
+        state,
+        kern,
+        _f1(T, R.params),
+        out,
+        hand,
+        acc,
     )
+
+
+@numba.njit(cache=True, inline="always")
+def _records(T):
+    """The hand-off's records: int64 rows of the same bytes, viewed as float64."""
+    return numba.carray(_f64_at(T[Row.records, 0]), (T[Row.records, 1], T[Row.records, 2]))
 
 
 def address_table(arrays, table=TABLE) -> np.ndarray:
@@ -274,7 +306,7 @@ def address_table(arrays, table=TABLE) -> np.ndarray:
     if len(arrays) != len(table):
         raise RuntimeError("flank_loop: the address table and its layout disagree")
     T = np.zeros((len(arrays), 5), dtype=np.int64)
-    for k, (a, (dt, nd)) in enumerate(zip(arrays, table)):
+    for k, (a, (_, dt, nd)) in enumerate(zip(arrays, table)):
         if a.dtype != np.dtype(dt) or a.ndim != nd or not a.flags.c_contiguous:
             raise RuntimeError(
                 f"flank_loop: array {k} is {a.dtype} {a.shape}, expected {dt} with {nd} dimensions, C order"
@@ -316,28 +348,25 @@ def sample_flanks(
     return nteeth, pen, fr, W, wr, pm, rm + m
 
 
-# the per-run arrays of sample_flanks in FlankLoop's sample table, in this order
+# the per-run arrays of sample_flanks in FlankLoop's sample table: (name, dtype, ndim) per row, in row order
 SAMPLE_TABLE = (
-    ("f8", 2),  # 0 meta
-    ("f8", 1),  # 1 weight
-    ("f8", 1),  # 2 depth
-    ("f8", 3),  # 3 work
-    ("f8", 3),  # 4 PatternLog's inv_rho
-    ("f8", 3),  # 5 PatternLog's line_len
-    ("f4", 3),  # 6 points in tooth 0's frame (the run's)
-    ("f4", 3),  # 7 forces
-    ("f4", 3),  # 8 points
+    ("meta", "f8", 2),  # meta
+    ("weight", "f8", 1),
+    ("depth", "f8", 1),
+    ("work", "f8", 3),  # work
+    ("inv_rho", "f8", 3),  # PatternLog's inv_rho
+    ("line_len", "f8", 3),  # PatternLog's line_len
+    ("pts", "f4", 3),  # points in tooth 0's frame (the run's)
+    ("forces", "f4", 3),  # forces
+    ("pts_world", "f4", 3),  # points
 )
+SampleRow = enum.IntEnum("SampleRow", [name for name, _, _ in SAMPLE_TABLE], start=0)
 
 
 @numba.njit(cache=True)
 def sample_table(T, adr, frame, pos, own, efc_force, buf, rbuf, ncon, n_fc, cone3, th2, z2, a, i, e_star, pm, rm):
     """sample_flanks with its per-run arrays given by address and shape (T: one row per SAMPLE_TABLE entry)."""
-    f32 = (
-        numba.carray(_f32_at(T[6, 0]), (T[6, 1], T[6, 2], T[6, 3])),
-        numba.carray(_f32_at(T[7, 0]), (T[7, 1], T[7, 2], T[7, 3])),
-        numba.carray(_f32_at(T[8, 0]), (T[8, 1], T[8, 2], T[8, 3])),
-    )
+    f32 = (_f32x3(T, SampleRow.pts), _f32x3(T, SampleRow.forces), _f32x3(T, SampleRow.pts_world))
     return sample_flanks(
         adr,
         frame,
@@ -347,16 +376,16 @@ def sample_table(T, adr, frame, pos, own, efc_force, buf, rbuf, ncon, n_fc, cone
         ncon,
         n_fc,
         cone3,
-        _f2(T, 0),
-        _f1(T, 1),
-        _f1(T, 2),
+        _f2(T, SampleRow.meta),
+        _f1(T, SampleRow.weight),
+        _f1(T, SampleRow.depth),
         th2,
         z2,
         a,
         i,
         f32,
-        _f3(T, 3),
-        (_f3(T, 4), _f3(T, 5), e_star, buf, pm),
+        _f3(T, SampleRow.work),
+        (_f3(T, SampleRow.inv_rho), _f3(T, SampleRow.line_len), e_star, buf, pm),
         (rbuf, rm),
     )
 
@@ -411,33 +440,34 @@ class FlankLoop:
         array is replaced)."""
         fc = self.fc
         k = fc.kernel
-        self.arrays = (  # kept alive here: run_table reads them by address
-            d.ctrl,
-            d.qvel,
-            d.qpos,
-            d.actuator_force,
-            d.sensordata,
-            d.xpos,
-            d.xmat,
-            k.fb,
-            k.ib,
-            fc.ks,
-            fc.params,
-            fc.handed[1],  # pos, depth, weight, frame: what is handed to MuJoCo (FlankContacts.handed)
-            fc.handed[0],
-            fc.handed[3],
-            fc.handed[2],
-            buf.bytes.view(np.int64),
-            buf.off,
-            fc.solref,
-            fc.solreffriction,
-            self.state,
-            self.acc,
-            np.concatenate([STAGE_ADDRESSES, [_MJ_ADD_CONTACT]]).astype(np.int64),
-            self.iv,
-            self.fv,
-            k.mfric,
-        )
+        by_name = {  # kept alive here (self.arrays): run_table reads them by address
+            "ctrl": d.ctrl,
+            "qvel": d.qvel,
+            "qpos": d.qpos,
+            "act": d.actuator_force,
+            "sensordata": d.sensordata,
+            "xpos": d.xpos,
+            "xmat": d.xmat,
+            "fb": k.fb,
+            "ib": k.ib,
+            "ks": fc.ks,
+            "params": fc.params,
+            "pos": fc.handed[1],  # pos, depth, weight, frame: what is handed to MuJoCo (FlankContacts.handed)
+            "depth": fc.handed[0],
+            "weight": fc.handed[3],
+            "frame": fc.handed[2],
+            "records": buf.bytes.view(np.int64),
+            "rec_off": buf.off,
+            "solref": fc.solref,
+            "solreffriction": fc.solreffriction,
+            "state": self.state,
+            "acc": self.acc,
+            "stages": np.concatenate([STAGE_ADDRESSES, [_MJ_ADD_CONTACT]]).astype(np.int64),
+            "iv": self.iv,
+            "fv": self.fv,
+            "mfric": k.mfric,
+        }
+        self.arrays = tuple(by_name[name] for name, _, _ in TABLE)
         self.table = address_table(self.arrays)
         self._kernel = k
 
@@ -468,7 +498,10 @@ class FlankLoop:
         fc = self.fc
         if self._store is not store or self._pattern is not pattern or self._sample_kernel is not fc.kernel:
             cv = pattern.cv
-            self._sample_arrays = (fc.meta, fc.weight, fc.depth, self.work, cv.inv_rho, cv.line_len) + tuple(store)
+            pts, forces, pts_world = store
+            by_name = {"meta": fc.meta, "weight": fc.weight, "depth": fc.depth, "work": self.work}
+            by_name.update(inv_rho=cv.inv_rho, line_len=cv.line_len, pts=pts, forces=forces, pts_world=pts_world)
+            self._sample_arrays = tuple(by_name[name] for name, _, _ in SAMPLE_TABLE)
             self._sample_T = address_table(self._sample_arrays, SAMPLE_TABLE)
             self._store, self._pattern, self._sample_kernel = store, pattern, fc.kernel
         return self._sample_T

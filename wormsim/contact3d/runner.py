@@ -124,13 +124,13 @@ def _loop(src, bm: BuiltModel, scenario: Scenario, d, guards, S_all, rlog, store
             cmd_blk, load_blk = cmd_arr.tolist(), load_arr.tolist()
         o = (i % block) * rec
         if fast is not None and fast.usable():
-            i_next, pending = fast.run(cmd_arr, load_arr, i, min(n_rec, i - i % block + block), o, src.pattern, rlog)
+            i_next, event = fast.run(cmd_arr, load_arr, i, min(n_rec, i - i % block + block), o, src.pattern, rlog)
             if progress is not None and i_next > i:
                 progress.update(float(S_all[0, i_next - 1]))
             i = i_next
-            if not pending:  # samples done up to i_next (the block's end)
+            if event == fast.NONE:  # samples done up to i_next (the block's end)
                 continue
-            o = (i % block) * rec  # sample i's steps are done; its per-sample work follows in Python
+            o = (i % block) * rec  # sample i's steps are done; the event's work (its sample) follows in Python
             sums = tuple(src.loop.acc.tolist())
         elif fast is not None:
             sums = src.steps(cmd_arr, load_arr, o, rec)
