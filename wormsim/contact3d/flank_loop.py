@@ -60,6 +60,31 @@ STAGES_AFTER = (
 )
 N_BEFORE = len(STAGES_BEFORE)  # the stages before the flank contacts are added
 NO_WINDOW = np.iinfo(np.int64).min  # the window's first centre is not set yet
+# run_interval's integer and float parameters (FlankLoop.iv, FlankLoop.fv): the rows by name, the one declaration
+IV = enum.IntEnum(
+    "IV",
+    (
+        "drive_actuator",
+        "load_actuator",
+        "worm_dof",
+        "wheel_dof",
+        "worm_actuator",  # the worm shaft's actuator (the drive's or the load's)
+        "wheel_actuator",
+        "sensor",  # the contact sensor's address in sensordata
+        "worm_qpos",
+        "wheel_qpos",
+        "worm_body",
+        "wheel_body",
+        "displaced",  # assembly errors: the poses from the bodies (wormsim.tooth.pose)
+        "window_teeth",
+        "slices",
+        "record_size",  # the mjContact record's size
+        "record_base",  # the record buffer's address
+        "friction_rows",  # solreffriction written into the records
+    ),
+    start=0,
+)
+FV = enum.IntEnum("FV", ("tooth0", "pitch", "margin", "taper", "mu"), start=0)
 
 
 def _addresses() -> np.ndarray:
@@ -90,19 +115,23 @@ def run_interval(fns, m_addr, d_addr, cmd, load, j0, j1, mjd, iv, fv, state, ker
     """Steps j0..j1-1 of the command arrays cmd (drive) and load (module docstring).
 
     mjd = (ctrl, qvel, qpos, actuator_force, sensordata, xpos, xmat): d's own arrays;
-    iv = (drive actuator, load actuator, worm dof, wheel dof, worm-shaft actuator, wheel-shaft actuator, contact sensor
-    address, worm qpos address, wheel qpos address, worm body, wheel body, displaced, window teeth, slices,
-    mjContact record size, record buffer address, solreffriction written);
-    fv = (tooth 0's angle, pitch angle, margin, taper, friction coefficient); state = (the window's centre tooth, the
-    last step's contact count); kern = FlankContacts.kernel's buffers (fb, ib; flanks.PackedKernel) and ks (the
-    window's teeth, a view of ib); params = the kernel's P (a view of fb); out = the kernel's (pos, depth, weight,
-    frame, mfric), the merged ones with one contact per tooth flank (FlankContacts.handed, wormsim.tooth.merge); hand =
-    (records, field offsets, solref, solreffriction).
+    iv, fv: the integer and float parameters (rows IV, FV: the actuators, dofs, qpos addresses, bodies, window and
+    records; tooth 0's angle, the pitch angle, margin, taper, friction coefficient);
+    state = (the window's centre tooth, the last step's contact count);
+    kern = FlankContacts.kernel's buffers (fb, ib; flanks.PackedKernel) and ks (the window's teeth, a view of ib);
+    params = the kernel's P (a view of fb);
+    out = the kernel's (pos, depth, weight, frame, mfric), the merged ones with one contact per tooth flank
+    (FlankContacts.handed, wormsim.tooth.merge);
+    hand = (records, field offsets, solref, solreffriction).
     acc (series.SUMS) receives the sums over the steps (series.add_step). Returns the number of contacts MuJoCo did
     not take (arena full) summed over the steps."""
     ctrl, qvel, qpos, act, sd, xpos, xmat = mjd
-    ia_drv, ia_load, dof1, dof2, a1, a2, s0, qa1, qa2, worm_body, wheel_body, displaced, W, slices, size, base, fr = iv
-    tooth0, pitch, margin0, taper, mu = fv
+    ia_drv, ia_load, dof1, dof2 = iv[IV.drive_actuator], iv[IV.load_actuator], iv[IV.worm_dof], iv[IV.wheel_dof]
+    a1, a2, s0 = iv[IV.worm_actuator], iv[IV.wheel_actuator], iv[IV.sensor]
+    qa1, qa2 = iv[IV.worm_qpos], iv[IV.wheel_qpos]
+    worm_body, wheel_body, displaced, W = iv[IV.worm_body], iv[IV.wheel_body], iv[IV.displaced], iv[IV.window_teeth]
+    size, base, fr = iv[IV.record_size], iv[IV.record_base], iv[IV.friction_rows]
+    tooth0, pitch, margin0, taper, mu = fv[FV.tooth0], fv[FV.pitch], fv[FV.margin], fv[FV.taper], fv[FV.mu]
     fb, ib, ks = kern
     pos, depth, weight, frame, fscale = out
     rec, off, solref, solreffriction = hand
@@ -269,10 +298,7 @@ def run_table(T, m_addr, d_addr, cmd, load, j0, j1):
     out = (_f2(T, R.pos), _f1(T, R.depth), _f1(T, R.weight), _f2(T, R.frame), _f1(T, R.mfric))
     rec = _records(T)
     hand = (rec, _i1(T, R.rec_off), _f1(T, R.solref), _f1(T, R.solreffriction))
-    v = _i1(T, R.iv)
-    iv = (v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7], v[8], v[9], v[10], v[11], v[12], v[13], v[14], v[15], v[16])
-    fw = _f1(T, R.fv)
-    fv = (fw[0], fw[1], fw[2], fw[3], fw[4])
+    iv, fv = _i1(T, R.iv), _f1(T, R.fv)
     state, acc = _i1(T, R.state), _f1(T, R.acc)
     return run_interval(
         _i1(T, R.stages),
@@ -402,29 +428,28 @@ class FlankLoop:
         if m.nv == 2:
             m.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_ISLAND)
         buf = fc.buffer
-        self.iv = np.array(
-            [
-                drive_actuator,
-                load_actuator,
-                bm.worm_dof,
-                bm.wheel_dof,
-                a1,
-                a2,
-                sensor_adr,
-                fc.qa1,
-                fc.qa2,
-                bm.worm_body,
-                bm.wheel_body,
-                int(fc.displaced),
-                bm.window_teeth,
-                fc.slices,
-                buf.size,
-                buf.address,
-                0,
-            ],
-            dtype=np.int64,
-        )
-        self.fv = np.array([float(bm.tooth0_angle_rad), fc.pitch, fc.margin0, fc.taper_rad, 0.0])  # mu: `run`
+        iv = {
+            IV.drive_actuator: drive_actuator,
+            IV.load_actuator: load_actuator,
+            IV.worm_dof: bm.worm_dof,
+            IV.wheel_dof: bm.wheel_dof,
+            IV.worm_actuator: a1,
+            IV.wheel_actuator: a2,
+            IV.sensor: sensor_adr,
+            IV.worm_qpos: fc.qa1,
+            IV.wheel_qpos: fc.qa2,
+            IV.worm_body: bm.worm_body,
+            IV.wheel_body: bm.wheel_body,
+            IV.displaced: int(fc.displaced),
+            IV.window_teeth: bm.window_teeth,
+            IV.slices: fc.slices,
+            IV.record_size: buf.size,
+            IV.record_base: buf.address,
+            IV.friction_rows: 0,  # `prepare`
+        }
+        self.iv = np.array([iv[k] for k in IV], dtype=np.int64)
+        fv = {FV.tooth0: float(bm.tooth0_angle_rad), FV.pitch: fc.pitch, FV.margin: fc.margin0, FV.taper: fc.taper_rad}
+        self.fv = np.array([fv.get(k, 0.0) for k in FV])  # mu: `prepare`
         self.state = np.array([NO_WINDOW if fc._c is None else fc._c, fc.n], dtype=np.int64)
         self.acc = np.zeros(N_SUMS)
         self._tables(d, buf)
@@ -478,8 +503,8 @@ class FlankLoop:
             fc._pack()
         if fc.kernel is not self._kernel:
             self._tables(self.d, fc.buffer)
-        self.iv[-1] = fc.solreffriction[1] != 0.0
-        self.fv[4] = fc.mu
+        self.iv[IV.friction_rows] = fc.solreffriction[1] != 0.0
+        self.fv[FV.mu] = fc.mu
         return self.table
 
     def sync(self) -> None:

@@ -30,7 +30,18 @@ import numpy as np
 from numba import types
 from numba.extending import intrinsic
 
-from wormsim.contact3d.flank_loop import Row, SampleRow, _f1, _f64_at, _i1, _i64_at, _records, run_table, sample_table
+from wormsim.contact3d.flank_loop import (
+    FV,
+    Row,
+    SampleRow,
+    _f1,
+    _f64_at,
+    _i1,
+    _i64_at,
+    _records,
+    run_table,
+    sample_table,
+)
 from wormsim.contact3d.friction_law import mu_at
 from wormsim.contact3d.guards import PENETRATED, RUNNING, STUCK, contact_event, state_event
 from wormsim.contact3d.mjdata_layout import mjdata_offsets
@@ -93,7 +104,7 @@ def _i32_at(typingctx, addr):
 def _set_friction(T, mu):
     """FlankContacts.set_friction where the cone's dimension stays: mu into the loop's fv and the hand-off's records
     (both friction entries), as set_template leaves them."""
-    _f1(T, Row.fv)[4] = mu
+    _f1(T, Row.fv)[FV.mu] = mu
     recs = _records(T)
     o5 = _i1(T, Row.rec_off)[5]
     for r in range(recs.shape[0]):

@@ -471,7 +471,7 @@ def _take(buf, o, shape):
     return buf[o : o + k].reshape(shape), o + k
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _views(fb, ib):
     """The packed buffers' fields as views (_layout at the sizes in ib's header): the float fields in _F_FIELDS
     order, the int fields in _I_FIELDS order. PackedKernel's numpy fields and find_packed's unpacking both come
