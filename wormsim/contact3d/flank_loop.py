@@ -136,7 +136,7 @@ def run_interval(fns, m_addr, d_addr, cmd, load, j0, j1, mjd, iv, fv, state, ker
     pos, depth, weight, frame, fscale = out
     rec, off, solref, solreffriction = hand
     nb = N_BEFORE
-    acc[:] = 0.0
+    sums = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
     dropped = 0
     for j in range(j0, j1):
         ctrl[ia_drv] = cmd[j]
@@ -182,7 +182,9 @@ def run_interval(fns, m_addr, d_addr, cmd, load, j0, j1, mjd, iv, fv, state, ker
             dropped += k - added
         for s in range(nb, fns.shape[0] - 1):
             _call_stage(fns[s], m_addr, d_addr)
-        add_step(acc, act, sd, a1, a2, s0, w1j, w2j)  # the per-step sums (wormsim.contact3d.series)
+        sums = add_step(sums, act, sd, a1, a2, s0, w1j, w2j)  # the per-step sums (wormsim.contact3d.series)
+    for k in range(N_SUMS):
+        acc[k] = sums[k]
     return dropped
 
 

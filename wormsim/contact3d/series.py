@@ -45,25 +45,22 @@ N_SUMS = len(SUMS)
 
 
 @numba.njit(cache=True, inline="always")
-def add_step(acc, act, sd, a1, a2, s0, w1, w2):
-    """One step into the interval's sums acc (SUMS order, zeroed at the interval's start): the worm's and the
-    wheel's actuator torques act[a1], act[a2] and powers T w with the speeds w1, w2 read before the step, the contact
+def add_step(sums, act, sd, a1, a2, s0, w1, w2):
+    """The interval's sums (SUMS order; all 0.0 at its start) with one step added: the worm's and the wheel's
+    actuator torques act[a1], act[a2] and powers T w with the speeds w1, w2 read before the step, the contact
     sensor's count, resultant F on the wheel (global frame) and its moment about the wheel axis M_z = tau_z + p_x F_y
     - p_y F_x (sensordata from s0: found, F (3), torque about the point (3), point (3)), and the peak |F_x| (the
-    start-up impact is shorter than an interval)."""
+    start-up impact is shorter than an interval). A tuple in and out: the compiled loop keeps it in registers."""
+    t1, t2, p1, p2, nc, fx, fy, fz, mz, fpk = sums
     q1, q2 = act[a1], act[a2]
-    acc[0] += q1
-    acc[1] += q2
-    acc[2] += q1 * w1
-    acc[3] += q2 * w2
-    acc[4] += sd[s0]
     f0, f1, f2 = sd[s0 + 1], sd[s0 + 2], sd[s0 + 3]
-    acc[5] += f0
-    if abs(f0) > acc[9]:
-        acc[9] = abs(f0)
-    acc[6] += f1
-    acc[7] += f2
-    acc[8] += sd[s0 + 6] + sd[s0 + 7] * f1 - sd[s0 + 8] * f0
+    if abs(f0) > fpk:
+        fpk = abs(f0)
+    mz += sd[s0 + 6] + sd[s0 + 7] * f1 - sd[s0 + 8] * f0
+    return t1 + q1, t2 + q2, p1 + q1 * w1, p2 + q2 * w2, nc + sd[s0], fx + f0, fy + f1, fz + f2, mz, fpk
+
+
+ZERO_SUMS = (0.0,) * N_SUMS  # the sums at an interval's start
 
 
 @numba.njit(cache=True)

@@ -19,7 +19,7 @@ import mujoco
 import numpy as np
 
 from wormsim.contact3d.mjcf import BuiltModel
-from wormsim.contact3d.series import N_SUMS, add_step
+from wormsim.contact3d.series import ZERO_SUMS, add_step
 from wormsim.contact3d.slots import repose_window
 
 _ROWS3 = np.arange(3)  # the normal and two tangent rows of an elliptic-cone contact
@@ -47,14 +47,14 @@ class PieceSource:
         ia_drv, ia_load, a1, a2, s0 = self.io
         sd, act, qv, ctrl = d.sensordata, d.actuator_force, d.qvel, d.ctrl
         dof1, dof2 = bm.worm_dof, bm.wheel_dof
-        acc = np.zeros(N_SUMS)
+        sums = ZERO_SUMS
         for j in range(o, o + rec):
             ctrl[ia_drv] = cmd_blk[j]
             ctrl[ia_load] = load_blk[j]
             w1j, w2j = float(qv[dof1]), float(qv[dof2])
             mujoco.mj_step(m, d)
-            add_step(acc, act, sd, a1, a2, s0, w1j, w2j)
-        return tuple(acc.tolist())
+            sums = add_step(sums, act, sd, a1, a2, s0, w1j, w2j)
+        return sums
 
     def sample(self, i: int, th2: float, mu: float, rlog, store: tuple) -> tuple:
         """Re-pose the window, set mu on the pieces, read the contacts (contact_details)."""
