@@ -29,6 +29,7 @@ about 1.3-3.5 us per stage call on the binding and 10-20 us per step on the runn
 from __future__ import annotations
 
 import ctypes
+import enum
 import math
 
 import mujoco
@@ -41,6 +42,7 @@ from numba.extending import intrinsic
 from wormsim.contact3d.contact_sums import radial_and_radius, radius_mean
 from wormsim.contact3d.flank_handoff import _MJ_ADD_CONTACT, _fill_add, _library
 from wormsim.contact3d.flank_step import _contact_forces
+from wormsim.contact3d.series import N_SUMS, add_step
 from wormsim.tooth.hertz import _rows
 from wormsim.tooth.kernel import find_packed
 from wormsim.tooth.pose import set_pose
@@ -57,8 +59,32 @@ STAGES_AFTER = (
     "mj_step2",
 )
 N_BEFORE = len(STAGES_BEFORE)  # the stages before the flank contacts are added
-N_ACC = 10  # the per-interval sums (`run_interval`)
 NO_WINDOW = np.iinfo(np.int64).min  # the window's first centre is not set yet
+# run_interval's integer and float parameters (FlankLoop.iv, FlankLoop.fv): the rows by name, the one declaration
+IV = enum.IntEnum(
+    "IV",
+    (
+        "drive_actuator",
+        "load_actuator",
+        "worm_dof",
+        "wheel_dof",
+        "worm_actuator",  # the worm shaft's actuator (the drive's or the load's)
+        "wheel_actuator",
+        "sensor",  # the contact sensor's address in sensordata
+        "worm_qpos",
+        "wheel_qpos",
+        "worm_body",
+        "wheel_body",
+        "displaced",  # assembly errors: the poses from the bodies (wormsim.tooth.pose)
+        "window_teeth",
+        "slices",
+        "record_size",  # the mjContact record's size
+        "record_base",  # the record buffer's address
+        "friction_rows",  # solreffriction written into the records
+    ),
+    start=0,
+)
+FV = enum.IntEnum("FV", ("tooth0", "pitch", "margin", "taper", "mu"), start=0)
 
 
 def _addresses() -> np.ndarray:
@@ -89,25 +115,28 @@ def run_interval(fns, m_addr, d_addr, cmd, load, j0, j1, mjd, iv, fv, state, ker
     """Steps j0..j1-1 of the command arrays cmd (drive) and load (module docstring).
 
     mjd = (ctrl, qvel, qpos, actuator_force, sensordata, xpos, xmat): d's own arrays;
-    iv = (drive actuator, load actuator, worm dof, wheel dof, worm-shaft actuator, wheel-shaft actuator, contact sensor
-    address, worm qpos address, wheel qpos address, worm body, wheel body, displaced, window teeth, slices,
-    mjContact record size, record buffer address, solreffriction written);
-    fv = (tooth 0's angle, pitch angle, margin, taper, friction coefficient); state = (the window's centre tooth, the
-    last step's contact count); kern = FlankContacts.kernel's buffers (fb, ib; flanks.PackedKernel) and ks (the
-    window's teeth, a view of ib); params = the kernel's P (a view of fb); out = the kernel's (pos, depth, weight,
-    frame, mfric), the merged ones with one contact per tooth flank (FlankContacts.handed, wormsim.tooth.merge); hand =
-    (records, field offsets, solref, solreffriction).
-    acc (N_ACC) receives the sums over the steps: worm and wheel actuator torque, worm and wheel power, contact count,
-    F_x, F_y, F_z, M_z about the wheel axis, the peak |F_x|. Returns the number of contacts MuJoCo did not take
-    (arena full) summed over the steps."""
+    iv, fv: the integer and float parameters (rows IV, FV: the actuators, dofs, qpos addresses, bodies, window and
+    records; tooth 0's angle, the pitch angle, margin, taper, friction coefficient);
+    state = (the window's centre tooth, the last step's contact count);
+    kern = FlankContacts.kernel's buffers (fb, ib; flanks.PackedKernel) and ks (the window's teeth, a view of ib);
+    params = the kernel's P (a view of fb);
+    out = the kernel's (pos, depth, weight, frame, mfric), the merged ones with one contact per tooth flank
+    (FlankContacts.handed, wormsim.tooth.merge);
+    hand = (records, field offsets, solref, solreffriction).
+    acc (series.SUMS) receives the sums over the steps (series.add_step). Returns the number of contacts MuJoCo did
+    not take (arena full) summed over the steps."""
     ctrl, qvel, qpos, act, sd, xpos, xmat = mjd
-    ia_drv, ia_load, dof1, dof2, a1, a2, s0, qa1, qa2, worm_body, wheel_body, displaced, W, slices, size, base, fr = iv
-    tooth0, pitch, margin0, taper, mu = fv
+    ia_drv, ia_load, dof1, dof2 = iv[IV.drive_actuator], iv[IV.load_actuator], iv[IV.worm_dof], iv[IV.wheel_dof]
+    a1, a2, s0 = iv[IV.worm_actuator], iv[IV.wheel_actuator], iv[IV.sensor]
+    qa1, qa2 = iv[IV.worm_qpos], iv[IV.wheel_qpos]
+    worm_body, wheel_body, displaced, W = iv[IV.worm_body], iv[IV.wheel_body], iv[IV.displaced], iv[IV.window_teeth]
+    size, base, fr = iv[IV.record_size], iv[IV.record_base], iv[IV.friction_rows]
+    tooth0, pitch, margin0, taper, mu = fv[FV.tooth0], fv[FV.pitch], fv[FV.margin], fv[FV.taper], fv[FV.mu]
     fb, ib, ks = kern
     pos, depth, weight, frame, fscale = out
     rec, off, solref, solreffriction = hand
     nb = N_BEFORE
-    t1 = t2 = p1 = p2 = nc = fx = fy = fz = mz = fpk = 0.0
+    sums = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
     dropped = 0
     for j in range(j0, j1):
         ctrl[ia_drv] = cmd[j]
@@ -153,22 +182,9 @@ def run_interval(fns, m_addr, d_addr, cmd, load, j0, j1, mjd, iv, fv, state, ker
             dropped += k - added
         for s in range(nb, fns.shape[0] - 1):
             _call_stage(fns[s], m_addr, d_addr)
-        # the runner's per-step sums (wormsim.contact3d.runner.run_model)
-        q1, q2 = act[a1], act[a2]
-        t1 += q1
-        t2 += q2
-        p1 += q1 * w1j
-        p2 += q2 * w2j
-        nc += sd[s0]
-        f0, f1, f2 = sd[s0 + 1], sd[s0 + 2], sd[s0 + 3]
-        fx += f0
-        if abs(f0) > fpk:
-            fpk = abs(f0)
-        fy += f1
-        fz += f2
-        mz += sd[s0 + 6] + sd[s0 + 7] * f1 - sd[s0 + 8] * f0
-    acc[0], acc[1], acc[2], acc[3], acc[4] = t1, t2, p1, p2, nc
-    acc[5], acc[6], acc[7], acc[8], acc[9] = fx, fy, fz, mz, fpk
+        sums = add_step(sums, act, sd, a1, a2, s0, w1j, w2j)  # the per-step sums (wormsim.contact3d.series)
+    for k in range(N_SUMS):
+        acc[k] = sums[k]
     return dropped
 
 
@@ -205,34 +221,36 @@ def _i64_at(typingctx, addr):
     return sig, codegen
 
 
-# the arrays of run_interval in FlankLoop's address table: (dtype, ndim) per row, in this order
+# the arrays of run_interval in FlankLoop's address table: (name, dtype, ndim) per row, in row order; the one
+# declaration of the table's layout (Row: the rows by name, for run_table's unpacking and FlankLoop's arrays)
 TABLE = (
-    ("f8", 1),  # 0 d.ctrl
-    ("f8", 1),  # 1 d.qvel
-    ("f8", 1),  # 2 d.qpos
-    ("f8", 1),  # 3 d.actuator_force
-    ("f8", 1),  # 4 d.sensordata
-    ("f8", 2),  # 5 d.xpos
-    ("f8", 2),  # 6 d.xmat
-    ("f8", 1),  # 7 the kernel's float buffer (flanks.PackedKernel.fb)
-    ("i8", 1),  # 8 its int buffer (ib)
-    ("i8", 1),  # 9 ks (a view of ib)
-    ("f8", 1),  # 10 params (P, a view of fb)
-    ("f8", 2),  # 11 pos
-    ("f8", 1),  # 12 depth
-    ("f8", 1),  # 13 weight
-    ("f8", 2),  # 14 frame
-    ("i8", 2),  # 15 the hand-off's records (as int64 rows; run_interval views them as float64)
-    ("i8", 1),  # 16 the records' field offsets
-    ("f8", 1),  # 17 solref
-    ("f8", 1),  # 18 solreffriction
-    ("i8", 1),  # 19 state
-    ("f8", 1),  # 20 acc
-    ("i8", 1),  # 21 the stage addresses
-    ("i8", 1),  # 22 iv
-    ("f8", 1),  # 23 fv
-    ("f8", 1),  # 24 the merged contacts' friction scale (wormsim.tooth.merge: mfric)
+    ("ctrl", "f8", 1),  # d.ctrl
+    ("qvel", "f8", 1),  # d.qvel
+    ("qpos", "f8", 1),  # d.qpos
+    ("act", "f8", 1),  # d.actuator_force
+    ("sensordata", "f8", 1),  # d.sensordata
+    ("xpos", "f8", 2),  # d.xpos
+    ("xmat", "f8", 2),  # d.xmat
+    ("fb", "f8", 1),  # the kernel's float buffer (flanks.PackedKernel.fb)
+    ("ib", "i8", 1),  # its int buffer (ib)
+    ("ks", "i8", 1),  # ks (a view of ib)
+    ("params", "f8", 1),  # params (P, a view of fb)
+    ("pos", "f8", 2),
+    ("depth", "f8", 1),
+    ("weight", "f8", 1),
+    ("frame", "f8", 2),
+    ("records", "i8", 2),  # the hand-off's records (as int64 rows; run_interval views them as float64)
+    ("rec_off", "i8", 1),  # the records' field offsets
+    ("solref", "f8", 1),
+    ("solreffriction", "f8", 1),
+    ("state", "i8", 1),
+    ("acc", "f8", 1),
+    ("stages", "i8", 1),  # the stage addresses
+    ("iv", "i8", 1),
+    ("fv", "f8", 1),
+    ("mfric", "f8", 1),  # the merged contacts' friction scale (wormsim.tooth.merge: mfric)
 )
+Row = enum.IntEnum("Row", [name for name, _, _ in TABLE], start=0)  # T[Row.qpos]: numba reads members as constants
 
 
 @numba.njit(cache=True, inline="always")
@@ -256,6 +274,11 @@ def _f4(T, k):
 
 
 @numba.njit(cache=True, inline="always")
+def _f32x3(T, k):
+    return numba.carray(_f32_at(T[k, 0]), (T[k, 1], T[k, 2], T[k, 3]))
+
+
+@numba.njit(cache=True, inline="always")
 def _i1(T, k):
     return numba.carray(_i64_at(T[k, 0]), (T[k, 1],))
 
@@ -270,18 +293,39 @@ def run_table(T, m_addr, d_addr, cmd, load, j0, j1):
     """run_interval with its arrays given by address and shape (T: one row per TABLE entry, (address, shape));
     numba unboxes one array instead of 30 per call (about 10-20 us per call saved, docs/contact3d.md). Releases the
     GIL, as MuJoCo's bindings do around mj_step: wormsim.run imports the report's libraries meanwhile."""
-    mjd = (_f1(T, 0), _f1(T, 1), _f1(T, 2), _f1(T, 3), _f1(T, 4), _f2(T, 5), _f2(T, 6))
-    kern = (_f1(T, 7), _i1(T, 8), _i1(T, 9))
-    out = (_f2(T, 11), _f1(T, 12), _f1(T, 13), _f2(T, 14), _f1(T, 24))
-    rec = numba.carray(_f64_at(T[15, 0]), (T[15, 1], T[15, 2]))  # int64 rows of the same bytes as float64
-    hand = (rec, _i1(T, 16), _f1(T, 17), _f1(T, 18))
-    v = _i1(T, 22)
-    iv = (v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7], v[8], v[9], v[10], v[11], v[12], v[13], v[14], v[15], v[16])
-    fw = _f1(T, 23)
-    fv = (fw[0], fw[1], fw[2], fw[3], fw[4])
+    R = Row
+    mjd = (_f1(T, R.ctrl), _f1(T, R.qvel), _f1(T, R.qpos), _f1(T, R.act), _f1(T, R.sensordata))
+    mjd2 = (_f2(T, R.xpos), _f2(T, R.xmat))
+    kern = (_f1(T, R.fb), _i1(T, R.ib), _i1(T, R.ks))
+    out = (_f2(T, R.pos), _f1(T, R.depth), _f1(T, R.weight), _f2(T, R.frame), _f1(T, R.mfric))
+    rec = _records(T)
+    hand = (rec, _i1(T, R.rec_off), _f1(T, R.solref), _f1(T, R.solreffriction))
+    iv, fv = _i1(T, R.iv), _f1(T, R.fv)
+    state, acc = _i1(T, R.state), _f1(T, R.acc)
     return run_interval(
-        _i1(T, 21), m_addr, d_addr, cmd, load, j0, j1, mjd, iv, fv, _i1(T, 19), kern, _f1(T, 10), out, hand, _f1(T, 20)
+        _i1(T, R.stages),
+        m_addr,
+        d_addr,
+        cmd,
+        load,
+        j0,
+        j1,
+        mjd + mjd2,
+        iv,
+        fv,
+        state,
+        kern,
+        _f1(T, R.params),
+        out,
+        hand,
+        acc,
     )
+
+
+@numba.njit(cache=True, inline="always")
+def _records(T):
+    """The hand-off's records: int64 rows of the same bytes, viewed as float64."""
+    return numba.carray(_f64_at(T[Row.records, 0]), (T[Row.records, 1], T[Row.records, 2]))
 
 
 def address_table(arrays, table=TABLE) -> np.ndarray:
@@ -290,7 +334,7 @@ def address_table(arrays, table=TABLE) -> np.ndarray:
     if len(arrays) != len(table):
         raise RuntimeError("flank_loop: the address table and its layout disagree")
     T = np.zeros((len(arrays), 5), dtype=np.int64)
-    for k, (a, (dt, nd)) in enumerate(zip(arrays, table)):
+    for k, (a, (_, dt, nd)) in enumerate(zip(arrays, table)):
         if a.dtype != np.dtype(dt) or a.ndim != nd or not a.flags.c_contiguous:
             raise RuntimeError(
                 f"flank_loop: array {k} is {a.dtype} {a.shape}, expected {dt} with {nd} dimensions, C order"
@@ -332,28 +376,25 @@ def sample_flanks(
     return nteeth, pen, fr, W, wr, pm, rm + m
 
 
-# the per-run arrays of sample_flanks in FlankLoop's sample table, in this order
+# the per-run arrays of sample_flanks in FlankLoop's sample table: (name, dtype, ndim) per row, in row order
 SAMPLE_TABLE = (
-    ("f8", 2),  # 0 meta
-    ("f8", 1),  # 1 weight
-    ("f8", 1),  # 2 depth
-    ("f8", 3),  # 3 work
-    ("f8", 3),  # 4 PatternLog's inv_rho
-    ("f8", 3),  # 5 PatternLog's line_len
-    ("f4", 3),  # 6 points in tooth 0's frame (the run's)
-    ("f4", 3),  # 7 forces
-    ("f4", 3),  # 8 points
+    ("meta", "f8", 2),  # meta
+    ("weight", "f8", 1),
+    ("depth", "f8", 1),
+    ("work", "f8", 3),  # work
+    ("inv_rho", "f8", 3),  # PatternLog's inv_rho
+    ("line_len", "f8", 3),  # PatternLog's line_len
+    ("pts", "f4", 3),  # points in tooth 0's frame (the run's)
+    ("forces", "f4", 3),  # forces
+    ("pts_world", "f4", 3),  # points
 )
+SampleRow = enum.IntEnum("SampleRow", [name for name, _, _ in SAMPLE_TABLE], start=0)
 
 
 @numba.njit(cache=True)
 def sample_table(T, adr, frame, pos, own, efc_force, buf, rbuf, ncon, n_fc, cone3, th2, z2, a, i, e_star, pm, rm):
     """sample_flanks with its per-run arrays given by address and shape (T: one row per SAMPLE_TABLE entry)."""
-    f32 = (
-        numba.carray(_f32_at(T[6, 0]), (T[6, 1], T[6, 2], T[6, 3])),
-        numba.carray(_f32_at(T[7, 0]), (T[7, 1], T[7, 2], T[7, 3])),
-        numba.carray(_f32_at(T[8, 0]), (T[8, 1], T[8, 2], T[8, 3])),
-    )
+    f32 = (_f32x3(T, SampleRow.pts), _f32x3(T, SampleRow.forces), _f32x3(T, SampleRow.pts_world))
     return sample_flanks(
         adr,
         frame,
@@ -363,16 +404,16 @@ def sample_table(T, adr, frame, pos, own, efc_force, buf, rbuf, ncon, n_fc, cone
         ncon,
         n_fc,
         cone3,
-        _f2(T, 0),
-        _f1(T, 1),
-        _f1(T, 2),
+        _f2(T, SampleRow.meta),
+        _f1(T, SampleRow.weight),
+        _f1(T, SampleRow.depth),
         th2,
         z2,
         a,
         i,
         f32,
-        _f3(T, 3),
-        (_f3(T, 4), _f3(T, 5), e_star, buf, pm),
+        _f3(T, SampleRow.work),
+        (_f3(T, SampleRow.inv_rho), _f3(T, SampleRow.line_len), e_star, buf, pm),
         (rbuf, rm),
     )
 
@@ -389,31 +430,30 @@ class FlankLoop:
         if m.nv == 2:
             m.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_ISLAND)
         buf = fc.buffer
-        self.iv = np.array(
-            [
-                drive_actuator,
-                load_actuator,
-                bm.worm_dof,
-                bm.wheel_dof,
-                a1,
-                a2,
-                sensor_adr,
-                fc.qa1,
-                fc.qa2,
-                bm.worm_body,
-                bm.wheel_body,
-                int(fc.displaced),
-                bm.window_teeth,
-                fc.slices,
-                buf.size,
-                buf.address,
-                0,
-            ],
-            dtype=np.int64,
-        )
-        self.fv = np.array([float(bm.tooth0_angle_rad), fc.pitch, fc.margin0, fc.taper_rad, 0.0])  # mu: `run`
+        iv = {
+            IV.drive_actuator: drive_actuator,
+            IV.load_actuator: load_actuator,
+            IV.worm_dof: bm.worm_dof,
+            IV.wheel_dof: bm.wheel_dof,
+            IV.worm_actuator: a1,
+            IV.wheel_actuator: a2,
+            IV.sensor: sensor_adr,
+            IV.worm_qpos: fc.qa1,
+            IV.wheel_qpos: fc.qa2,
+            IV.worm_body: bm.worm_body,
+            IV.wheel_body: bm.wheel_body,
+            IV.displaced: int(fc.displaced),
+            IV.window_teeth: bm.window_teeth,
+            IV.slices: fc.slices,
+            IV.record_size: buf.size,
+            IV.record_base: buf.address,
+            IV.friction_rows: 0,  # `prepare`
+        }
+        self.iv = np.array([iv[k] for k in IV], dtype=np.int64)
+        fv = {FV.tooth0: float(bm.tooth0_angle_rad), FV.pitch: fc.pitch, FV.margin: fc.margin0, FV.taper: fc.taper_rad}
+        self.fv = np.array([fv.get(k, 0.0) for k in FV])  # mu: `prepare`
         self.state = np.array([NO_WINDOW if fc._c is None else fc._c, fc.n], dtype=np.int64)
-        self.acc = np.zeros(N_ACC)
+        self.acc = np.zeros(N_SUMS)
         self._tables(d, buf)
         self.dropped = 0
         cap = fc.pos.shape[0]
@@ -427,33 +467,34 @@ class FlankLoop:
         array is replaced)."""
         fc = self.fc
         k = fc.kernel
-        self.arrays = (  # kept alive here: run_table reads them by address
-            d.ctrl,
-            d.qvel,
-            d.qpos,
-            d.actuator_force,
-            d.sensordata,
-            d.xpos,
-            d.xmat,
-            k.fb,
-            k.ib,
-            fc.ks,
-            fc.params,
-            fc.handed[1],  # pos, depth, weight, frame: what is handed to MuJoCo (FlankContacts.handed)
-            fc.handed[0],
-            fc.handed[3],
-            fc.handed[2],
-            buf.bytes.view(np.int64),
-            buf.off,
-            fc.solref,
-            fc.solreffriction,
-            self.state,
-            self.acc,
-            np.concatenate([STAGE_ADDRESSES, [_MJ_ADD_CONTACT]]).astype(np.int64),
-            self.iv,
-            self.fv,
-            k.mfric,
-        )
+        by_name = {  # kept alive here (self.arrays): run_table reads them by address
+            "ctrl": d.ctrl,
+            "qvel": d.qvel,
+            "qpos": d.qpos,
+            "act": d.actuator_force,
+            "sensordata": d.sensordata,
+            "xpos": d.xpos,
+            "xmat": d.xmat,
+            "fb": k.fb,
+            "ib": k.ib,
+            "ks": fc.ks,
+            "params": fc.params,
+            "pos": fc.handed[1],  # pos, depth, weight, frame: what is handed to MuJoCo (FlankContacts.handed)
+            "depth": fc.handed[0],
+            "weight": fc.handed[3],
+            "frame": fc.handed[2],
+            "records": buf.bytes.view(np.int64),
+            "rec_off": buf.off,
+            "solref": fc.solref,
+            "solreffriction": fc.solreffriction,
+            "state": self.state,
+            "acc": self.acc,
+            "stages": np.concatenate([STAGE_ADDRESSES, [_MJ_ADD_CONTACT]]).astype(np.int64),
+            "iv": self.iv,
+            "fv": self.fv,
+            "mfric": k.mfric,
+        }
+        self.arrays = tuple(by_name[name] for name, _, _ in TABLE)
         self.table = address_table(self.arrays)
         self._kernel = k
 
@@ -464,8 +505,8 @@ class FlankLoop:
             fc._pack()
         if fc.kernel is not self._kernel:
             self._tables(self.d, fc.buffer)
-        self.iv[-1] = fc.solreffriction[1] != 0.0
-        self.fv[4] = fc.mu
+        self.iv[IV.friction_rows] = fc.solreffriction[1] != 0.0
+        self.fv[FV.mu] = fc.mu
         return self.table
 
     def sync(self) -> None:
@@ -484,7 +525,10 @@ class FlankLoop:
         fc = self.fc
         if self._store is not store or self._pattern is not pattern or self._sample_kernel is not fc.kernel:
             cv = pattern.cv
-            self._sample_arrays = (fc.meta, fc.weight, fc.depth, self.work, cv.inv_rho, cv.line_len) + tuple(store)
+            pts, forces, pts_world = store
+            by_name = {"meta": fc.meta, "weight": fc.weight, "depth": fc.depth, "work": self.work}
+            by_name.update(inv_rho=cv.inv_rho, line_len=cv.line_len, pts=pts, forces=forces, pts_world=pts_world)
+            self._sample_arrays = tuple(by_name[name] for name, _, _ in SAMPLE_TABLE)
             self._sample_T = address_table(self._sample_arrays, SAMPLE_TABLE)
             self._store, self._pattern, self._sample_kernel = store, pattern, fc.kernel
         return self._sample_T

@@ -22,6 +22,7 @@ layout raises, naming the MuJoCo version).
 
 from __future__ import annotations
 
+import enum
 import math
 
 import numba
@@ -29,9 +30,20 @@ import numpy as np
 from numba import types
 from numba.extending import intrinsic
 
-from wormsim.contact3d.flank_loop import _f1, _f64_at, _i1, _i64_at, run_table, sample_table
-from wormsim.contact3d.friction_law import mu_at, mu_params
-from wormsim.contact3d.guards import state_event
+from wormsim.contact3d.flank_loop import (
+    FV,
+    Row,
+    SampleRow,
+    _f1,
+    _f64_at,
+    _i1,
+    _i64_at,
+    _records,
+    run_table,
+    sample_table,
+)
+from wormsim.contact3d.friction_law import mu_at
+from wormsim.contact3d.guards import PENETRATED, RUNNING, STUCK, contact_event, state_event
 from wormsim.contact3d.mjdata_layout import mjdata_offsets
 from wormsim.contact3d.series import column
 from wormsim.tooth.merge import split_forces
@@ -40,8 +52,10 @@ ENABLED = True  # the runner's switch (tests compare against the per-sample path
 ADR_CAP = 4096  # contacts per step the compiled sample reads (more: the sample goes to the Python path)
 
 # io: what run_samples hands back
-IO_NEXT, IO_PENDING, IO_TURN_MAX, IO_PM, IO_RM, IO_DROPPED = range(6)
-# g (float parameters), in this order
+IO_NEXT, IO_PENDING, IO_TURN_MAX, IO_PM, IO_RM, IO_DROPPED, IO_EVENT = range(7)
+# io[IO_EVENT]: why run_samples handed a sample back to the runner's Python path (0: it did not)
+EV_NONE, EV_GUARD, EV_FRICTION_CHECK, EV_CONE, EV_LOG_FULL, EV_DROPPED = range(6)
+# g (float parameters): their names in row order, the one declaration of g's layout
 G_NAMES = (
     "dt",
     "direction",
@@ -58,7 +72,6 @@ G_NAMES = (
     "mu_a",
     "mu_b",
     "mu_c",
-    "mu_d",
     "mu",  # the coefficient the contacts carry now (FlankContacts.mu)
     "rpm",  # (rad/s) per rpm
     "a",
@@ -73,7 +86,7 @@ G_NAMES = (
     "z2",
     "deg",
 )
-G = {k: n for n, k in enumerate(G_NAMES)}
+G = enum.IntEnum("G", G_NAMES, start=0)  # g's rows by name: g[G.dt] (numba reads the members as constants)
 
 
 @intrinsic
@@ -87,6 +100,18 @@ def _i32_at(typingctx, addr):
     return sig, codegen
 
 
+@numba.njit(cache=True, inline="always")
+def _set_friction(T, mu):
+    """FlankContacts.set_friction where the cone's dimension stays: mu into the loop's fv and the hand-off's records
+    (both friction entries), as set_template leaves them."""
+    _f1(T, Row.fv)[FV.mu] = mu
+    recs = _records(T)
+    o5 = _i1(T, Row.rec_off)[5]
+    for r in range(recs.shape[0]):
+        recs[r, o5] = mu
+        recs[r, o5 + 1] = mu
+
+
 @numba.njit(cache=True, nogil=True)
 def run_samples(T, Ts, m_addr, d_addr, cmd, load, i0, i1, o0, rec, S, g, off, frame, pos, adr, pat_buf, r_buf, io, mrg):
     """Samples i0..i1-1 (module docstring); sample i's steps are o0 + (i - i0) rec .. + rec of cmd and load.
@@ -95,13 +120,14 @@ def run_samples(T, Ts, m_addr, d_addr, cmd, load, i0, i1, o0, rec, S, g, off, fr
     room; pat_buf, r_buf the pattern's and the radius log's rows; io: IO_* (io[IO_PM], io[IO_RM] the logs' rows used
     on entry); mrg: with one contact per tooth flank (merge) the kernel's (grp, share, mfric, mwrap) and the per-slice
     rows' room (FlankContacts.slice_rows), else None."""
-    acc = _f1(T, 20)
-    state = numba.carray(_i64_at(T[19, 0]), (T[19, 1],))
-    qpos, qvel = _f1(T, 2), _f1(T, 1)
-    depth = _f1(Ts, 2)
-    ib = _i1(T, 8)
-    qa1, qa2, dof1, dof2 = int(g[23]), int(g[24]), int(g[25]), int(g[26])
-    dt, direction, ratio, turn_lim, jump_rad, pen_lim = g[0], g[1], g[2], g[3], g[4], g[5]
+    acc = _f1(T, Row.acc)
+    state = _i1(T, Row.state)
+    qpos, qvel = _f1(T, Row.qpos), _f1(T, Row.qvel)
+    depth = _f1(Ts, SampleRow.depth)
+    ib = _i1(T, Row.ib)
+    qa1, qa2, dof1, dof2 = int(g[G.qa1]), int(g[G.qa2]), int(g[G.dof1]), int(g[G.dof2])
+    dt, direction, ratio = g[G.dt], g[G.direction], g[G.ratio]
+    turn_lim, jump_rad, pen_lim = g[G.overspeed_turn], g[G.jump_rad], g[G.pen_lim]
     tptr = _f64_at(d_addr + off[0])
     nptr = _i32_at(d_addr + off[1])
     eptr = _i32_at(d_addr + off[2])
@@ -109,12 +135,13 @@ def run_samples(T, Ts, m_addr, d_addr, cmd, load, i0, i1, o0, rec, S, g, off, fr
     fptr = _i64_at(d_addr + off[4])
     bptr = _i32_at(d_addr + off[5])
     size, o_adr = off[6], off[7]
-    mu_now = g[16]
+    mu_now = g[G.mu]
     cone3 = mu_now > 0.0
     turn_max = io[IO_TURN_MAX]
     pm, rm = int(io[IO_PM]), int(io[IO_RM])
-    z2 = int(g[27])
+    z2 = int(g[G.z2])
     io[IO_PENDING] = 0.0
+    io[IO_EVENT] = EV_NONE
     for i in range(i0, i1):
         o = o0 + (i - i0) * rec
         io[IO_NEXT] = i
@@ -124,6 +151,7 @@ def run_samples(T, Ts, m_addr, d_addr, cmd, load, i0, i1, o0, rec, S, g, off, fr
         io[IO_PENDING] = 1.0  # from here on sample i's steps are done
         io[IO_DROPPED] = dropped
         if dropped:
+            io[IO_EVENT] = EV_DROPPED  # contacts MuJoCo did not take
             return
         cmd_i = cmd[o + rec - 1]
         th1, th2 = qpos[qa1], qpos[qa2]
@@ -131,27 +159,25 @@ def run_samples(T, Ts, m_addr, d_addr, cmd, load, i0, i1, o0, rec, S, g, off, fr
         t = tptr[0]
         event, te, turn = state_event(th1, th2, w1, w2, bptr[0], dt, turn_lim, direction, ratio, jump_rad)
         if event != 0:  # Guards.state raises: the Python path
+            io[IO_EVENT] = EV_GUARD
             return
-        if t > g[8]:  # the friction guard's next check
+        if t > g[G.next_check]:  # the friction guard's next check
+            io[IO_EVENT] = EV_FRICTION_CHECK
             return
-        vs = abs(w1) * g[9] / g[10]
-        mu = mu_at(vs, g[11], g[12], g[13], g[14], g[28])
+        vs = abs(w1) * g[G.r1] / g[G.cos_gamma]
+        mu = mu_at(vs, g[G.mu_kind], g[G.mu_a], g[G.mu_b], g[G.mu_c], g[G.deg])
         if mu != mu_now:  # FlankContacts.set_friction: the records' friction, where the cone's dimension stays
-            if (mu > 0.0) != (mu_now > 0.0):
+            if (mu > 0.0) != (mu_now > 0.0):  # the cone's dimension changes (FlankContacts.set_friction)
+                io[IO_EVENT] = EV_CONE
                 return
-            fw = _f1(T, 23)
-            fw[4] = mu
-            recs = numba.carray(_f64_at(T[15, 0]), (T[15, 1], T[15, 2]))
-            o5 = _i1(T, 16)[5]
-            for r in range(recs.shape[0]):
-                recs[r, o5] = mu
-                recs[r, o5 + 1] = mu
+            _set_friction(T, mu)
             mu_now = mu
-            g[16] = mu
+            g[G.mu] = mu
         # the sample's contacts: d.contact's efc addresses, the largest penetration (Guards.contact's first check)
         ncon = nptr[0]
         n_fc = state[1]
         if ncon > adr.shape[0] or pm + n_fc > pat_buf.shape[0] or rm + n_fc > r_buf.shape[0]:
+            io[IO_EVENT] = EV_LOG_FULL
             return
         n = n_fc if mrg is not None else min(n_fc, ncon)
         pen = 0.0
@@ -160,11 +186,13 @@ def run_samples(T, Ts, m_addr, d_addr, cmd, load, i0, i1, o0, rec, S, g, off, fr
             for c in range(1, n):
                 if depth[c] > pen:
                     pen = depth[c]
-        if pen > pen_lim:
+        w_drive = w1 if g[G.worm_is_drive] != 0.0 else w2
+        event = contact_event(
+            t, pen, pen_lim, w_drive, cmd_i, g[G.speed_driven] != 0.0, g[G.lock_start], g[G.lock_fraction]
+        )
+        if event == PENETRATED or event == STUCK or (event == RUNNING and g[G.locked] != 0.0):
+            io[IO_EVENT] = EV_GUARD  # Guards.contact raises, or the lock guard acts or keeps state
             return
-        w_drive = w1 if g[22] != 0.0 else w2
-        if g[20] != 0.0 and t > g[6] and (g[21] != 0.0 or abs(w_drive) < g[7] * abs(cmd_i)):
-            return  # the lock guard acts or keeps state: the Python path
         cbase = cptr[0]
         for k in range(ncon):
             adr[k] = _i32_at(cbase + k * size + o_adr)[0]
@@ -187,9 +215,9 @@ def run_samples(T, Ts, m_addr, d_addr, cmd, load, i0, i1, o0, rec, S, g, off, fr
                 True,
                 th2,
                 z2,
-                g[18],
+                g[G.a],
                 i,
-                g[19],
+                g[G.e_star],
                 pm,
                 rm,
             )
@@ -208,16 +236,16 @@ def run_samples(T, Ts, m_addr, d_addr, cmd, load, i0, i1, o0, rec, S, g, off, fr
                 cone3,
                 th2,
                 z2,
-                g[18],
+                g[G.a],
                 i,
-                g[19],
+                g[G.e_star],
                 pm,
                 rm,
             )
         turn_max = max(turn_max, turn)
         r_c = wr / W if W > 0 else math.nan
         sums = (acc[0], acc[1], acc[2], acc[3], acc[4], acc[5], acc[6], acc[7], acc[8], acc[9])
-        col = column(t, th1, th2, w1, w2, cmd_i, sums, rec, nteeth, pen2, mu, te, fr, r_c, g[17])
+        col = column(t, th1, th2, w1, w2, cmd_i, sums, rec, nteeth, pen2, mu, te, fr, r_c, g[G.rpm])
         for k in range(len(col)):
             S[k, i] = col[k]
         io[IO_PENDING] = 0.0
@@ -230,7 +258,10 @@ class FlankSamples:
     """run_samples' parameters for one run (the runner's FlankLoop, guards, friction law, logs); `run` steps and
     samples a stretch of one command block."""
 
-    def __init__(self, loop, guards, scenario, bm, worm_is_drive: bool, rec: int, series: np.ndarray):
+    NONE = EV_NONE  # run's event when the stretch is done
+
+    def __init__(self, loop, guards, bm, rec: int, series: np.ndarray):
+        """The parameters from the guards and the run's plan (bm.plan: the friction law, the drive's kind)."""
         from wormsim import gear_theory as gt
         from wormsim.units import RPM
 
@@ -238,46 +269,46 @@ class FlankSamples:
         self.loop, self.fc, self.guards, self.rec, self.S = loop, fc, guards, rec, series
         self.off = mjdata_offsets()
         g = np.zeros(len(G_NAMES))
-        g[G["dt"]] = guards.dt
-        g[G["direction"]] = bm.direction
-        g[G["ratio"]] = geo.ratio
-        g[G["overspeed_turn"]] = guards.turn_lim
-        g[G["jump_rad"]] = guards.jump_rad
-        g[G["pen_lim"]] = guards.pen_lim
-        g[G["lock_start"]] = guards.lock_start
-        g[G["lock_fraction"]] = gt.LOCK_SPEED_FRACTION
-        g[G["r1"]] = geo.r1
-        g[G["cos_gamma"]] = math.cos(geo.gamma)
-        kind, a, b, c_, deg = mu_params(scenario.contact)
-        g[G["mu_kind"]], g[G["mu_a"]], g[G["mu_b"]], g[G["mu_c"]] = kind, a, b, c_
-        g[G["deg"]] = deg
-        g[G["rpm"]] = RPM
-        g[G["a"]] = geo.a
-        g[G["speed_driven"]] = float(guards.speed_driven)
-        g[G["worm_is_drive"]] = float(worm_is_drive)
-        g[G["qa1"]], g[G["qa2"]] = fc.qa1, fc.qa2
-        g[G["dof1"]], g[G["dof2"]] = bm.worm_dof, bm.wheel_dof
-        g[G["z2"]] = geo.z2
+        g[G.dt] = guards.dt
+        g[G.direction] = bm.direction
+        g[G.ratio] = geo.ratio
+        g[G.overspeed_turn] = guards.turn_lim
+        g[G.jump_rad] = guards.jump_rad
+        g[G.pen_lim] = guards.pen_lim
+        g[G.lock_start] = guards.lock_start
+        g[G.lock_fraction] = gt.LOCK_SPEED_FRACTION
+        g[G.r1] = geo.r1
+        g[G.cos_gamma] = math.cos(geo.gamma)
+        kind, a, b, c_, deg = bm.plan.mu_params
+        g[G.mu_kind], g[G.mu_a], g[G.mu_b], g[G.mu_c] = kind, a, b, c_
+        g[G.deg] = deg
+        g[G.rpm] = RPM
+        g[G.a] = geo.a
+        g[G.speed_driven] = float(guards.speed_driven)
+        g[G.worm_is_drive] = float(bm.plan.drive_on == "worm")
+        g[G.qa1], g[G.qa2] = fc.qa1, fc.qa2
+        g[G.dof1], g[G.dof2] = bm.worm_dof, bm.wheel_dof
+        g[G.z2] = geo.z2
         self.g = g
         self.adr = np.zeros(ADR_CAP, dtype=np.int32)
-        self.io = np.zeros(6)
+        self.io = np.zeros(IO_EVENT + 1)
         self._store: tuple = ()
 
     def usable(self) -> bool:
         """The compiled samples apply: rigid poses, every contact MuJoCo's so far."""
         return ENABLED and not self.fc.displaced and self.loop.dropped == 0
 
-    def run(self, cmd, load, i0: int, i1: int, o0: int, pattern, rlog) -> tuple[int, bool]:
-        """Samples i0..i1-1 (run_samples); returns (the next sample, whether its steps are done and its per-sample
-        work is left to the runner's Python path)."""
+    def run(self, cmd, load, i0: int, i1: int, o0: int, pattern, rlog) -> tuple[int, int]:
+        """Samples i0..i1-1 (run_samples); returns (the next sample, the event: EV_NONE when the stretch is done,
+        else why that sample, its steps done, is left to the runner's Python path)."""
         loop, fc, g, io, guards = self.loop, self.fc, self.g, self.io, self.guards
         T = loop.prepare()
         k = fc.kernel
         Ts = loop.sample_table_for(pattern, self._store)
-        g[G["next_check"]] = guards.friction.next_check
-        g[G["mu"]] = fc.mu
-        g[G["e_star"]] = pattern.e_star
-        g[G["locked"]] = float(guards.locked_since is not None)
+        g[G.next_check] = guards.friction.next_check
+        g[G.mu] = fc.mu
+        g[G.e_star] = pattern.e_star
+        g[G.locked] = float(guards.locked_since is not None)
         io[IO_TURN_MAX], io[IO_PM], io[IO_RM] = guards.turn_max, pattern.m, rlog.m
         run_samples(
             T,
@@ -302,13 +333,13 @@ class FlankSamples:
             (k.grp, k.share, k.mfric, k.mwrap, fc._adr, fc._efc) if fc.merge else None,
         )
         loop.sync()
-        if g[G["mu"]] != fc.mu:  # changed in the call (run_samples): as FlankContacts.set_friction leaves it
-            fc.mu = float(g[G["mu"]])
+        if g[G.mu] != fc.mu:  # changed in the call (run_samples): as FlankContacts.set_friction leaves it
+            fc.mu = float(g[G.mu])
             fc.template.friction = [fc.mu, fc.mu, 0.0, 0.0, 0.0]
         loop.dropped += int(io[IO_DROPPED])
         guards.turn_max = float(io[IO_TURN_MAX])
         pattern.m, rlog.m = int(io[IO_PM]), int(io[IO_RM])
-        return int(io[IO_NEXT]), bool(io[IO_PENDING])
+        return int(io[IO_NEXT]), int(io[IO_EVENT])
 
     def bind(self, store: tuple) -> None:
         """The run's point, force and world-point arrays (FlankLoop.sample's store)."""

@@ -77,12 +77,15 @@ def _alignment(adr, dim, friction, f, v, v_min):
 class FrictionGuard:
     """The check of the module docstring, one call per sample."""
 
-    def __init__(self, scenario, bm, nominal_normal_force_n: float, rec_interval_s: float):
+    def __init__(self, bm, rec_interval_s: float, scenario):
+        """bm.plan: the ramps' end, the transition velocity, the working load's normal force; the scenario only for
+        the error's message (friction_error)."""
+        plan = bm.plan
         self.scenario, self.bm = scenario, bm
-        self.start = gt.ramps_end_s(scenario)
+        self.start = plan.ramps_end_s
         self.hold = max(HOLD_S, 5 * rec_interval_s)
-        self.v_min = scenario.contact.transition_velocity_m_s
-        self.f_nominal = nominal_normal_force_n
+        self.v_min = plan.transition_velocity_m_s
+        self.f_nominal = plan.normal_force_n
         self.since: float | None = None
         self.next_check = self.start
 

@@ -28,6 +28,7 @@ from wormsim.scenario import Scenario
 from wormsim.units import rad_s_to_rpm
 
 DIVERGED, OVERSPEED, JUMPED = 1, 2, 3  # state_event's codes (0: none)
+PENETRATED, STUCK, RUNNING = 4, 5, 6  # contact_event's codes (0: none)
 
 
 @numba.njit(cache=True, inline="always")
@@ -47,23 +48,41 @@ def state_event(th1, th2, w1, w2, badqacc, dt, turn_lim, direction, ratio, jump_
     return 0, te, turn
 
 
-class Guards:
-    """The checks after every record interval (module docstring); each raises its SimulationError subclass."""
+@numba.njit(cache=True, inline="always")
+def contact_event(t, pen, pen_lim, w_drive, cmd, speed_driven, lock_start, lock_fraction):
+    """The contact checks of a sample, in order: PENETRATED (the largest penetration pen beyond pen_lim), then for a
+    speed-driven drive after lock_start STUCK (|w_drive| below lock_fraction of its command |cmd|:
+    gear_theory.drive_stuck) or RUNNING; 0 when the lock is not watched. Guards.contact and the compiled samples
+    (wormsim.contact3d.flank_samples) both decide by it."""
+    if pen > pen_lim:
+        return PENETRATED
+    if speed_driven and t > lock_start:
+        if abs(w_drive) < lock_fraction * abs(cmd):
+            return STUCK
+        return RUNNING
+    return 0
 
-    def __init__(self, bm: BuiltModel, scenario: Scenario, dt: float, rec: int):
-        self.bm, self.scenario, self.dt = bm, scenario, dt
+
+class Guards:
+    """The checks after every record interval (module docstring); each raises its SimulationError subclass. What they
+    check against comes from the run's plan (bm.plan: the timestep, the drive's kind, the guards' times, the working
+    load); the scenario only completes the error messages (wormsim.contact3d.diagnosis quotes its inputs)."""
+
+    def __init__(self, bm: BuiltModel, rec: int, scenario: Scenario):
+        plan = bm.plan
+        self.bm, self.scenario, self.dt = bm, scenario, plan.timestep_s
         geo = bm.geometry
         self.pen_lim = gt.penetration_limit_m(geo.m_x)
         self.pitch_angle = 2 * math.pi / geo.z2
         self.turn_lim = OVERSPEED_GUARD * MAX_WORM_TURN_PER_STEP_RAD
         self.jump_rad = JUMP_PITCH * self.pitch_angle
-        self.lock_start = gt.lock_check_start_s(scenario)
-        self.lock_hold = max(gt.LOCK_HOLD_S, 20 * rec * dt)
-        self.speed_driven = scenario.drive.speed_rpm is not None
+        self.lock_start = plan.lock_start_s
+        self.lock_hold = max(gt.LOCK_HOLD_S, 20 * rec * self.dt)
+        self.speed_driven = plan.speed_driven
         self.locked_since: float | None = None
         self.turn_max = 0.0
         # sliding contacts' friction against their slip (wormsim.contact3d.friction_guard)
-        self.friction = FrictionGuard(scenario, bm, bm.plan.normal_force_n, rec * dt)
+        self.friction = FrictionGuard(bm, rec * self.dt, scenario)
 
     def state(self, d: mujoco.MjData, t: float, th1: float, th2: float, w1: float, w2: float) -> float:
         """Divergence, overspeed, teeth jumped, friction against the slip; returns the transmission error (rad)."""
@@ -85,13 +104,15 @@ class Guards:
         return te
 
     def contact(self, t: float, pen: float, w_drive: float, cmd: float) -> None:
-        """Penetration beyond the limit; a speed-driven drive stuck below half its command (locked)."""
-        if pen > self.pen_lim:
+        """Penetration beyond the limit; a speed-driven drive stuck below half its command (locked) for lock_hold."""
+        code = contact_event(
+            t, pen, self.pen_lim, w_drive, cmd, self.speed_driven, self.lock_start, gt.LOCK_SPEED_FRACTION
+        )
+        if code == PENETRATED:
             raise penetration_error(t, pen, self.pen_lim, self.dt, self.bm)
-        if self.speed_driven and t > self.lock_start:
-            if gt.drive_stuck(w_drive, cmd):
-                self.locked_since = t if self.locked_since is None else self.locked_since
-                if t - self.locked_since > self.lock_hold:
-                    raise locked_error(t, w_drive, cmd, self.bm, self.scenario)
-            else:
-                self.locked_since = None
+        if code == STUCK:
+            self.locked_since = t if self.locked_since is None else self.locked_since
+            if t - self.locked_since > self.lock_hold:
+                raise locked_error(t, w_drive, cmd, self.bm, self.scenario)
+        elif code == RUNNING:
+            self.locked_since = None

@@ -164,6 +164,14 @@ def hertz_line_stiffness_n_per_m(materials: Materials, contact_length_m: float) 
     return math.pi * contact_length_m * effective_modulus_pa(materials) / 4.0
 
 
+def pair_stiffness_n_per_m(contact: Contact, materials: Materials, face_width_m: float) -> tuple[float, str]:
+    """(the tooth pair's stiffness, its source): contact.stiffness_n_per_m ("scenario"), else the Hertz line
+    stiffness over the face width ("hertz")."""
+    if contact.stiffness_n_per_m is not None:
+        return contact.stiffness_n_per_m, "scenario"
+    return hertz_line_stiffness_n_per_m(materials, face_width_m), "hertz"
+
+
 def contact_law(
     contact: Contact, materials: Materials, face_width_m: float, contacts_per_pair: int, inv_mass_hat: float
 ) -> ContactLaw:
@@ -172,10 +180,7 @@ def contact_law(
     `inv_mass_hat` is A_hat = 1 / m_eff, the constraint-space inverse mass the model assigns to every
     worm-wheel contact (wormsim.contact3d.mjcf sets body_invweight0 so that it holds).
     """
-    if contact.stiffness_n_per_m is not None:
-        k_pair, source = contact.stiffness_n_per_m, "scenario"
-    else:
-        k_pair, source = hertz_line_stiffness_n_per_m(materials, face_width_m), "hertz"
+    k_pair, source = pair_stiffness_n_per_m(contact, materials, face_width_m)
     n_ref = max(int(contacts_per_pair), 1)
     k_c = k_pair / n_ref
     m_eff = 1.0 / inv_mass_hat

@@ -42,7 +42,14 @@ from meshgen.pieces import GearSet
 from wormsim import gear_theory as gt
 from wormsim.contact3d import mass_scaling, shafts
 from wormsim.contact3d.backlash import check_backlash, check_conjugate_interference
-from wormsim.contact3d.law import ContactLaw, contact_law, friction_damping_n_s_per_m, friction_impratio
+from wormsim.contact3d.friction_law import mu_params
+from wormsim.contact3d.law import (
+    ContactLaw,
+    contact_law,
+    friction_damping_n_s_per_m,
+    friction_impratio,
+    pair_stiffness_n_per_m,
+)
 from wormsim.contact3d.mass_scaling import ScalingCheck
 from wormsim.contact3d.timestep import choose_timestep
 from wormsim.friction import friction_coefficient
@@ -110,8 +117,8 @@ class Inertias:
 @dataclass(frozen=True)
 class Prepared:
     """The run's plan, derived once from the scenario before the model is built and handed down: geometry, pieces,
-    inertias, the contact law, the flank grid, the drive and load commands and the working loads the law and the
-    guards are sized for (the timestep and the window follow in BuiltModel)."""
+    inertias, the contact law, the flank grid, the drive and load commands, the working loads the law and the
+    guards are sized for, the drive's kind and the guards' times; build_model adds the timestep and the window."""
 
     geometry: GearGeometry
     pieces: GearSet
@@ -123,6 +130,15 @@ class Prepared:
     normal_force_n: float = 0.0  # nominal_normal_force_n: the whole mesh's normal force at the working load
     commands: gt.Commands | None = None  # the drive and load commands over time (gear_theory.commands)
     grid: FlankGrid | None = None  # contact.geometry flanks: the flank grid of law.contacts_per_pair slices
+    drive_on: str = "worm"  # drive.on: the shaft the drive turns
+    speed_driven: bool = True  # drive.speed_rpm given (the lock guard watches the drive's speed)
+    ramps_end_s: float = 0.0  # both commands at full value (gear_theory.ramps_end_s)
+    lock_start_s: float = 0.0  # the lock guard's start (gear_theory.lock_check_start_s)
+    mu_params: tuple = ()  # the friction law mu(Vs) (wormsim.contact3d.friction_law.mu_params)
+    transition_velocity_m_s: float = 0.0  # contact.transition_velocity_m_s
+    e_star_pa: float = 0.0  # the pair's effective modulus (gear_theory.effective_modulus_pa)
+    timestep_s: float = 0.0  # the model's timestep (build_model: choose_timestep's or the one given)
+    window_teeth: int = 0  # the wheel tooth slots with collision (build_model)
 
 
 Plan = Prepared
@@ -257,7 +273,7 @@ def prepare(scenario: Scenario, gs: GearSet | None = None) -> Prepared:
     # n_ref: the pieces across the face width, or with contact.geometry flanks the flank contacts' slices
     slabs = flank_slices(scenario, geo) if scenario.contact.geometry == "flanks" else max(1, _slabs_per_flank(gs))
     # simulation.mass_scaling (wormsim.contact3d.mass_scaling): every inertia x S before the law takes them
-    law1 = contact_law(scenario.contact, scenario.materials, geo.face_width, slabs, arm1**2 / I1 + arm2**2 / I2)
+    k_pair, _ = pair_stiffness_n_per_m(scenario.contact, scenario.materials, geo.face_width)
     scaling = mass_scaling.resolve(
         scenario,
         ratio=geo.ratio,
@@ -265,19 +281,18 @@ def prepare(scenario: Scenario, gs: GearSet | None = None) -> Prepared:
         gamma=geo.gamma,
         alpha_n=geo.alpha_n,
         mu=float(friction_coefficient(scenario.contact, 1.0)),
-        pair_stiffness_n_per_m=law1.pair_stiffness_n_per_m,
-        inv_mass_hat=law1.inv_mass_hat,
+        pair_stiffness_n_per_m=k_pair,
+        inv_mass_hat=arm1**2 / I1 + arm2**2 / I2,
         inertias_kg_m2=(I1, I2),
         segments_per_turn=0 if scenario.contact.geometry == "flanks" else gs.resolution.worm_segments_per_turn or 0,
     )
     S = scaling.factor
     a1, a2 = arm1**2 / (S * I1), arm2**2 / (S * I2)
-    law = law1
-    if S != 1:  # the law again with the scaled inertias
+    if S != 1:  # the scaled inertias
         ine = Inertias(*(S * v for v in astuple(ine)))
         if flanks and not scenario.contact.slices:
             slabs = min(slabs, SLICES_MASS_SCALED)  # a scaled run keeps means only (tooth.grid.SLICES_MASS_SCALED)
-        law = contact_law(scenario.contact, scenario.materials, geo.face_width, slabs, a1 + a2)
+    law = contact_law(scenario.contact, scenario.materials, geo.face_width, slabs, a1 + a2)  # the law, once
     mu0 = float(friction_coefficient(scenario.contact, 0.0))
     mu_max = max(mu0, float(friction_coefficient(scenario.contact, 1.0)))
     f_n = nominal_normal_force_n(scenario, geo)
@@ -291,7 +306,25 @@ def prepare(scenario: Scenario, gs: GearSet | None = None) -> Prepared:
     law = replace(law, impratio=friction_impratio(law, mu_max, f_n, scenario.contact.transition_velocity_m_s))
     grid = flank_grid(geo, law.contacts_per_pair) if flanks else None
     cmds = gt.commands(scenario, expected_direction(scenario, geo))
-    return Prepared(geo, gs, ine, law, a1, a2, scaling, f_n, cmds, grid)
+    return Prepared(
+        geo,
+        gs,
+        ine,
+        law,
+        a1,
+        a2,
+        scaling,
+        f_n,
+        cmds,
+        grid,
+        drive_on=scenario.drive.on,
+        speed_driven=scenario.drive.speed_rpm is not None,
+        ramps_end_s=gt.ramps_end_s(scenario),
+        lock_start_s=gt.lock_check_start_s(scenario),
+        mu_params=mu_params(scenario.contact),
+        transition_velocity_m_s=scenario.contact.transition_velocity_m_s,
+        e_star_pa=gt.effective_modulus_pa(scenario.materials),
+    )
 
 
 # ----------------------------------------------------------------------------- build
@@ -402,7 +435,7 @@ def build_model(
         tooth_shift_rad=shift,
         kinematic_tca=kin,
         deviations=dev,
-        plan=p,
+        plan=replace(p, timestep_s=h, window_teeth=W),
     )
     if check_backlash_vs_pieces:
         # the model itself at the rigid-conjugate pose (wormsim.contact3d.backlash.check_conjugate_interference): exit 2

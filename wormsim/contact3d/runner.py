@@ -30,7 +30,7 @@ from wormsim import prewarm
 from wormsim.contact3d import jit_warmup, mass_scaling
 from wormsim.contact3d.contact_sums import RadiusLog
 from wormsim.contact3d.diagnosis import diverged_error
-from wormsim.contact3d.friction_law import mu_of, mu_params
+from wormsim.contact3d.friction_law import mu_of
 from wormsim.contact3d.guards import Guards
 from wormsim.contact3d.metrics import contact3d_summary
 from wormsim.contact3d.mjcf import BuiltModel, build_model
@@ -63,18 +63,18 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
     n_steps = int(round(scenario.simulation.duration_s / dt))
     rec = _record_every(scenario, dt, n_steps, bm.meta.get("mass_scaling", 1) > 1)
     n_rec = n_steps // rec
-    guards = Guards(bm, scenario, dt, rec)
+    guards = Guards(bm, rec, scenario)
     S_all = np.zeros((len(SERIES), n_rec))  # one column per sample, written at once
     S = dict(zip(SERIES, S_all))
     store = tuple(np.full((n_rec, MAX_POINTS, 3), np.nan, dtype=np.float32) for _ in range(3))  # p0, F, world p
     rlog = RadiusLog()  # the contacts' radii and weights: the efficiency at the contact radius (contact_sums)
-    worm_is_drive = scenario.drive.on == "worm"
+    worm_is_drive = bm.plan.drive_on == "worm"
     s0 = int(m.sensor_adr[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SENSOR, "mesh_force")])
     ia_drv, ia_load = bm.drive_actuator, bm.load_actuator
     a1, a2 = (ia_drv, ia_load) if worm_is_drive else (ia_load, ia_drv)  # the worm's and the wheel's actuator
     io = (ia_drv, ia_load, a1, a2, s0)
     flanks = bm.meta.get("contact_geometry") == "flanks"
-    src = FlankSource(bm, d, io, scenario, guards, rec, S_all, store) if flanks else PieceSource(bm, d, io)
+    src = FlankSource(bm, d, io, guards, rec, S_all, store) if flanks else PieceSource(bm, d, io)
     slog = ShaftLog(m, bm.meta["shafts"], n_rec) if "shafts" in bm.meta else None  # wormsim.contact3d.shafts
     t_wall = time.perf_counter()
     prewarm.loop_started()  # the writers' warm-up thread goes now, beside the GIL-free loop (wormsim.prewarm)
@@ -111,8 +111,8 @@ def _loop(src, bm: BuiltModel, scenario: Scenario, d, guards, S_all, rlog, store
     qa_worm = int(m.jnt_qposadr[m.dof_jntid[bm.worm_dof]])
     qa_wheel = int(m.jnt_qposadr[m.dof_jntid[bm.wheel_dof]])
     qp, qv = d.qpos, d.qvel
-    worm_is_drive = scenario.drive.on == "worm"
-    mu_p = mu_params(scenario.contact)
+    worm_is_drive = bm.plan.drive_on == "worm"
+    mu_p = bm.plan.mu_params
     cmds = bm.plan.commands  # the commands at each step's midpoint, for blocks of about 4096 steps at once
     block = max(1, 4096 // rec)
     fast = src.fast
@@ -124,13 +124,13 @@ def _loop(src, bm: BuiltModel, scenario: Scenario, d, guards, S_all, rlog, store
             cmd_blk, load_blk = cmd_arr.tolist(), load_arr.tolist()
         o = (i % block) * rec
         if fast is not None and fast.usable():
-            i_next, pending = fast.run(cmd_arr, load_arr, i, min(n_rec, i - i % block + block), o, src.pattern, rlog)
+            i_next, event = fast.run(cmd_arr, load_arr, i, min(n_rec, i - i % block + block), o, src.pattern, rlog)
             if progress is not None and i_next > i:
                 progress.update(float(S_all[0, i_next - 1]))
             i = i_next
-            if not pending:  # samples done up to i_next (the block's end)
+            if event == fast.NONE:  # samples done up to i_next (the block's end)
                 continue
-            o = (i % block) * rec  # sample i's steps are done; its per-sample work follows in Python
+            o = (i % block) * rec  # sample i's steps are done; the event's work (its sample) follows in Python
             sums = tuple(src.loop.acc.tolist())
         elif fast is not None:
             sums = src.steps(cmd_arr, load_arr, o, rec)

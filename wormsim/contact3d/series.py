@@ -1,6 +1,7 @@
-"""The run's time series: their names in row order (SERIES, the layout of the series array) and one sample's column
-(`column`), compiled once and called by the Python sample loop (wormsim.contact3d.runner) and by the compiled one
-(wormsim.contact3d.flank_samples) alike.
+"""The run's time series: their names in row order (SERIES, the layout of the series array), the per-step sums of a
+record interval (SUMS, `add_step`) and one sample's column (`column`), each compiled once and called by the Python
+paths (wormsim.contact3d.runner, the pieces' steps in wormsim.contact3d.sources) and by the compiled ones
+(wormsim.contact3d.flank_loop, wormsim.contact3d.flank_samples) alike.
 
 The interval's mean resultant on the wheel is resolved at the pitch point P = (0, -r2, 0) on the line of centres, in
 the wheel's directions there (DIN 3975 F_t2, F_r2, F_a2; seed 001 resolves ADAMS's contact force the same way):
@@ -38,11 +39,35 @@ SERIES = (
 )
 
 
+# the per-step sums of a record interval, in the order of the sums array (add_step) and of column's `sums`
+SUMS = ("worm_torque", "wheel_torque", "worm_power", "wheel_power", "contacts", "f_x", "f_y", "f_z", "m_z", "f_x_peak")
+N_SUMS = len(SUMS)
+
+
+@numba.njit(cache=True, inline="always")
+def add_step(sums, act, sd, a1, a2, s0, w1, w2):
+    """The interval's sums (SUMS order; all 0.0 at its start) with one step added: the worm's and the wheel's
+    actuator torques act[a1], act[a2] and powers T w with the speeds w1, w2 read before the step, the contact
+    sensor's count, resultant F on the wheel (global frame) and its moment about the wheel axis M_z = tau_z + p_x F_y
+    - p_y F_x (sensordata from s0: found, F (3), torque about the point (3), point (3)), and the peak |F_x| (the
+    start-up impact is shorter than an interval). A tuple in and out: the compiled loop keeps it in registers."""
+    t1, t2, p1, p2, nc, fx, fy, fz, mz, fpk = sums
+    q1, q2 = act[a1], act[a2]
+    f0, f1, f2 = sd[s0 + 1], sd[s0 + 2], sd[s0 + 3]
+    if abs(f0) > fpk:
+        fpk = abs(f0)
+    mz += sd[s0 + 6] + sd[s0 + 7] * f1 - sd[s0 + 8] * f0
+    return t1 + q1, t2 + q2, p1 + q1 * w1, p2 + q2 * w2, nc + sd[s0], fx + f0, fy + f1, fz + f2, mz, fpk
+
+
+ZERO_SUMS = (0.0,) * N_SUMS  # the sums at an interval's start
+
+
 @numba.njit(cache=True)
 def column(t, th1, th2, w1, w2, cmd, sums, rec, nteeth, pen, mu, te, fr_lc, r_c, rpm):
     """One sample's column in SERIES order: the state at the interval's end, the interval's per-step sums
-    sums = (T1, T2, P1, P2, contacts, F_x, F_y, F_z, M_z, |F_x| peak) over its rec steps as means, and the sample's
-    contact outputs; rpm = (rad/s) per rpm. The efficiency at the contact radius is filled after the run."""
+    sums (SUMS order: T1, T2, P1, P2, contacts, F_x, F_y, F_z, M_z, |F_x| peak) over its rec steps as means, and the
+    sample's contact outputs; rpm = (rad/s) per rpm. The efficiency at the contact radius is filled after the run."""
     t1, t2, p1, p2, nc, fx, fy, fz, mz, fpk = sums
     return (
         t,  # t_s

@@ -18,8 +18,8 @@ import math
 import mujoco
 import numpy as np
 
-from wormsim import gear_theory as gt
 from wormsim.contact3d.mjcf import BuiltModel
+from wormsim.contact3d.series import ZERO_SUMS, add_step
 from wormsim.contact3d.slots import repose_window
 
 _ROWS3 = np.arange(3)  # the normal and two tangent rows of an elliptic-cone contact
@@ -41,32 +41,20 @@ class PieceSource:
 
     def steps(self, cmd_blk: list, load_blk: list, o: int, rec: int) -> tuple:
         """Steps o..o+rec-1 of the block's commands one mj_step each; the per-step sums of the module docstring
-        (the actuator forces of each step, computed at its start with the speeds read before it; the contact
-        sensor's resultant: found, F (3), torque about the point (3), point (3); global frame, on the wheel)."""
+        (wormsim.contact3d.series.add_step: the actuator forces of each step, computed at its start with the speeds
+        read before it; the contact sensor's resultant on the wheel)."""
         m, d, bm = self.m, self.d, self.bm
         ia_drv, ia_load, a1, a2, s0 = self.io
         sd, act, qv, ctrl = d.sensordata, d.actuator_force, d.qvel, d.ctrl
         dof1, dof2 = bm.worm_dof, bm.wheel_dof
-        fx = fy = fz = mz = nc = t1 = t2 = p1 = p2 = fpk = 0.0
+        sums = ZERO_SUMS
         for j in range(o, o + rec):
             ctrl[ia_drv] = cmd_blk[j]
             ctrl[ia_load] = load_blk[j]
-            w1j, w2j = qv[dof1], qv[dof2]
+            w1j, w2j = float(qv[dof1]), float(qv[dof2])
             mujoco.mj_step(m, d)
-            q1, q2 = act[a1], act[a2]
-            t1 += q1
-            t2 += q2
-            p1 += q1 * w1j
-            p2 += q2 * w2j
-            nc += sd[s0]
-            f0, f1, f2 = sd[s0 + 1], sd[s0 + 2], sd[s0 + 3]
-            fx += f0
-            if abs(f0) > fpk:  # the per-step peak (the start-up impact is shorter than an interval)
-                fpk = abs(f0)
-            fy += f1
-            fz += f2
-            mz += sd[s0 + 6] + sd[s0 + 7] * f1 - sd[s0 + 8] * f0
-        return t1, t2, p1, p2, nc, fx, fy, fz, mz, fpk
+            sums = add_step(sums, act, sd, a1, a2, s0, w1j, w2j)
+        return sums
 
     def sample(self, i: int, th2: float, mu: float, rlog, store: tuple) -> tuple:
         """Re-pose the window, set mu on the pieces, read the contacts (contact_details)."""
@@ -86,7 +74,7 @@ class FlankSource:
     """contact.geometry flanks: the exact-flank contacts (wormsim.contact3d.flank_step) in the compiled step loop,
     the contact pattern and Hertz pressure logged per sample (wormsim.tooth.hertz)."""
 
-    def __init__(self, bm: BuiltModel, d: mujoco.MjData, io: tuple, scenario, guards, rec: int, S_all, store):
+    def __init__(self, bm: BuiltModel, d: mujoco.MjData, io: tuple, guards, rec: int, S_all, store):
         from wormsim.contact3d.flank_loop import FlankLoop
         from wormsim.contact3d.flank_samples import FlankSamples
         from wormsim.contact3d.flank_step import FlankContacts, split_forward
@@ -94,11 +82,11 @@ class FlankSource:
 
         self.bm, self.d = bm, d
         self.fc = fc = FlankContacts(bm, bm.law.contacts_per_pair)
-        self.pattern = PatternLog(fc, gt.effective_modulus_pa(scenario.materials))
+        self.pattern = PatternLog(fc, bm.plan.e_star_pa)
         split_forward(bm.model, d, fc.add)
         self.coll = np.zeros(0, dtype=int)
         self.loop = FlankLoop(fc, d, *io)
-        self.fast = FlankSamples(self.loop, guards, scenario, bm, scenario.drive.on == "worm", rec, S_all)
+        self.fast = FlankSamples(self.loop, guards, bm, rec, S_all)
         self.fast.bind(store)
 
     def steps(self, cmd_arr: np.ndarray, load_arr: np.ndarray, o: int, rec: int) -> tuple:

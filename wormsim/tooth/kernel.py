@@ -448,15 +448,76 @@ _F_FIELDS += (
     "mwrap",
     "axes",
 )  # wormsim.tooth.merge
+_I_FIELDS = ("span", "ks", "stamp")
 _I_HEADER = 8  # S, N, cap, len(P), W, z2, merge (one contact per tooth flank), merged contacts
 
 
-def _shapes(S: int, N: int, cap: int, nP: int, W: int, z2: int) -> tuple[list, list]:
-    """Shapes of the packed buffers' fields, in order (PackedKernel; find_packed unpacks the same order)."""
-    f = [(2, S, N, 2), (2, S, N), (2, S, 2), (S,), (nP,), (cap, 3), (cap, 3), (cap,), (cap, 4), (cap, 2), (cap,)]
-    f += [(cap, 9), (z2, 2, S, 3), (3,), (6,), (N,), (N,), (N, 3), (N, 3)]
-    f += [(cap, 3), (cap, 3), (cap,), (cap,), (cap, 9), (cap,), (cap,), (cap,), (cap,), (13,)]
-    return f, [(2, S, 2), (W,), (N,)]
+@numba.njit(cache=True)
+def _layout(S, N, cap, nP, W, z2):
+    """The packed buffers' layout, declared once: the shapes of the float buffer's fields (_F_FIELDS order) and of
+    the int buffer's after its header (_I_FIELDS order). PackedKernel sizes the buffers by it; `_views` cuts them."""
+    f = ((2, S, N, 2), (2, S, N), (2, S, 2), (S,), (nP,), (cap, 3), (cap, 3), (cap,), (cap, 4), (cap, 2), (cap,))
+    f2 = ((cap, 9), (z2, 2, S, 3), (3,), (6,), (N,), (N,), (N, 3), (N, 3))
+    f3 = ((cap, 3), (cap, 3), (cap,), (cap,), (cap, 9), (cap,), (cap,), (cap,), (cap,), (13,))
+    return f + f2 + f3, ((2, S, 2), (W,), (N,))
+
+
+@numba.njit(cache=True, inline="always")
+def _take(buf, o, shape):
+    """buf's next field of this shape from offset o, as a view; with the offset after it."""
+    k = 1
+    for x in shape:
+        k *= x
+    return buf[o : o + k].reshape(shape), o + k
+
+
+@numba.njit(cache=True, inline="always")
+def _views(fb, ib):
+    """The packed buffers' fields as views (_layout at the sizes in ib's header): the float fields in _F_FIELDS
+    order, the int fields in _I_FIELDS order. PackedKernel's numpy fields and find_packed's unpacking both come
+    from here."""
+    f, i = _layout(ib[0], ib[1], ib[2], ib[3], ib[4], ib[5])
+    o = 0
+    xy, o = _take(fb, o, f[0])
+    c, o = _take(fb, o, f[1])
+    c_range, o = _take(fb, o, f[2])
+    zeta, o = _take(fb, o, f[3])
+    P, o = _take(fb, o, f[4])
+    pos, o = _take(fb, o, f[5])
+    nrm, o = _take(fb, o, f[6])
+    depth, o = _take(fb, o, f[7])
+    meta, o = _take(fb, o, f[8])
+    line, o = _take(fb, o, f[9])
+    weight, o = _take(fb, o, f[10])
+    frame, o = _take(fb, o, f[11])
+    mtab, o = _take(fb, o, f[12])
+    mc, o = _take(fb, o, f[13])
+    tmp, o = _take(fb, o, f[14])
+    gaps, o = _take(fb, o, f[15])
+    exc, o = _take(fb, o, f[16])
+    pts, o = _take(fb, o, f[17])
+    nrs, o = _take(fb, o, f[18])
+    mpos, o = _take(fb, o, f[19])
+    mnrm, o = _take(fb, o, f[20])
+    mdepth, o = _take(fb, o, f[21])
+    mweight, o = _take(fb, o, f[22])
+    mframe, o = _take(fb, o, f[23])
+    grp, o = _take(fb, o, f[24])
+    share, o = _take(fb, o, f[25])
+    mfric, o = _take(fb, o, f[26])
+    mwrap, o = _take(fb, o, f[27])
+    axes, o = _take(fb, o, f[28])
+    o = _I_HEADER
+    span, o = _take(ib, o, i[0])
+    ks, o = _take(ib, o, i[1])
+    stamp, o = _take(ib, o, i[2])
+    floats = (xy, c, c_range, zeta, P, pos, nrm, depth, meta, line, weight, frame, mtab, mc, tmp, gaps, exc, pts, nrs)
+    floats2 = (mpos, mnrm, mdepth, mweight, mframe, grp, share, mfric, mwrap, axes)
+    return floats + floats2, (span, ks, stamp)
+
+
+def _size(shapes) -> int:
+    return sum(int(np.prod(sh)) for sh in shapes)
 
 
 class PackedKernel:
@@ -464,26 +525,19 @@ class PackedKernel:
     find_packed(fb, ib, theta1, theta2, margin, taper_rad), runs find_contacts, slice_weights and contact_frames:
     numba's dispatch costs ~0.25 us per array argument (the three calls with their 28 arrays and find_contacts' work
     allocation cost ~9 us of Python per step). The fields are numpy views of the buffers (pos, nrm, depth, meta, line,
-    weight, frame, P, memo, span, ks: write ks and P in place). merge: also one contact per tooth flank
-    (wormsim.tooth.merge: mpos, mnrm, mdepth, mweight, mframe, mfric, mwrap, their number in ib[7];
-    grp, share; axes: the hinges, set by the caller)."""
+    weight, frame, P, memo, span, ks: write ks and P in place), cut by `_views` from the one layout `_layout`.
+    merge: also one contact per tooth flank (wormsim.tooth.merge: mpos, mnrm, mdepth, mweight, mframe, mfric, mwrap,
+    their number in ib[7]; grp, share; axes: the hinges, set by the caller)."""
 
     def __init__(self, grid: FlankGrid, P: np.ndarray, cap: int, W: int, z2: int, merge: bool = False):
         S, N = grid.slices, grid.c.shape[2]
-        fs, is_ = _shapes(S, N, cap, len(P), W, z2)
-        self.fb = np.zeros(sum(int(np.prod(sh)) for sh in fs))
-        self.ib = np.zeros(_I_HEADER + sum(int(np.prod(sh)) for sh in is_), dtype=np.int64)
+        fs, is_ = _layout(S, N, cap, len(P), W, z2)
+        self.fb = np.zeros(_size(fs))
+        self.ib = np.zeros(_I_HEADER + _size(is_), dtype=np.int64)
         self.ib[:7] = (S, N, cap, len(P), W, z2, int(merge))
-        o = 0
-        for name, sh in zip(_F_FIELDS, fs):
-            k = int(np.prod(sh))
-            setattr(self, name, self.fb[o : o + k].reshape(sh))
-            o += k
-        o = _I_HEADER
-        for name, sh in zip(("span", "ks", "stamp"), is_):
-            k = int(np.prod(sh))
-            setattr(self, name, self.ib[o : o + k].reshape(sh))
-            o += k
+        floats, ints = _views(self.fb, self.ib)
+        for name, v in zip(_F_FIELDS + _I_FIELDS, floats + ints, strict=True):
+            setattr(self, name, v)
         self.xy[:], self.c[:], self.c_range[:], self.zeta[:] = grid.xy, grid.c, grid.c_range, grid.zeta
         self.span[:] = grid.span
         self.P[:] = P
@@ -495,71 +549,12 @@ def find_packed(fb, ib, theta1, theta2, margin, taper_rad):
     """find_contacts (with its memo), slice_weights and contact_frames on a PackedKernel's buffers at worm angle
     theta1, wheel angle theta2 for the window teeth in its ks; returns the number of contacts (their fields in
     pos, nrm, depth, weight, frame, meta, line; with ib[6], the merged contacts as well, PackedKernel)."""
-    S, N, cap, nP, W, z2 = ib[0], ib[1], ib[2], ib[3], ib[4], ib[5]
-    o = 0
-    xy = fb[o : o + 4 * S * N].reshape((2, S, N, 2))
-    o += 4 * S * N
-    c = fb[o : o + 2 * S * N].reshape((2, S, N))
-    o += 2 * S * N
-    c_range = fb[o : o + 4 * S].reshape((2, S, 2))
-    o += 4 * S
-    zeta = fb[o : o + S]
-    o += S
-    P = fb[o : o + nP]
-    o += nP
-    pos = fb[o : o + 3 * cap].reshape((cap, 3))
-    o += 3 * cap
-    nrm = fb[o : o + 3 * cap].reshape((cap, 3))
-    o += 3 * cap
-    depth = fb[o : o + cap]
-    o += cap
-    meta = fb[o : o + 4 * cap].reshape((cap, 4))
-    o += 4 * cap
-    line = fb[o : o + 2 * cap].reshape((cap, 2))
-    o += 2 * cap
-    weight = fb[o : o + cap]
-    o += cap
-    frame = fb[o : o + 9 * cap].reshape((cap, 9))
-    o += 9 * cap
-    mtab = fb[o : o + 6 * z2 * S].reshape((z2, 2, S, 3))
-    o += 6 * z2 * S
-    mc = fb[o : o + 3]
-    o += 3
-    tmp = fb[o : o + 6]
-    o += 6
-    gaps = fb[o : o + N]
-    o += N
-    exc = fb[o : o + N]
-    o += N
-    pts = fb[o : o + 3 * N].reshape((N, 3))
-    o += 3 * N
-    nrs = fb[o : o + 3 * N].reshape((N, 3))
-    o += 3 * N
-    mpos = fb[o : o + 3 * cap].reshape((cap, 3))
-    o += 3 * cap
-    mnrm = fb[o : o + 3 * cap].reshape((cap, 3))
-    o += 3 * cap
-    mdepth = fb[o : o + cap]
-    o += cap
-    mweight = fb[o : o + cap]
-    o += cap
-    mframe = fb[o : o + 9 * cap].reshape((cap, 9))
-    o += 9 * cap
-    grp = fb[o : o + cap]
-    o += cap
-    share = fb[o : o + cap]
-    o += cap
-    mfric = fb[o : o + cap]
-    o += cap
-    mwrap = fb[o : o + cap]
-    o += cap
-    axes = fb[o : o + 13]
-    o = 8
-    span = ib[o : o + 4 * S].reshape((2, S, 2))
-    o += 4 * S
-    ks = ib[o : o + W]
-    o += W
-    stamp = ib[o : o + N]
+    S = ib[0]
+    floats, ints = _views(fb, ib)
+    xy, c, c_range, zeta, P, pos, nrm, depth, meta, line, weight, frame = floats[:12]
+    mtab, mc, tmp, gaps, exc, pts, nrs = floats[12:19]
+    mpos, mnrm, mdepth, mweight, mframe, grp, share, mfric, mwrap, axes = floats[19:]
+    span, ks, stamp = ints
     if taper_rad <= 0.0:
         taper_rad = TAPER_SHARE * margin
     n = _find_contacts(
