@@ -50,6 +50,22 @@ def warm_text() -> None:
     MathTextParser("agg").parse(r"$\mathdefault{10^{-2}}$", dpi=100, prop=prop)
 
 
+def in_dask_worker() -> bool:
+    """True in a task of a dask.distributed worker (wormsim sweep). There the warm-up thread is not started: the
+    worker's own threads (its GC diagnosis callback among them) and a second thread importing extension modules beside
+    the task's imports can deadlock CPython's import (seen: numpy.fft beside matplotlib, a sweep point that never
+    ended), and a sweep's parallelism is across processes anyway."""
+    if "distributed" not in sys.modules:
+        return False
+    try:
+        from distributed import get_worker
+
+        get_worker()
+    except (ImportError, ValueError):
+        return False
+    return True
+
+
 class Writers:
     """The writers' warm-up thread of one run (module docstring). gated: wait for loop_started() (or release())."""
 
@@ -62,7 +78,8 @@ class Writers:
         self.error: BaseException | None = None
         self.cancelled = False
         self.thread = threading.Thread(target=self._run, name="wormsim-prewarm-writers", daemon=True)
-        self.thread.start()
+        if not in_dask_worker():  # a sweep's worker: no warm-up thread (in_dask_worker)
+            self.thread.start()
 
     def _run(self) -> None:
         global _text_warmed
@@ -95,6 +112,7 @@ class Writers:
         """Let the thread go if it still waits, and wait for it (before anything uses matplotlib)."""
         global _gate
         self.gate.set()
-        self.thread.join(JOIN_TIMEOUT_S)
+        if self.thread.ident is not None:
+            self.thread.join(JOIN_TIMEOUT_S)
         if _gate is self.gate:
             _gate = None

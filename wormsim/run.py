@@ -83,6 +83,7 @@ def run_scenario(scenario: Scenario, out_dir: str | Path, progress: bool | None 
 
         rating = rating_before_run(scenario)
     mod = model_module(scenario.model)
+    simulate_level = mod.simulate  # the level's modules imported here, before the warm-up thread imports beside them
     rd = ResultDir(out_dir)
     base = {"model": scenario.model, "scenario": scenario.name}
     t0 = time.perf_counter()
@@ -92,7 +93,7 @@ def run_scenario(scenario: Scenario, out_dir: str | Path, progress: bool | None 
         with Progress(
             scenario.simulation.duration_s, label=f"{scenario.name} ({scenario.model})", enabled=progress
         ) as bar:
-            res = mod.simulate(scenario, progress=bar)
+            res = simulate_level(scenario, progress=bar)
         wall = time.perf_counter() - t0
         res.summary["warnings"] = run_warnings(res)  # results to read with care (F_t p2p, off-flank contacts)
         rated = {} if rating is None else rating_summary_keys(scenario, rating, res.summary)
