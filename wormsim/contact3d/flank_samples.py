@@ -22,6 +22,7 @@ layout raises, naming the MuJoCo version).
 
 from __future__ import annotations
 
+import ctypes
 import enum
 import math
 
@@ -30,6 +31,7 @@ import numpy as np
 from numba import types
 from numba.extending import intrinsic
 
+from wormsim.contact3d.flank_handoff import _library
 from wormsim.contact3d.flank_loop import (
     FV,
     Row,
@@ -38,6 +40,7 @@ from wormsim.contact3d.flank_loop import (
     _f64_at,
     _i1,
     _i64_at,
+    _call_stage,
     _records,
     run_table,
     sample_table,
@@ -46,6 +49,7 @@ from wormsim.contact3d.friction_law import mu_at
 from wormsim.contact3d.guards import PENETRATED, RUNNING, STUCK, contact_event, state_event
 from wormsim.contact3d.mjdata_layout import mjdata_offsets
 from wormsim.contact3d.series import column
+from wormsim.contact3d.shafts import gather
 from wormsim.tooth.merge import split_forces
 
 ENABLED = True  # the runner's switch (tests compare against the per-sample path)
@@ -113,13 +117,17 @@ def _set_friction(T, mu):
 
 
 @numba.njit(cache=True, nogil=True)
-def run_samples(T, Ts, m_addr, d_addr, cmd, load, i0, i1, o0, rec, S, g, off, frame, pos, adr, pat_buf, r_buf, io, mrg):
+def run_samples(
+    T, Ts, m_addr, d_addr, cmd, load, i0, i1, o0, rec, S, g, off, frame, pos, adr, pat_buf, r_buf, io, mrg, shaft
+):
     """Samples i0..i1-1 (module docstring); sample i's steps are o0 + (i - i0) rec .. + rec of cmd and load.
     T, Ts: flank_loop's run and sample tables; S the series (series.SERIES rows); g the parameters (G_NAMES); off
     the checked mjData offsets (wormsim.contact3d.mjdata_layout); frame, pos the kernel's contacts; adr (ADR_CAP) work
     room; pat_buf, r_buf the pattern's and the radius log's rows; io: IO_* (io[IO_PM], io[IO_RM] the logs' rows used
     on entry); mrg: with one contact per tooth flank (merge) the kernel's (grp, share, mfric, mwrap) and the per-slice
-    rows' room (FlankContacts.slice_rows), else None."""
+    rows' room (FlankContacts.slice_rows), else None; shaft = (mj_rnePostConstraint's address or 0, the shaft log's
+    raw addresses, its raw rows: wormsim.contact3d.shafts.ShaftLog), the addresses empty without `shafts:`."""
+    rne, sh_adr, sh_raw = shaft
     acc = _f1(T, Row.acc)
     state = _i1(T, Row.state)
     qpos, qvel = _f1(T, Row.qpos), _f1(T, Row.qvel)
@@ -242,6 +250,9 @@ def run_samples(T, Ts, m_addr, d_addr, cmd, load, i0, i1, o0, rec, S, g, off, fr
                 pm,
                 rm,
             )
+        if rne != 0:  # ShaftLog.record: the reactions, then the raw values
+            _call_stage(rne, m_addr, d_addr)
+        gather(sh_adr, sh_raw, i)
         turn_max = max(turn_max, turn)
         r_c = wr / W if W > 0 else math.nan
         sums = (acc[0], acc[1], acc[2], acc[3], acc[4], acc[5], acc[6], acc[7], acc[8], acc[9])
@@ -260,8 +271,9 @@ class FlankSamples:
 
     NONE = EV_NONE  # run's event when the stretch is done
 
-    def __init__(self, loop, guards, bm, rec: int, series: np.ndarray):
-        """The parameters from the guards and the run's plan (bm.plan: the friction law, the drive's kind)."""
+    def __init__(self, loop, guards, bm, rec: int, series: np.ndarray, store: tuple, slog=None):
+        """The parameters from the guards and the run's plan (bm.plan: the friction law, the drive's kind); the run's
+        series, point store (FlankLoop.sample's) and shaft log (wormsim.contact3d.shafts.ShaftLog, or None)."""
         from wormsim import gear_theory as gt
         from wormsim.units import RPM
 
@@ -292,11 +304,17 @@ class FlankSamples:
         self.g = g
         self.adr = np.zeros(ADR_CAP, dtype=np.int32)
         self.io = np.zeros(IO_EVENT + 1)
-        self._store: tuple = ()
+        self._store = store
+        rne = _library().mj_rnePostConstraint if slog is not None and slog.reactions else None
+        rne_fn = 0 if rne is None else ctypes.cast(rne, ctypes.c_void_p).value
+        if slog is None:
+            self.shaft = (0, np.zeros(0, dtype=np.int64), np.zeros((1, 0)))
+        else:
+            self.shaft = (rne_fn, slog.addresses(loop.d), slog.raw)
 
     def usable(self) -> bool:
-        """The compiled samples apply: rigid poses, every contact MuJoCo's so far."""
-        return ENABLED and not self.fc.displaced and self.loop.dropped == 0
+        """The compiled samples apply: every contact MuJoCo's so far."""
+        return ENABLED and self.loop.dropped == 0
 
     def run(self, cmd, load, i0: int, i1: int, o0: int, pattern, rlog) -> tuple[int, int]:
         """Samples i0..i1-1 (run_samples); returns (the next sample, the event: EV_NONE when the stretch is done,
@@ -331,6 +349,7 @@ class FlankSamples:
             rlog.buf,
             io,
             (k.grp, k.share, k.mfric, k.mwrap, fc._adr, fc._efc) if fc.merge else None,
+            self.shaft,
         )
         loop.sync()
         if g[G.mu] != fc.mu:  # changed in the call (run_samples): as FlankContacts.set_friction leaves it
@@ -340,7 +359,3 @@ class FlankSamples:
         guards.turn_max = float(io[IO_TURN_MAX])
         pattern.m, rlog.m = int(io[IO_PM]), int(io[IO_RM])
         return int(io[IO_NEXT]), int(io[IO_EVENT])
-
-    def bind(self, store: tuple) -> None:
-        """The run's point, force and world-point arrays (FlankLoop.sample's store)."""
-        self._store = store
