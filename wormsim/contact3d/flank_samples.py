@@ -205,51 +205,15 @@ def run_samples(
         for k in range(ncon):
             adr[k] = _i32_at(cbase + k * size + o_adr)[0]
         efc = numba.carray(_f64_at(fptr[0]), (max(eptr[0], 0),))
-        if mrg is not None:  # FlankContacts.slice_rows: the merged contacts' forces split over their slices
+        a_s, e_s, nc, c3 = adr[:ncon], efc, ncon, cone3  # the contacts' rows (FlankContacts.slice_rows)
+        if mrg is not None:  # one contact per tooth flank: the merged contacts' forces split over their slices
             grp, share, mfric, mwrap, adr_m, efc_m = mrg
             nh = min(ib[7], ncon)
             split_forces(adr[:ncon], efc, ncon - nh, cone3, grp, share, mfric, mwrap, n_fc, adr_m, efc_m)
-            nteeth, pen2, fr, W, wr, pm, rm = sample_table(
-                Ts,
-                adr_m[:n_fc],
-                frame,
-                pos,
-                True,
-                efc_m,
-                pat_buf,
-                r_buf,
-                n_fc,
-                n_fc,
-                True,
-                th2,
-                z2,
-                g[G.a],
-                i,
-                g[G.e_star],
-                pm,
-                rm,
-            )
-        else:
-            nteeth, pen2, fr, W, wr, pm, rm = sample_table(
-                Ts,
-                adr[:ncon],
-                frame,
-                pos,
-                True,
-                efc,
-                pat_buf,
-                r_buf,
-                ncon,
-                n_fc,
-                cone3,
-                th2,
-                z2,
-                g[G.a],
-                i,
-                g[G.e_star],
-                pm,
-                rm,
-            )
+            a_s, e_s, nc, c3 = adr_m[:n_fc], efc_m, n_fc, True
+        nteeth, pen2, fr, W, wr, pm, rm = sample_table(
+            Ts, a_s, frame, pos, True, e_s, pat_buf, r_buf, nc, n_fc, c3, th2, z2, g[G.a], i, g[G.e_star], pm, rm
+        )
         if rne != 0:  # ShaftLog.record: the reactions, then the raw values
             _call_stage(rne, m_addr, d_addr)
         gather(sh_adr, sh_raw, i)
@@ -302,7 +266,7 @@ class FlankSamples:
         g[G.dof1], g[G.dof2] = bm.worm_dof, bm.wheel_dof
         g[G.z2] = geo.z2
         self.g = g
-        self.adr = np.zeros(ADR_CAP, dtype=np.int32)
+        self.adr = np.zeros(ADR_CAP, dtype=np.int64)
         self.io = np.zeros(IO_EVENT + 1)
         self._store = store
         rne = _library().mj_rnePostConstraint if slog is not None and slog.reactions else None
