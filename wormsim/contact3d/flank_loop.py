@@ -16,9 +16,10 @@ the Python binding is its error interception: an mju_error inside a stage (MuJoC
 exhausted) is not turned into a Python exception here. MuJoCo's warnings (d.warning) are counted as before, and the
 runner's guards read them after each interval.
 
-`sample` is the runner's per-sample work on the flank contacts in one compiled call: flank_step.flank_contact_details
-(forces, points, teeth touching, largest penetration), hertz.PatternLog.record (the contact pattern's rows),
-contact_sums.radial_and_radius, and the points stored into the run's arrays.
+`sample` is the runner's per-sample work on the flank contacts in one compiled call (`sample_flanks`, which
+flank_samples.run_samples calls too): flank_step._contact_forces (forces, points, teeth touching; with displaced
+poses the points via the displaced wheel body's frame), the largest penetration, hertz._rows (the contact pattern's
+rows), contact_sums.radial_and_radius, and the points stored into the run's arrays.
 
 Both take their per-run arrays as one table of addresses and shapes (`run_table`, `sample_table`: numba's unboxing of
 ~30 arrays cost 10-20 us per call). Flank runs turn MuJoCo's islands off (`FlankLoop`: two dofs, one island; measured

@@ -5,15 +5,18 @@ the per-sample Python (~45-60 us a sample: dispatch, guards, the series column) 
 Per sample, in the runner's order and with its floating-point operations (bit-identical series, pattern and radius
 logs, contact points: tests/test_flank_samples.py): the steps; the state read from d (shaft angles and speeds,
 d.time); the runner's Guards.state checks (non-finite state or MuJoCo's bad-qacc warning, overspeed, teeth jumped);
-mu from the friction law (wormsim.friction.friction_coefficient_scalar's three forms); flank_loop.sample_flanks; the
-penetration and lock checks of Guards.contact; the series column (series.SERIES order).
+mu from the friction law (wormsim.friction.friction_coefficient_scalar's three forms); flank_loop.sample_flanks (with
+displaced poses, errors: or shafts:, the points go into tooth 0's frame through the displaced wheel body's frame);
+the penetration and lock checks of Guards.contact; the shafts' log (ShaftLog.record: mj_rnePostConstraint by address
+where a bearing is rigid, then its raw values, wormsim.contact3d.shafts.gather); the series column (series.SERIES
+order).
 
 Anything else hands the sample back to the runner's Python path, after its steps and before any of its per-sample
 work: a guard that would act (it raises or keeps state: a stuck drive, the friction guard's next check), a friction
 coefficient that starts or stops being zero (FlankContacts.set_friction changes the cone's dimension; other changes
 are written into the hand-off's records here, as set_template leaves them), a contact log that needs room, contacts
 MuJoCo did not take.
-The runner then does that sample as before, so errors and their messages are the Python guards' own.
+The runner then does that sample (runner._sample), so errors and their messages are the Python guards' own.
 
 d's scalar fields (time, ncon, nefc) and arena pointers (contact, efc_force) are read at their byte offsets in
 mjData, from MuJoCo's declared layout and checked once per process (wormsim.contact3d.mjdata_layout: an unknown

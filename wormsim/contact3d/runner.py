@@ -2,18 +2,21 @@
 
 `simulate(scenario, progress) -> Result` (the interface of wormsim.run). `run_model` makes the guards
 (wormsim.contact3d.guards), the contact source (wormsim.contact3d.sources: the exact flanks or the convex pieces,
-behind one interface) and the series array (wormsim.contact3d.series), then `_loop` runs the record intervals:
-each interval's steps (the drive and load commands at each step's midpoint; the source sums the actuator torques,
-the shaft powers T w and the contact sensor's resultant on the wheel over the steps), then per sample the state,
-the guards' checks, mu(Vs) at the sliding speed Vs = |omega1| r1 / cos(gamma) (wormsim.contact3d.friction_law), the
-source's contact outputs (teeth touching, largest penetration, contact points in tooth 0's frame, the radial force on
-the line of centres and the contact radius) and one series column: forces, moment, contact count, torques and powers
-are the MEANS over the interval (a box-car: the 10-80 kHz contact vibration does not alias into the meshing band),
-angles and speeds the values at its end. A flank source with compiled samples (wormsim.contact3d.flank_samples) runs
-whole stretches of samples in one call and hands back the samples whose guards act or whose services are due.
+behind one interface), the shafts' log (wormsim.contact3d.shafts, with `shafts:`) and the series array
+(wormsim.contact3d.series), then `_loop` runs the record intervals: each interval's steps (the drive and load commands
+at each step's midpoint; the source sums the actuator torques, the shaft powers T w and the contact sensor's
+resultant on the wheel over the steps), then per sample (`_sample`) the state, the guards' checks, mu(Vs) at the
+sliding speed Vs = |omega1| r1 / cos(gamma) (wormsim.contact3d.friction_law), the source's contact outputs (teeth
+touching, largest penetration, contact points in tooth 0's frame, the radial force on the line of centres and the
+contact radius), the shafts' log and one series column: forces, moment, contact count, torques and powers are the
+MEANS over the interval (a box-car: the 10-80 kHz contact vibration does not alias into the meshing band), angles and
+speeds the values at its end. The flank source does all of this compiled (wormsim.contact3d.flank_samples), whole
+stretches of samples in one call, and hands back to `_sample` only the samples of its events (a guard that acts, a
+service that is due).
 
 After the loop: the summary (wormsim.contact3d.metrics), the source's own keys (the flanks' contact pattern and
-pressure), the mass-scaling check and, above the stable limit, the ringing check (wormsim.contact3d.ringing_check).
+pressure), the shafts' series and keys, the mass-scaling check and, above the stable limit, the ringing check
+(wormsim.contact3d.ringing_check).
 The timestep is the model's, chosen before it was built (wormsim.contact3d.timestep.choose_timestep).
 """
 
