@@ -98,9 +98,10 @@ class FlankSource:
         self.rec = rec
 
     def advance(self, cmd: np.ndarray, load: np.ndarray, i: int, i_end: int, o: int, rlog) -> tuple[int, tuple | None]:
-        """Samples i..i_end-1 compiled (FlankSamples.run) up to an event; on an event, or where the compiled samples do
-        not apply (flank_samples.ENABLED off, contacts MuJoCo did not take), sample i's steps alone (FlankLoop.run)
-        and their sums."""
+        """Samples i..i_end-1 compiled (FlankSamples.run): (i_end, None) at the stretch's end, or at an event the
+        event's sample with its steps done and their sums. Where the compiled samples do not apply
+        (flank_samples.ENABLED off, contacts MuJoCo did not take): sample i's steps alone (FlankLoop.run) and their
+        sums."""
         if self.fast.usable():
             i, event = self.fast.run(cmd, load, i, i_end, o, self.pattern, rlog)
             return i, None if event == self.fast.NONE else tuple(self.loop.acc.tolist())
