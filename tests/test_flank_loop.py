@@ -91,14 +91,33 @@ def test_compiled_loop_equals_python_split_step(sets, mode):
     assert loop.dropped == 0
 
 
+ERRORS = ["errors.center_distance_mm=0.02", "errors.worm_runout_mm=0.01", "errors.wheel_axial_offset_mm=0.02"]
+
+
+def _numpy_points_tooth0(P: np.ndarray, meta: np.ndarray, pw: np.ndarray, z2: int) -> np.ndarray:
+    """Points in tooth 0's frame via the displaced wheel body (wormsim.tooth.pose) in numpy: X_g^-1 w, then turned by
+    -(2 pi k / z2 + f_k / r2) about z."""
+    from wormsim.tooth.pose import SHIFT, WHEEL
+
+    X = P[WHEEL : WHEEL + 12].reshape(3, 4)
+    pb = (pw - X[:, 3]) @ X[:, :3]
+    ks = meta[:, 0]
+    ang = -(2 * math.pi * ks / z2 + P[SHIFT + np.mod(ks.astype(np.int64), len(P) - SHIFT)])
+    c, s = np.cos(ang), np.sin(ang)
+    return np.stack([c * pb[:, 0] - s * pb[:, 1], s * pb[:, 0] + c * pb[:, 1], pb[:, 2]], axis=1)
+
+
 @pytest.mark.parametrize("mode", MODES)
-def test_compiled_sample_equals_numpy_path(mode):
-    """FlankLoop.sample against flank_contact_details, PatternLog.record and the numpy sums the runner used."""
+@pytest.mark.parametrize("sets", [[], ERRORS], ids=["rigid", "errors"])
+def test_compiled_sample_equals_numpy_path(mode, sets):
+    """FlankLoop.sample against flank_contact_details, PatternLog.record and the numpy sums the runner used; with
+    assembly errors its points in tooth 0's frame against the displaced wheel body's frame in numpy (a few ulps:
+    numpy's matrix product and cos may round differently)."""
     from wormsim import gear_theory as gt
     from wormsim.contact3d.flank_step import flank_contact_details
     from wormsim.tooth.hertz import PatternLog
 
-    sc = load_scenario(SCEN / "screw_jack.yaml", BASE + [f"contact.flank_contacts={mode}"])
+    sc = load_scenario(SCEN / "screw_jack.yaml", BASE + sets + [f"contact.flank_contacts={mode}"])
     bm = build_model(sc)
     m, geo = bm.model, bm.geometry
     d = mujoco.MjData(m)
@@ -111,7 +130,13 @@ def test_compiled_sample_equals_numpy_path(mode):
     assert fc.n > 4
     mu = 0.05
     ref_log, log = PatternLog(fc, 2.2e11), PatternLog(fc, 2.2e11)
+    assert fc.displaced == bool(sets)
     nteeth, pen, p0, F, pw = flank_contact_details(fc, d)
+    if sets:
+        n = fc.n if fc.merge else min(fc.n, d.ncon)
+        ref = _numpy_points_tooth0(fc.params, fc.meta[:n][np.asarray(fc.slice_rows(d)[0]) >= 0], pw, geo.z2)
+        scale = np.abs(ref).max()
+        assert np.abs(p0 - ref).max() <= 8 * np.finfo(float).eps * scale, np.abs(p0 - ref).max() / scale
     ref_log.record(3, d)
     store = tuple(np.full((5, 4, 3), np.nan, dtype=np.float32) for _ in range(3))
     rlog = RadiusLog()

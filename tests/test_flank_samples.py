@@ -30,6 +30,18 @@ CASES = {
         JACK,
         SHORT + ["contact.friction_static=null", "contact.friction_dynamic=null", "contact.friction=0"],
     ),
+    # displaced poses (wormsim.tooth.pose): assembly errors, and shafts on bearings (a compliant worm shaft that
+    # bends: springs; a rigid wheel shaft: mj_rnePostConstraint's reactions)
+    "errors": (JACK, SHORT + ["errors.center_distance_mm=0.02", "errors.shaft_angle_deg=0.05"]),
+    "shafts": (
+        JACK,
+        SHORT
+        + [
+            "shafts={worm: {bearings_mm: [-60, 60], radial_stiffness_n_per_um: 500, bending: true},"
+            " wheel: {bearings_mm: [-30, 30]}}",
+            "simulation.record_every=2",
+        ],
+    ),
 }
 WALL = ("step_wall_us", "wall_time_s")
 

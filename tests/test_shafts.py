@@ -152,3 +152,78 @@ def test_bad_shafts_input_names_the_field():
     stiff = {"worm": {"bearings_mm": [-60, 60], "radial_stiffness_n_per_um": 1e6}}
     with pytest.raises(ScenarioError, match="simulation.timestep_s"):
         build_model(_scenario(stiff))
+
+
+@pytest.mark.parametrize("block", [RIGID, json.dumps({"worm": {"bearings_mm": [-60, 60], "bending": True}})])
+def test_shaft_log_series_equal_the_per_sample_formulas(block):
+    """ShaftLog's raw rows and its series after the loop against the outputs computed from mjData at each sample
+    (the constraint reaction of the outermost shaft body about the mesh point, in the shaft frame, split by the
+    statics; the deflections from the joints): bit for bit, up to a few ulps where numpy's matrix products round."""
+    import mujoco
+
+    from wormsim import gear_theory as gt
+    from wormsim.contact3d.flank_step import FlankContacts, split_forward
+
+    sc = _scenario(json.loads(block))
+    sc.drive.ramp_s, sc.load.ramp_s = 0.001, 0.001  # loaded within the samples
+    bm = build_model(sc)
+    m = bm.model
+    d = mujoco.MjData(m)
+    fc = FlankContacts(bm, bm.law.contacts_per_pair)
+    split_forward(m, d, fc.add)
+    cmds = gt.commands(sc, bm.direction)
+    n, every = 12, 25
+    log = shafts.ShaftLog(m, bm.meta["shafts"], n)
+    ref: dict[str, list[float]] = {}
+    for i in range(n):
+        for j in range(every):
+            t = np.array([(i * every + j + 0.5) * m.opt.timestep])
+            d.ctrl[bm.drive_actuator], d.ctrl[bm.load_actuator] = cmds.drive(t)[0], cmds.load(t)[0]
+            fc.step(m, d)
+        log.record(i, d)
+        for k, v in _per_sample(m, d, log).items():
+            ref.setdefault(k, []).append(v)
+    S = log.series()
+    assert S.keys() == ref.keys()
+    assert max(np.hypot(ref["worm_bearing1_radial_x_n"], ref["worm_bearing1_radial_y_n"])) > 10.0  # loaded
+    for k, v in ref.items():
+        scale = max(np.abs(v).max(), 1e-300)
+        assert np.abs(S[k] - np.array(v)).max() <= 4 * np.finfo(float).eps * scale, k
+
+
+def _per_sample(m, d, log: shafts.ShaftLog) -> dict[str, float]:
+    """The shafts' outputs at this instant from mjData (ShaftLog's docstring), one sample."""
+    import mujoco
+
+    if log.reactions:
+        mujoco.mj_rnePostConstraint(m, d)
+    out = {}
+    for part, ids in log.parts.items():
+        sup = log.supports[part]
+        field = {c: k for c, (_, k) in enumerate(log.cols)}  # raw column -> flat index in its field
+        q = d.qpos
+        a = ids["defl"]
+        out[f"{part}_deflection_mesh_x_m"] = 0.0 + sum(q[field[c]] for c in (a[0], a[2]) if c >= 0)
+        out[f"{part}_deflection_mesh_y_m"] = 0.0 + sum(q[field[c]] for c in (a[1], a[3]) if c >= 0)
+        if ids["rigid"]:
+            b = field[ids["xpos"][0]] // 3
+            torque, force = d.cfrc_int[b, :3], d.cfrc_int[b, 3:]
+            moment = torque + np.cross(d.subtree_com[m.body_rootid[b]] - d.xpos[b], force)
+            R = d.xmat[b].reshape(3, 3)
+            if ids["hinge"] >= 0:
+                th = float(q[field[ids["hinge"]]])
+                R = R @ np.array([[math.cos(th), math.sin(th), 0.0], [-math.sin(th), math.cos(th), 0.0], [0, 0, 1.0]])
+            f_loc, m_loc = R.T @ force, R.T @ moment
+            split = shafts.bearing_split(f_loc, m_loc, sup.bearings_m)
+        for bb in range(2):
+            for ax in range(2):
+                key = f"{part}_bearing{bb}_radial_{'xy'[ax]}_n"
+                if ids["tendons"][0][0] >= 0:
+                    out[key] = -sup.radial_n_per_m * d.ten_length[field[ids["tendons"][bb][ax]]]
+                else:
+                    out[key] = float(split[bb][ax])
+        if ids["axial"] >= 0:
+            out[f"{part}_bearing_axial_n"] = -sup.axial_n_per_m * q[field[ids["axial"]]]
+        else:
+            out[f"{part}_bearing_axial_n"] = float(f_loc[2])
+    return out

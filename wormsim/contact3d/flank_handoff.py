@@ -57,6 +57,17 @@ def _call_add(typingctx, fn, m_addr, d_addr, c_addr):
     return sig, codegen
 
 
+@intrinsic
+def _f64_at(typingctx, addr):
+    """The float64 pointer at an address (int64)."""
+    sig = types.CPointer(types.float64)(types.int64)
+
+    def codegen(context, builder, signature, args):
+        return builder.inttoptr(args[0], context.get_value_type(types.CPointer(types.float64)))
+
+    return sig, codegen
+
+
 @numba.njit(cache=True)
 def _fill_add(
     fn,

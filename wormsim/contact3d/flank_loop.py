@@ -16,9 +16,10 @@ the Python binding is its error interception: an mju_error inside a stage (MuJoC
 exhausted) is not turned into a Python exception here. MuJoCo's warnings (d.warning) are counted as before, and the
 runner's guards read them after each interval.
 
-`sample` is the runner's per-sample work on the flank contacts in one compiled call: flank_step.flank_contact_details
-(forces, points, teeth touching, largest penetration), hertz.PatternLog.record (the contact pattern's rows),
-contact_sums.radial_and_radius, and the points stored into the run's arrays.
+`sample` is the runner's per-sample work on the flank contacts in one compiled call (`sample_flanks`, which
+flank_samples.run_samples calls too): flank_step._contact_forces (forces, points, teeth touching; with displaced
+poses the points via the displaced wheel body's frame), the largest penetration, hertz._rows (the contact pattern's
+rows), contact_sums.radial_and_radius, and the points stored into the run's arrays.
 
 Both take their per-run arrays as one table of addresses and shapes (`run_table`, `sample_table`: numba's unboxing of
 ~30 arrays cost 10-20 us per call). Flank runs turn MuJoCo's islands off (`FlankLoop`: two dofs, one island; measured
@@ -40,7 +41,7 @@ from numba import types
 from numba.extending import intrinsic
 
 from wormsim.contact3d.contact_sums import radial_and_radius, radius_mean
-from wormsim.contact3d.flank_handoff import _MJ_ADD_CONTACT, _fill_add, _library
+from wormsim.contact3d.flank_handoff import _MJ_ADD_CONTACT, _f64_at, _fill_add, _library
 from wormsim.contact3d.flank_step import _contact_forces
 from wormsim.contact3d.series import N_SUMS, add_step
 from wormsim.tooth.hertz import _rows
@@ -186,17 +187,6 @@ def run_interval(fns, m_addr, d_addr, cmd, load, j0, j1, mjd, iv, fv, state, ker
     for k in range(N_SUMS):
         acc[k] = sums[k]
     return dropped
-
-
-@intrinsic
-def _f64_at(typingctx, addr):
-    """The float64 pointer at an address (int64)."""
-    sig = types.CPointer(types.float64)(types.int64)
-
-    def codegen(context, builder, signature, args):
-        return builder.inttoptr(args[0], context.get_value_type(types.CPointer(types.float64)))
-
-    return sig, codegen
 
 
 @intrinsic
@@ -346,10 +336,11 @@ def address_table(arrays, table=TABLE) -> np.ndarray:
 
 @numba.njit(cache=True)
 def sample_flanks(
-    adr, frame, pos, own, efc_force, ncon, n_fc, cone3, meta, weight, depth, th2, z2, a, i, store, work, pat, rlog
+    adr, frame, pos, own, efc_force, ncon, n_fc, cone3, meta, weight, depth, P, th2, z2, a, i, store, work, pat, rlog
 ):
     """FlankLoop.sample's compiled part (module docstring): adr the contacts' efc_address; frame, pos theirs or,
-    where own, the kernel's (the same values: flank_handoff copies them into the contacts); store = (points in tooth
+    where own, the kernel's (the same values: flank_handoff copies them into the contacts); P the kernel's P (the
+    poses, with assembly errors: flank_step._contact_forces); store = (points in tooth
     0's frame, forces, points; the run's float32 arrays, row i); work (3, cap, 3); pat = PatternLog's (inv_rho,
     line_len, E*, buffer, rows used); rlog = contact_sums.RadiusLog's (buffer, rows used). Returns (teeth touching,
     largest penetration, F_r,lc, sum w, sum w r, the pattern's rows used, the radius log's rows used)."""
@@ -361,7 +352,7 @@ def sample_flanks(
         return 0, 0.0, -0.0, 0.0, 0.0, pm, rm
     k0 = ncon - n
     f0 = 0 if own else k0
-    m, nteeth = _contact_forces(adr[k0:], frame[f0:], pos[f0:], efc_force, cone3, meta, th2, z2, work)
+    m, nteeth = _contact_forces(adr[k0:], frame[f0:], pos[f0:], efc_force, cone3, meta, th2, z2, work, P)
     pen = depth[0]
     for c in range(1, n):
         if depth[c] > pen:
@@ -381,6 +372,7 @@ SAMPLE_TABLE = (
     ("meta", "f8", 2),  # meta
     ("weight", "f8", 1),
     ("depth", "f8", 1),
+    ("params", "f8", 1),  # the kernel's P (FlankContacts.params)
     ("work", "f8", 3),  # work
     ("inv_rho", "f8", 3),  # PatternLog's inv_rho
     ("line_len", "f8", 3),  # PatternLog's line_len
@@ -407,6 +399,7 @@ def sample_table(T, adr, frame, pos, own, efc_force, buf, rbuf, ncon, n_fc, cone
         _f2(T, SampleRow.meta),
         _f1(T, SampleRow.weight),
         _f1(T, SampleRow.depth),
+        _f1(T, SampleRow.params),
         th2,
         z2,
         a,
@@ -526,7 +519,7 @@ class FlankLoop:
         if self._store is not store or self._pattern is not pattern or self._sample_kernel is not fc.kernel:
             cv = pattern.cv
             pts, forces, pts_world = store
-            by_name = {"meta": fc.meta, "weight": fc.weight, "depth": fc.depth, "work": self.work}
+            by_name = {"meta": fc.meta, "weight": fc.weight, "depth": fc.depth, "params": fc.params, "work": self.work}
             by_name.update(inv_rho=cv.inv_rho, line_len=cv.line_len, pts=pts, forces=forces, pts_world=pts_world)
             self._sample_arrays = tuple(by_name[name] for name, _, _ in SAMPLE_TABLE)
             self._sample_T = address_table(self._sample_arrays, SAMPLE_TABLE)

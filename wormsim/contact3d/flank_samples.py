@@ -5,15 +5,18 @@ the per-sample Python (~45-60 us a sample: dispatch, guards, the series column) 
 Per sample, in the runner's order and with its floating-point operations (bit-identical series, pattern and radius
 logs, contact points: tests/test_flank_samples.py): the steps; the state read from d (shaft angles and speeds,
 d.time); the runner's Guards.state checks (non-finite state or MuJoCo's bad-qacc warning, overspeed, teeth jumped);
-mu from the friction law (wormsim.friction.friction_coefficient_scalar's three forms); flank_loop.sample_flanks; the
-penetration and lock checks of Guards.contact; the series column (series.SERIES order).
+mu from the friction law (wormsim.friction.friction_coefficient_scalar's three forms); flank_loop.sample_flanks (with
+displaced poses, errors: or shafts:, the points go into tooth 0's frame through the displaced wheel body's frame);
+the penetration and lock checks of Guards.contact; the shafts' log (ShaftLog.record: mj_rnePostConstraint by address
+where a bearing is rigid, then its raw values, wormsim.contact3d.shafts.gather); the series column (series.SERIES
+order).
 
 Anything else hands the sample back to the runner's Python path, after its steps and before any of its per-sample
 work: a guard that would act (it raises or keeps state: a stuck drive, the friction guard's next check), a friction
 coefficient that starts or stops being zero (FlankContacts.set_friction changes the cone's dimension; other changes
 are written into the hand-off's records here, as set_template leaves them), a contact log that needs room, contacts
 MuJoCo did not take.
-The runner then does that sample as before, so errors and their messages are the Python guards' own.
+The runner then does that sample (runner._sample), so errors and their messages are the Python guards' own.
 
 d's scalar fields (time, ncon, nefc) and arena pointers (contact, efc_force) are read at their byte offsets in
 mjData, from MuJoCo's declared layout and checked once per process (wormsim.contact3d.mjdata_layout: an unknown
@@ -22,6 +25,7 @@ layout raises, naming the MuJoCo version).
 
 from __future__ import annotations
 
+import ctypes
 import enum
 import math
 
@@ -30,10 +34,12 @@ import numpy as np
 from numba import types
 from numba.extending import intrinsic
 
+from wormsim.contact3d.flank_handoff import _library
 from wormsim.contact3d.flank_loop import (
     FV,
     Row,
     SampleRow,
+    _call_stage,
     _f1,
     _f64_at,
     _i1,
@@ -46,6 +52,7 @@ from wormsim.contact3d.friction_law import mu_at
 from wormsim.contact3d.guards import PENETRATED, RUNNING, STUCK, contact_event, state_event
 from wormsim.contact3d.mjdata_layout import mjdata_offsets
 from wormsim.contact3d.series import column
+from wormsim.contact3d.shafts import gather
 from wormsim.tooth.merge import split_forces
 
 ENABLED = True  # the runner's switch (tests compare against the per-sample path)
@@ -113,13 +120,17 @@ def _set_friction(T, mu):
 
 
 @numba.njit(cache=True, nogil=True)
-def run_samples(T, Ts, m_addr, d_addr, cmd, load, i0, i1, o0, rec, S, g, off, frame, pos, adr, pat_buf, r_buf, io, mrg):
+def run_samples(
+    T, Ts, m_addr, d_addr, cmd, load, i0, i1, o0, rec, S, g, off, frame, pos, adr, pat_buf, r_buf, io, mrg, shaft
+):
     """Samples i0..i1-1 (module docstring); sample i's steps are o0 + (i - i0) rec .. + rec of cmd and load.
     T, Ts: flank_loop's run and sample tables; S the series (series.SERIES rows); g the parameters (G_NAMES); off
     the checked mjData offsets (wormsim.contact3d.mjdata_layout); frame, pos the kernel's contacts; adr (ADR_CAP) work
     room; pat_buf, r_buf the pattern's and the radius log's rows; io: IO_* (io[IO_PM], io[IO_RM] the logs' rows used
     on entry); mrg: with one contact per tooth flank (merge) the kernel's (grp, share, mfric, mwrap) and the per-slice
-    rows' room (FlankContacts.slice_rows), else None."""
+    rows' room (FlankContacts.slice_rows), else None; shaft = (mj_rnePostConstraint's address or 0, the shaft log's
+    raw addresses, its raw rows: wormsim.contact3d.shafts.ShaftLog), the addresses empty without `shafts:`."""
+    rne, sh_adr, sh_raw = shaft
     acc = _f1(T, Row.acc)
     state = _i1(T, Row.state)
     qpos, qvel = _f1(T, Row.qpos), _f1(T, Row.qvel)
@@ -197,51 +208,18 @@ def run_samples(T, Ts, m_addr, d_addr, cmd, load, i0, i1, o0, rec, S, g, off, fr
         for k in range(ncon):
             adr[k] = _i32_at(cbase + k * size + o_adr)[0]
         efc = numba.carray(_f64_at(fptr[0]), (max(eptr[0], 0),))
-        if mrg is not None:  # FlankContacts.slice_rows: the merged contacts' forces split over their slices
+        a_s, e_s, nc, c3 = adr[:ncon], efc, ncon, cone3  # the contacts' rows (FlankContacts.slice_rows)
+        if mrg is not None:  # one contact per tooth flank: the merged contacts' forces split over their slices
             grp, share, mfric, mwrap, adr_m, efc_m = mrg
             nh = min(ib[7], ncon)
             split_forces(adr[:ncon], efc, ncon - nh, cone3, grp, share, mfric, mwrap, n_fc, adr_m, efc_m)
-            nteeth, pen2, fr, W, wr, pm, rm = sample_table(
-                Ts,
-                adr_m[:n_fc],
-                frame,
-                pos,
-                True,
-                efc_m,
-                pat_buf,
-                r_buf,
-                n_fc,
-                n_fc,
-                True,
-                th2,
-                z2,
-                g[G.a],
-                i,
-                g[G.e_star],
-                pm,
-                rm,
-            )
-        else:
-            nteeth, pen2, fr, W, wr, pm, rm = sample_table(
-                Ts,
-                adr[:ncon],
-                frame,
-                pos,
-                True,
-                efc,
-                pat_buf,
-                r_buf,
-                ncon,
-                n_fc,
-                cone3,
-                th2,
-                z2,
-                g[G.a],
-                i,
-                g[G.e_star],
-                pm,
-                rm,
-            )
+            a_s, e_s, nc, c3 = adr_m[:n_fc], efc_m, n_fc, True
+        nteeth, pen2, fr, W, wr, pm, rm = sample_table(
+            Ts, a_s, frame, pos, True, e_s, pat_buf, r_buf, nc, n_fc, c3, th2, z2, g[G.a], i, g[G.e_star], pm, rm
+        )
+        if rne != 0:  # ShaftLog.record: the reactions, then the raw values
+            _call_stage(rne, m_addr, d_addr)
+        gather(sh_adr, sh_raw, i)
         turn_max = max(turn_max, turn)
         r_c = wr / W if W > 0 else math.nan
         sums = (acc[0], acc[1], acc[2], acc[3], acc[4], acc[5], acc[6], acc[7], acc[8], acc[9])
@@ -260,8 +238,9 @@ class FlankSamples:
 
     NONE = EV_NONE  # run's event when the stretch is done
 
-    def __init__(self, loop, guards, bm, rec: int, series: np.ndarray):
-        """The parameters from the guards and the run's plan (bm.plan: the friction law, the drive's kind)."""
+    def __init__(self, loop, guards, bm, rec: int, series: np.ndarray, store: tuple, slog=None):
+        """The parameters from the guards and the run's plan (bm.plan: the friction law, the drive's kind); the run's
+        series, point store (FlankLoop.sample's) and shaft log (wormsim.contact3d.shafts.ShaftLog, or None)."""
         from wormsim import gear_theory as gt
         from wormsim.units import RPM
 
@@ -290,13 +269,19 @@ class FlankSamples:
         g[G.dof1], g[G.dof2] = bm.worm_dof, bm.wheel_dof
         g[G.z2] = geo.z2
         self.g = g
-        self.adr = np.zeros(ADR_CAP, dtype=np.int32)
+        self.adr = np.zeros(ADR_CAP, dtype=np.int64)
         self.io = np.zeros(IO_EVENT + 1)
-        self._store: tuple = ()
+        self._store = store
+        rne = _library().mj_rnePostConstraint if slog is not None and slog.reactions else None
+        rne_fn = 0 if rne is None else ctypes.cast(rne, ctypes.c_void_p).value
+        if slog is None:
+            self.shaft = (0, np.zeros(0, dtype=np.int64), np.zeros((1, 0)))
+        else:
+            self.shaft = (rne_fn, slog.addresses(loop.d), slog.raw)
 
     def usable(self) -> bool:
-        """The compiled samples apply: rigid poses, every contact MuJoCo's so far."""
-        return ENABLED and not self.fc.displaced and self.loop.dropped == 0
+        """The compiled samples apply: every contact MuJoCo's so far."""
+        return ENABLED and self.loop.dropped == 0
 
     def run(self, cmd, load, i0: int, i1: int, o0: int, pattern, rlog) -> tuple[int, int]:
         """Samples i0..i1-1 (run_samples); returns (the next sample, the event: EV_NONE when the stretch is done,
@@ -331,6 +316,7 @@ class FlankSamples:
             rlog.buf,
             io,
             (k.grp, k.share, k.mfric, k.mwrap, fc._adr, fc._efc) if fc.merge else None,
+            self.shaft,
         )
         loop.sync()
         if g[G.mu] != fc.mu:  # changed in the call (run_samples): as FlankContacts.set_friction leaves it
@@ -340,7 +326,3 @@ class FlankSamples:
         guards.turn_max = float(io[IO_TURN_MAX])
         pattern.m, rlog.m = int(io[IO_PM]), int(io[IO_RM])
         return int(io[IO_NEXT]), int(io[IO_EVENT])
-
-    def bind(self, store: tuple) -> None:
-        """The run's point, force and world-point arrays (FlankLoop.sample's store)."""
-        self._store = store

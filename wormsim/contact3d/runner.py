@@ -2,18 +2,21 @@
 
 `simulate(scenario, progress) -> Result` (the interface of wormsim.run). `run_model` makes the guards
 (wormsim.contact3d.guards), the contact source (wormsim.contact3d.sources: the exact flanks or the convex pieces,
-behind one interface) and the series array (wormsim.contact3d.series), then `_loop` runs the record intervals:
-each interval's steps (the drive and load commands at each step's midpoint; the source sums the actuator torques,
-the shaft powers T w and the contact sensor's resultant on the wheel over the steps), then per sample the state,
-the guards' checks, mu(Vs) at the sliding speed Vs = |omega1| r1 / cos(gamma) (wormsim.contact3d.friction_law), the
-source's contact outputs (teeth touching, largest penetration, contact points in tooth 0's frame, the radial force on
-the line of centres and the contact radius) and one series column: forces, moment, contact count, torques and powers
-are the MEANS over the interval (a box-car: the 10-80 kHz contact vibration does not alias into the meshing band),
-angles and speeds the values at its end. A flank source with compiled samples (wormsim.contact3d.flank_samples) runs
-whole stretches of samples in one call and hands back the samples whose guards act or whose services are due.
+behind one interface), the shafts' log (wormsim.contact3d.shafts, with `shafts:`) and the series array
+(wormsim.contact3d.series), then `_loop` runs the record intervals: each interval's steps (the drive and load commands
+at each step's midpoint; the source sums the actuator torques, the shaft powers T w and the contact sensor's
+resultant on the wheel over the steps), then per sample (`_sample`) the state, the guards' checks, mu(Vs) at the
+sliding speed Vs = |omega1| r1 / cos(gamma) (wormsim.contact3d.friction_law), the source's contact outputs (teeth
+touching, largest penetration, contact points in tooth 0's frame, the radial force on the line of centres and the
+contact radius), the shafts' log and one series column: forces, moment, contact count, torques and powers are the
+MEANS over the interval (a box-car: the 10-80 kHz contact vibration does not alias into the meshing band), angles and
+speeds the values at its end. The flank source does all of this compiled (wormsim.contact3d.flank_samples), whole
+stretches of samples in one call, and hands back to `_sample` only the samples of its events (a guard that acts, a
+service that is due).
 
 After the loop: the summary (wormsim.contact3d.metrics), the source's own keys (the flanks' contact pattern and
-pressure), the mass-scaling check and, above the stable limit, the ringing check (wormsim.contact3d.ringing_check).
+pressure), the shafts' series and keys, the mass-scaling check and, above the stable limit, the ringing check
+(wormsim.contact3d.ringing_check).
 The timestep is the model's, chosen before it was built (wormsim.contact3d.timestep.choose_timestep).
 """
 
@@ -74,11 +77,11 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
     a1, a2 = (ia_drv, ia_load) if worm_is_drive else (ia_load, ia_drv)  # the worm's and the wheel's actuator
     io = (ia_drv, ia_load, a1, a2, s0)
     flanks = bm.meta.get("contact_geometry") == "flanks"
-    src = FlankSource(bm, d, io, guards, rec, S_all, store) if flanks else PieceSource(bm, d, io)
     slog = ShaftLog(m, bm.meta["shafts"], n_rec) if "shafts" in bm.meta else None  # wormsim.contact3d.shafts
+    src = FlankSource(bm, d, io, guards, rec, S_all, store, slog) if flanks else PieceSource(bm, d, io, rec)
     t_wall = time.perf_counter()
     prewarm.loop_started()  # the writers' warm-up thread goes now, beside the GIL-free loop (wormsim.prewarm)
-    _loop(src, bm, scenario, d, guards, S_all, rlog, store, rec, progress, slog)
+    _loop(src, bm, d, guards, S_all, rlog, store, rec, progress, slog)
     force_signs(S, bm.geometry.hand)  # into docs/outputs.md's convention
     S["efficiency_theory_at_contact_radius"][:] = rlog.efficiency(S["friction_coefficient"], bm.geometry, worm_is_drive)
     wall = time.perf_counter() - t_wall
@@ -102,56 +105,50 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
     )
 
 
-def _loop(src, bm: BuiltModel, scenario: Scenario, d, guards, S_all, rlog, store, rec: int, progress, slog) -> None:
-    """The samples: each record interval's steps (the compiled stretch of samples where the source has one), then
-    the state, the guards, mu(Vs), the source's contact outputs, the shafts' log (slog, None without `shafts:`) and
-    the series column."""
-    m, geo, dt = bm.model, bm.geometry, bm.timestep_s
-    n_rec = S_all.shape[1]
-    qa_worm = int(m.jnt_qposadr[m.dof_jntid[bm.worm_dof]])
-    qa_wheel = int(m.jnt_qposadr[m.dof_jntid[bm.wheel_dof]])
-    qp, qv = d.qpos, d.qvel
-    worm_is_drive = bm.plan.drive_on == "worm"
-    mu_p = bm.plan.mu_params
-    cmds = bm.plan.commands  # the commands at each step's midpoint, for blocks of about 4096 steps at once
+def _loop(src, bm: BuiltModel, d, guards, S_all, rlog, store, rec: int, progress, slog) -> None:
+    """The samples in blocks of about 4096 steps' commands (each step's at its midpoint): the source advances
+    (wormsim.contact3d.sources: a flank source runs whole stretches of samples compiled and hands back only the
+    samples of its events) and `_sample` does the samples it hands back."""
+    dt, n_rec = bm.timestep_s, S_all.shape[1]
+    cmds = bm.plan.commands
     block = max(1, 4096 // rec)
-    fast = src.fast
     i = 0
     while i < n_rec:
         if i % block == 0:
             t_blk = (i * rec + np.arange(min(block, n_rec - i) * rec) + 0.5) * dt
             cmd_arr, load_arr = cmds.drive(t_blk), cmds.load(t_blk)
-            cmd_blk, load_blk = cmd_arr.tolist(), load_arr.tolist()
-        o = (i % block) * rec
-        if fast is not None and fast.usable():
-            i_next, event = fast.run(cmd_arr, load_arr, i, min(n_rec, i - i % block + block), o, src.pattern, rlog)
-            if progress is not None and i_next > i:
-                progress.update(float(S_all[0, i_next - 1]))
-            i = i_next
-            if event == fast.NONE:  # samples done up to i_next (the block's end)
-                continue
-            o = (i % block) * rec  # sample i's steps are done; the event's work (its sample) follows in Python
-            sums = tuple(src.loop.acc.tolist())
-        elif fast is not None:
-            sums = src.steps(cmd_arr, load_arr, o, rec)
-        else:
-            sums = src.steps(cmd_blk, load_blk, o, rec)
-        cmd = cmd_blk[o + rec - 1]
-        th1, th2 = float(qp[qa_worm]), float(qp[qa_wheel])
-        w1, w2 = float(qv[bm.worm_dof]), float(qv[bm.wheel_dof])
-        t = float(d.time)
-        te = guards.state(d, t, th1, th2, w1, w2)
-        mu = mu_of(abs(w1) * geo.r1 / math.cos(geo.gamma), mu_p)  # at the sliding speed Vs
-        # each contact's force turned about the worm axis onto the line of centres: the radial force DIN 3975's
-        # single pitch-point contact means; the force-weighted contact radius and efficiency there (contact_sums)
-        nteeth, pen, fr_lc, r_c = src.sample(i, th2, mu, rlog, store)
-        guards.contact(t, pen, w1 if worm_is_drive else w2, cmd)
-        if slog is not None:
-            slog.record(i, d)
-        S_all[:, i] = column(t, th1, th2, w1, w2, cmd, sums, rec, nteeth, pen, mu, te, fr_lc, r_c, RPM)
+        i_end = min(n_rec, i - i % block + block)
+        i, sums = src.advance(cmd_arr, load_arr, i, i_end, (i % block) * rec, rlog)
+        if sums is None:  # samples done up to i
+            if progress is not None:
+                progress.update(float(S_all[0, i - 1]))
+            continue
+        cmd = float(cmd_arr[(i % block) * rec + rec - 1])
+        _sample(src, bm, d, guards, S_all, rlog, store, rec, slog, i, cmd, sums)
         if progress is not None:
-            progress.update(t)
+            progress.update(float(d.time))
         i += 1
+
+
+def _sample(src, bm: BuiltModel, d, guards, S_all, rlog, store, rec: int, slog, i: int, cmd: float, sums) -> None:
+    """Sample i after its steps (cmd the drive command of its last step, sums its steps' sums): the state, the
+    guards, mu(Vs), the source's contact outputs, the shafts' log (slog, None without `shafts:`) and the series
+    column."""
+    m, geo = bm.model, bm.geometry
+    qp, qv = d.qpos, d.qvel
+    th1 = float(qp[m.jnt_qposadr[m.dof_jntid[bm.worm_dof]]])
+    th2 = float(qp[m.jnt_qposadr[m.dof_jntid[bm.wheel_dof]]])
+    w1, w2 = float(qv[bm.worm_dof]), float(qv[bm.wheel_dof])
+    t = float(d.time)
+    te = guards.state(d, t, th1, th2, w1, w2)
+    mu = mu_of(abs(w1) * geo.r1 / math.cos(geo.gamma), bm.plan.mu_params)  # at the sliding speed Vs
+    # each contact's force turned about the worm axis onto the line of centres: the radial force DIN 3975's
+    # single pitch-point contact means; the force-weighted contact radius and efficiency there (contact_sums)
+    nteeth, pen, fr_lc, r_c = src.sample(i, th2, mu, rlog, store)
+    guards.contact(t, pen, w1 if bm.plan.drive_on == "worm" else w2, cmd)
+    if slog is not None:
+        slog.record(i, d)
+    S_all[:, i] = column(t, th1, th2, w1, w2, cmd, sums, rec, nteeth, pen, mu, te, fr_lc, r_c, RPM)
 
 
 def force_signs(S: dict, hand: int) -> None:

@@ -41,9 +41,11 @@ import math
 from dataclasses import dataclass
 
 import mujoco
+import numba
 import numpy as np
 
 from meshgen.geometry import GearGeometry
+from wormsim.contact3d.flank_handoff import _f64_at
 from wormsim.scenario import Scenario, ScenarioError, ShaftSupport
 
 DAMPING_RATIO = 0.05  # bearings' and bending's damping, share of critical against the shaft's mass (an assumption:
@@ -260,7 +262,12 @@ class ShaftLog:
     """The shafts' outputs (module docstring), one value per sample: displacements from the joints, a compliant
     bearing's force from its spring (tendon or slide), a rigid bearing's force from the reaction MuJoCo's constraint
     solve puts on the shaft (mj_rnePostConstraint's cfrc_int of the outermost shaft body: the force and moment its
-    parent exerts), split over the two bearings by the shaft's statics (bearing_split)."""
+    parent exerts), split over the two bearings by the shaft's statics (bearing_split).
+
+    Per sample the log keeps only the raw mjData values these need (`cols`: (field, flat index) of qpos, ten_length,
+    cfrc_int, subtree_com, xpos, xmat), copied by `gather` from their addresses (the compiled samples of
+    wormsim.contact3d.flank_samples call the same gather and, where `reactions`, mj_rnePostConstraint first); `series`
+    computes the outputs from them for all samples at once."""
 
     def __init__(self, model: mujoco.MjModel, supports: dict[str, Support | None], n: int, prefix: str = ""):
         self.model = model
@@ -277,81 +284,116 @@ class ShaftLog:
         def bid(name: str) -> int:
             return mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, prefix + name)
 
+        self.cols: list[tuple[str, int]] = []
         self.parts: dict[str, dict] = {}
         self.reactions = False
         for part, sup in supports.items():
             if sup is None:
                 continue
             carrier = bid(f"{part}_carrier")
+            tendons = [(tid(f"{part}_bearing{i}_x"), tid(f"{part}_bearing{i}_y")) for i in range(2)]
+            axial = jq(f"{part}_axial")
             ids = {
-                "defl": [jq(f"{part}_radial_x"), jq(f"{part}_radial_y"), jq(f"{part}_bend_x"), jq(f"{part}_bend_y")],
-                "axial": jq(f"{part}_axial"),
-                "tendons": [(tid(f"{part}_bearing{i}_x"), tid(f"{part}_bearing{i}_y")) for i in range(2)],
-                "root": carrier if carrier >= 0 else bid(part),  # the outermost shaft body
-                "hinge": -1 if carrier >= 0 else jq(f"{part}_hinge"),  # its rotation to take out (no carrier)
+                "defl": [self._col("qpos", jq(f"{part}_{j}")) for j in ("radial_x", "radial_y", "bend_x", "bend_y")],
+                "axial": self._col("qpos", axial),
+                "tendons": [(self._col("ten_length", tx), self._col("ten_length", ty)) for tx, ty in tendons],
+                "rigid": tendons[0][0] < 0 or axial < 0,
             }
-            ids["rigid"] = ids["tendons"][0][0] < 0 or ids["axial"] < 0
+            if ids["rigid"]:
+                b = carrier if carrier >= 0 else bid(part)  # the outermost shaft body
+                root = int(model.body_rootid[b])
+                ids["cfrc"] = [self._col("cfrc_int", 6 * b + k) for k in range(6)]
+                ids["com"] = [self._col("subtree_com", 3 * root + k) for k in range(3)]
+                ids["xpos"] = [self._col("xpos", 3 * b + k) for k in range(3)]
+                ids["xmat"] = [self._col("xmat", 9 * b + k) for k in range(9)]
+                ids["hinge"] = -1 if carrier >= 0 else self._col("qpos", jq(f"{part}_hinge"))  # its rotation
             self.reactions |= ids["rigid"]
             self.parts[part] = ids
-        self.S: dict[str, np.ndarray] = {}
-        for part in self.parts:
-            keys = [f"{part}_deflection_mesh_{a}_m" for a in "xy"] + [f"{part}_bearing_axial_n"]
-            keys += [f"{part}_bearing{i}_radial_{a}_n" for i in range(2) for a in "xy"]
-            for k in keys:
-                self.S[k] = np.zeros(n)
+        self.raw = np.zeros((n, len(self.cols)))
+        self._d: mujoco.MjData | None = None
+        self._adr = np.zeros(0, dtype=np.int64)
+
+    def _col(self, field: str, index: int) -> int:
+        """The raw column of mjData's field at the flat index (-1 for -1: the joint or tendon is absent)."""
+        if index < 0:
+            return -1
+        self.cols.append((field, index))
+        return len(self.cols) - 1
+
+    def addresses(self, d: mujoco.MjData) -> np.ndarray:
+        """The raw columns' addresses in d (int64; d's arrays stay where mj_makeData put them)."""
+        if d is not self._d:
+            arrays = {f: getattr(d, f) for f in {f for f, _ in self.cols}}
+            adr = [arrays[f].ctypes.data + arrays[f].itemsize * k for f, k in self.cols]
+            self._d, self._adr = d, np.array(adr, dtype=np.int64)
+        return self._adr
 
     def record(self, i: int, d: mujoco.MjData) -> None:
-        """Sample i: the displacements and the bearings' forces on the shaft at this instant (shaft frame: z the
-        axis, x and y across it as the rigid model's part frame at hinge angle 0)."""
-        q, L = d.qpos, d.ten_length
-        S = self.S
+        """Sample i: the raw values at this instant (after mj_rnePostConstraint where a bearing is rigid)."""
         if self.reactions:
             mujoco.mj_rnePostConstraint(self.model, d)
+        gather(self.addresses(d), self.raw, i)
+
+    def series(self) -> dict[str, np.ndarray]:
+        """The outputs per sample (shaft frame: z the axis, x and y across it as the rigid model's part frame at hinge
+        angle 0): the displacements and the bearings' forces on the shaft."""
+        raw = self.raw
+        S: dict[str, np.ndarray] = {}
+
+        def col(c: int) -> np.ndarray:
+            return raw[:, c]
+
         for part, ids in self.parts.items():
             sup = self.supports[part]
             a = ids["defl"]
-            S[f"{part}_deflection_mesh_x_m"][i] = sum(q[k] for k in (a[0], a[2]) if k >= 0)
-            S[f"{part}_deflection_mesh_y_m"][i] = sum(q[k] for k in (a[1], a[3]) if k >= 0)
+            for ax, (c1, c2) in (("x", (a[0], a[2])), ("y", (a[1], a[3]))):
+                v = np.zeros(len(raw))
+                for c in (c1, c2):
+                    if c >= 0:
+                        v = v + col(c)
+                S[f"{part}_deflection_mesh_{ax}_m"] = v
             if ids["rigid"]:
-                f_loc, m_loc = self._reaction(d, ids)
+                f_loc, m_loc = self._reaction(ids)
                 split = bearing_split(f_loc, m_loc, sup.bearings_m)
             if ids["tendons"][0][0] >= 0:
                 k = sup.radial_n_per_m
                 for b, (tx, ty) in enumerate(ids["tendons"]):
-                    S[f"{part}_bearing{b}_radial_x_n"][i] = -k * L[tx]
-                    S[f"{part}_bearing{b}_radial_y_n"][i] = -k * L[ty]
+                    S[f"{part}_bearing{b}_radial_x_n"] = -k * col(tx)
+                    S[f"{part}_bearing{b}_radial_y_n"] = -k * col(ty)
             else:
                 for b in range(2):
-                    S[f"{part}_bearing{b}_radial_x_n"][i] = split[b][0]
-                    S[f"{part}_bearing{b}_radial_y_n"][i] = split[b][1]
+                    S[f"{part}_bearing{b}_radial_x_n"] = split[b][0]
+                    S[f"{part}_bearing{b}_radial_y_n"] = split[b][1]
             if ids["axial"] >= 0:
-                S[f"{part}_bearing_axial_n"][i] = -sup.axial_n_per_m * q[ids["axial"]]
+                S[f"{part}_bearing_axial_n"] = -sup.axial_n_per_m * col(ids["axial"])
             else:
-                S[f"{part}_bearing_axial_n"][i] = f_loc[2]
+                S[f"{part}_bearing_axial_n"] = f_loc[:, 2].copy()
+        return S
 
-    def _reaction(self, d: mujoco.MjData, ids: dict) -> tuple[np.ndarray, np.ndarray]:
-        """(force, moment about the mesh point) the parent exerts on the shaft, in the shaft frame."""
-        b = ids["root"]
-        c = d.subtree_com[self.model.body_rootid[b]]
-        torque, force = d.cfrc_int[b, :3], d.cfrc_int[b, 3:]
-        p = d.xpos[b]
+    def _reaction(self, ids: dict) -> tuple[np.ndarray, np.ndarray]:
+        """Per sample (force, moment about the mesh point) the parent exerts on the shaft, in the shaft frame."""
+        raw = self.raw
+        cf = raw[:, ids["cfrc"]]
+        torque, force = cf[:, :3], cf[:, 3:]
+        c, p = raw[:, ids["com"]], raw[:, ids["xpos"]]
         moment = torque + np.cross(c - p, force)  # about p
-        R = d.xmat[b].reshape(3, 3)
+        R = raw[:, ids["xmat"]].reshape(-1, 3, 3)
         if ids["hinge"] >= 0:  # the part body turns with its hinge: back to the shaft's own frame
-            th = float(d.qpos[ids["hinge"]])
-            ct, st = math.cos(th), math.sin(th)
-            R = R @ np.array([[ct, st, 0.0], [-st, ct, 0.0], [0.0, 0.0, 1.0]])
-        return R.T @ force, R.T @ moment
-
-    def series(self) -> dict[str, np.ndarray]:
-        return self.S
+            th = raw[:, ids["hinge"]]
+            ct = np.array([math.cos(v) for v in th])
+            st = np.array([math.sin(v) for v in th])
+            Rz = np.zeros((len(th), 3, 3))
+            Rz[:, 0, 0], Rz[:, 0, 1], Rz[:, 1, 0], Rz[:, 1, 1], Rz[:, 2, 2] = ct, st, -st, ct, 1.0
+            R = R @ Rz
+        Rt = R.transpose(0, 2, 1)
+        return (Rt @ force[:, :, None])[:, :, 0], (Rt @ moment[:, :, None])[:, :, 0]
 
     def summary(self, t: np.ndarray, window: tuple[float, float] | list[float]) -> dict:
         """The shafts' summary keys over the steady window (module docstring; INTERFACE.md, third wave)."""
         sl = (t >= window[0]) & (t <= window[1])
         if not sl.any():
             sl = np.ones_like(t, dtype=bool)
-        S: dict[str, np.ndarray] = self.S
+        S = self.series()
         out: dict[str, float | list[float]] = {}
         for part in ("worm", "wheel"):
             if part not in self.parts:
@@ -372,14 +414,21 @@ class ShaftLog:
         return out
 
 
-def bearing_split(force: np.ndarray, moment: np.ndarray, bearings_m: tuple[float, float]) -> list[tuple[float, float]]:
+@numba.njit(cache=True, nogil=True)
+def gather(adr, raw, i):
+    """Row i of raw: the float64 values at the addresses adr (ShaftLog.addresses)."""
+    for k in range(adr.shape[0]):
+        raw[i, k] = _f64_at(adr[k])[0]
+
+
+def bearing_split(force: np.ndarray, moment: np.ndarray, bearings_m: tuple[float, float]) -> list[tuple]:
     """The radial forces (x, y) of two bearings at s0, s1 on the axis that carry a shaft load (force, moment about
-    the mesh point, shaft frame): F_0 + F_1 = F and sum s_i e_z x F_i = M across the axis, i.e.
+    the mesh point, shaft frame; rows of samples): F_0 + F_1 = F and sum s_i e_z x F_i = M across the axis, i.e.
     s0 Fx0 + s1 Fx1 = M_y and s0 Fy0 + s1 Fy1 = -M_x (a statically determinate two-bearing shaft)."""
     s0, s1 = bearings_m
-    fx1 = (moment[1] - s0 * force[0]) / (s1 - s0)
-    fy1 = (-moment[0] - s0 * force[1]) / (s1 - s0)
-    return [(float(force[0] - fx1), float(force[1] - fy1)), (float(fx1), float(fy1))]
+    fx1 = (moment[..., 1] - s0 * force[..., 0]) / (s1 - s0)
+    fy1 = (-moment[..., 0] - s0 * force[..., 1]) / (s1 - s0)
+    return [(force[..., 0] - fx1, force[..., 1] - fy1), (fx1, fy1)]
 
 
 def mount(spec: mujoco.MjSpec, scenario: Scenario, geo: GearGeometry) -> dict[str, Support | None]:

@@ -1,14 +1,17 @@
 """The contact sources of a contact3d run, behind one interface the runner drives (wormsim.contact3d.runner):
 
-    steps(cmd, load, o, rec) -> (T1, T2, P1, P2, contacts, F_x, F_y, F_z, M_z, |F_x| peak) summed over rec steps,
+    advance(cmd, load, i, i_end, o, rlog) -> (i', sums): sample i's steps o..o+rec-1 of the block's command arrays
+        and, where the source compiles its samples, the samples after it up to i_end (exclusive); sums None: the
+        samples up to i' are done; else sample i' has its steps done (sums: (T1, T2, P1, P2, contacts, F_x, F_y,
+        F_z, M_z, |F_x| peak) over them) and its per-sample work is the runner's,
     sample(i, th2, mu, rlog, store) -> (teeth touching, largest penetration, F_r at the line of centres, contact
                                         radius), with row i of store (points in tooth 0's frame, forces, points),
-    fast: the compiled record intervals (wormsim.contact3d.flank_samples) where the source has them, else None,
     finish(S, summary, extra): the source's own summary keys and outputs after the loop.
 
 PieceSource: the convex collision pieces in MuJoCo's own collision (contact.geometry pieces), stepped by mj_step.
 FlankSource: the exact flanks (contact.geometry flanks, wormsim.tooth's kernel) handed to MuJoCo between collision and
-constraints, stepped by the compiled loop (wormsim.contact3d.flank_loop)."""
+constraints, stepped and sampled by the compiled loop (wormsim.contact3d.flank_samples, wormsim.contact3d.flank_loop);
+its samples come back to the runner only on the compiled loop's events."""
 
 from __future__ import annotations
 
@@ -28,22 +31,25 @@ _ROWS3 = np.arange(3)  # the normal and two tangent rows of an elliptic-cone con
 class PieceSource:
     """contact.geometry pieces: MuJoCo's collision of the convex pieces, the wheel's window re-posed per sample."""
 
-    fast = None
-
-    def __init__(self, bm: BuiltModel, d: mujoco.MjData, io: tuple):
-        """io = (drive actuator, load actuator, worm actuator, wheel actuator, contact sensor address)."""
+    def __init__(self, bm: BuiltModel, d: mujoco.MjData, io: tuple, rec: int):
+        """io = (drive actuator, load actuator, worm actuator, wheel actuator, contact sensor address); rec the steps
+        per sample."""
         self.bm, self.m, self.d = bm, bm.model, d
-        self.io = io
+        self.io, self.rec = io, rec
+        self._block: tuple = (None, [], [])  # the command block's arrays as lists (one conversion per block)
         self.coll = np.concatenate([bm.worm_geoms, bm.wheel_slot_geoms.ravel()])
         self.window = repose_window(bm, 0.0)
         self.mu_set: float | None = None
         mujoco.mj_forward(self.m, d)
 
-    def steps(self, cmd_blk: list, load_blk: list, o: int, rec: int) -> tuple:
-        """Steps o..o+rec-1 of the block's commands one mj_step each; the per-step sums of the module docstring
+    def advance(self, cmd: np.ndarray, load: np.ndarray, i: int, i_end: int, o: int, rlog) -> tuple[int, tuple]:
+        """Sample i's steps o..o+rec-1, one mj_step each; the per-step sums of the module docstring
         (wormsim.contact3d.series.add_step: the actuator forces of each step, computed at its start with the speeds
         read before it; the contact sensor's resultant on the wheel)."""
-        m, d, bm = self.m, self.d, self.bm
+        if self._block[0] is not cmd:
+            self._block = (cmd, cmd.tolist(), load.tolist())
+        _, cmd_blk, load_blk = self._block
+        m, d, bm, rec = self.m, self.d, self.bm, self.rec
         ia_drv, ia_load, a1, a2, s0 = self.io
         sd, act, qv, ctrl = d.sensordata, d.actuator_force, d.qvel, d.ctrl
         dof1, dof2 = bm.worm_dof, bm.wheel_dof
@@ -54,7 +60,7 @@ class PieceSource:
             w1j, w2j = float(qv[dof1]), float(qv[dof2])
             mujoco.mj_step(m, d)
             sums = add_step(sums, act, sd, a1, a2, s0, w1j, w2j)
-        return sums
+        return i, sums
 
     def sample(self, i: int, th2: float, mu: float, rlog, store: tuple) -> tuple:
         """Re-pose the window, set mu on the pieces, read the contacts (contact_details)."""
@@ -74,7 +80,9 @@ class FlankSource:
     """contact.geometry flanks: the exact-flank contacts (wormsim.contact3d.flank_step) in the compiled step loop,
     the contact pattern and Hertz pressure logged per sample (wormsim.tooth.hertz)."""
 
-    def __init__(self, bm: BuiltModel, d: mujoco.MjData, io: tuple, guards, rec: int, S_all, store):
+    def __init__(self, bm: BuiltModel, d: mujoco.MjData, io: tuple, guards, rec: int, S_all, store, slog):
+        """io as PieceSource's; the run's guards, series array S_all, point store and shaft log (None without
+        `shafts:`), which the compiled samples write."""
         from wormsim.contact3d.flank_loop import FlankLoop
         from wormsim.contact3d.flank_samples import FlankSamples
         from wormsim.contact3d.flank_step import FlankContacts, split_forward
@@ -86,26 +94,23 @@ class FlankSource:
         split_forward(bm.model, d, fc.add)
         self.coll = np.zeros(0, dtype=int)
         self.loop = FlankLoop(fc, d, *io)
-        self.fast = FlankSamples(self.loop, guards, bm, rec, S_all)
-        self.fast.bind(store)
+        self.fast = FlankSamples(self.loop, guards, bm, rec, S_all, store, slog)
+        self.rec = rec
 
-    def steps(self, cmd_arr: np.ndarray, load_arr: np.ndarray, o: int, rec: int) -> tuple:
-        """Steps o..o+rec-1 in one compiled call (FlankLoop.run); its sums."""
-        return tuple(self.loop.run(cmd_arr, load_arr, o, o + rec).tolist())
+    def advance(self, cmd: np.ndarray, load: np.ndarray, i: int, i_end: int, o: int, rlog) -> tuple[int, tuple | None]:
+        """Samples i..i_end-1 compiled (FlankSamples.run): (i_end, None) at the stretch's end, or at an event the
+        event's sample with its steps done and their sums. Where the compiled samples do not apply
+        (flank_samples.ENABLED off, contacts MuJoCo did not take): sample i's steps alone (FlankLoop.run) and their
+        sums."""
+        if self.fast.usable():
+            i, event = self.fast.run(cmd, load, i, i_end, o, self.pattern, rlog)
+            return i, None if event == self.fast.NONE else tuple(self.loop.acc.tolist())
+        return i, tuple(self.loop.run(cmd, load, o, o + self.rec).tolist())
 
     def sample(self, i: int, th2: float, mu: float, rlog, store: tuple) -> tuple:
-        """Set mu on the flank contacts; read them (compiled: FlankLoop.sample; with assembly errors
-        flank_contact_details and the pattern's rows)."""
-        fc = self.fc
-        fc.set_friction(mu)
-        if not fc.displaced:
-            return self.loop.sample(i, self.pattern, rlog, store)
-        from wormsim.contact3d.flank_step import flank_contact_details
-
-        nteeth, pen, p0, F, pw = flank_contact_details(fc, self.d)
-        self.pattern.record(i, self.d)
-        fr_lc, r_c = _store_points(i, p0, F, pw, rlog, store, self.bm.geometry.a)
-        return nteeth, pen, fr_lc, r_c
+        """Set mu on the flank contacts; read them (FlankLoop.sample, compiled)."""
+        self.fc.set_friction(mu)
+        return self.loop.sample(i, self.pattern, rlog, store)
 
     def finish(self, S: dict, summary: dict, extra: dict) -> None:
         """The loaded contact pattern and Hertz stress over the steady window (wormsim.tooth.hertz)."""

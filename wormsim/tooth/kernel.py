@@ -135,7 +135,9 @@ def flank_memo(grid: FlankGrid, z2: int) -> tuple[np.ndarray, np.ndarray]:
 def _find_contacts(xy, c, c_range, span, zeta, ks, theta1, theta2, margin, taper_rad, P, out, work, memo):
     """find_contacts with its work arrays passed in, compiled without numba's reference counting (_nrt=False): the
     inlined helpers take arrays, and with it every helper call cost an atomic incref/decref pair per array (about
-    60 % of the kernel's time; docs/contact3d.md, "Exact flanks: cost").
+    60 % of the kernel's time; docs/contact3d.md, "Exact flanks: cost"). Per window tooth, flank and slice in the
+    candidate window: the memo's check (`_memo_skips`), the start point (`_start_point`), the slice's contact
+    (`_slice_contact`).
 
     The open-slice memo (memo = flank_memo(...); an empty table turns it off, as do displaced poses): a slice whose
     flanks were apart at its last evaluation, with the gap's minimum gline_e > 0 inside the profile (not at its ends,
@@ -145,11 +147,10 @@ def _find_contacts(xy, c, c_range, span, zeta, ks, theta1, theta2, margin, taper
     recorded mesh cycles of the three seeds it moved by <= 1.5e-5 m_x at constant TE (J = 1e-3 m_x), and a point of the
     wheel moves by rho |dTE| relative to the conjugate pose (factor 2 for the gap's gradient). A skipped slice gives no
     contact, as its evaluation would: tests/test_flank_kernel_memo.py compares with and without over mesh cycles."""
-    pos, nrm, depth, meta, line = out
     tmp, gaps, exc, pts, nrs, stamp = work
     mtab, mc = memo
     use_memo = mtab.shape[0] > 0 and P.shape[0] <= N_WORM_PARAMS
-    S, N = c.shape[1], c.shape[2]
+    S = c.shape[1]
     pitch = P[11]
     te = _wrap(theta2 - P[12] * theta1, pitch)
     taper_end = margin  # edge contacts fade to zero at this distance past the profile's conjugate range
@@ -164,6 +165,7 @@ def _find_contacts(xy, c, c_range, span, zeta, ks, theta1, theta2, margin, taper
         if P.shape[0] > N_WORM_PARAMS:
             ang, dk = tooth_angle(k, P)  # wheel body frame, pitch deviation dk (wormsim.tooth.pose)
         ca, sa = math.cos(ang), math.sin(ang)
+        ev = (xy, ca, sa, theta1, P, tmp, gaps, exc, pts, nrs, stamp)
         for sg in range(2):
             target = _wrap(theta2 + pitch * (k + sg) + dk, 2 * math.pi)
             lo, hi = target - margin, target + margin
@@ -174,173 +176,238 @@ def _find_contacts(xy, c, c_range, span, zeta, ks, theta1, theta2, margin, taper
                 # the worm flank) fades to zero at the window's edge instead of being cut there with its load:
                 # the line depth is scaled by the taper over the last taper_rad of the margin without the TE term
                 # (a property of the slice's position, not of the wheel's lag; zero before the window cuts)
-                out = max(c_range[sg, j, 0] - target, target - c_range[sg, j, 1], 0.0)
-                taper = min(max((taper_end - out) / taper_rad, 0.0), 1.0)
-                if use_memo:
-                    km = k % mtab.shape[0]
-                    ge = mtab[km, sg, j, 0]
-                    if ge > 0.0:
-                        if (
-                            abs(theta1 - mtab[km, sg, j, 2]) <= mc[2]
-                            and ge - 2.0 * mc[0] * abs(te - mtab[km, sg, j, 1]) - mc[1] > MEMO_GAP_SHARE * ge
-                        ):
-                            continue
-                        mtab[km, sg, j, 0] = 0.0
-                # start at the active point whose conjugate angle is nearest the target (the contact line's point;
-                # bisection, c is monotone along the active profile)
-                a, b = span[sg, j, 0], span[sg, j, 1]
-                if a < 0:
+                past = max(c_range[sg, j, 0] - target, target - c_range[sg, j, 1], 0.0)
+                taper = min(max((taper_end - past) / taper_rad, 0.0), 1.0)
+                if use_memo and _memo_skips(mtab, mc, k, sg, j, theta1, te):
                     continue
-                inc = c[sg, j, b] > c[sg, j, a]
-                while b - a > 1:
-                    mid = (a + b) // 2
-                    cm = c[sg, j, mid]
-                    if cm != cm:  # a point trimmed inside the row (wormsim.tooth.trim): scan the row instead
-                        a = -1
-                        break
-                    if (cm < target) == inc:
-                        a = mid
-                    else:
-                        b = mid
-                if a >= 0:
-                    i_s = a if abs(c[sg, j, a] - target) <= abs(c[sg, j, b] - target) else b
-                else:
-                    i_s, dc = -1, np.inf
-                    for i in range(span[sg, j, 0], span[sg, j, 1] + 1):
-                        ci = c[sg, j, i]
-                        if ci == ci and abs(ci - target) < dc:
-                            dc, i_s = abs(ci - target), i
+                if span[sg, j, 0] < 0:
+                    continue
+                i_s = _start_point(c, span, sg, j, target)
                 sid += 1
-                zj = zeta[j]
-                ib = i_s
-                best = _gap_at(xy, sg, j, ib, zj, ca, sa, theta1, P, tmp, gaps, exc, pts, nrs, stamp, sid)
-                # descend along the profile to the minimum of the extended gap (one minimum per slice: the gap across
-                # a contact line is quadratic)
-                step = 0
-                gl = _gap_at(xy, sg, j, ib - 1, zj, ca, sa, theta1, P, tmp, gaps, exc, pts, nrs, stamp, sid)
-                gr = _gap_at(xy, sg, j, ib + 1, zj, ca, sa, theta1, P, tmp, gaps, exc, pts, nrs, stamp, sid)
-                if gl < best and gl <= gr:
-                    step, ib, best = -1, ib - 1, gl
-                elif gr < best:
-                    step, ib, best = 1, ib + 1, gr
-                while step != 0:
-                    gn = _gap_at(xy, sg, j, ib + step, zj, ca, sa, theta1, P, tmp, gaps, exc, pts, nrs, stamp, sid)
-                    if gn < best:
-                        ib, best = ib + step, gn
-                    else:
-                        break
-                if best == np.inf:
-                    continue
-                gm = _gap_at(xy, sg, j, ib - 1, zj, ca, sa, theta1, P, tmp, gaps, exc, pts, nrs, stamp, sid)
-                gp = _gap_at(xy, sg, j, ib + 1, zj, ca, sa, theta1, P, tmp, gaps, exc, pts, nrs, stamp, sid)
-                # parabola q(x) = best + qa x + qb x^2 through the deepest point and its neighbours (the gap across a
-                # contact line is quadratic; the extended gap is one smooth surface across the worm's edges)
-                qa, qb, x = 0.0, 0.0, 0.0
-                par = gm < np.inf and gp < np.inf and gm - 2.0 * best + gp > 0.0
-                if par:
-                    qa, qb = 0.5 * (gp - gm), 0.5 * (gm - 2.0 * best + gp)
-                    x = -qa / (2.0 * qb)
-                    # blended with the parabola through the next three points towards the vertex, by lam = |x| (0 at
-                    # the grid point, 1/2 where the deepest point passes to the neighbour: there both sides blend the
-                    # same two parabolas), so the line's depth and point do not step when the deepest point moves on
-                    s1 = 1 if x > 0.0 else -1
-                    g2 = _gap_at(xy, sg, j, ib + 2 * s1, zj, ca, sa, theta1, P, tmp, gaps, exc, pts, nrs, stamp, sid)
-                    qa2, qb2, _, ok2 = _end_parabola(best, gp if s1 > 0 else gm, g2, s1)
-                    if ok2 and x != 0.0:
-                        lam = min(abs(x), 0.5)
-                        qa, qb = (1.0 - lam) * qa + lam * qa2, (1.0 - lam) * qb + lam * qb2
-                        x = -qa / (2.0 * qb)
-                elif (gm == np.inf) != (gp == np.inf):
-                    # the deepest point is the active profile's end: the parabola through it and its two inner
-                    # neighbours (the one the central fit uses once the next point is deeper), its vertex clamped
-                    # to the profile, so the line point moves continuously onto the end instead of jumping to it
-                    s1 = 1 if gm == np.inf else -1
-                    g1 = gp if s1 > 0 else gm
-                    g2 = _gap_at(xy, sg, j, ib + 2 * s1, zj, ca, sa, theta1, P, tmp, gaps, exc, pts, nrs, stamp, sid)
-                    qa, qb, x, par = _end_parabola(best, g1, g2, s1)
-                x = min(max(x, -1.0), 1.0)
-                nb = ib + 1 if x > 0.0 else ib - 1
-                e_x = exc[ib] if x == 0.0 else exc[ib] + abs(x) * (exc[nb] - exc[ib])
-                x_l = x
-                if e_x <= 0.0:
-                    gmin = best + qa * x + qb * x * x
-                elif exc[ib] <= 0.0:
-                    # the minimum lies just past the worm's tip, root or end face: the contact is the worm's edge on
-                    # the wheel flank, where the excess crosses zero between ib and nb
-                    x = (x / abs(x)) * exc[ib] / (exc[ib] - exc[nb])
-                    gmin = best + qa * x + qb * x * x
-                else:
-                    # the minimum lies outside: walk towards the inside to the first point there; the edge contact
-                    # sits where the excess crosses zero, its depth falls to zero continuously as the line moves on
-                    step = -1 if (gm < np.inf and (gp == np.inf or exc[ib - 1] < exc[ib + 1])) else 1
-                    ia = ib
-                    gmin = np.inf
-                    while True:
-                        ibn = ia + step
-                        gn = _gap_at(xy, sg, j, ibn, zj, ca, sa, theta1, P, tmp, gaps, exc, pts, nrs, stamp, sid)
-                        if gn == np.inf:
-                            break
-                        if exc[ibn] <= 0.0:
-                            w = exc[ia] / (exc[ia] - exc[ibn])
-                            x = (ia - ib) + w * step
-                            if par and abs(x) <= 1.0:
-                                gmin = best + qa * x + qb * x * x
-                            else:
-                                gmin = gaps[ia] + w * (gn - gaps[ia])
-                            break
-                        ia = ibn
-                        if gaps[ia] >= 0.0:
-                            break  # past the parabola's reach: the linear crossings from here on are >= 0
-                gline = best + qa * x_l + qb * x_l * x_l
-                if gmin >= 0.0 and gline >= 0.0:
-                    if use_memo and par and e_x <= 0.0 and gline > 0.0 and span[sg, j, 0] < ib < span[sg, j, 1]:
-                        km = k % mtab.shape[0]
-                        mtab[km, sg, j, 0], mtab[km, sg, j, 1], mtab[km, sg, j, 2] = gline, te, theta1
-                    continue
-                if gmin == np.inf:
-                    x = x_l  # no edge inside reach: the line's point (only its weight can make it carry)
-                # the contact point and normal at fractional index f, linear between the grid points around it
-                f = ib + x
-                i0 = min(int(math.floor(f)), N - 2)
-                t = f - i0
-                if t <= 0.0:
-                    px, py, pz = pts[i0, 0], pts[i0, 1], pts[i0, 2]
-                    nx, ny, nz = nrs[i0, 0], nrs[i0, 1], nrs[i0, 2]
-                else:
-                    px = (1 - t) * pts[i0, 0] + t * pts[i0 + 1, 0]
-                    py = (1 - t) * pts[i0, 1] + t * pts[i0 + 1, 1]
-                    pz = (1 - t) * pts[i0, 2] + t * pts[i0 + 1, 2]
-                    nx = (1 - t) * nrs[i0, 0] + t * nrs[i0 + 1, 0]
-                    ny = (1 - t) * nrs[i0, 1] + t * nrs[i0 + 1, 1]
-                    nz = (1 - t) * nrs[i0, 2] + t * nrs[i0 + 1, 2]
-                    nn = math.sqrt(nx * nx + ny * ny + nz * nz)
-                    nx, ny, nz = nx / nn, ny / nn, nz / nn
-                # static worm frame -> assembly: (x, y, z)_asm = (-z_s, x_s - a, -y_s), i.e. R0 applied
-                ax, ay, az = -nz, nx, -ny
-                if P.shape[0] > N_WORM_PARAMS:
-                    ax, ay, az = static_dir_to_world(nx, ny, nz, P)
-                dlt = -gmin if gmin < np.inf else -gline
-                if n >= depth.shape[0]:
+                memo_row = (use_memo, mtab, te)
+                n, full = _slice_contact(ev, span, zeta, sg, j, k, i_s, sid, taper, memo_row, out, n)
+                if full:
                     return n
-                pos[n, 0] = px + 0.5 * dlt * ax
-                pos[n, 1] = py + 0.5 * dlt * ay
-                pos[n, 2] = pz + 0.5 * dlt * az
-                nrm[n, 0], nrm[n, 1], nrm[n, 2] = ax, ay, az
-                depth[n] = max(dlt, 0.0)
-                dz = zeta[1] - zeta[0]
-                if e_x < -INSIDE_SHARE * dz:
-                    # the slice's strip lies wholly inside the threaded region: the excess changes by at most the
-                    # distance moved (a max of distances), so |sl| <= dz, e / |sl| < -1/2 and the weight is 1
-                    # either way (slice_weights); e / dz is kept instead of the slope's two evaluations
-                    line[n, 0] = e_x / dz
-                else:
-                    line[n, 0] = _excess_in_slices(
-                        e_x, _face_slope(xy, sg, j, ib + x_l, zj, dz, ca, sa, theta1, P, tmp)
-                    )
-                line[n, 1] = -gline * taper
-                meta[n, 0], meta[n, 1], meta[n, 2], meta[n, 3] = k, sg, j, f
-                n += 1
     return n
+
+
+@numba.njit(cache=True, inline="always")
+def _memo_skips(mtab, mc, k, sg, j, theta1, te):
+    """The open-slice memo's check of (tooth k, flank sg, slice j) (_find_contacts); a memorised slice that is not
+    skipped is forgotten."""
+    km = k % mtab.shape[0]
+    ge = mtab[km, sg, j, 0]
+    if ge > 0.0:
+        if (
+            abs(theta1 - mtab[km, sg, j, 2]) <= mc[2]
+            and ge - 2.0 * mc[0] * abs(te - mtab[km, sg, j, 1]) - mc[1] > MEMO_GAP_SHARE * ge
+        ):
+            return True
+        mtab[km, sg, j, 0] = 0.0
+    return False
+
+
+@numba.njit(cache=True, inline="always")
+def _start_point(c, span, sg, j, target):
+    """The active point of (flank sg, slice j) whose conjugate angle is nearest the target (the contact line's point;
+    bisection, c is monotone along the active profile; a row with a point trimmed inside it is scanned instead);
+    -1 where no point of the row is active."""
+    a, b = span[sg, j, 0], span[sg, j, 1]
+    inc = c[sg, j, b] > c[sg, j, a]
+    while b - a > 1:
+        mid = (a + b) // 2
+        cm = c[sg, j, mid]
+        if cm != cm:  # a point trimmed inside the row (wormsim.tooth.trim): scan the row instead
+            a = -1
+            break
+        if (cm < target) == inc:
+            a = mid
+        else:
+            b = mid
+    if a >= 0:
+        return a if abs(c[sg, j, a] - target) <= abs(c[sg, j, b] - target) else b
+    i_s, dc = -1, np.inf
+    for i in range(span[sg, j, 0], span[sg, j, 1] + 1):
+        ci = c[sg, j, i]
+        if ci == ci and abs(ci - target) < dc:
+            dc, i_s = abs(ci - target), i
+    return i_s
+
+
+@numba.njit(cache=True, inline="always")
+def _g(ev, sg, j, i, zj, sid):
+    """_gap_at with the tooth's evaluation context ev = (xy, ca, sa, theta1, P, tmp, gaps, exc, pts, nrs, stamp)."""
+    xy, ca, sa, theta1, P, tmp, gaps, exc, pts, nrs, stamp = ev
+    return _gap_at(xy, sg, j, i, zj, ca, sa, theta1, P, tmp, gaps, exc, pts, nrs, stamp, sid)
+
+
+@numba.njit(cache=True, inline="always")
+def _slice_contact(ev, span, zeta, sg, j, k, i_s, sid, taper, memo_row, out, n):
+    """The contact of (tooth k, flank sg, slice j) from the start point i_s (module docstring): the gap's minimum
+    along the profile (`_descend`), the parabola through it (`_line_parabola`), the worm's edge where the minimum
+    lies past it (`_edge_minimum`); written as contact n (`_write_contact`) where it touches, else the slice
+    memorised where it is open (memo_row = (use_memo, table, TE)). Returns (the contacts written, out full)."""
+    exc = ev[7]
+    zj = zeta[j]
+    ib, best = _descend(ev, sg, j, zj, i_s, sid)
+    if best == np.inf:
+        return n, False
+    qa, qb, x, par, gm, gp = _line_parabola(ev, sg, j, zj, ib, best, sid)
+    x = min(max(x, -1.0), 1.0)
+    nb = ib + 1 if x > 0.0 else ib - 1
+    e_x = exc[ib] if x == 0.0 else exc[ib] + abs(x) * (exc[nb] - exc[ib])
+    x_l = x
+    gmin, x = _edge_minimum(ev, sg, j, zj, ib, nb, best, qa, qb, x, e_x, par, gm, gp, sid)
+    gline = best + qa * x_l + qb * x_l * x_l
+    if gmin >= 0.0 and gline >= 0.0:
+        use_memo, mtab, te = memo_row
+        if use_memo and par and e_x <= 0.0 and gline > 0.0 and span[sg, j, 0] < ib < span[sg, j, 1]:
+            km = k % mtab.shape[0]
+            mtab[km, sg, j, 0], mtab[km, sg, j, 1], mtab[km, sg, j, 2] = gline, te, ev[3]
+        return n, False
+    if gmin == np.inf:
+        x = x_l  # no edge inside reach: the line's point (only its weight can make it carry)
+    if n >= out[2].shape[0]:
+        return n, True
+    _write_contact(ev, zeta, sg, j, k, ib, x, x_l, e_x, gmin, gline, taper, out, n)
+    return n + 1, False
+
+
+@numba.njit(cache=True, inline="always")
+def _descend(ev, sg, j, zj, ib, sid):
+    """From profile point ib down along the profile to the minimum of the extended gap (one minimum per slice: the
+    gap across a contact line is quadratic); returns (its index, its gap), the gap +inf where there is none."""
+    best = _g(ev, sg, j, ib, zj, sid)
+    step = 0
+    gl = _g(ev, sg, j, ib - 1, zj, sid)
+    gr = _g(ev, sg, j, ib + 1, zj, sid)
+    if gl < best and gl <= gr:
+        step, ib, best = -1, ib - 1, gl
+    elif gr < best:
+        step, ib, best = 1, ib + 1, gr
+    while step != 0:
+        gn = _g(ev, sg, j, ib + step, zj, sid)
+        if gn < best:
+            ib, best = ib + step, gn
+        else:
+            break
+    return ib, best
+
+
+@numba.njit(cache=True, inline="always")
+def _line_parabola(ev, sg, j, zj, ib, best, sid):
+    """The parabola q(x) = best + qa x + qb x^2 through the deepest point ib and its neighbours (the gap across a
+    contact line is quadratic; the extended gap is one smooth surface across the worm's edges), blended towards its
+    vertex, or at the active profile's end the one through the end and its two inner neighbours. Returns (qa, qb,
+    its vertex x, whether there is one, the neighbours' gaps gm, gp)."""
+    gm = _g(ev, sg, j, ib - 1, zj, sid)
+    gp = _g(ev, sg, j, ib + 1, zj, sid)
+    qa, qb, x = 0.0, 0.0, 0.0
+    par = gm < np.inf and gp < np.inf and gm - 2.0 * best + gp > 0.0
+    if par:
+        qa, qb = 0.5 * (gp - gm), 0.5 * (gm - 2.0 * best + gp)
+        x = -qa / (2.0 * qb)
+        # blended with the parabola through the next three points towards the vertex, by lam = |x| (0 at the grid
+        # point, 1/2 where the deepest point passes to the neighbour: there both sides blend the same two
+        # parabolas), so the line's depth and point do not step when the deepest point moves on
+        s1 = 1 if x > 0.0 else -1
+        g2 = _g(ev, sg, j, ib + 2 * s1, zj, sid)
+        qa2, qb2, _, ok2 = _end_parabola(best, gp if s1 > 0 else gm, g2, s1)
+        if ok2 and x != 0.0:
+            lam = min(abs(x), 0.5)
+            qa, qb = (1.0 - lam) * qa + lam * qa2, (1.0 - lam) * qb + lam * qb2
+            x = -qa / (2.0 * qb)
+    elif (gm == np.inf) != (gp == np.inf):
+        # the deepest point is the active profile's end: the parabola through it and its two inner neighbours (the
+        # one the central fit uses once the next point is deeper), its vertex clamped to the profile, so the line
+        # point moves continuously onto the end instead of jumping to it
+        s1 = 1 if gm == np.inf else -1
+        g1 = gp if s1 > 0 else gm
+        g2 = _g(ev, sg, j, ib + 2 * s1, zj, sid)
+        qa, qb, x, par = _end_parabola(best, g1, g2, s1)
+    return qa, qb, x, par, gm, gp
+
+
+@numba.njit(cache=True, inline="always")
+def _edge_minimum(ev, sg, j, zj, ib, nb, best, qa, qb, x, e_x, par, gm, gp, sid):
+    """The slice's gap minimum inside the threaded region and its fractional offset x from ib: the parabola's where
+    the line's point (excess e_x) lies inside; else the worm's edge on the wheel flank, where the excess crosses
+    zero (between ib and nb, or walking inwards from ib); +inf where no edge lies within reach."""
+    gaps, exc = ev[6], ev[7]
+    if e_x <= 0.0:
+        return best + qa * x + qb * x * x, x
+    if exc[ib] <= 0.0:
+        # the minimum lies just past the worm's tip, root or end face: the contact is the worm's edge on the wheel
+        # flank, where the excess crosses zero between ib and nb
+        x = (x / abs(x)) * exc[ib] / (exc[ib] - exc[nb])
+        return best + qa * x + qb * x * x, x
+    # the minimum lies outside: walk towards the inside to the first point there; the edge contact sits where the
+    # excess crosses zero, its depth falls to zero continuously as the line moves on
+    step = -1 if (gm < np.inf and (gp == np.inf or exc[ib - 1] < exc[ib + 1])) else 1
+    ia = ib
+    gmin = np.inf
+    while True:
+        ibn = ia + step
+        gn = _g(ev, sg, j, ibn, zj, sid)
+        if gn == np.inf:
+            break
+        if exc[ibn] <= 0.0:
+            w = exc[ia] / (exc[ia] - exc[ibn])
+            x = (ia - ib) + w * step
+            if par and abs(x) <= 1.0:
+                gmin = best + qa * x + qb * x * x
+            else:
+                gmin = gaps[ia] + w * (gn - gaps[ia])
+            break
+        ia = ibn
+        if gaps[ia] >= 0.0:
+            break  # past the parabola's reach: the linear crossings from here on are >= 0
+    return gmin, x
+
+
+@numba.njit(cache=True, inline="always")
+def _write_contact(ev, zeta, sg, j, k, ib, x, x_l, e_x, gmin, gline, taper, out, n):
+    """Contact n of (tooth k, flank sg, slice j) at fractional profile index ib + x: its point and normal linear
+    between the grid points around it, moved half the depth along the normal (find_contacts' fields)."""
+    xy, ca, sa, theta1, P, tmp, pts, nrs = ev[0], ev[1], ev[2], ev[3], ev[4], ev[5], ev[8], ev[9]
+    pos, nrm, depth, meta, line = out
+    N = xy.shape[2]
+    f = ib + x
+    i0 = min(int(math.floor(f)), N - 2)
+    t = f - i0
+    if t <= 0.0:
+        px, py, pz = pts[i0, 0], pts[i0, 1], pts[i0, 2]
+        nx, ny, nz = nrs[i0, 0], nrs[i0, 1], nrs[i0, 2]
+    else:
+        px = (1 - t) * pts[i0, 0] + t * pts[i0 + 1, 0]
+        py = (1 - t) * pts[i0, 1] + t * pts[i0 + 1, 1]
+        pz = (1 - t) * pts[i0, 2] + t * pts[i0 + 1, 2]
+        nx = (1 - t) * nrs[i0, 0] + t * nrs[i0 + 1, 0]
+        ny = (1 - t) * nrs[i0, 1] + t * nrs[i0 + 1, 1]
+        nz = (1 - t) * nrs[i0, 2] + t * nrs[i0 + 1, 2]
+        nn = math.sqrt(nx * nx + ny * ny + nz * nz)
+        nx, ny, nz = nx / nn, ny / nn, nz / nn
+    # static worm frame -> assembly: (x, y, z)_asm = (-z_s, x_s - a, -y_s), i.e. R0 applied
+    ax, ay, az = -nz, nx, -ny
+    if P.shape[0] > N_WORM_PARAMS:
+        ax, ay, az = static_dir_to_world(nx, ny, nz, P)
+    dlt = -gmin if gmin < np.inf else -gline
+    pos[n, 0] = px + 0.5 * dlt * ax
+    pos[n, 1] = py + 0.5 * dlt * ay
+    pos[n, 2] = pz + 0.5 * dlt * az
+    nrm[n, 0], nrm[n, 1], nrm[n, 2] = ax, ay, az
+    depth[n] = max(dlt, 0.0)
+    dz = zeta[1] - zeta[0]
+    zj = zeta[j]
+    if e_x < -INSIDE_SHARE * dz:
+        # the slice's strip lies wholly inside the threaded region: the excess changes by at most the distance moved
+        # (a max of distances), so |sl| <= dz, e / |sl| < -1/2 and the weight is 1 either way (slice_weights); e / dz
+        # is kept instead of the slope's two evaluations
+        line[n, 0] = e_x / dz
+    else:
+        line[n, 0] = _excess_in_slices(e_x, _face_slope(xy, sg, j, ib + x_l, zj, dz, ca, sa, theta1, P, tmp))
+    line[n, 1] = -gline * taper
+    meta[n, 0], meta[n, 1], meta[n, 2], meta[n, 3] = k, sg, j, f
 
 
 @numba.njit(cache=True, inline="always")

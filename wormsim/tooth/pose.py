@@ -101,10 +101,15 @@ def static_dir_to_world(nx, ny, nz, P):
     )
 
 
-def wheel_body_points(P: np.ndarray, pos: np.ndarray) -> np.ndarray:
-    """World points -> the wheel body frame (X_g^-1)."""
-    X = P[WHEEL : WHEEL + 12].reshape(3, 4)
-    return (pos - X[:, 3]) @ X[:, :3]
+@numba.njit(cache=True, inline="always")
+def to_wheel_body(wx, wy, wz, P):
+    """A world point in the wheel body's frame (X_g^-1: the offset turned back by X_g's rotation, its transpose)."""
+    dx, dy, dz = wx - P[WHEEL + 3], wy - P[WHEEL + 7], wz - P[WHEEL + 11]
+    return (
+        dx * P[WHEEL] + dy * P[WHEEL + 4] + dz * P[WHEEL + 8],
+        dx * P[WHEEL + 1] + dy * P[WHEEL + 5] + dz * P[WHEEL + 9],
+        dx * P[WHEEL + 2] + dy * P[WHEEL + 6] + dz * P[WHEEL + 10],
+    )
 
 
 def error_margin_rad(g, grid, dev, quantile: float = 0.99) -> float:
@@ -134,9 +139,3 @@ def error_margin_rad(g, grid, dev, quantile: float = 0.99) -> float:
             vals.append(gm[np.isfinite(gm)])
     v = np.concatenate(vals)
     return delta * float(np.quantile(v, quantile)) if v.size else 0.0
-
-
-def tooth_shift_of(P: np.ndarray, ks: np.ndarray) -> np.ndarray:
-    """f_k / r2 of wheel teeth ks (P's tail)."""
-    z2 = P.shape[0] - SHIFT
-    return P[SHIFT + np.mod(np.asarray(ks, dtype=np.int64), z2)]
