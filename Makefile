@@ -26,8 +26,10 @@ lint: $(STAMP)
 	$(BIN)/ruff format --check .
 	$(BIN)/mypy $(TYPED)
 
+# the suite on every core (pytest-xdist, one test file per worker at a time: a file's module fixtures are built once)
+JOBS   ?= $(shell nproc 2>/dev/null || echo 1)
 test: lint
-	$(BIN)/python -m pytest -q
+	$(BIN)/python -m pytest -q -n $(JOBS) --dist loadfile
 
 # the tests kept out of `make test` for time (tests/conftest.py LONG_TESTS)
 test-long: $(STAMP)
