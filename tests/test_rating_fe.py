@@ -128,6 +128,7 @@ def test_rate_fe_writes_the_root_stress(tmp_path, fe_cache, monkeypatch, capsys)
     assert out["safety_root_sim"] == pytest.approx(60 / out["root_stress_max_mpa"])
     assert math.isfinite(out["fe_root"]["position_mm"][0])
     assert "FE root stress" in (tmp_path / "out" / "rating.md").read_text()
+    assert "safety_root_sim" in capsys.readouterr().out  # the terminal summary lists it with --fe
 
 
 def test_root_stress_limit_defaults_to_the_material_row():

@@ -554,9 +554,9 @@ def root_stress_limit_mpa(given_mpa: float | None, material: str | None) -> tupl
     if row is None or row.tau_flim_t_mpa is None:
         return None, f"the material table has no sourced root strength (tau_FlimT) for {material}"
     return TRESCA_FACTOR * row.tau_flim_t_mpa, (
-        f"limit {TRESCA_FACTOR:g} x tau_FlimT = {TRESCA_FACTOR * row.tau_flim_t_mpa:g} MPa of {row.name} "
-        f"(tau_FlimT {row.tau_flim_t_mpa:g} MPa: {row.source}; max principal = 2 x max shear in a uniaxial stress, "
-        "Tresca; an equivalence assumption: tau_FlimT is calibrated on the nominal tau_F)"
+        f"limit {TRESCA_FACTOR:g} x tau_FlimT = {TRESCA_FACTOR * row.tau_flim_t_mpa:g} MPa of {row.name} (tau_FlimT of "
+        "the material table; Tresca: max principal = 2 x max shear in a uniaxial stress; an equivalence assumption, "
+        "docs/rating.md)"
     )
 
 
