@@ -128,3 +128,33 @@ def test_rate_fe_writes_the_root_stress(tmp_path, fe_cache, monkeypatch, capsys)
     assert out["safety_root_sim"] == pytest.approx(60 / out["root_stress_max_mpa"])
     assert math.isfinite(out["fe_root"]["position_mm"][0])
     assert "FE root stress" in (tmp_path / "out" / "rating.md").read_text()
+    assert "safety_root_sim" in capsys.readouterr().out  # the terminal summary lists it with --fe
+
+
+def test_root_stress_limit_defaults_to_the_material_row():
+    """safety_root_sim's limit: the given rating.root_stress_limit_mpa, else 2 tau_FlimT of the wheel material's row
+    (Tresca), and none for POM (no tau_FlimT in the table)."""
+    from wormsim.rating.materials import WHEEL_MATERIALS
+
+    assert fe_root.root_stress_limit_mpa(60.0, "GJL-250")[0] == 60.0
+    assert fe_root.root_stress_limit_mpa(None, "GJL-250")[0] == 2 * WHEEL_MATERIALS["GJL-250"].tau_flim_t_mpa
+    limit, why = fe_root.root_stress_limit_mpa(None, "POM")
+    assert limit is None and "POM" in why
+
+
+def test_summary_with_fe_root_stress_has_the_simulated_safety_factors(fe_cache, monkeypatch):
+    """`rating: {root_stress: fe}` at contact3d: the summary keys carry root_stress_max_mpa, safety_root_sim (limit
+    2 tau_FlimT of GJL-250 by default) and safety_pitting_sim from the simulated mean Hertz pressure (sigma_H, the
+    run's contact_pressure_mean_mpa)."""
+    from wormsim.rating.summary import pitting_limit_mpa, rating_before_run, summary_keys
+
+    monkeypatch.setenv("WORMSIM_CACHE", str(fe_cache))
+    sc = load_scenario(
+        SCENARIOS / "screw_jack.yaml",
+        ["rating.root_stress=fe", "rating.wheel_material=GJL-250", "rating.fe_positions=2"],
+    )
+    rating = rating_before_run(sc)
+    keys = summary_keys(sc, rating, {"contact_pressure_mean_mpa": 150.0})
+    assert keys["root_stress_max_mpa"] > 0
+    assert keys["safety_root_sim"] == pytest.approx(2 * 70.0 / keys["root_stress_max_mpa"])  # GJL-250: 70 MPa
+    assert keys["safety_pitting_sim"] == pytest.approx(pitting_limit_mpa(rating) / 150.0)

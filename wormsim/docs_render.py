@@ -811,8 +811,34 @@ def flank_forms_checks_table(name: str = "flank_forms") -> str:
     return _table(["check", *(g.replace("_", " ") for g in gears)], rows) + "\n" + _source(name)
 
 
+def rating_seeds_table(name: str = "rating_seeds") -> str:
+    """The rating with the FE root stress on each seed beside what the seed reports (sweeps/rating_seeds.py)."""
+    rows = []
+    for seed, r in load(name)["seeds"].items():
+        x, y, z = r["position_mm"]
+        where = (
+            f"root, z {z:.1f} of +-{r['face_half_width_mm']:.1f} mm, position {r['position_index'] + 1} of "
+            f"{r['positions']}"
+        )
+        rows.append(
+            [
+                f"{r['seed']} {seed} ({r['wheel_material']}, {r['wheel_torque_nm']:.4g} N m)",
+                "refused (plastic)" if r["refused"] else _fmt(r["safety_pitting"]),
+                _fmt(r["safety_wear"]),
+                _fmt(r["safety_root"]),
+                _fmt(r["safety_root_sim"]),
+                f"{_fmt(r['root_stress_max_mpa'])}; {where}",
+                r["seed_says"],
+            ]
+        )
+    head = ["seed (wheel, T2)", "S_H", "S_W", "S_F", "S_F,sim (FE)", "FE root stress max [MPa]; where"]
+    head += ["what the seed reports"]
+    return _table(head, rows) + "\n" + _source(name)
+
+
 TABLES: dict[str, Callable[[], str]] = {
     "torsional_seeds": torsional_seeds_table,
+    "rating_seeds": rating_seeds_table,
     "torsional_samples": torsional_samples_table,
     "mesh_stiffness_seeds": mesh_stiffness_seeds_table,
     "contact_pattern": contact_pattern_table,

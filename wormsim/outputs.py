@@ -160,7 +160,8 @@ KEYS: dict[str, Key] = {
     "safety_root_sim": Key(
         "-",
         C,
-        "rating.root_stress fe: the root stress limit over root_stress_max_mpa (needs rating.root_stress_limit_mpa)",
+        "rating.root_stress fe: the root stress limit over root_stress_max_mpa (rating.root_stress_limit_mpa, else "
+        "2 tau_FlimT of the wheel material)",
     ),
     "backdrive_measured_self_locking": Key(
         "bool",

@@ -499,14 +499,17 @@ class Rating(_Strict):
         None,
         gt=0,
         le=10000,
-        description="permissible max principal root stress for safety_root_sim (no public value for the table's materials)",
+        description=(
+            "permissible max principal root stress for safety_root_sim; default 2 tau_FlimT of rating.wheel_material "
+            "(Tresca; none for POM)"
+        ),
     )
     fe_positions: int = Field(6, ge=1, le=64, description="FE root stress: mesh positions over one mesh cycle")
     fe_mesh_density: int = Field(
-        2,
+        1,
         ge=1,
         le=4,
-        description="FE root stress: mesh density d (elements 1.5 m_x / d, fillet rho_f / d; 1 coarse, 2 default)",
+        description="FE root stress: mesh density d (elements 1.5 m_x / d, fillet rho_f / d; 1 default, 2 the h/2 mesh)",
     )
 
 

@@ -17,7 +17,8 @@ def rate_command(scenario_path: str, out_dir: str, overrides: list[str], fe: boo
 
         add_fe_root_stress(sc, result)
     json_path, md_path = write_rating(out_dir, result, sc.name)
-    for key in ("safety_pitting", "safety_wear", "safety_root", "safety_deflection", "safety_temperature"):
+    keys = ["safety_pitting", "safety_wear", "safety_root", "safety_deflection", "safety_temperature"]
+    for key in keys + (["root_stress_max_mpa", "safety_root_sim"] if "fe_root" in result else []):
         v = result.get(key)
         print(f"  {key:<20}  {v:.3g}" if isinstance(v, float) else f"  {key:<20}  -")
     for w in result["warnings"]:

@@ -46,7 +46,7 @@ RIM_DEPTH_MX = 2.5  # rim below the throat root circle, in axial modules (model 
 ROOT_BAND_MX = 0.35  # root band: element centroids within this many m_x above the root torus radius
 FLANK_DENSE = 48  # flank points per section before resampling
 SURFACE_DENSITY = 2  # sampling of the outline sections that gmsh re-meshes (the geometry; the element size is apart)
-CURVATURE_ELEMENTS = 4  # elements per full turn of a curved surface at density 1 (the default density 2: 8)
+CURVATURE_ELEMENTS = 4  # elements per full turn of a curved surface at density 1 (the default; density 2: 8)
 LOAD_RADIUS_MX = 0.25  # radius of the patch over which a contact sample's force is spread (surface vertices)
 LOAD_EXCLUSION_MX = 0.25  # elements within this many m_x of a contact sample are not root elements at that position
 EDGE_EXCLUSION_MX = 0.5  # nor elements within this many m_x of the wheel's end faces (module docstring)
@@ -278,7 +278,7 @@ def _solver(Kff, doflocs: np.ndarray, free: np.ndarray):
     import scipy.sparse.linalg as spla
 
     if Kff.shape[0] <= DIRECT_DOFS_MAX:
-        lu = spla.splu(Kff.tocsc())
+        lu = spla.splu(Kff.tocsc(), permc_spec="MMD_AT_PLUS_A")  # symmetric ordering: 0.6 x COLAMD's fill here
         return lu.solve
     import pyamg
 
@@ -294,7 +294,8 @@ def _solver(Kff, doflocs: np.ndarray, free: np.ndarray):
     B[comp == 1, 4], B[comp == 2, 4] = -x[2, comp == 1], x[1, comp == 2]
     B[comp == 2, 5], B[comp == 0, 5] = -x[0, comp == 2], x[2, comp == 0]
     del n
-    ml = pyamg.smoothed_aggregation_solver(Kff, B=B, max_coarse=500)
+    # the coarsest level by SuperLU: pinv's dense SVD of it costs more than all the cycles (a ~2400-dof coarse level)
+    ml = pyamg.smoothed_aggregation_solver(Kff, B=B, max_coarse=500, coarse_solver="splu")
 
     def solve(b):
         return ml.solve(b, tol=CG_RTOL, accel="cg", maxiter=500)
@@ -377,9 +378,9 @@ class ToothMesh:
     r_in: float
 
 
-def tooth_mesh(g: GearGeometry, density: int = 2, size_m: float | None = None, use_cache: bool = True) -> ToothMesh:
+def tooth_mesh(g: GearGeometry, density: int = 1, size_m: float | None = None, use_cache: bool = True) -> ToothMesh:
     """The tetrahedral mesh of the one-tooth sector, cached by geometry (meshgen.cache). `density` d sets the element
-    sizes together (d = 2 is the default, d = 1 and 2 are an h / (h/2) pair): largest 1.5 m_x / d (or size_m),
+    sizes together (d = 1 is the default, d = 1 and 2 are an h / (h/2) pair): largest 1.5 m_x / d (or size_m),
     smallest FILLET_COEF m_x / d (the fillet radius over d), CURVATURE_ELEMENTS d per full turn of a curved surface."""
     from dataclasses import asdict
 
@@ -403,7 +404,7 @@ def root_stress(
     side: int,
     t2_nm: float,
     positions: int,
-    density: int = 2,
+    density: int = 1,
     size_m: float | None = None,
     use_cache: bool = True,
 ) -> dict:
@@ -419,7 +420,7 @@ def root_stress_cases(
     side: int,
     torques_nm: list[float],
     positions: int,
-    density: int = 2,
+    density: int = 1,
     size_m: float | None = None,
     use_cache: bool = True,
 ) -> list[dict]:
@@ -535,6 +536,29 @@ def _boundary_faces(T: np.ndarray) -> np.ndarray:
 
 # ----------------------------------------------------------------------------- the rating's use
 
+TRESCA_FACTOR = 2.0  # max principal / max shear stress of a uniaxial stress state (Mohr's circle; Tresca criterion)
+
+
+def root_stress_limit_mpa(given_mpa: float | None, material: str | None) -> tuple[float | None, str]:
+    """The permissible max principal root stress of safety_root_sim and its origin: rating.root_stress_limit_mpa
+    when given; else TRESCA_FACTOR x tau_FlimT of the wheel material's row (wormsim.rating.materials, the DIN 3996
+    values as MITCalc lists them): the root fillet's surface is in a nearly uniaxial stress state, whose largest
+    shear stress is half its max principal stress (Tresca), so the shear strength tau_FlimT is met at a max
+    principal stress of 2 tau_FlimT. tau_FlimT is calibrated on method B's nominal tau_F, not on a local FE stress:
+    the derived limit is an equivalence assumption, stated as such. None where the row has no tau_FlimT (POM)."""
+    from wormsim.rating.materials import WHEEL_MATERIALS
+
+    if given_mpa is not None:
+        return given_mpa, "rating.root_stress_limit_mpa"
+    row = WHEEL_MATERIALS.get(material) if material is not None else None
+    if row is None or row.tau_flim_t_mpa is None:
+        return None, f"the material table has no sourced root strength (tau_FlimT) for {material}"
+    return TRESCA_FACTOR * row.tau_flim_t_mpa, (
+        f"limit {TRESCA_FACTOR:g} x tau_FlimT = {TRESCA_FACTOR * row.tau_flim_t_mpa:g} MPa of {row.name} (tau_FlimT of "
+        "the material table; Tresca: max principal = 2 x max shear in a uniaxial stress; an equivalence assumption, "
+        "docs/rating.md)"
+    )
+
 
 def add_fe_root_stress(scenario, result: dict) -> dict:
     """root_stress_max_mpa, root_stress_range_mpa, safety_root_sim (and `fe_root`, the details) into a rating result
@@ -558,14 +582,16 @@ def add_fe_root_stress(scenario, result: dict) -> dict:
     result["fe_root"] = fe
     result["root_stress_max_mpa"] = fe["root_stress_max_mpa"]
     result["root_stress_range_mpa"] = fe["root_stress_range_mpa"]
-    if r.root_stress_limit_mpa is not None:
-        result["safety_root_sim"] = r.root_stress_limit_mpa / fe["root_stress_max_mpa"]
+    limit, why = root_stress_limit_mpa(r.root_stress_limit_mpa, result["inputs"].get("wheel_material"))
+    fe["root_stress_limit_mpa"] = limit
+    fe["root_stress_limit_source"] = why
+    if limit is not None:
+        result["safety_root_sim"] = limit / fe["root_stress_max_mpa"]
+        if r.root_stress_limit_mpa is None:
+            result["warnings"].append(f"safety_root_sim: {why}; give rating.root_stress_limit_mpa to use another limit")
     else:
         result["safety_root_sim"] = None
-        result["warnings"].append(
-            "safety_root_sim not given: no public bending-fatigue limit of the wheel materials as a max principal "
-            "stress; give rating.root_stress_limit_mpa"
-        )
+        result["warnings"].append(f"safety_root_sim not given: {why}; give rating.root_stress_limit_mpa")
     src = "FE root stress: gmsh + scikit-fem on meshgen's wheel tooth, loaded by the torsional TCA's contact lines"
     if src not in result["sources"]:
         result["sources"].append(src)
