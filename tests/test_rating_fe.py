@@ -104,6 +104,23 @@ def test_root_stress_mesh_convergence():
     assert h2["root_stress_max_mpa"] == pytest.approx(h["root_stress_max_mpa"], rel=0.05)
 
 
+@pytest.mark.long
+@pytest.mark.xfail(
+    strict=True,
+    reason="at the default 6 positions the peak sits near an end face, where density 1 resolves least: screw jack "
+    "7.85 MPa at density 1 against 7.11 MPa at density 2 (+10 %, docs/decisions/0027-fe-root-density-1.md)",
+)
+def test_root_stress_mesh_convergence_at_the_default_positions():
+    """h vs h/2 on the screw jack at rating.fe_positions' default (6): within 5 %."""
+    from wormsim.scenario import Rating
+
+    positions = Rating().fe_positions
+    sc, g = _screw_jack()
+    h = fe_root.root_stress(g, 130e9, 0.25, 1, 12.0, positions, density=1)
+    h2 = fe_root.root_stress(g, 130e9, 0.25, 1, 12.0, positions, density=2)
+    assert h2["root_stress_max_mpa"] == pytest.approx(h["root_stress_max_mpa"], rel=0.05)
+
+
 def test_rate_fe_writes_the_root_stress(tmp_path, fe_cache, monkeypatch, capsys):
     monkeypatch.setenv("WORMSIM_CACHE", str(fe_cache))
     code = cli.main(
