@@ -268,18 +268,24 @@ def prepare(scenario: Scenario, gs: GearSet | None = None) -> Prepared:
         raise ScenarioError("model: contact3d needs gear: and drive: blocks")
     flanks = scenario.contact.geometry == "flanks"  # the flank contacts need the solid meshes only, no pieces
     geo, gs = (derive(scenario.gear), gs) if gs is not None else (solid_set if flanks else gear_set)(scenario)
-    duty = gt.duty(scenario, expected_direction(geo))  # the drive and load, once
+    ine = shaft_inertias(scenario, geo, gs)
+    # n_ref: the pieces across the face width, or with contact.geometry flanks the flank contacts' slices
+    slabs = flank_slices(scenario, geo) if scenario.contact.geometry == "flanks" else max(1, _slabs_per_flank(gs))
+    direction = expected_direction(geo)
+    mu0, mu1 = float(friction_coefficient(scenario.contact, 0.0)), float(friction_coefficient(scenario.contact, 1.0))
+    # the drive and load, once (gear_theory): their commands, the worm's speed, the working and the drive's torques
+    duty = gt.duty(scenario, direction)
     drv, load = duty.drive, duty.load
-    mu1 = float(friction_coefficient(scenario.contact, 1.0))
     w1 = gt.worm_speed_command_rad_s(drv, geo.ratio)
     t_drive = gt.expected_drive_torque_of(drv, load, geo.ratio, geo.gamma, geo.alpha_n, mu1)
-    ine = shaft_inertias(scenario, geo, gs)
+    t2 = gt.working_wheel_torque_of(drv, load, geo.ratio)
+    kv = gt.servo_gain_of(drv, t_drive) if duty.speed_driven else None
     arm1, arm2 = gt.mesh_arms_m(geo.r1, geo.r2, geo.alpha_n, geo.gamma)
+    e_star = gt.effective_modulus_pa(scenario.materials)
+    f_n, v_s = nominal_normal_force_n(t2, geo), nominal_sliding_speed_m_s(w1, geo)
     # driven-machine inertia J on the loaded shaft (joint armature) belongs to that shaft's effective mass
     I1 = ine.worm_inertia_kg_m2 + ine.worm_load_inertia_kg_m2
     I2 = ine.wheel_inertia_kg_m2 + ine.wheel_load_inertia_kg_m2
-    # n_ref: the pieces across the face width, or with contact.geometry flanks the flank contacts' slices
-    slabs = flank_slices(scenario, geo) if scenario.contact.geometry == "flanks" else max(1, _slabs_per_flank(gs))
     # simulation.mass_scaling (wormsim.contact3d.mass_scaling): every inertia x S before the law takes them
     k_pair, _ = pair_stiffness_n_per_m(scenario.contact, scenario.materials, geo.face_width)
     scaling = mass_scaling.resolve(
@@ -301,14 +307,11 @@ def prepare(scenario: Scenario, gs: GearSet | None = None) -> Prepared:
         if flanks and not scenario.contact.slices:
             slabs = min(slabs, SLICES_MASS_SCALED)  # a scaled run keeps means only (tooth.grid.SLICES_MASS_SCALED)
     law = contact_law(scenario.contact, scenario.materials, geo.face_width, slabs, a1 + a2)  # the law, once
-    mu0 = float(friction_coefficient(scenario.contact, 0.0))
     mu_max = max(mu0, mu1)
-    t2 = gt.working_wheel_torque_of(drv, load, geo.ratio)
-    f_n = nominal_normal_force_n(t2, geo)
     if flanks:  # the flank contacts' own friction-row damping, law (4)
         law = replace(
             law,
-            friction_damping_n_s_per_m=friction_damping_n_s_per_m(law, mu_max, f_n, nominal_sliding_speed_m_s(w1, geo)),
+            friction_damping_n_s_per_m=friction_damping_n_s_per_m(law, mu_max, f_n, v_s),
         )
     law = replace(law, impratio=friction_impratio(law, mu_max, f_n, scenario.contact.transition_velocity_m_s))
     grid = flank_grid(geo, law.contacts_per_pair) if flanks else None
@@ -329,12 +332,12 @@ def prepare(scenario: Scenario, gs: GearSet | None = None) -> Prepared:
         lock_start_s=duty.lock_check_start_s,
         mu_params=mu_params(scenario.contact),
         transition_velocity_m_s=scenario.contact.transition_velocity_m_s,
-        e_star_pa=gt.effective_modulus_pa(scenario.materials),
+        e_star_pa=e_star,
         duty=duty,
         worm_speed_rad_s=w1,
         wheel_torque_nm=t2,
         drive_torque_nm=t_drive,
-        servo_gain_nm_s=gt.servo_gain_of(drv, t_drive) if duty.speed_driven else None,
+        servo_gain_nm_s=kv,
     )
 
 
