@@ -143,6 +143,7 @@ class Prepared:
     wheel_torque_nm: float = 0.0  # T2 at the working load (gear_theory.working_wheel_torque_of)
     drive_torque_nm: float = 0.0  # the drive's torque at the full load (gear_theory.expected_drive_torque_of)
     servo_gain_nm_s: float | None = None  # a speed drive's kv (gear_theory.servo_gain_of); None for a torque drive
+    supports: dict = field(default_factory=dict)  # part -> its Support (wormsim.contact3d.shafts.support) or None
 
 
 Plan = Prepared
@@ -269,6 +270,7 @@ def prepare(scenario: Scenario, gs: GearSet | None = None) -> Prepared:
     flanks = scenario.contact.geometry == "flanks"  # the flank contacts need the solid meshes only, no pieces
     geo, gs = (derive(scenario.gear), gs) if gs is not None else (solid_set if flanks else gear_set)(scenario)
     ine = shaft_inertias(scenario, geo, gs)
+    supports = {part: shafts.support(scenario, geo, part) for part in ("worm", "wheel")}
     # n_ref: the pieces across the face width, or with contact.geometry flanks the flank contacts' slices
     slabs = flank_slices(scenario, geo) if scenario.contact.geometry == "flanks" else max(1, _slabs_per_flank(gs))
     direction = expected_direction(geo)
@@ -338,6 +340,7 @@ def prepare(scenario: Scenario, gs: GearSet | None = None) -> Prepared:
         wheel_torque_nm=t2,
         drive_torque_nm=t_drive,
         servo_gain_nm_s=kv,
+        supports=supports,
     )
 
 
@@ -379,7 +382,7 @@ def build_model(
     spec = mujoco.MjSpec.from_file(str(TEMPLATE))
     spec.modelname = scenario.name
     _place_bodies(spec, geo, p.inertias, dev)
-    sups = shafts.mount(spec, scenario, geo) if scenario.shafts is not None else None  # bearings, bending
+    sups = shafts.mount(spec, p.supports, geo) if scenario.shafts is not None else None  # bearings, bending
     worm_names, slot_names, W = _add_geoms(
         spec, geo, gs, law, float(friction_coefficient(scenario.contact, 0.0)), window_teeth, shift, flanks
     )
