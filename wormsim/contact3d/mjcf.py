@@ -116,8 +116,9 @@ class Inertias:
 @dataclass(frozen=True)
 class Prepared:
     """The run's plan, derived once from the scenario before the model is built and handed down: geometry, pieces,
-    inertias, the contact law, the flank grid, the drive and load commands, the working loads the law and the
-    guards are sized for, the drive's kind and the guards' times; build_model adds the timestep and the window."""
+    inertias, the shafts' supports, the contact law, the flank grid, the drive and load (gear_theory.Duty: their
+    commands, the drive's kind and the guards' times), the working loads the law and the guards are sized for;
+    build_model adds the timestep and the window."""
 
     geometry: GearGeometry
     pieces: GearSet
@@ -127,23 +128,43 @@ class Prepared:
     inv_mass_wheel: float  # arm2^2 / (I2 + J2)
     scaling: ScalingCheck | None = None  # simulation.mass_scaling: the factor used and its checks (inertias x it)
     normal_force_n: float = 0.0  # nominal_normal_force_n: the whole mesh's normal force at the working load
-    commands: gt.Commands | None = None  # the drive and load commands over time (duty.commands)
+    duty: gt.Duty | None = None  # the drive and load, their commands, ramps and working flank (gear_theory.duty)
     grid: FlankGrid | None = None  # contact.geometry flanks: the flank grid of law.contacts_per_pair slices
-    drive_on: str = "worm"  # drive.on: the shaft the drive turns
-    speed_driven: bool = True  # drive.speed_rpm given (the lock guard watches the drive's speed)
-    ramps_end_s: float = 0.0  # both commands at full value (duty.ramps_end_s)
-    lock_start_s: float = 0.0  # the lock guard's start (duty.lock_check_start_s)
     mu_params: tuple = ()  # the friction law mu(Vs) (wormsim.contact3d.friction_law.mu_params)
     transition_velocity_m_s: float = 0.0  # contact.transition_velocity_m_s
     e_star_pa: float = 0.0  # the pair's effective modulus (gear_theory.effective_modulus_pa)
     timestep_s: float = 0.0  # the model's timestep (build_model: timestep_for's or the one given)
     window_teeth: int = 0  # the wheel tooth slots with collision (build_model)
-    duty: gt.Duty | None = None  # the drive and load, their commands, ramps and working flank (gear_theory.duty)
     worm_speed_rad_s: float | None = None  # the commanded worm speed (gear_theory.worm_speed_command_rad_s)
     wheel_torque_nm: float = 0.0  # T2 at the working load (gear_theory.working_wheel_torque_of)
     drive_torque_nm: float = 0.0  # the drive's torque at the full load (gear_theory.expected_drive_torque_of)
     servo_gain_nm_s: float | None = None  # a speed drive's kv (gear_theory.servo_gain_of); None for a torque drive
     supports: dict = field(default_factory=dict)  # part -> its Support (wormsim.contact3d.shafts.support) or None
+
+    @property
+    def commands(self) -> gt.Commands:
+        """The drive and load commands over time (duty.commands)."""
+        return self.duty.commands
+
+    @property
+    def drive_on(self) -> str:
+        """drive.on: the shaft the drive turns."""
+        return self.duty.drive.on
+
+    @property
+    def speed_driven(self) -> bool:
+        """drive.speed_rpm given (the lock guard watches the drive's speed)."""
+        return self.duty.speed_driven
+
+    @property
+    def ramps_end_s(self) -> float:
+        """Both commands at full value (duty.ramps_end_s)."""
+        return self.duty.ramps_end_s
+
+    @property
+    def lock_start_s(self) -> float:
+        """The lock guard's start (duty.lock_check_start_s)."""
+        return self.duty.lock_check_start_s
 
 
 Plan = Prepared
@@ -326,16 +347,11 @@ def prepare(scenario: Scenario, gs: GearSet | None = None) -> Prepared:
         a2,
         scaling,
         f_n,
-        duty.commands,
+        duty,
         grid,
-        drive_on=drv.on,
-        speed_driven=duty.speed_driven,
-        ramps_end_s=duty.ramps_end_s,
-        lock_start_s=duty.lock_check_start_s,
         mu_params=mu_params(scenario.contact),
         transition_velocity_m_s=scenario.contact.transition_velocity_m_s,
         e_star_pa=e_star,
-        duty=duty,
         worm_speed_rad_s=w1,
         wheel_torque_nm=t2,
         drive_torque_nm=t_drive,
