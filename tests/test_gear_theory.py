@@ -120,6 +120,24 @@ def test_servo_gain_gives_the_speed_droop_at_the_expected_torque(scenario_dir):
     assert gt.expected_drive_torque_nm(back, i, g, an, 0.2) == pytest.approx(24.0 * i / gt.MIN_EFFICIENCY)
 
 
+def test_duty_holds_what_the_scenario_functions_give(scenario_dir):
+    """gear_theory.duty derives the drive and load once: its commands, ramps, lock start and working flank are the
+    scenario functions' own, for both drive sides and both hands."""
+    sc = load_scenario(scenario_dir / "seat_motor.yaml")
+    back = sc.model_copy(update={"drive": sc.drive.model_copy(update={"on": "wheel"})})
+    for s in (sc, back):
+        for hand in (1, -1):
+            d = gt.duty(s, hand)
+            assert d.commands == gt.commands(s, hand) and d.working_flank == gt.working_flank(s, hand)
+            assert (d.ramps_end_s, d.lock_check_start_s) == (gt.ramps_end_s(s), gt.lock_check_start_s(s))
+            assert d.speed_driven and d.drive is s.drive and d.load is s.load
+    assert gt.duty(sc, 1).working_flank == 1 and gt.duty(back, 1).working_flank == -1
+    # the worm's commanded speed: 36 rpm of scenarios/seat_motor.yaml on the worm, x the ratio from the wheel
+    w = 36 * 2 * math.pi / 60
+    assert gt.worm_speed_command_rad_s(sc.drive, 53.0) == pytest.approx(w)
+    assert gt.worm_speed_command_rad_s(back.drive, 53.0) == pytest.approx(53.0 * w)
+
+
 def test_guards_penetration_limit_and_stuck_drive():
     assert gt.penetration_limit_m(0.7e-3) == pytest.approx(0.28e-3)  # 0.4 m_x
     assert gt.drive_stuck(0.4, 1.0) and not gt.drive_stuck(0.6, 1.0) and gt.drive_stuck(-0.4, -1.0)

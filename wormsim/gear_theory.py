@@ -156,11 +156,15 @@ def mesh_arms_m(r1_m: float, r2_m: float, alpha_n_rad: float, lead_angle_rad: fl
 
 
 def working_wheel_torque_nm(scenario: Scenario, ratio: float) -> float:
-    """T2 through the mesh at the working load: the load, or the worm load times the ratio when the load is on the
-    worm; a torque driving the WHEEL counts too, the larger of the two (it passes through the mesh whatever the worm
-    does, and against a free worm it is the only load). A torque driving the worm is not counted: what it does not
-    pass to the wheel load accelerates the worm."""
-    load, drv = scenario.load, gear_drive(scenario)
+    """working_wheel_torque_of the scenario's drive and load."""
+    return working_wheel_torque_of(gear_drive(scenario), scenario.load, ratio)
+
+
+def working_wheel_torque_of(drv: Drive, load: Load, ratio: float) -> float:
+    """T2 (N m) through the mesh at the working load: the load, or the worm load times the ratio when the load is on
+    the worm; a torque driving the WHEEL counts too, the larger of the two (it passes through the mesh whatever the
+    worm does, and against a free worm it is the only load). A torque driving the worm is not counted: what it does
+    not pass to the wheel load accelerates the worm."""
     t2 = abs(load.torque_nm) * (1.0 if load.on == "wheel" else ratio)
     if drv.torque_nm is not None and drv.on == "wheel":
         t2 = max(t2, abs(drv.torque_nm))
@@ -214,8 +218,13 @@ def load_target_nm(drive: Drive, load: Load, direction: int) -> float:
 
 
 def ramps_end_s(scenario: Scenario) -> float:
-    """When both commands have reached their full value."""
-    return max(gear_drive(scenario).ramp_s, scenario.load.start_s + scenario.load.ramp_s)
+    """ramps_end_of the scenario's drive and load."""
+    return ramps_end_of(gear_drive(scenario), scenario.load)
+
+
+def ramps_end_of(drive: Drive, load: Load) -> float:
+    """When both commands have reached their full value (s)."""
+    return max(drive.ramp_s, load.start_s + load.ramp_s)
 
 
 @dataclass(frozen=True)
@@ -237,19 +246,71 @@ class Commands:
 
 
 def commands(scenario: Scenario, direction: int) -> Commands:
-    drv, load = gear_drive(scenario), scenario.load
+    """commands_of the scenario's drive and load."""
+    return commands_of(gear_drive(scenario), scenario.load, direction)
+
+
+def commands_of(drv: Drive, load: Load, direction: int) -> Commands:
+    """The drive's and the load's STEPs (Commands) for the expected direction (load_target_nm)."""
     return Commands(
         drive_target(drv), drv.ramp_s, load_target_nm(drv, load, direction), load.start_s, load.start_s + load.ramp_s
     )
 
 
 def working_flank(scenario: Scenario, hand: int) -> int:
+    """working_flank_of the scenario's drive."""
+    return working_flank_of(gear_drive(scenario), hand)
+
+
+def working_flank_of(drv: Drive, hand: int) -> int:
     """+1 when the mesh torque on the wheel is positive in the intended running (the worm drives against a resisting
     load: hand x sign(command)), -1 otherwise (the wheel drives: the mesh resists its motion). The flank side of
     meshgen.kinematic_tca and wormsim.tooth.mesh_stiffness."""
-    drv = gear_drive(scenario)
     s = 1 if drive_target(drv) >= 0 else -1
     return s * hand if drv.on == "worm" else -s
+
+
+def worm_speed_command_rad_s(drv: Drive, ratio: float) -> float | None:
+    """Worm speed (rad/s) the drive commands: |speed_rpm| when the worm is speed-driven, ratio x |speed_rpm| when the
+    wheel is (kinematics z2 / z1); None for a torque drive (its speed is known only while running)."""
+    if drv.speed_rpm is None:
+        return None
+    w = abs(rpm_to_rad_s(drv.speed_rpm))
+    return w if drv.on == "worm" else w * ratio
+
+
+@dataclass(frozen=True)
+class Duty:
+    """A gear-level run's drive and load (the scenario's drive: and load: blocks) and what follows from them and the
+    expected direction alone, derived once (duty) and handed down instead of the scenario."""
+
+    drive: Drive
+    load: Load
+    direction: int  # +1/-1: the load shaft's expected sign per sign of the drive command (the hand for a worm pair)
+    commands: Commands  # commands_of
+    ramps_end_s: float  # ramps_end_of
+    lock_check_start_s: float  # lock_check_after the ramps
+    working_flank: int  # working_flank_of (direction is the hand)
+
+    @property
+    def speed_driven(self) -> bool:
+        """drive.speed_rpm given (else drive.torque_nm)."""
+        return self.drive.speed_rpm is not None
+
+
+def duty(scenario: Scenario, direction: int) -> Duty:
+    """The scenario's Duty for the expected direction (the pair's hand)."""
+    drv, load = gear_drive(scenario), scenario.load
+    ramps = ramps_end_of(drv, load)
+    return Duty(
+        drv,
+        load,
+        direction,
+        commands_of(drv, load, direction),
+        ramps,
+        lock_check_after(ramps),
+        working_flank_of(drv, direction),
+    )
 
 
 # ----------------------------------------------------------------------------- speed servo
@@ -261,9 +322,15 @@ MIN_EFFICIENCY = 0.05  # floor of the efficiency in the expected torque (a self-
 def expected_drive_torque_nm(
     scenario: Scenario, ratio: float, lead_angle_rad: float, alpha_n_rad: float, mu: float
 ) -> float:
-    """Drive torque at the full load: T_load / i / eta (worm driving) or T_load i / eta (wheel driving), with
+    """expected_drive_torque_of the scenario's drive and load."""
+    return expected_drive_torque_of(gear_drive(scenario), scenario.load, ratio, lead_angle_rad, alpha_n_rad, mu)
+
+
+def expected_drive_torque_of(
+    drv: Drive, load: Load, ratio: float, lead_angle_rad: float, alpha_n_rad: float, mu: float
+) -> float:
+    """Drive torque (N m) at the full load: T_load / i / eta (worm driving) or T_load i / eta (wheel driving), with
     eta = efficiency_theory at mu, at least MIN_EFFICIENCY; at least 1e-3 N m."""
-    drv, load = gear_drive(scenario), scenario.load
     eta = efficiency_theory(lead_angle_rad, alpha_n_rad, mu, backdriving=drv.on == "wheel")
     if drv.on == "worm":
         t_exp = abs(load.torque_nm) / ratio / max(eta, MIN_EFFICIENCY)
@@ -273,14 +340,19 @@ def expected_drive_torque_nm(
 
 
 def servo_gain_nm_s(scenario: Scenario, ratio: float, lead_angle_rad: float, alpha_n_rad: float, mu: float) -> float:
-    """kv = T_expected / (SPEED_DROOP omega_cmd) of a speed-driven drive (contact3d's velocity actuator, the
-    torsional level's servo): the speed droops SPEED_DROOP of the command at the expected torque."""
-    speed_rpm = gear_drive(scenario).speed_rpm
-    if speed_rpm is None:
+    """servo_gain_of the scenario's drive at expected_drive_torque_nm."""
+    drv = gear_drive(scenario)
+    return servo_gain_of(drv, expected_drive_torque_of(drv, scenario.load, ratio, lead_angle_rad, alpha_n_rad, mu))
+
+
+def servo_gain_of(drv: Drive, expected_torque_nm: float) -> float:
+    """kv = T_expected / (SPEED_DROOP omega_cmd) (N m s/rad) of a speed-driven drive (contact3d's velocity actuator,
+    the torsional level's servo): the speed droops SPEED_DROOP of the command at the expected torque
+    (expected_drive_torque_of)."""
+    if drv.speed_rpm is None:
         raise ValueError("servo_gain_nm_s: the drive is torque-controlled")
-    w_cmd = abs(rpm_to_rad_s(speed_rpm))
-    t_exp = expected_drive_torque_nm(scenario, ratio, lead_angle_rad, alpha_n_rad, mu)
-    return t_exp / (SPEED_DROOP * max(w_cmd, 1e-3))
+    w_cmd = abs(rpm_to_rad_s(drv.speed_rpm))
+    return expected_torque_nm / (SPEED_DROOP * max(w_cmd, 1e-3))
 
 
 # ----------------------------------------------------------------------------- guards
@@ -297,7 +369,13 @@ def penetration_limit_m(m_x: float) -> float:
 
 
 def lock_check_start_s(scenario: Scenario) -> float:
-    return ramps_end_s(scenario) + LOCK_SETTLE_S
+    """lock_check_after the scenario's ramps (ramps_end_s)."""
+    return lock_check_after(ramps_end_s(scenario))
+
+
+def lock_check_after(ramps_end_s: float) -> float:
+    """The locked-drive check's start (s): LOCK_SETTLE_S after the ramps' end."""
+    return ramps_end_s + LOCK_SETTLE_S
 
 
 def drive_stuck(w_drive, command):

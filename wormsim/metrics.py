@@ -88,15 +88,19 @@ def dominant_frequency(
 
 
 def window_of(S: dict, scenario, geo) -> tuple[int, int, float]:
-    """Steady window [i0, i1) of a run and the mesh period used to find and trim it."""
+    """window_after the scenario's ramps (gear_theory.ramps_end_s) with its drive."""
+    return window_after(S, scenario.drive.on, gt.ramps_end_s(scenario), geo)
+
+
+def window_after(S: dict, drive_on: str, ramp_end: float, geo) -> tuple[int, int, float]:
+    """Steady window [i0, i1) of a run after its ramps' end (s) and the mesh period used to find and trim it; the
+    driven shaft's angle (the wheel's when drive_on is "worm") gives the speeds."""
     t = S["t_s"]
-    drv = scenario.drive
     w1 = S["worm_speed_rpm"]
     n1_guess = abs(float(np.mean(w1[len(w1) // 2 :]))) if len(w1) else 0.0
     f_mesh_guess = geo.z1 * n1_guess / 60.0
     period = 1.0 / f_mesh_guess if f_mesh_guess > 0 else 0.0
-    ramp_end = gt.ramps_end_s(scenario)
-    ang = S["wheel_angle_rad"] if drv.on == "worm" else S["worm_angle_rad"]
+    ang = S["wheel_angle_rad"] if drive_on == "worm" else S["worm_angle_rad"]
     i0, i1 = steady_window(t, interval_speed_rpm(t, ang), ramp_end, period)
     return i0, i1, period
 

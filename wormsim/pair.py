@@ -152,7 +152,7 @@ class WormPair:
         self.geometry = plan.geometry
         self.deviations = deviations
         self.tooth_shift_rad = tooth_shift_rad
-        self.supports = {part: shafts.support(scenario, plan.geometry, part) for part in ("worm", "wheel")}
+        self.supports = plan.supports  # part -> Support or None (wormsim.contact3d.shafts.support)
         self.prefix: str | None = None
         self.parent: str | None = None
         self._placement = np.eye(4)

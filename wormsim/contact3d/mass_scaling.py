@@ -43,7 +43,7 @@ import numpy as np
 
 from wormsim import gear_theory as gt
 from wormsim.errors import RingingError
-from wormsim.scenario import Scenario, ScenarioError
+from wormsim.scenario import ScenarioError
 from wormsim.units import rpm_to_rad_s
 
 KE_SHARE_TARGET = 0.01  # kinetic energy at most 1 % of the drive's work
@@ -71,15 +71,13 @@ class ScalingCheck:
     facet_hz: float = float("nan")  # contact.geometry pieces: worm pieces per turn x n1 / 60
 
 
-def _work_j(scenario: Scenario, ratio: float, gamma: float, alpha_n: float, mu: float, t_s: float) -> float:
-    """Drive work from 0 to t_s at the commanded speeds and the expected drive torque (module docstring)."""
-    drv = gt.gear_drive(scenario)
-    w_drv = abs(rpm_to_rad_s(drv.speed_rpm))
-    t_drv = gt.expected_drive_torque_nm(scenario, ratio, gamma, alpha_n, mu)
+def _work_j(duty: gt.Duty, t_drv: float, t_s: float) -> float:
+    """Drive work from 0 to t_s at the commanded speeds and the expected drive torque t_drv (module docstring)."""
+    w_drv = abs(rpm_to_rad_s(duty.drive.speed_rpm))
     if t_s <= 0:
         return 0.0
     t = np.linspace(0.0, t_s, 2001)
-    cmds = gt.commands(scenario, 1)
+    cmds = duty.commands  # only their magnitudes count
     s_drv = np.abs(cmds.drive(t)) / max(abs(cmds.drive_target), 1e-300)
     s_load = np.abs(cmds.load(t)) / abs(cmds.load_target_nm) if cmds.load_target_nm else np.ones_like(t)
     return float(np.trapezoid(t_drv * w_drv * s_drv * s_load, t))
@@ -91,29 +89,28 @@ def kinetic_energy_j(inertias_kg_m2: tuple[float, float], w1_rad_s, w2_rad_s):
 
 
 def check(
-    scenario: Scenario,
+    duty: gt.Duty,
     ratio: float,
     z1: int,
-    gamma: float,
-    alpha_n: float,
-    mu: float,
+    worm_speed_rad_s: float,
+    drive_torque_nm: float,
     pair_stiffness_n_per_m: float,
     inv_mass_hat: float,
     inertias_kg_m2: tuple[float, float],
     factor: float,
     segments_per_turn: int = 0,
 ) -> ScalingCheck:
-    """The quasi-static checks for factor S with the UNSCALED A_hat and shaft inertias (I1 + J1, I2 + J2);
-    segments_per_turn: the worm's convex pieces per turn (contact.geometry pieces; 0 for flanks)."""
-    drv = gt.gear_drive(scenario)
-    w1 = abs(rpm_to_rad_s(drv.speed_rpm)) * (1.0 if drv.on == "worm" else ratio)
+    """The quasi-static checks for factor S with the UNSCALED A_hat and shaft inertias (I1 + J1, I2 + J2) of a
+    speed-driven run (duty) at the commanded worm speed (gear_theory.worm_speed_command_rad_s) and the drive's
+    expected torque (gear_theory.expected_drive_torque_of); segments_per_turn: the worm's convex pieces per turn
+    (contact.geometry pieces; 0 for flanks)."""
+    w1 = worm_speed_rad_s
     mesh_hz = z1 * w1 / (2 * math.pi)
     mode1_hz = math.sqrt(pair_stiffness_n_per_m * inv_mass_hat) / (2 * math.pi)
     facet_hz = segments_per_turn * w1 / (2 * math.pi)
-    ramps = [drv.ramp_s] + ([scenario.load.ramp_s] if scenario.load.torque_nm != 0 else [])
+    ramps = [duty.drive.ramp_s] + ([duty.load.ramp_s] if duty.load.torque_nm != 0 else [])
     ramp = min(ramps)
-    t_end = gt.ramps_end_s(scenario)
-    work = _work_j(scenario, ratio, gamma, alpha_n, mu, t_end)
+    work = _work_j(duty, drive_torque_nm, duty.ramps_end_s)
     ke1 = float(kinetic_energy_j(inertias_kg_m2, w1, w1 / ratio))
     limits = {
         "mode": (mode1_hz / (MODE_TO_MESH_MIN * mesh_hz)) ** 2 if mesh_hz > 0 else float("inf"),
@@ -166,28 +163,28 @@ def refuse_if_dynamic(c: ScalingCheck, requested) -> None:
         )
 
 
-def resolve(scenario: Scenario, **kw) -> ScalingCheck:
-    """The factor a run uses: the scenario's number (checked: refuse_if_dynamic), or auto's (the largest passing S,
-    1-2-5 rounded down, 1 when even S = 1 fails a check). kw: check's arguments less `factor`."""
-    ms = scenario.simulation.mass_scaling
+def resolve(ms, duty: gt.Duty, **kw) -> ScalingCheck:
+    """The factor a run uses: ms, the scenario's simulation.mass_scaling (checked: refuse_if_dynamic), or auto's (the
+    largest passing S, 1-2-5 rounded down, 1 when even S = 1 fails a check). kw: check's arguments less `duty` and
+    `factor`."""
     if ms == 1:
         return (
-            check(scenario, factor=1.0, **kw)
-            if gt.gear_drive(scenario).speed_rpm is not None
+            check(duty, factor=1.0, **kw)
+            if duty.speed_driven
             else ScalingCheck(1.0, float("nan"), float("nan"), float("nan"), float("nan"), {})
         )
-    if gt.gear_drive(scenario).speed_rpm is None:
+    if not duty.speed_driven:
         raise ScenarioError(
             f"simulation.mass_scaling = {ms}: needs a speed-driven drive (drive.speed_rpm): with "
             "drive.torque_nm the speed, the meshing frequency and the kinetic energy are not known "
             "before the run; allowed: simulation.mass_scaling = 1 with a torque drive"
         )
-    c1 = check(scenario, factor=1.0, **kw)
+    c1 = check(duty, factor=1.0, **kw)
     if ms == "auto":
         s = min(AUTO_MAX, *c1.factor_limits.values())
         s = gt.round_down_125(s) if s >= 1 else 1.0
-        return check(scenario, factor=s, **kw)
-    c = check(scenario, factor=float(ms), **kw)
+        return check(duty, factor=s, **kw)
+    c = check(duty, factor=float(ms), **kw)
     refuse_if_dynamic(c, ms)
     return c
 
@@ -216,19 +213,20 @@ def floor_2_digits(x: float) -> float:
     return float(f"{math.floor(x / 10**e * (1 + 1e-12))}e{e}")
 
 
-def run_summary(S: dict, scenario: Scenario, meta: dict, summary: dict) -> dict:
-    """Summary keys of the run's scaling (mass_scaling, kinetic_energy_share, ...) and the ringing guard: a scaled run
-    whose efficiency exceeds 1 (output power above input: the power balance broken) or whose measured kinetic-energy
-    share exceeds RINGING_KE_SHARE raises RingingError (exit 3)."""
+def run_summary(S: dict, duty: gt.Duty, requested, meta: dict, summary: dict) -> dict:
+    """Summary keys of the run's scaling (mass_scaling, kinetic_energy_share, ..., requested: the scenario's
+    simulation.mass_scaling) and the ringing guard: a scaled run whose efficiency exceeds 1 (output power above input:
+    the power balance broken) or whose measured kinetic-energy share exceeds RINGING_KE_SHARE raises RingingError
+    (exit 3)."""
     c: ScalingCheck = meta["mass_scaling_check"]
-    drive_power = S["worm_power_w"] if scenario.drive.on == "worm" else S["wheel_power_w"]
-    share = measured_ke_share(S, meta["shaft_inertias_kg_m2"], gt.ramps_end_s(scenario), drive_power)
+    drive_power = S["worm_power_w"] if duty.drive.on == "worm" else S["wheel_power_w"]
+    share = measured_ke_share(S, meta["shaft_inertias_kg_m2"], duty.ramps_end_s, drive_power)
     out = {
         "mass_scaling": c.factor,
         "kinetic_energy_share": share,
         "kinetic_energy_share_estimate": c.ke_share_estimate,
         "mass_scaling_mesh_mode_hz": c.mode_hz,
-        "mass_scaling_requested": scenario.simulation.mass_scaling,
+        "mass_scaling_requested": requested,
     }
     if c.factor > 1:
         eff = summary.get("efficiency", float("nan"))

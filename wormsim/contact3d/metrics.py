@@ -7,14 +7,15 @@ from __future__ import annotations
 import numpy as np
 
 from wormsim import gear_theory as gt
-from wormsim.metrics import dominant_frequency, drive_summary, mean_speeds_rpm, window_of
+from wormsim.metrics import dominant_frequency, drive_summary, mean_speeds_rpm, window_after
 
 
 def contact3d_summary(S: dict, scenario, bm) -> dict:
-    """drive_summary plus the meshing frequency from the tangential force and contact statistics."""
-    geo = bm.geometry
+    """drive_summary plus the meshing frequency from the tangential force and contact statistics; the steady window
+    after the ramps of the run's plan (bm.plan.duty)."""
+    geo, duty = bm.geometry, bm.plan.duty
     t = S["t_s"]
-    i0, i1, _ = window_of(S, scenario, geo)
+    i0, i1, _ = window_after(S, duty.drive.on, duty.ramps_end_s, geo)
     sl = slice(i0, i1)
     n1, n2 = mean_speeds_rpm(S, i0, i1)
     # the convex pieces' facets excite the force at (segments per turn) x (worm speed): search below half that
@@ -34,7 +35,7 @@ def contact3d_summary(S: dict, scenario, bm) -> dict:
         "contacts_mean": float(np.mean(S["contacts"][sl])),
         "teeth_in_contact_mean": float(np.mean(S["teeth_in_contact"][sl])),
         "max_penetration_um": float(np.max(S["max_penetration_m"][sl]) * 1e6),
-        **radial_force_check(S, scenario, geo, sl),
+        **radial_force_check(S, duty.drive.on, geo, sl),
         **contact_radius_check(S, sl),
         **startup_peak(S, i0, i1),
     }
@@ -57,7 +58,7 @@ def contact_radius_check(S: dict, sl: slice) -> dict:
     }
 
 
-def radial_force_check(S: dict, scenario, geo, sl: slice) -> dict:
+def radial_force_check(S: dict, drive_on: str, geo, sl: slice) -> dict:
     """DIN 3975's radial force F_r2 = F_t2 tan(alpha_n) cos(rho') / cos(gamma + s rho') (s = +1 worm driving, -1
     back-driving, rho' = atan(mu / cos alpha_n)) assumes one contact at the pitch point on the line of centres. The
     3D contacts sit around the worm at angles phi (about its axis, from the line of centres), which turn their
@@ -69,7 +70,7 @@ def radial_force_check(S: dict, scenario, geo, sl: slice) -> dict:
         return {}
     mu = float(np.mean(S["friction_coefficient"][sl]))
     rho = gt.virtual_friction_angle_rad(mu, geo.alpha_n)
-    s = -1.0 if scenario.drive.on == "wheel" else 1.0
+    s = -1.0 if drive_on == "wheel" else 1.0
     ft = abs(float(np.mean(S["tangential_force_n"][sl])))
     return {
         "radial_force_line_of_centres_mean_n": abs(float(np.mean(S["radial_force_line_of_centres_n"][sl]))),

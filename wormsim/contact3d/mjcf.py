@@ -17,7 +17,7 @@ Built with mujoco.MjSpec from the template `models/worm_pair.xml` (see models/RE
   load.start_s over load.ramp_s; a driven-machine inertia load.inertia_kg_m2 is the loaded hinge's armature
   (rigid on the shaft) and counts in that shaft's effective mass of the contact law;
 - contact law: wormsim.contact3d.law (solref/solimp per collision geom; body_invweight0 set to A_hat);
-- timestep: chosen before the model is built (wormsim.contact3d.timestep.choose_timestep) and written once;
+- timestep: chosen before the model is built (wormsim.contact3d.timestep.timestep_for) and written once;
 - a contact sensor (worm against the wheel's subtree, reduce="netforce") gives the resultant tooth force
   every step, which wormsim.contact3d.runner averages over each record interval.
 """
@@ -51,13 +51,12 @@ from wormsim.contact3d.law import (
     pair_stiffness_n_per_m,
 )
 from wormsim.contact3d.mass_scaling import ScalingCheck
-from wormsim.contact3d.timestep import choose_timestep
+from wormsim.contact3d.timestep import timestep_for
 from wormsim.friction import friction_coefficient
 from wormsim.geometry import derive, displaced_pair, gear_set, solid_set
-from wormsim.scenario import Scenario, ScenarioError
+from wormsim.scenario import Scenario, ScenarioError, Simulation
 from wormsim.tooth.grid import SLICES_MASS_SCALED, FlankGrid, default_slices, flank_grid
 from wormsim.tooth.window import slot_quat, window_size, window_teeth_at
-from wormsim.units import rpm_to_rad_s
 
 TEMPLATE = files("wormsim.models") / "worm_pair.xml"  # models/, shipped as package data
 MESH_SENSOR_DATA = 1 | 2 | 4 | 16  # contact sensor fields found, force, torque, pos (mjtConDataField bits)
@@ -117,8 +116,9 @@ class Inertias:
 @dataclass(frozen=True)
 class Prepared:
     """The run's plan, derived once from the scenario before the model is built and handed down: geometry, pieces,
-    inertias, the contact law, the flank grid, the drive and load commands, the working loads the law and the
-    guards are sized for, the drive's kind and the guards' times; build_model adds the timestep and the window."""
+    inertias, the shafts' supports, the contact law, the flank grid, the drive and load (gear_theory.Duty: their
+    commands, the drive's kind and the guards' times), the working loads the law and the guards are sized for;
+    build_model adds the timestep and the window."""
 
     geometry: GearGeometry
     pieces: GearSet
@@ -128,17 +128,43 @@ class Prepared:
     inv_mass_wheel: float  # arm2^2 / (I2 + J2)
     scaling: ScalingCheck | None = None  # simulation.mass_scaling: the factor used and its checks (inertias x it)
     normal_force_n: float = 0.0  # nominal_normal_force_n: the whole mesh's normal force at the working load
-    commands: gt.Commands | None = None  # the drive and load commands over time (gear_theory.commands)
+    duty: gt.Duty | None = None  # the drive and load, their commands, ramps and working flank (gear_theory.duty)
     grid: FlankGrid | None = None  # contact.geometry flanks: the flank grid of law.contacts_per_pair slices
-    drive_on: str = "worm"  # drive.on: the shaft the drive turns
-    speed_driven: bool = True  # drive.speed_rpm given (the lock guard watches the drive's speed)
-    ramps_end_s: float = 0.0  # both commands at full value (gear_theory.ramps_end_s)
-    lock_start_s: float = 0.0  # the lock guard's start (gear_theory.lock_check_start_s)
     mu_params: tuple = ()  # the friction law mu(Vs) (wormsim.contact3d.friction_law.mu_params)
     transition_velocity_m_s: float = 0.0  # contact.transition_velocity_m_s
     e_star_pa: float = 0.0  # the pair's effective modulus (gear_theory.effective_modulus_pa)
-    timestep_s: float = 0.0  # the model's timestep (build_model: choose_timestep's or the one given)
+    timestep_s: float = 0.0  # the model's timestep (build_model: timestep_for's or the one given)
     window_teeth: int = 0  # the wheel tooth slots with collision (build_model)
+    worm_speed_rad_s: float | None = None  # the commanded worm speed (gear_theory.worm_speed_command_rad_s)
+    wheel_torque_nm: float = 0.0  # T2 at the working load (gear_theory.working_wheel_torque_of)
+    drive_torque_nm: float = 0.0  # the drive's torque at the full load (gear_theory.expected_drive_torque_of)
+    servo_gain_nm_s: float | None = None  # a speed drive's kv (gear_theory.servo_gain_of); None for a torque drive
+    supports: dict = field(default_factory=dict)  # part -> its Support (wormsim.contact3d.shafts.support) or None
+
+    @property
+    def commands(self) -> gt.Commands:
+        """The drive and load commands over time (duty.commands)."""
+        return self.duty.commands
+
+    @property
+    def drive_on(self) -> str:
+        """drive.on: the shaft the drive turns."""
+        return self.duty.drive.on
+
+    @property
+    def speed_driven(self) -> bool:
+        """drive.speed_rpm given (the lock guard watches the drive's speed)."""
+        return self.duty.speed_driven
+
+    @property
+    def ramps_end_s(self) -> float:
+        """Both commands at full value (duty.ramps_end_s)."""
+        return self.duty.ramps_end_s
+
+    @property
+    def lock_start_s(self) -> float:
+        """The lock guard's start (duty.lock_check_start_s)."""
+        return self.duty.lock_check_start_s
 
 
 Plan = Prepared
@@ -201,24 +227,23 @@ def _vertex_normals(mesh) -> np.ndarray:
     return np.asarray(trimesh.Trimesh(vertices=mesh.vertices, faces=mesh.faces, process=False).vertex_normals)
 
 
-def nominal_normal_force_n(scenario: Scenario, geo: GearGeometry) -> float:
-    """Whole-mesh normal force at the working load (gear_theory.normal_force_n of working_wheel_torque_nm). Sets
-    the friction rows' hardness (wormsim.contact3d.law (3)); with T2 = 0 impratio fell to 1 and a self-locking pair
-    crept back at ~110 rpm instead of 0.2 rpm (docs/stability_backlash_locking.md)."""
-    return gt.normal_force_n(gt.working_wheel_torque_nm(scenario, geo.ratio), geo.r2, geo.alpha_n, geo.gamma)
+def nominal_normal_force_n(wheel_torque_nm: float, geo: GearGeometry) -> float:
+    """Whole-mesh normal force at the working load (gear_theory.normal_force_n of the working wheel torque,
+    gear_theory.working_wheel_torque_of). Sets the friction rows' hardness (wormsim.contact3d.law (3)); with T2 = 0
+    impratio fell to 1 and a self-locking pair crept back at ~110 rpm instead of 0.2 rpm
+    (docs/stability_backlash_locking.md)."""
+    return gt.normal_force_n(wheel_torque_nm, geo.r2, geo.alpha_n, geo.gamma)
 
 
-def nominal_sliding_speed_m_s(scenario: Scenario, geo: GearGeometry) -> float:
-    """Vs = omega1 r1 / cos(gamma) at a speed-controlled drive's full speed (the worm's speed from the wheel's by
-    the ratio); 0 for a torque drive (speed not known before the run)."""
-    drv = scenario.drive
-    if drv is None or drv.speed_rpm is None:
+def nominal_sliding_speed_m_s(worm_speed_rad_s: float | None, geo: GearGeometry) -> float:
+    """Vs = omega1 r1 / cos(gamma) at a speed-controlled drive's full worm speed
+    (gear_theory.worm_speed_command_rad_s); 0 for a torque drive (None: speed not known before the run)."""
+    if worm_speed_rad_s is None:
         return 0.0
-    w1 = abs(rpm_to_rad_s(drv.speed_rpm)) * (geo.ratio if drv.on == "wheel" else 1.0)
-    return w1 * geo.r1 / math.cos(geo.gamma)
+    return worm_speed_rad_s * geo.r1 / math.cos(geo.gamma)
 
 
-def expected_direction(scenario: Scenario, geo: GearGeometry) -> int:
+def expected_direction(geo: GearGeometry) -> int:
     """+1/-1: sign of the driven shaft's speed per sign of the drive command. INTERFACE.md: a positive
     worm rotation drives the wheel positive for a right-hand worm (and back-driving the same way)."""
     return geo.hand
@@ -266,21 +291,33 @@ def prepare(scenario: Scenario, gs: GearSet | None = None) -> Prepared:
     flanks = scenario.contact.geometry == "flanks"  # the flank contacts need the solid meshes only, no pieces
     geo, gs = (derive(scenario.gear), gs) if gs is not None else (solid_set if flanks else gear_set)(scenario)
     ine = shaft_inertias(scenario, geo, gs)
+    supports = {part: shafts.support(scenario, geo, part) for part in ("worm", "wheel")}
+    # n_ref: the pieces across the face width, or with contact.geometry flanks the flank contacts' slices
+    slabs = flank_slices(scenario, geo) if scenario.contact.geometry == "flanks" else max(1, _slabs_per_flank(gs))
+    direction = expected_direction(geo)
+    mu0, mu1 = float(friction_coefficient(scenario.contact, 0.0)), float(friction_coefficient(scenario.contact, 1.0))
+    # the drive and load, once (gear_theory): their commands, the worm's speed, the working and the drive's torques
+    duty = gt.duty(scenario, direction)
+    drv, load = duty.drive, duty.load
+    w1 = gt.worm_speed_command_rad_s(drv, geo.ratio)
+    t_drive = gt.expected_drive_torque_of(drv, load, geo.ratio, geo.gamma, geo.alpha_n, mu1)
+    t2 = gt.working_wheel_torque_of(drv, load, geo.ratio)
+    kv = gt.servo_gain_of(drv, t_drive) if duty.speed_driven else None
     arm1, arm2 = gt.mesh_arms_m(geo.r1, geo.r2, geo.alpha_n, geo.gamma)
+    e_star = gt.effective_modulus_pa(scenario.materials)
+    f_n, v_s = nominal_normal_force_n(t2, geo), nominal_sliding_speed_m_s(w1, geo)
     # driven-machine inertia J on the loaded shaft (joint armature) belongs to that shaft's effective mass
     I1 = ine.worm_inertia_kg_m2 + ine.worm_load_inertia_kg_m2
     I2 = ine.wheel_inertia_kg_m2 + ine.wheel_load_inertia_kg_m2
-    # n_ref: the pieces across the face width, or with contact.geometry flanks the flank contacts' slices
-    slabs = flank_slices(scenario, geo) if scenario.contact.geometry == "flanks" else max(1, _slabs_per_flank(gs))
     # simulation.mass_scaling (wormsim.contact3d.mass_scaling): every inertia x S before the law takes them
     k_pair, _ = pair_stiffness_n_per_m(scenario.contact, scenario.materials, geo.face_width)
     scaling = mass_scaling.resolve(
-        scenario,
+        scenario.simulation.mass_scaling,
+        duty,
         ratio=geo.ratio,
         z1=geo.z1,
-        gamma=geo.gamma,
-        alpha_n=geo.alpha_n,
-        mu=float(friction_coefficient(scenario.contact, 1.0)),
+        worm_speed_rad_s=w1,
+        drive_torque_nm=t_drive,
         pair_stiffness_n_per_m=k_pair,
         inv_mass_hat=arm1**2 / I1 + arm2**2 / I2,
         inertias_kg_m2=(I1, I2),
@@ -293,19 +330,14 @@ def prepare(scenario: Scenario, gs: GearSet | None = None) -> Prepared:
         if flanks and not scenario.contact.slices:
             slabs = min(slabs, SLICES_MASS_SCALED)  # a scaled run keeps means only (tooth.grid.SLICES_MASS_SCALED)
     law = contact_law(scenario.contact, scenario.materials, geo.face_width, slabs, a1 + a2)  # the law, once
-    mu0 = float(friction_coefficient(scenario.contact, 0.0))
-    mu_max = max(mu0, float(friction_coefficient(scenario.contact, 1.0)))
-    f_n = nominal_normal_force_n(scenario, geo)
+    mu_max = max(mu0, mu1)
     if flanks:  # the flank contacts' own friction-row damping, law (4)
         law = replace(
             law,
-            friction_damping_n_s_per_m=friction_damping_n_s_per_m(
-                law, mu_max, f_n, nominal_sliding_speed_m_s(scenario, geo)
-            ),
+            friction_damping_n_s_per_m=friction_damping_n_s_per_m(law, mu_max, f_n, v_s),
         )
     law = replace(law, impratio=friction_impratio(law, mu_max, f_n, scenario.contact.transition_velocity_m_s))
     grid = flank_grid(geo, law.contacts_per_pair) if flanks else None
-    cmds = gt.commands(scenario, expected_direction(scenario, geo))
     return Prepared(
         geo,
         gs,
@@ -315,15 +347,16 @@ def prepare(scenario: Scenario, gs: GearSet | None = None) -> Prepared:
         a2,
         scaling,
         f_n,
-        cmds,
+        duty,
         grid,
-        drive_on=scenario.drive.on,
-        speed_driven=scenario.drive.speed_rpm is not None,
-        ramps_end_s=gt.ramps_end_s(scenario),
-        lock_start_s=gt.lock_check_start_s(scenario),
         mu_params=mu_params(scenario.contact),
         transition_velocity_m_s=scenario.contact.transition_velocity_m_s,
-        e_star_pa=gt.effective_modulus_pa(scenario.materials),
+        e_star_pa=e_star,
+        worm_speed_rad_s=w1,
+        wheel_torque_nm=t2,
+        drive_torque_nm=t_drive,
+        servo_gain_nm_s=kv,
+        supports=supports,
     )
 
 
@@ -340,7 +373,7 @@ def build_model(
     """The compiled contact3d model. check_backlash_vs_pieces=False skips wormsim.contact3d.backlash's checks (only
     to measure what happens below their limit). window_teeth: wheel tooth slots with collision (default
     window_size; geo.z2 = every tooth, for a standalone file that the viewer can turn without re-posing).
-    timestep_s: the timestep to build with (default: choose_timestep's)."""
+    timestep_s: the timestep to build with (default: timestep_for's)."""
     p = prepare(scenario, gs)
     geo, gs, law = p.geometry, p.pieces, p.law
     flanks = scenario.contact.geometry == "flanks"
@@ -353,7 +386,7 @@ def build_model(
         else {}
     )
     h, h_source = (
-        choose_timestep(scenario, geo, law, p.scaling.factor)
+        timestep_for(scenario.simulation.timestep_s, p.worm_speed_rad_s, law, p.scaling.factor)
         if timestep_s is None
         else (timestep_s, "given to build_model")
     )
@@ -365,15 +398,15 @@ def build_model(
     spec = mujoco.MjSpec.from_file(str(TEMPLATE))
     spec.modelname = scenario.name
     _place_bodies(spec, geo, p.inertias, dev)
-    sups = shafts.mount(spec, scenario, geo) if scenario.shafts is not None else None  # bearings, bending
+    sups = shafts.mount(spec, p.supports, geo) if scenario.shafts is not None else None  # bearings, bending
     worm_names, slot_names, W = _add_geoms(
         spec, geo, gs, law, float(friction_coefficient(scenario.contact, 0.0)), window_teeth, shift, flanks
     )
-    kv, drive_sign = _add_actuators(spec, scenario, geo)
+    kv, drive_sign = _add_actuators(spec, p.duty, p.servo_gain_nm_s)
     spec.joint(f"{scenario.load.on}_hinge").armature = max(
         p.inertias.worm_load_inertia_kg_m2, p.inertias.wheel_load_inertia_kg_m2
     )  # x mass_scaling
-    _set_options(spec, scenario, law, h)
+    _set_options(spec, scenario.simulation, law, h)
     _add_mesh_sensor(spec)
     model = spec.compile()
 
@@ -426,7 +459,7 @@ def build_model(
         slot_bodies=slot_bodies,
         window_teeth=W,
         tooth0_angle_rad=wheel.tooth_angle(geo, 0),
-        direction=expected_direction(scenario, geo),
+        direction=p.duty.direction,
         drive_sign=drive_sign,
         pieces=gs,
         timestep_s=h,
@@ -551,17 +584,13 @@ def _add_geoms(
     return worm_names, slot_names, W
 
 
-def _add_actuators(spec: mujoco.MjSpec, scenario: Scenario, geo: GearGeometry) -> tuple[float | None, int]:
-    """Drive (speed: velocity servo with gear_theory.servo_gain_nm_s; torque: motor) and load (motor) on their
+def _add_actuators(spec: mujoco.MjSpec, duty: gt.Duty, kv: float | None) -> tuple[float | None, int]:
+    """Drive (speed: velocity servo of gain kv, Prepared.servo_gain_nm_s; torque: motor) and load (motor) on their
     hinges; the driven machine's inertia is the loaded hinge's armature. Returns (kv or None, drive sign)."""
-    drv, load = scenario.drive, scenario.load
+    drv, load = duty.drive, duty.load
     a = spec.add_actuator()
     a.name, a.target, a.trntype = "drive", f"{drv.on}_hinge", mujoco.mjtTrn.mjTRN_JOINT
-    kv = None
     if drv.speed_rpm is not None:
-        kv = gt.servo_gain_nm_s(
-            scenario, geo.ratio, geo.gamma, geo.alpha_n, float(friction_coefficient(scenario.contact, 1.0))
-        )
         a.set_to_velocity(kv=kv)
         drive_sign = int(np.sign(drv.speed_rpm)) or 1
     else:
@@ -576,13 +605,14 @@ def _add_actuators(spec: mujoco.MjSpec, scenario: Scenario, geo: GearGeometry) -
     return kv, drive_sign
 
 
-def _set_options(spec: mujoco.MjSpec, scenario: Scenario, law: ContactLaw, timestep_s: float) -> None:
+def _set_options(spec: mujoco.MjSpec, sim: Simulation, law: ContactLaw, timestep_s: float) -> None:
+    """The timestep, impratio and the simulation: block's integrator and speculative contacts."""
     o = spec.option
     o.timestep = timestep_s
     o.impratio = law.impratio  # friction rows' hardness, wormsim.contact3d.law (3)
-    if scenario.simulation.speculative:
+    if sim.speculative:
         o.enableflags |= int(mujoco.mjtEnableBit.mjENBL_SPECULATIVE)
-    o.integrator = INTEGRATORS[scenario.simulation.integrator]
+    o.integrator = INTEGRATORS[sim.integrator]
 
 
 def _add_mesh_sensor(spec: mujoco.MjSpec) -> None:
@@ -642,10 +672,10 @@ def write_model(scenario: Scenario, out_dir: str | Path) -> Path:
     geo = derive(scenario.gear) if scenario.gear is not None else None
     bm = build_model(scenario, window_teeth=geo.z2 if geo is not None else None)
     spec = bm.spec
-    cmds = gt.commands(scenario, bm.direction)
+    cmds = bm.plan.commands
     ctrl = {"drive": float(cmds.drive_target), "load": float(cmds.load_target_nm)}
     for act in spec.actuators:
-        if act.name == "drive" and gt.gear_drive(scenario).speed_rpm is not None:
+        if act.name == "drive" and bm.plan.speed_driven:
             kv = float(act.gainprm[0])
             act.set_to_velocity(kv=kv / RPM_PER_RAD_S**2)
             act.gear = [RPM_PER_RAD_S, 0, 0, 0, 0, 0]

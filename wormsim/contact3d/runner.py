@@ -28,7 +28,6 @@ import time
 import mujoco
 import numpy as np
 
-from wormsim import gear_theory as gt
 from wormsim import prewarm
 from wormsim.contact3d import jit_warmup, mass_scaling
 from wormsim.contact3d.contact_sums import RadiusLog
@@ -93,12 +92,12 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
     if slog is not None:  # the shafts' deflections and bearing forces
         S.update(slog.series())
         summary.update(slog.summary(S["t_s"], summary["steady_window_s"]))
-    summary.update(mass_scaling.run_summary(S, scenario, bm.meta, summary))  # and the ringing guard (exit 3)
+    summary.update(mass_scaling.run_summary(S, bm.plan.duty, scenario.simulation.mass_scaling, bm.meta, summary))
     rang = ringing(S, summary, dt, bm.law.stable_limit_s) if flanks else None  # flanks (ringing_check)
     if rang is not None:
         raise diverged_error(rang[0], dt, bm, rang[1])
     if bm.kinematic_tca is not None:  # errors: the displaced exact flanks' kinematic TE and play
-        kin = bm.kinematic_tca.summary(bm.geometry, gt.working_flank(scenario, bm.geometry.hand))
+        kin = bm.kinematic_tca.summary(bm.geometry, bm.plan.duty.working_flank)
         summary.update({k: v for k, v in kin.items() if not k.startswith("contact_pattern")})
     return Result(
         model="contact3d", summary=summary, series=S, steps=n_rec * rec, sim_time_s=float(d.time), extra=extra

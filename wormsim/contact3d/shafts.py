@@ -431,10 +431,10 @@ def bearing_split(force: np.ndarray, moment: np.ndarray, bearings_m: tuple[float
     return [(force[..., 0] - fx1, force[..., 1] - fy1), (fx1, fy1)]
 
 
-def mount(spec: mujoco.MjSpec, scenario: Scenario, geo: GearGeometry) -> dict[str, Support | None]:
-    """contact3d's model (wormsim.contact3d.mjcf, after its bodies are placed): each part with a shafts: block
-    rebuilt on its carrier (add_part) with the placement, hinge, mass and inertia the rigid model gave it."""
-    sups = {part: support(scenario, geo, part) for part in ("worm", "wheel")}
+def mount(spec: mujoco.MjSpec, sups: dict[str, Support | None], geo: GearGeometry) -> dict[str, Support | None]:
+    """contact3d's model (wormsim.contact3d.mjcf, after its bodies are placed): each part with a Support (support, in
+    the run's plan) rebuilt on its carrier (add_part) with the placement, hinge, mass and inertia the rigid model gave
+    it."""
     radius = {"worm": geo.r_f1, "wheel": geo.r_f1}  # the wheel's carrier holds no shaft mass (TINY_MASS_KG)
     for part, sup in sups.items():
         if sup is None or not sup.moves:

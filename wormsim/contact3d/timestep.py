@@ -13,9 +13,9 @@ from __future__ import annotations
 from meshgen.geometry import GearGeometry
 from wormsim.contact3d.law import ContactLaw
 from wormsim.contact3d.mass_scaling import SCALED_STEP_FRACTION, floor_2_digits
-from wormsim.gear_theory import round_down_125
+from wormsim.gear_theory import gear_drive, round_down_125, worm_speed_command_rad_s
 from wormsim.scenario import Scenario, ScenarioError
-from wormsim.units import rad_s_to_rpm, rpm_to_rad_s
+from wormsim.units import rad_s_to_rpm
 
 DEFAULT_FRACTION = 0.4  # default timestep: this fraction of the stable limit, rounded down to 1-2-5
 MAX_WORM_TURN_PER_STEP_RAD = 0.035  # largest worm rotation per step contact3d resolves (2.0 deg;
@@ -31,16 +31,6 @@ def default_timestep(law: ContactLaw, contacts: int | None = None) -> float:
     return round_down_125(DEFAULT_FRACTION * limit)
 
 
-def worm_speed_command_rad_s(scenario: Scenario, ratio: float) -> float | None:
-    """Worm speed the drive commands: |speed_rpm| when the worm is speed-driven, ratio x |speed_rpm| when the wheel
-    is (kinematics z2 / z1); None for a torque drive (its speed is known only while running)."""
-    drv = scenario.drive
-    if drv.speed_rpm is None:
-        return None
-    w = abs(rpm_to_rad_s(drv.speed_rpm))
-    return w if drv.on == "worm" else w * ratio
-
-
 def speed_timestep_limit_s(w1_rad_s: float) -> float:
     """Largest timestep at worm speed w1: h <= MAX_WORM_TURN_PER_STEP_RAD / w1."""
     return MAX_WORM_TURN_PER_STEP_RAD / w1_rad_s
@@ -49,12 +39,17 @@ def speed_timestep_limit_s(w1_rad_s: float) -> float:
 def choose_timestep(
     scenario: Scenario, geo: GearGeometry, law: ContactLaw, mass_scaling: float = 1.0
 ) -> tuple[float, str]:
-    """(timestep, timestep_source): the scenario's (checked against the speed limit), else the contact's default
-    unless the commanded worm speed needs a smaller one: then the speed limit rounded down to 1-2-5. A mass-scaled run
-    (mass_scaling > 1; `law` is then the scaled one) defaults to SCALED_STEP_FRACTION of the scaled stable limit,
-    rounded down to two digits (wormsim.contact3d.mass_scaling)."""
-    w1 = worm_speed_command_rad_s(scenario, geo.ratio)
-    h = scenario.simulation.timestep_s
+    """timestep_for the scenario's simulation.timestep_s and its drive's worm speed
+    (gear_theory.worm_speed_command_rad_s)."""
+    w1 = worm_speed_command_rad_s(gear_drive(scenario), geo.ratio)
+    return timestep_for(scenario.simulation.timestep_s, w1, law, mass_scaling)
+
+
+def timestep_for(h: float | None, w1: float | None, law: ContactLaw, mass_scaling: float = 1.0) -> tuple[float, str]:
+    """(timestep, timestep_source): h, the scenario's simulation.timestep_s (checked against the speed limit at the
+    commanded worm speed w1, None for a torque drive), else the contact's default unless w1 needs a smaller one: then
+    the speed limit rounded down to 1-2-5. A mass-scaled run (mass_scaling > 1; `law` is then the scaled one) defaults
+    to SCALED_STEP_FRACTION of the scaled stable limit, rounded down to two digits (wormsim.contact3d.mass_scaling)."""
     if h is not None:
         # above the contact's stable limit the divergence guard's diagnosis (which names that limit) comes first
         if h <= law.stable_limit_s and w1 is not None and w1 * h > MAX_WORM_TURN_PER_STEP_RAD:
