@@ -541,8 +541,8 @@ def _take(buf, o, shape):
 @numba.njit(cache=True, inline="always")
 def _views(fb, ib):
     """The packed buffers' fields as views (_layout at the sizes in ib's header): the float fields in _F_FIELDS
-    order, the int fields in _I_FIELDS order. PackedKernel's numpy fields and find_packed's unpacking both come
-    from here."""
+    order, the int fields in _I_FIELDS order: find_packed's unpacking (PackedKernel cuts its numpy fields by the
+    same _layout in Python, `_cut`)."""
     f, i = _layout(ib[0], ib[1], ib[2], ib[3], ib[4], ib[5])
     o = 0
     xy, o = _take(fb, o, f[0])
@@ -587,6 +587,17 @@ def _size(shapes) -> int:
     return sum(int(np.prod(sh)) for sh in shapes)
 
 
+def _cut(buf: np.ndarray, o: int, shapes) -> list[np.ndarray]:
+    """buf's fields of these shapes from offset o on, as numpy views (_take's cut, in Python: PackedKernel's fields
+    without compiling `_views` as an entry point of its own)."""
+    views = []
+    for sh in shapes:
+        k = int(np.prod(sh))
+        views.append(buf[o : o + k].reshape(sh))
+        o += k
+    return views
+
+
 class PackedKernel:
     """The kernel's inputs, outputs, memo and work arrays in one float and one int buffer, so that one compiled call,
     find_packed(fb, ib, theta1, theta2, margin, taper_rad), runs find_contacts, slice_weights and contact_frames:
@@ -602,8 +613,8 @@ class PackedKernel:
         self.fb = np.zeros(_size(fs))
         self.ib = np.zeros(_I_HEADER + _size(is_), dtype=np.int64)
         self.ib[:7] = (S, N, cap, len(P), W, z2, int(merge))
-        floats, ints = _views(self.fb, self.ib)
-        for name, v in zip(_F_FIELDS + _I_FIELDS, floats + ints, strict=True):
+        views = _cut(self.fb, 0, fs) + _cut(self.ib, _I_HEADER, is_)
+        for name, v in zip(_F_FIELDS + _I_FIELDS, views, strict=True):
             setattr(self, name, v)
         self.xy[:], self.c[:], self.c_range[:], self.zeta[:] = grid.xy, grid.c, grid.c_range, grid.zeta
         self.span[:] = grid.span
