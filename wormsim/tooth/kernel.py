@@ -55,9 +55,10 @@ def _eval(x0, y0, zeta, ca, sa, theta1, P, out):
     x, y = ca * x0 - sa * y0, sa * x0 + ca * y0
     if P.shape[0] > N_WORM_PARAMS:
         xs, ys, zs = to_static(x, y, zeta, P, out)
-        return worm_gap_ext(xs, ys, zs, theta1, P, out)
-    out[3], out[4], out[5] = x, y, zeta
-    return worm_gap_ext(y + P[10], -zeta, -x, theta1, P, out)
+    else:
+        out[3], out[4], out[5] = x, y, zeta
+        xs, ys, zs = y + P[10], -zeta, -x
+    return worm_gap_ext(xs, ys, zs, theta1, P, out)  # one inlined copy for both poses
 
 
 @numba.njit(cache=True, inline="always")
@@ -276,22 +277,38 @@ def _slice_contact(ev, span, zeta, sg, j, k, i_s, sid, taper, memo_row, out, n):
 @numba.njit(cache=True, inline="always")
 def _descend(ev, sg, j, zj, ib, sid):
     """From profile point ib down along the profile to the minimum of the extended gap (one minimum per slice: the
-    gap across a contact line is quadratic); returns (its index, its gap), the gap +inf where there is none."""
-    best = _g(ev, sg, j, ib, zj, sid)
+    gap across a contact line is quadratic); returns (its index, its gap), the gap +inf where there is none. The
+    points ib, ib - 1, ib + 1, then the next ones in the falling direction, from one evaluation site in a loop (each
+    inlined _g is a copy of the gap's evaluation to compile)."""
+    best = gl = np.inf
     step = 0
-    gl = _g(ev, sg, j, ib - 1, zj, sid)
-    gr = _g(ev, sg, j, ib + 1, zj, sid)
-    if gl < best and gl <= gr:
-        step, ib, best = -1, ib - 1, gl
-    elif gr < best:
-        step, ib, best = 1, ib + 1, gr
-    while step != 0:
-        gn = _g(ev, sg, j, ib + step, zj, sid)
-        if gn < best:
+    phase = 0  # 0: ib, 1: ib - 1, 2: ib + 1, 3: walking in direction step
+    while True:
+        i = ib if phase == 0 else ib - 1 if phase == 1 else ib + 1 if phase == 2 else ib + step
+        gn = _g(ev, sg, j, i, zj, sid)
+        if phase == 0:
+            best = gn
+        elif phase == 1:
+            gl = gn
+        elif phase == 2:
+            if gl < best and gl <= gn:
+                step, ib, best = -1, ib - 1, gl
+            elif gn < best:
+                step, ib, best = 1, ib + 1, gn
+            else:
+                break
+        elif gn < best:
             ib, best = ib + step, gn
         else:
             break
+        phase = min(phase + 1, 3)
     return ib, best
+
+
+@numba.njit(cache=True, inline="always")
+def _known(gaps, i):
+    """The gap of profile point i that _descend evaluated in this slice (+inf off the grid, as _gap_at)."""
+    return gaps[i] if 0 <= i < gaps.shape[0] else np.inf
 
 
 @numba.njit(cache=True, inline="always")
@@ -299,32 +316,37 @@ def _line_parabola(ev, sg, j, zj, ib, best, sid):
     """The parabola q(x) = best + qa x + qb x^2 through the deepest point ib and its neighbours (the gap across a
     contact line is quadratic; the extended gap is one smooth surface across the worm's edges), blended towards its
     vertex, or at the active profile's end the one through the end and its two inner neighbours. Returns (qa, qb,
-    its vertex x, whether there is one, the neighbours' gaps gm, gp)."""
-    gm = _g(ev, sg, j, ib - 1, zj, sid)
-    gp = _g(ev, sg, j, ib + 1, zj, sid)
+    its vertex x, whether there is one, the neighbours' gaps gm, gp). The neighbours are _descend's (evaluated);
+    the point two steps on has one evaluation site for both cases."""
+    gaps = ev[6]
+    gm = _known(gaps, ib - 1)
+    gp = _known(gaps, ib + 1)
     qa, qb, x = 0.0, 0.0, 0.0
     par = gm < np.inf and gp < np.inf and gm - 2.0 * best + gp > 0.0
+    end = (gm == np.inf) != (gp == np.inf)
     if par:
         qa, qb = 0.5 * (gp - gm), 0.5 * (gm - 2.0 * best + gp)
         x = -qa / (2.0 * qb)
-        # blended with the parabola through the next three points towards the vertex, by lam = |x| (0 at the grid
-        # point, 1/2 where the deepest point passes to the neighbour: there both sides blend the same two
-        # parabolas), so the line's depth and point do not step when the deepest point moves on
         s1 = 1 if x > 0.0 else -1
-        g2 = _g(ev, sg, j, ib + 2 * s1, zj, sid)
-        qa2, qb2, _, ok2 = _end_parabola(best, gp if s1 > 0 else gm, g2, s1)
-        if ok2 and x != 0.0:
-            lam = min(abs(x), 0.5)
-            qa, qb = (1.0 - lam) * qa + lam * qa2, (1.0 - lam) * qb + lam * qb2
-            x = -qa / (2.0 * qb)
-    elif (gm == np.inf) != (gp == np.inf):
-        # the deepest point is the active profile's end: the parabola through it and its two inner neighbours (the
-        # one the central fit uses once the next point is deeper), its vertex clamped to the profile, so the line
-        # point moves continuously onto the end instead of jumping to it
+    else:
         s1 = 1 if gm == np.inf else -1
+    if par or end:
         g1 = gp if s1 > 0 else gm
         g2 = _g(ev, sg, j, ib + 2 * s1, zj, sid)
-        qa, qb, x, par = _end_parabola(best, g1, g2, s1)
+        if par:
+            # blended with the parabola through the next three points towards the vertex, by lam = |x| (0 at the
+            # grid point, 1/2 where the deepest point passes to the neighbour: there both sides blend the same two
+            # parabolas), so the line's depth and point do not step when the deepest point moves on
+            qa2, qb2, _, ok2 = _end_parabola(best, g1, g2, s1)
+            if ok2 and x != 0.0:
+                lam = min(abs(x), 0.5)
+                qa, qb = (1.0 - lam) * qa + lam * qa2, (1.0 - lam) * qb + lam * qb2
+                x = -qa / (2.0 * qb)
+        else:
+            # the deepest point is the active profile's end: the parabola through it and its two inner neighbours
+            # (the one the central fit uses once the next point is deeper), its vertex clamped to the profile, so
+            # the line point moves continuously onto the end instead of jumping to it
+            qa, qb, x, par = _end_parabola(best, g1, g2, s1)
     return qa, qb, x, par, gm, gp
 
 
