@@ -47,23 +47,8 @@ INSIDE_SHARE = 0.5 * (1.0 + 1e-3)  # line points deeper inside than this x the s
 
 
 @numba.njit(cache=True, inline="always")
-def _eval(x0, y0, zeta, ca, sa, theta1, P, out):
-    """Extended gap and excess (worm_gap_ext) of the wheel point (x0, y0, zeta) turned by the angle (cos ca, sin sa)
-    about z (assembly frame), and the turned point in out[3:6]. With a displaced pose in P
-    (wormsim.tooth.pose) the turned point is in the wheel body's frame and goes through the poses instead
-    (pose.to_static)."""
-    x, y = ca * x0 - sa * y0, sa * x0 + ca * y0
-    if P.shape[0] > N_WORM_PARAMS:
-        xs, ys, zs = to_static(x, y, zeta, P, out)
-    else:
-        out[3], out[4], out[5] = x, y, zeta
-        xs, ys, zs = y + P[10], -zeta, -x
-    return worm_gap_ext(xs, ys, zs, theta1, P, out)  # one inlined copy for both poses
-
-
-@numba.njit(cache=True, inline="always")
 def _excess(x0, y0, zeta, ca, sa, P, tmp):
-    """The excess alone (worm_gap_ext's second value, the same operations) of the wheel point of _eval: a square root,
+    """The excess alone (worm_gap_ext's second value, the same operations) of the wheel point of _g: a square root,
     no angle (the face slope needs no gap)."""
     x, y = ca * x0 - sa * y0, sa * x0 + ca * y0
     if P.shape[0] > N_WORM_PARAMS:
@@ -72,26 +57,6 @@ def _excess(x0, y0, zeta, ca, sa, P, tmp):
         xs, ys, zs = y + P[10], -zeta, -x
     r = math.sqrt(xs * xs + ys * ys)
     return max(r - P[3], P[2] - r, abs(zs) - P[4])
-
-
-@numba.njit(cache=True, inline="always")
-def _gap_at(xy, sg, j, i, zeta, ca, sa, theta1, P, tmp, gaps, exc, pts, nrs, stamp, sid):
-    """Extended gap of profile point i of (flank sg, slice j), evaluated once per slice (stamp[i] == sid) and kept in
-    gaps, exc (excess), pts, nrs; +inf off the grid and at points that are not active flank points."""
-    if i < 0 or i >= gaps.shape[0]:
-        return np.inf
-    if stamp[i] == sid:
-        return gaps[i]
-    stamp[i] = sid
-    x0 = xy[sg, j, i, 0]
-    if x0 != x0:
-        gaps[i], exc[i] = np.inf, np.inf
-        return np.inf
-    gv, ex = _eval(x0, xy[sg, j, i, 1], zeta, ca, sa, theta1, P, tmp)
-    gaps[i], exc[i] = gv, ex
-    pts[i, 0], pts[i, 1], pts[i, 2] = tmp[3], tmp[4], tmp[5]
-    nrs[i, 0], nrs[i, 1], nrs[i, 2] = tmp[0], tmp[1], tmp[2]
-    return gv
 
 
 @numba.njit(cache=True)
@@ -237,9 +202,35 @@ def _start_point(c, span, sg, j, target):
 
 @numba.njit(cache=True, inline="always")
 def _g(ev, sg, j, i, zj, sid):
-    """_gap_at with the tooth's evaluation context ev = (xy, ca, sa, theta1, P, tmp, gaps, exc, pts, nrs, stamp)."""
+    """Extended gap (worm_gap_ext) of profile point i of (flank sg, slice j) at the face position zj, with the tooth's
+    evaluation context ev = (xy, ca, sa, theta1, P, tmp, gaps, exc, pts, nrs, stamp): evaluated once per slice
+    (stamp[i] == sid) and kept in gaps, exc (excess), pts (the wheel point turned by the angle (cos ca, sin sa) about
+    z, assembly frame), nrs (the unit gradient, static worm frame); +inf off the grid and at points that are not
+    active flank points. With a displaced pose in P (wormsim.tooth.pose) the turned point is in the wheel body's frame
+    and goes through the poses (pose.to_static). One function level, as numba copies an inlined callee's IR (with its
+    own inlined callees) per call site and level."""
     xy, ca, sa, theta1, P, tmp, gaps, exc, pts, nrs, stamp = ev
-    return _gap_at(xy, sg, j, i, zj, ca, sa, theta1, P, tmp, gaps, exc, pts, nrs, stamp, sid)
+    if i < 0 or i >= gaps.shape[0]:
+        return np.inf
+    if stamp[i] == sid:
+        return gaps[i]
+    stamp[i] = sid
+    x0 = xy[sg, j, i, 0]
+    if x0 != x0:
+        gaps[i], exc[i] = np.inf, np.inf
+        return np.inf
+    y0 = xy[sg, j, i, 1]
+    x, y = ca * x0 - sa * y0, sa * x0 + ca * y0
+    if P.shape[0] > N_WORM_PARAMS:
+        xs, ys, zs = to_static(x, y, zj, P, tmp)
+    else:
+        tmp[3], tmp[4], tmp[5] = x, y, zj
+        xs, ys, zs = y + P[10], -zj, -x
+    gv, ex = worm_gap_ext(xs, ys, zs, theta1, P, tmp)
+    gaps[i], exc[i] = gv, ex
+    pts[i, 0], pts[i, 1], pts[i, 2] = tmp[3], tmp[4], tmp[5]
+    nrs[i, 0], nrs[i, 1], nrs[i, 2] = tmp[0], tmp[1], tmp[2]
+    return gv
 
 
 @numba.njit(cache=True, inline="always")
@@ -307,7 +298,7 @@ def _descend(ev, sg, j, zj, ib, sid):
 
 @numba.njit(cache=True, inline="always")
 def _known(gaps, i):
-    """The gap of profile point i that _descend evaluated in this slice (+inf off the grid, as _gap_at)."""
+    """The gap of profile point i that _descend evaluated in this slice (+inf off the grid, as _g)."""
     return gaps[i] if 0 <= i < gaps.shape[0] else np.inf
 
 
@@ -333,11 +324,11 @@ def _line_parabola(ev, sg, j, zj, ib, best, sid):
     if par or end:
         g1 = gp if s1 > 0 else gm
         g2 = _g(ev, sg, j, ib + 2 * s1, zj, sid)
+        qa2, qb2, x2, ok2 = _end_parabola(best, g1, g2, s1)
         if par:
             # blended with the parabola through the next three points towards the vertex, by lam = |x| (0 at the
             # grid point, 1/2 where the deepest point passes to the neighbour: there both sides blend the same two
             # parabolas), so the line's depth and point do not step when the deepest point moves on
-            qa2, qb2, _, ok2 = _end_parabola(best, g1, g2, s1)
             if ok2 and x != 0.0:
                 lam = min(abs(x), 0.5)
                 qa, qb = (1.0 - lam) * qa + lam * qa2, (1.0 - lam) * qb + lam * qb2
@@ -346,7 +337,7 @@ def _line_parabola(ev, sg, j, zj, ib, best, sid):
             # the deepest point is the active profile's end: the parabola through it and its two inner neighbours
             # (the one the central fit uses once the next point is deeper), its vertex clamped to the profile, so
             # the line point moves continuously onto the end instead of jumping to it
-            qa, qb, x, par = _end_parabola(best, g1, g2, s1)
+            qa, qb, x, par = qa2, qb2, x2, ok2
     return qa, qb, x, par, gm, gp
 
 
