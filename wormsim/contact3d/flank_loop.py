@@ -538,7 +538,9 @@ class FlankLoop:
         T = self.sample_table_for(pattern, store)
         con = d.contact
         own = self.dropped == 0  # d.contact's last fc.n entries are the kernel's contacts, in order
-        adr, efc, ncon, cone3 = con.efc_address, d.efc_force, d.ncon, fc.mu > 0  # the template's dim 3 (set_friction)
+        # the template's dim 3 (set_friction); efc_address as a contiguous int64 copy, run_samples' type (one
+        # compiled signature of sample_table)
+        adr, efc, ncon, cone3 = con.efc_address.astype(np.int64), d.efc_force, d.ncon, fc.mu > 0
         if fc.merge:  # the merged contacts' forces split over the slices (FlankContacts.slice_rows)
             adr, efc, _, _, cone3 = fc.slice_rows(d)
             ncon = n = len(adr)

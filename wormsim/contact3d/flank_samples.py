@@ -208,14 +208,17 @@ def run_samples(
         for k in range(ncon):
             adr[k] = _i32_at(cbase + k * size + o_adr)[0]
         efc = numba.carray(_f64_at(fptr[0]), (max(eptr[0], 0),))
-        a_s, e_s, nc, c3 = adr[:ncon], efc, ncon, cone3  # the contacts' rows (FlankContacts.slice_rows)
+        # the contacts' rows (FlankContacts.slice_rows), typed as FlankLoop.sample passes them (one compiled
+        # signature of sample_table: int64 counts, a non-literal bool)
+        a_s, e_s, nc, c3 = adr[:ncon], efc, np.int64(ncon), cone3
         if mrg is not None:  # one contact per tooth flank: the merged contacts' forces split over their slices
             grp, share, mfric, mwrap, adr_m, efc_m = mrg
             nh = min(ib[7], ncon)
             split_forces(adr[:ncon], efc, ncon - nh, cone3, grp, share, mfric, mwrap, n_fc, adr_m, efc_m)
             a_s, e_s, nc, c3 = adr_m[:n_fc], efc_m, n_fc, True
+        own = dropped == 0  # True here: d.contact's last entries are the kernel's contacts
         nteeth, pen2, fr, W, wr, pm, rm = sample_table(
-            Ts, a_s, frame, pos, True, e_s, pat_buf, r_buf, nc, n_fc, c3, th2, z2, g[G.a], i, g[G.e_star], pm, rm
+            Ts, a_s, frame, pos, own, e_s, pat_buf, r_buf, nc, n_fc, c3, th2, z2, g[G.a], i, g[G.e_star], pm, rm
         )
         if rne != 0:  # ShaftLog.record: the reactions, then the raw values
             _call_stage(rne, m_addr, d_addr)

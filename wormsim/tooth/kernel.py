@@ -47,22 +47,8 @@ INSIDE_SHARE = 0.5 * (1.0 + 1e-3)  # line points deeper inside than this x the s
 
 
 @numba.njit(cache=True, inline="always")
-def _eval(x0, y0, zeta, ca, sa, theta1, P, out):
-    """Extended gap and excess (worm_gap_ext) of the wheel point (x0, y0, zeta) turned by the angle (cos ca, sin sa)
-    about z (assembly frame), and the turned point in out[3:6]. With a displaced pose in P
-    (wormsim.tooth.pose) the turned point is in the wheel body's frame and goes through the poses instead
-    (pose.to_static)."""
-    x, y = ca * x0 - sa * y0, sa * x0 + ca * y0
-    if P.shape[0] > N_WORM_PARAMS:
-        xs, ys, zs = to_static(x, y, zeta, P, out)
-        return worm_gap_ext(xs, ys, zs, theta1, P, out)
-    out[3], out[4], out[5] = x, y, zeta
-    return worm_gap_ext(y + P[10], -zeta, -x, theta1, P, out)
-
-
-@numba.njit(cache=True, inline="always")
 def _excess(x0, y0, zeta, ca, sa, P, tmp):
-    """The excess alone (worm_gap_ext's second value, the same operations) of the wheel point of _eval: a square root,
+    """The excess alone (worm_gap_ext's second value, the same operations) of the wheel point of _g: a square root,
     no angle (the face slope needs no gap)."""
     x, y = ca * x0 - sa * y0, sa * x0 + ca * y0
     if P.shape[0] > N_WORM_PARAMS:
@@ -71,26 +57,6 @@ def _excess(x0, y0, zeta, ca, sa, P, tmp):
         xs, ys, zs = y + P[10], -zeta, -x
     r = math.sqrt(xs * xs + ys * ys)
     return max(r - P[3], P[2] - r, abs(zs) - P[4])
-
-
-@numba.njit(cache=True, inline="always")
-def _gap_at(xy, sg, j, i, zeta, ca, sa, theta1, P, tmp, gaps, exc, pts, nrs, stamp, sid):
-    """Extended gap of profile point i of (flank sg, slice j), evaluated once per slice (stamp[i] == sid) and kept in
-    gaps, exc (excess), pts, nrs; +inf off the grid and at points that are not active flank points."""
-    if i < 0 or i >= gaps.shape[0]:
-        return np.inf
-    if stamp[i] == sid:
-        return gaps[i]
-    stamp[i] = sid
-    x0 = xy[sg, j, i, 0]
-    if x0 != x0:
-        gaps[i], exc[i] = np.inf, np.inf
-        return np.inf
-    gv, ex = _eval(x0, xy[sg, j, i, 1], zeta, ca, sa, theta1, P, tmp)
-    gaps[i], exc[i] = gv, ex
-    pts[i, 0], pts[i, 1], pts[i, 2] = tmp[3], tmp[4], tmp[5]
-    nrs[i, 0], nrs[i, 1], nrs[i, 2] = tmp[0], tmp[1], tmp[2]
-    return gv
 
 
 @numba.njit(cache=True)
@@ -236,9 +202,35 @@ def _start_point(c, span, sg, j, target):
 
 @numba.njit(cache=True, inline="always")
 def _g(ev, sg, j, i, zj, sid):
-    """_gap_at with the tooth's evaluation context ev = (xy, ca, sa, theta1, P, tmp, gaps, exc, pts, nrs, stamp)."""
+    """Extended gap (worm_gap_ext) of profile point i of (flank sg, slice j) at the face position zj, with the tooth's
+    evaluation context ev = (xy, ca, sa, theta1, P, tmp, gaps, exc, pts, nrs, stamp): evaluated once per slice
+    (stamp[i] == sid) and kept in gaps, exc (excess), pts (the wheel point turned by the angle (cos ca, sin sa) about
+    z, assembly frame), nrs (the unit gradient, static worm frame); +inf off the grid and at points that are not
+    active flank points. With a displaced pose in P (wormsim.tooth.pose) the turned point is in the wheel body's frame
+    and goes through the poses (pose.to_static). One function level, as numba copies an inlined callee's IR (with its
+    own inlined callees) per call site and level."""
     xy, ca, sa, theta1, P, tmp, gaps, exc, pts, nrs, stamp = ev
-    return _gap_at(xy, sg, j, i, zj, ca, sa, theta1, P, tmp, gaps, exc, pts, nrs, stamp, sid)
+    if i < 0 or i >= gaps.shape[0]:
+        return np.inf
+    if stamp[i] == sid:
+        return gaps[i]
+    stamp[i] = sid
+    x0 = xy[sg, j, i, 0]
+    if x0 != x0:
+        gaps[i], exc[i] = np.inf, np.inf
+        return np.inf
+    y0 = xy[sg, j, i, 1]
+    x, y = ca * x0 - sa * y0, sa * x0 + ca * y0
+    if P.shape[0] > N_WORM_PARAMS:
+        xs, ys, zs = to_static(x, y, zj, P, tmp)
+    else:
+        tmp[3], tmp[4], tmp[5] = x, y, zj
+        xs, ys, zs = y + P[10], -zj, -x
+    gv, ex = worm_gap_ext(xs, ys, zs, theta1, P, tmp)
+    gaps[i], exc[i] = gv, ex
+    pts[i, 0], pts[i, 1], pts[i, 2] = tmp[3], tmp[4], tmp[5]
+    nrs[i, 0], nrs[i, 1], nrs[i, 2] = tmp[0], tmp[1], tmp[2]
+    return gv
 
 
 @numba.njit(cache=True, inline="always")
@@ -276,22 +268,38 @@ def _slice_contact(ev, span, zeta, sg, j, k, i_s, sid, taper, memo_row, out, n):
 @numba.njit(cache=True, inline="always")
 def _descend(ev, sg, j, zj, ib, sid):
     """From profile point ib down along the profile to the minimum of the extended gap (one minimum per slice: the
-    gap across a contact line is quadratic); returns (its index, its gap), the gap +inf where there is none."""
-    best = _g(ev, sg, j, ib, zj, sid)
+    gap across a contact line is quadratic); returns (its index, its gap), the gap +inf where there is none. The
+    points ib, ib - 1, ib + 1, then the next ones in the falling direction, from one evaluation site in a loop (each
+    inlined _g is a copy of the gap's evaluation to compile)."""
+    best = gl = np.inf
     step = 0
-    gl = _g(ev, sg, j, ib - 1, zj, sid)
-    gr = _g(ev, sg, j, ib + 1, zj, sid)
-    if gl < best and gl <= gr:
-        step, ib, best = -1, ib - 1, gl
-    elif gr < best:
-        step, ib, best = 1, ib + 1, gr
-    while step != 0:
-        gn = _g(ev, sg, j, ib + step, zj, sid)
-        if gn < best:
+    phase = 0  # 0: ib, 1: ib - 1, 2: ib + 1, 3: walking in direction step
+    while True:
+        i = ib if phase == 0 else ib - 1 if phase == 1 else ib + 1 if phase == 2 else ib + step
+        gn = _g(ev, sg, j, i, zj, sid)
+        if phase == 0:
+            best = gn
+        elif phase == 1:
+            gl = gn
+        elif phase == 2:
+            if gl < best and gl <= gn:
+                step, ib, best = -1, ib - 1, gl
+            elif gn < best:
+                step, ib, best = 1, ib + 1, gn
+            else:
+                break
+        elif gn < best:
             ib, best = ib + step, gn
         else:
             break
+        phase = min(phase + 1, 3)
     return ib, best
+
+
+@numba.njit(cache=True, inline="always")
+def _known(gaps, i):
+    """The gap of profile point i that _descend evaluated in this slice (+inf off the grid, as _g)."""
+    return gaps[i] if 0 <= i < gaps.shape[0] else np.inf
 
 
 @numba.njit(cache=True, inline="always")
@@ -299,32 +307,37 @@ def _line_parabola(ev, sg, j, zj, ib, best, sid):
     """The parabola q(x) = best + qa x + qb x^2 through the deepest point ib and its neighbours (the gap across a
     contact line is quadratic; the extended gap is one smooth surface across the worm's edges), blended towards its
     vertex, or at the active profile's end the one through the end and its two inner neighbours. Returns (qa, qb,
-    its vertex x, whether there is one, the neighbours' gaps gm, gp)."""
-    gm = _g(ev, sg, j, ib - 1, zj, sid)
-    gp = _g(ev, sg, j, ib + 1, zj, sid)
+    its vertex x, whether there is one, the neighbours' gaps gm, gp). The neighbours are _descend's (evaluated);
+    the point two steps on has one evaluation site for both cases."""
+    gaps = ev[6]
+    gm = _known(gaps, ib - 1)
+    gp = _known(gaps, ib + 1)
     qa, qb, x = 0.0, 0.0, 0.0
     par = gm < np.inf and gp < np.inf and gm - 2.0 * best + gp > 0.0
+    end = (gm == np.inf) != (gp == np.inf)
     if par:
         qa, qb = 0.5 * (gp - gm), 0.5 * (gm - 2.0 * best + gp)
         x = -qa / (2.0 * qb)
-        # blended with the parabola through the next three points towards the vertex, by lam = |x| (0 at the grid
-        # point, 1/2 where the deepest point passes to the neighbour: there both sides blend the same two
-        # parabolas), so the line's depth and point do not step when the deepest point moves on
         s1 = 1 if x > 0.0 else -1
-        g2 = _g(ev, sg, j, ib + 2 * s1, zj, sid)
-        qa2, qb2, _, ok2 = _end_parabola(best, gp if s1 > 0 else gm, g2, s1)
-        if ok2 and x != 0.0:
-            lam = min(abs(x), 0.5)
-            qa, qb = (1.0 - lam) * qa + lam * qa2, (1.0 - lam) * qb + lam * qb2
-            x = -qa / (2.0 * qb)
-    elif (gm == np.inf) != (gp == np.inf):
-        # the deepest point is the active profile's end: the parabola through it and its two inner neighbours (the
-        # one the central fit uses once the next point is deeper), its vertex clamped to the profile, so the line
-        # point moves continuously onto the end instead of jumping to it
+    else:
         s1 = 1 if gm == np.inf else -1
+    if par or end:
         g1 = gp if s1 > 0 else gm
         g2 = _g(ev, sg, j, ib + 2 * s1, zj, sid)
-        qa, qb, x, par = _end_parabola(best, g1, g2, s1)
+        qa2, qb2, x2, ok2 = _end_parabola(best, g1, g2, s1)
+        if par:
+            # blended with the parabola through the next three points towards the vertex, by lam = |x| (0 at the
+            # grid point, 1/2 where the deepest point passes to the neighbour: there both sides blend the same two
+            # parabolas), so the line's depth and point do not step when the deepest point moves on
+            if ok2 and x != 0.0:
+                lam = min(abs(x), 0.5)
+                qa, qb = (1.0 - lam) * qa + lam * qa2, (1.0 - lam) * qb + lam * qb2
+                x = -qa / (2.0 * qb)
+        else:
+            # the deepest point is the active profile's end: the parabola through it and its two inner neighbours
+            # (the one the central fit uses once the next point is deeper), its vertex clamped to the profile, so
+            # the line point moves continuously onto the end instead of jumping to it
+            qa, qb, x, par = qa2, qb2, x2, ok2
     return qa, qb, x, par, gm, gp
 
 
@@ -541,8 +554,8 @@ def _take(buf, o, shape):
 @numba.njit(cache=True, inline="always")
 def _views(fb, ib):
     """The packed buffers' fields as views (_layout at the sizes in ib's header): the float fields in _F_FIELDS
-    order, the int fields in _I_FIELDS order. PackedKernel's numpy fields and find_packed's unpacking both come
-    from here."""
+    order, the int fields in _I_FIELDS order: find_packed's unpacking (PackedKernel cuts its numpy fields by the
+    same _layout in Python, `_cut`)."""
     f, i = _layout(ib[0], ib[1], ib[2], ib[3], ib[4], ib[5])
     o = 0
     xy, o = _take(fb, o, f[0])
@@ -587,6 +600,17 @@ def _size(shapes) -> int:
     return sum(int(np.prod(sh)) for sh in shapes)
 
 
+def _cut(buf: np.ndarray, o: int, shapes) -> list[np.ndarray]:
+    """buf's fields of these shapes from offset o on, as numpy views (_take's cut, in Python: PackedKernel's fields
+    without compiling `_views` as an entry point of its own)."""
+    views = []
+    for sh in shapes:
+        k = int(np.prod(sh))
+        views.append(buf[o : o + k].reshape(sh))
+        o += k
+    return views
+
+
 class PackedKernel:
     """The kernel's inputs, outputs, memo and work arrays in one float and one int buffer, so that one compiled call,
     find_packed(fb, ib, theta1, theta2, margin, taper_rad), runs find_contacts, slice_weights and contact_frames:
@@ -602,8 +626,8 @@ class PackedKernel:
         self.fb = np.zeros(_size(fs))
         self.ib = np.zeros(_I_HEADER + _size(is_), dtype=np.int64)
         self.ib[:7] = (S, N, cap, len(P), W, z2, int(merge))
-        floats, ints = _views(self.fb, self.ib)
-        for name, v in zip(_F_FIELDS + _I_FIELDS, floats + ints, strict=True):
+        views = _cut(self.fb, 0, fs) + _cut(self.ib, _I_HEADER, is_)
+        for name, v in zip(_F_FIELDS + _I_FIELDS, views, strict=True):
             setattr(self, name, v)
         self.xy[:], self.c[:], self.c_range[:], self.zeta[:] = grid.xy, grid.c, grid.c_range, grid.zeta
         self.span[:] = grid.span

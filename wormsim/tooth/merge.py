@@ -25,6 +25,7 @@ from __future__ import annotations
 import math
 
 import numba
+import numpy as np
 
 
 @numba.njit(cache=True)
@@ -35,7 +36,7 @@ def merge_flanks(meta, n, pos, nrm, depth, weight, grp, share, mpos, mnrm, mdept
     direction, a point on the wheel axis, its direction, the wheel's speed per worm speed): the hinges for the
     moment-arm and friction corrections (module docstring). Returns the number of merged contacts."""
     g = 0
-    i = 0
+    i = np.int64(0)  # not a literal: _match_arms compiles once (int64), not also for Literal[int](0)
     while i < n:
         e = i + 1
         while e < n and meta[e, 0] == meta[i, 0] and meta[e, 1] == meta[i, 1]:
