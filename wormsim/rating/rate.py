@@ -191,12 +191,26 @@ def rate(scenario: Scenario) -> dict:
         "mean Hertz stress at T2 = K_A T2,nom", iso.PORT,
     )  # fmt: skip
 
-    # --- friction and efficiency
+    out["contact_stress_mean_iso_mpa"] = sigma_hm
+    mu, eta = _friction(f, r, mat, v_gm, gamma, q, z2, x2, u, b2h, m_x, a)
+    out["friction_iso"], out["efficiency_iso"] = mu, eta
+    out["safety_pitting"] = _pitting(f, r, mat, v_gm, a, sigma_hm)
+    out["safety_wear"] = _wear(f, r, u, gamma, sigma_hm, a, e_red, n1, m_x, v_gm, warnings)
+    f_tm2, out["safety_root"] = _root(f, geo, mat, t2, d2, b2h, m_x, gamma)
+    out["safety_deflection"] = _deflection(f, r, geo, f_tm2, gamma, mu, e1, m_x, warnings)
+    out["oil_temperature_c"], out["safety_temperature"] = _temperature(f, r, a, n1, d1, t2, u, eta)
+
+    _agma(out, f, geo, n1, t2, r, mat, warnings)
+    return _finish(out, f, inputs, warnings)
+
+
+def _friction(f: Factors, r: Rating, mat: WheelMaterial, v_gm, gamma, q, z2, x2, u, b2h, m_x, a) -> tuple:
+    """Friction and efficiency: mu_zm = mu_0T Y_S Y_G Y_W Y_R and the mesh efficiencies; returns (mu_zm, eta_z)."""
+    grey = mat.kind == "grey_iron"
     h_star = f.add(
         "h_star", "h*", iso.film_thickness_factor(q, z2, x2, u, b2h, m_x), "-",
         "dimensionless mean film thickness (DIN 3996:1998 fit)", iso.PORT,
     )  # fmt: skip
-    grey = mat.kind == "grey_iron"
     mu_0t = f.add(
         "mu_0t", "mu_0T", iso.base_friction(v_gm, r.lubricant, grey), "-",
         "base friction of the test gear" + (" (grey cast-iron fit)" if grey else f" (tin bronze, {r.lubricant} oil)"),
@@ -221,11 +235,11 @@ def rate(scenario: Scenario) -> dict:
         "efficiency_iso_wheel_driving", "eta_z'", iso.efficiency_wheel_driving(gamma, mu), "-",
         "mesh efficiency, wheel driving (0: self-locking)", iso.PORT,
     )  # fmt: skip
-    out["contact_stress_mean_iso_mpa"] = sigma_hm
-    out["friction_iso"] = mu
-    out["efficiency_iso"] = eta
+    return mu, eta
 
-    # --- pitting
+
+def _pitting(f: Factors, r: Rating, mat: WheelMaterial, v_gm, a, sigma_hm) -> float:
+    """Pitting: S_H = sigma_HG / sigma_Hm."""
     z_h = f.add("z_h", "Z_h", iso.pitting_life_factor(r.life_h), "-", "life factor (pitting)", iso.PORT)
     z_v = f.add("z_v", "Z_v", iso.pitting_speed_factor(v_gm), "-", "speed factor (pitting)", iso.PORT)
     z_s = f.add("z_s", "Z_s", iso.pitting_size_factor(a), "-", "size factor (pitting)", iso.PORT)
@@ -242,9 +256,11 @@ def rate(scenario: Scenario) -> dict:
         "sigma_hg_mpa", "sigma_HG", iso.pitting_limit_mpa(mat.sigma_hlim_t_mpa, z_h, z_v, z_s, z_u, z_oil), "MPa",
         "permissible mean Hertz stress", iso.PORT,
     )  # fmt: skip
-    out["safety_pitting"] = f.add("safety_pitting", "S_H", sigma_hg / sigma_hm, "-", "sigma_HG / sigma_Hm", iso.PORT)
+    return f.add("safety_pitting", "S_H", sigma_hg / sigma_hm, "-", "sigma_HG / sigma_Hm", iso.PORT)
 
-    # --- wear
+
+def _wear(f: Factors, r: Rating, u, gamma, sigma_hm, a, e_red, n1, m_x, v_gm, warnings: list[str]) -> float | None:
+    """Wear: S_W = delta_Wlim,n / delta_Wn, None without rating.wear_intensity (J_W's tables are not public)."""
     s_star = f.add("s_star", "s*", iso.sliding_path_factor(u, gamma), "-", "sliding path factor", iso.PORT)
     n_l = f.add("n_l", "N_L", iso.wheel_load_cycles(r.life_h, n1, u), "-", "wheel revolutions over the life", iso.PORT)
     s_wm = f.add(
@@ -263,14 +279,18 @@ def rate(scenario: Scenario) -> dict:
     if r.wear_intensity is not None:
         j_w = f.add("j_w", "J_W", r.wear_intensity, "-", "wear intensity (input)", "rating.wear_intensity")
         d_wn = f.add("wear_depth_mm", "delta_Wn", j_w * s_wm, "mm", "flank wear over the life", iso.PORT)
-        out["safety_wear"] = f.add("safety_wear", "S_W", d_wlim / d_wn, "-", "delta_Wlim,n / delta_Wn", iso.PORT)
+        return f.add("safety_wear", "S_W", d_wlim / d_wn, "-", "delta_Wlim,n / delta_Wn", iso.PORT)
     else:
         warnings.append(
             "safety_wear not given: the wear intensity J_W comes from DIN 3996 tables that are not public; give "
             "rating.wear_intensity"
         )
+    return None
 
-    # --- tooth root (the wheel tooth's root thickness from the mid-plane section: s_f2 = s2 + 2 h_f tan(alpha_x))
+
+def _root(f: Factors, geo, mat: WheelMaterial, t2, d2, b2h, m_x, gamma) -> tuple:
+    """Tooth root (the wheel tooth's root thickness from the mid-plane section: s_f2 = s2 + 2 h_f tan(alpha_x)):
+    returns (F_tm2, S_F = tau_FG / tau_F)."""
     f_tm2 = f.add(
         "f_tm2_n", "F_tm2", iso.wheel_tangential_force_n(t2, d2), "N", "wheel tangential force at T2", iso.PORT
     )
@@ -294,9 +314,11 @@ def rate(scenario: Scenario) -> dict:
         "tau_fg_mpa", "tau_FG", mat.tau_flim_t_mpa, "MPa",
         "permissible root shear stress = tau_FlimT (life and size factors taken as 1: not public)", mat.source,
     )  # fmt: skip
-    out["safety_root"] = f.add("safety_root", "S_F", tau_fg / tau_f, "-", "tau_FG / tau_F", iso.PORT)
+    return f_tm2, f.add("safety_root", "S_F", tau_fg / tau_f, "-", "tau_FG / tau_F", iso.PORT)
 
-    # --- worm deflection
+
+def _deflection(f: Factors, r: Rating, geo, f_tm2, gamma, mu, e1, m_x, warnings: list[str]) -> float:
+    """Worm deflection: S_delta = delta_lim / delta_m."""
     span = r.worm_bearing_span_mm if r.worm_bearing_span_mm is not None else 2.0 * geo.worm_length * MM_PER_M
     if r.worm_bearing_span_mm is None:
         warnings.append(
@@ -314,9 +336,11 @@ def rate(scenario: Scenario) -> dict:
         "worm deflection at the mesh", iso.PORT,
     )  # fmt: skip
     d_lim = f.add("deflection_limit_mm", "delta_lim", iso.deflection_limit_mm(m_x), "mm", "0.04 sqrt(m_x)", iso.PORT)
-    out["safety_deflection"] = f.add("safety_deflection", "S_delta", d_lim / d_m, "-", "delta_lim / delta_m", iso.PORT)
+    return f.add("safety_deflection", "S_delta", d_lim / d_m, "-", "delta_lim / delta_m", iso.PORT)
 
-    # --- losses and oil sump temperature (splash lubrication, AGMA housing heat balance)
+
+def _temperature(f: Factors, r: Rating, a, n1, d1, t2, u, eta) -> tuple:
+    """Losses and oil sump temperature (splash lubrication, AGMA housing heat balance): returns (theta_S, S_T)."""
     p_v0 = f.add("idle_loss_w", "P_V0", iso.idle_loss_w(a, n1), "W", "no-load loss", iso.PORT)
     p_vd = f.add("seal_loss_w", "P_VD", 2.0 * iso.seal_loss_w(d1, n1), "W", "two worm shaft seals", iso.PORT)
     p_vz = f.add("mesh_loss_w", "P_Vz", iso.mesh_loss_w(t2, n1, u, eta), "W", "mesh loss at T2", iso.PORT)
@@ -336,13 +360,7 @@ def rate(scenario: Scenario) -> dict:
     theta_lim = f.add(
         "theta_slim_c", "theta_Slim", THETA_SLIM_C[r.lubricant], "C", "permissible sump temperature", iso.PORT
     )
-    out["oil_temperature_c"] = theta_s
-    out["safety_temperature"] = f.add(
-        "safety_temperature", "S_T", theta_lim / theta_s, "-", "theta_Slim / theta_S", iso.PORT
-    )
-
-    _agma(out, f, geo, n1, t2, r, mat, warnings)
-    return _finish(out, f, inputs, warnings)
+    return theta_s, f.add("safety_temperature", "S_T", theta_lim / theta_s, "-", "theta_Slim / theta_S", iso.PORT)
 
 
 def _agma(out: dict, f: Factors, geo, n1: float, t2: float, r: Rating, mat: WheelMaterial, warnings: list[str]):
