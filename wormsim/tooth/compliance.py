@@ -362,13 +362,14 @@ def _moduli(materials) -> tuple[float, float, float, float]:
     return h.youngs_modulus_gpa * 1e9, h.poisson_ratio, w.youngs_modulus_gpa * 1e9, w.poisson_ratio
 
 
-def compute(g: GearGeometry, materials, density: int = 1) -> ToothCompliance:
-    """The FE models and the grid (module docstring)."""
+def compute(g: GearGeometry, materials, density: int = 1, teeth: int = TEETH) -> ToothCompliance:
+    """The FE models and the grid (module docstring); teeth: the wheel sector's teeth (1 for the study of the
+    neighbours' effect)."""
     from wormsim.gear_theory import effective_modulus_pa
 
     t0 = time.perf_counter()
     e2, nu2, e1, nu1 = _moduli(materials)
-    wh = wheel_influence(g, e2, nu2, density)
+    wh = wheel_influence(g, e2, nu2, density, teeth)
     wo = worm_compliance(g, e1, nu1, density)
     return ToothCompliance(
         zeta_m=wh["zeta"], s=wh["s"], points_m=wh["points"], wheel_m_per_n=wh["influence"],

@@ -173,15 +173,18 @@ def _at_angle(g, comp, fld, gen, theta2: float, torque: float, side: int, e_star
     return F, e, (P, arm, ds, k), q, hertz_line_pressure_pa(q, e_star, inv_rho)
 
 
-def compute(g: GearGeometry, materials, torque_nm: float, samples: int, side: int, density: int) -> LTCAResult:
-    """(1) at `samples` worm angles over one mesh cycle (module docstring)."""
+def compute(
+    g: GearGeometry, materials, torque_nm: float, samples: int, side: int, density: int, comp=None
+) -> LTCAResult:
+    """(1) at `samples` worm angles over one mesh cycle (module docstring); comp: a ToothCompliance to use instead of
+    tooth_compliance(g, materials, density) (for studies of its parts)."""
     import contourpy
 
     from wormsim.gear_theory import effective_modulus_pa
     from wormsim.tooth import mesh_stiffness as ms
     from wormsim.tooth.compliance import tooth_compliance
 
-    comp = tooth_compliance(g, materials, density)
+    comp = tooth_compliance(g, materials, density) if comp is None else comp
     e_star = effective_modulus_pa(materials)
     fld = ms._flank_field(g, side)
     gen = contourpy.contour_generator(z=fld.c, name="serial", corner_mask=True)
