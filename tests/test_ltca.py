@@ -85,3 +85,13 @@ def test_refuses_deviations(screw_jack):
     sc, g = screw_jack
     with pytest.raises(NotImplementedError):
         ltca.loaded_contact(g, sc.materials, 12.0, deviations=object())
+
+
+def test_flank_sides_mirror(screw_jack):
+    """The reverse flank (side -1) is the working flank mirrored in the face (a symmetric thread and tooth): the same
+    stiffness and shares, with the compliance grid read mirrored (ToothCompliance.kernel)."""
+    sc, g = screw_jack
+    fwd = ltca.loaded_contact(g, sc.materials, 12.0, side=1).summary()
+    rev = ltca.loaded_contact(g, sc.materials, 12.0, side=-1).summary()
+    for key, value in fwd.items():
+        assert rev[key] == pytest.approx(value, rel=1e-6), key
