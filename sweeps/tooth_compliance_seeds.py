@@ -25,6 +25,17 @@ from wormsim.tooth import compliance, ltca, mesh_stiffness
 
 ROOT = Path(__file__).resolve().parents[1]
 SEEDS = ("seat_motor", "screw_jack", "involute_41")
+# wheel materials on the screw jack's gear (steel worm 210 GPa, 0.269): (E GPa, nu, source)
+MATERIALS = {
+    "steel": (210.0, 0.3, "steel"),
+    "GJS-400": (175.0, 0.3, "wormsim.rating.materials (DIN 3996 via MITCalc)"),
+    "CuAl10Fe5Ni5": (122.6, 0.35, "wormsim.rating.materials"),
+    "GJL-250": (98.1, 0.3, "wormsim.rating.materials"),
+    "CuSn12": (88.3, 0.35, "wormsim.rating.materials (KISSsoft report)"),
+    "POM": (3.1, 0.39, "seed 001 (scenarios/seat_motor.yaml)"),
+    "PA66": (2.8, 0.4, "typical dry PA66 datasheet value, an assumption (no source in the repository)"),
+}
+GRID_FINE = (13, 7)  # the flank grid's refinement check
 
 
 def main() -> None:
@@ -70,8 +81,23 @@ def main() -> None:
         "mesh_stiffness_one_tooth_n_per_m": float(np.mean(one.mesh_stiffness_n_per_m)),
         "mesh_stiffness_worm_thread_rigid_n_per_m": float(np.mean(no_worm.mesh_stiffness_n_per_m)),
     }
-    print(parts)
-    print(record("tooth_compliance_seeds", {"runs": runs, "screw_jack_parts": parts}))
+    # the flank grid refined (13 x 7 instead of 9 x 5)
+    saved = (compliance.GRID_FACE, compliance.GRID_PROFILE)
+    compliance.GRID_FACE, compliance.GRID_PROFILE = GRID_FINE
+    try:
+        fine = ltca.compute(g, sc.materials, 12.0, 16, 1, 1, comp=compliance.compute(g, sc.materials, 1))
+    finally:
+        compliance.GRID_FACE, compliance.GRID_PROFILE = saved
+    parts["mesh_stiffness_grid_13x7_n_per_m"] = float(np.mean(fine.mesh_stiffness_n_per_m))
+    print(parts, flush=True)
+    mats = {}
+    for name, (e_gpa, nu, source) in MATERIALS.items():
+        m = sc.materials.model_copy(deep=True)
+        m.wheel.youngs_modulus_gpa, m.wheel.poisson_ratio = e_gpa, nu
+        r = ltca.loaded_contact(g, m, 12.0)
+        mats[name] = {"wheel_e_gpa": e_gpa, "wheel_nu": nu, "source": source, **r.summary()}
+        print(name, mats[name], flush=True)
+    print(record("tooth_compliance_seeds", {"runs": runs, "screw_jack_parts": parts, "screw_jack_materials": mats}))
 
 
 if __name__ == "__main__":

@@ -727,9 +727,30 @@ def tooth_compliance_seeds_table(name: str = "tooth_compliance_seeds") -> str:
     note = (
         f"\nStiffness per width in N/(mm um). Screw jack, the FE model's parts: one wheel tooth instead of three "
         f"{parts['mesh_stiffness_one_tooth_n_per_m'] / base:.3f} x the mean k_mesh, the worm thread rigid "
-        f"{parts['mesh_stiffness_worm_thread_rigid_n_per_m'] / base:.3f} x.\n"
+        f"{parts['mesh_stiffness_worm_thread_rigid_n_per_m'] / base:.3f} x"
     )
-    return _table(head, rows) + note + "\n" + _source(name)
+    if "mesh_stiffness_grid_13x7_n_per_m" in parts:
+        note += f", the flank grid 13 x 7 instead of 9 x 5 {parts['mesh_stiffness_grid_13x7_n_per_m'] / base:.3f} x"
+    return _table(head, rows) + note + ".\n\n" + _source(name)
+
+
+def tooth_compliance_materials_table(name: str = "tooth_compliance_seeds") -> str:
+    """The LTCA on the screw jack's gear with each wheel material (sweeps/tooth_compliance_seeds.py)."""
+    mats = load(name)["screw_jack_materials"]
+    ref = mats["CuSn12"]["mesh_stiffness_mean_n_per_m"]
+    rows = [
+        [
+            f"{k} ({m['wheel_e_gpa']:g} GPa, {m['wheel_nu']:g})",
+            f"{m['mesh_stiffness_per_width_n_per_mm_um']:.3g}",
+            f"{m['mesh_stiffness_mean_n_per_m'] / ref:.3f}",
+            f"{m['load_share_max']:.3f}",
+            f"{m['transmission_error_loaded_p2p_urad']:.3g}",
+            m["source"],
+        ]
+        for k, m in mats.items()
+    ]
+    head = ["wheel", "k_mesh / b2 (N/(mm um))", "k / k(CuSn12)", "load share max", "loaded TE p2p (urad)", "E, nu from"]
+    return _table(head, rows) + "\n" + _source(name)
 
 
 def cli_wall_table(name: str = "cli_wall") -> str:
@@ -873,6 +894,7 @@ TABLES: dict[str, Callable[[], str]] = {
     "torsional_samples": torsional_samples_table,
     "mesh_stiffness_seeds": mesh_stiffness_seeds_table,
     "tooth_compliance_seeds": tooth_compliance_seeds_table,
+    "tooth_compliance_materials": tooth_compliance_materials_table,
     "contact_pattern": contact_pattern_table,
     "ci_seeds": ci_seeds_table,
     "errors_shaft_angle": errors_shaft_angle_table,
