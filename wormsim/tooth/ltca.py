@@ -43,7 +43,7 @@ from meshgen import wheel
 from meshgen.cache import cached
 from meshgen.geometry import GearGeometry
 
-CODE_VERSION = "ltca-2"
+CODE_VERSION = "ltca-3"
 SEGMENTS_PER_WIDTH = 24  # contact-line segments per face width
 FLATTENING_ITERATIONS = 6  # secant iterations of the nonlinear flattening
 MIN_PIECE_WIDTHS = 0.01  # contact-line pieces shorter than this share of b2 are left out
@@ -51,9 +51,10 @@ MIN_PIECE_WIDTHS = 0.01  # contact-line pieces shorter than this share of b2 are
 
 @dataclass(frozen=True)
 class Contacts:
-    """The loaded segments at one worm angle (wheel frame, the flank of space k: wormsim.tooth.mesh_stiffness)."""
+    """The loaded segments at one worm angle, in the wheel-fixed frame (meshgen.wheel's: tooth k is tooth 0 turned by
+    2 pi k / z2; the wheel itself stands at theta2 then)."""
 
-    points_m: np.ndarray  # (k, 3)
+    points_m: np.ndarray  # (k, 3) on the flank of space k (wormsim.tooth.mesh_stiffness)
     tooth: np.ndarray  # (k,) space index k
     length_m: np.ndarray  # (k,) ds
     arm_m: np.ndarray  # (k,)
@@ -70,7 +71,7 @@ class LTCAResult:
     te_loaded_rad: np.ndarray  # (N,)
     mesh_stiffness_n_per_m: np.ndarray  # (N,)
     load_share: np.ndarray  # (N, T) per wheel tooth (columns: teeth[] below)
-    teeth: np.ndarray  # (T,) the space index k of each column at theta1 = 0
+    teeth: np.ndarray  # (T,) the wheel-fixed space index k of each column (space k's flank carries)
     teeth_in_contact: np.ndarray  # (N,)
     contacts: tuple  # (N,) Contacts
     arm0_m: float
@@ -196,11 +197,14 @@ def compute(
         theta2 = g.hand * t1 * g.z1 / g.z2
         F, e, (P, arm, ds, k), q, p = _at_angle(g, comp, fld, gen, theta2, torque_nm, side, e_star)
         te.append(e)
-        # the tooth of space k at theta1 is the tooth of space k + n at theta1 + n periods: label by k at theta1 = 0
         share = {int(kk): float(np.sum((F * arm)[k == kk]) / torque_nm) for kk in np.unique(k)}
         shares.append(share)
         n_teeth.append(sum(1 for v in share.values() if v > 0))
-        contacts.append(Contacts(P, k, ds, arm, q, p))
+        turn = k * 2 * math.pi / g.z2  # the field's space-0 point -> the same point of space k
+        Pk = np.stack(
+            [P[:, 0] * np.cos(turn) - P[:, 1] * np.sin(turn), P[:, 0] * np.sin(turn) + P[:, 1] * np.cos(turn)]
+        )
+        contacts.append(Contacts(np.column_stack([Pk.T, P[:, 2]]), k, ds, arm, q, p))
     teeth = np.array(sorted({kk for sh in shares for kk in sh}))
     load_share = np.array([[sh.get(int(kk), 0.0) for kk in teeth] for sh in shares])
     te_arr = np.array(te)
