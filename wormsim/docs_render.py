@@ -731,6 +731,11 @@ def tooth_compliance_seeds_table(name: str = "tooth_compliance_seeds") -> str:
     )
     if "mesh_stiffness_grid_13x7_n_per_m" in parts:
         note += f", the flank grid 13 x 7 instead of 9 x 5 {parts['mesh_stiffness_grid_13x7_n_per_m'] / base:.3f} x"
+    if "mesh_stiffness_at_4x_load_n_per_m" in parts:
+        note += (
+            f"; at a quarter of its 12 N m {parts['mesh_stiffness_at_0.25x_load_n_per_m'] / base:.3f} x, at 4 times "
+            f"{parts['mesh_stiffness_at_4x_load_n_per_m'] / base:.3f} x (the flattening)"
+        )
     return _table(head, rows) + note + ".\n\n" + _source(name)
 
 
