@@ -522,11 +522,16 @@ def _support(rd: _Reader, shaft: Component, gear: Component, part: str, notes) -
     rigid = RIGID_N_PER_M * 1e-6
     if kr and min(kr) < rigid:
         sup["radial_stiffness_n_per_um"] = _r(min(kr))
+        rd.sources[f"shafts.{part}.radial_stiffness_n_per_um"] = "the bearings' radial_stiffness (N / m)"
         if max(kr) != min(kr):
             notes.append(f"shaft[{shaft.id}]: bearing radial stiffnesses {kr} N/um differ; the smaller is used")
     if ka and min(ka) < rigid:
         sup["axial_stiffness_n_per_um"] = _r(ka[sup["locating_bearing"]] if len(ka) == 2 else min(ka))
+        rd.sources[f"shafts.{part}.axial_stiffness_n_per_um"] = "the locating bearing's axial_stiffness (N / m)"
     rd.sources[f"shafts.{part}"] = ", ".join(f"{b.type}[{b.id}]" for b in bearings) + f" on shaft[{shaft.id}]"
+    rd.sources[f"shafts.{part}.bearings_mm"] = (
+        "the bearings' u_coordinate_on_shaft_inner_side - the gear's u_coordinate_on_shaft"
+    )
     if part == "worm":
         sections = [c for c, role in rd.related(shaft.id, "assembly", "assembly") if c.type == "shaft_section"]
         sup["bending"] = bool(sections)
