@@ -135,3 +135,25 @@ def test_torsional_on_the_shifted_gear(tmp_path):
     mu = s["friction_coefficient_mean"]
     assert s["efficiency"] == pytest.approx(gt.efficiency_theory(g.gamma_m, g.alpha_n, mu), rel=0.01)
     assert abs(gt.efficiency_theory(g.gamma, g.alpha_n, mu) / s["efficiency"] - 1) > 0.01
+
+
+@pytest.mark.parametrize("name", ["contact3d_shifted_1x40"])
+def test_contact3d_on_the_shifted_1x40(name):
+    """The screw jack's worm (m_x 2.5, q 10, ZI, alpha_n 20 deg) on a 40-tooth wheel shifted by x2 = +0.5 (a = 63.75
+    mm) at contact3d, with tests/test_flank_forms_validation.py's short run: ratio 0.1 %, torque balance 2 %,
+    efficiency within 3 % of the wedge law at the contacts' radius, the contacts near the operating radius r_m1
+    (measured: ratio 40.0000, F_t2 400.003 N of 400, efficiency 0.6365 against 0.6373, contacts at 13.2 mm with
+    r1 12.5 and r_m1 13.75 mm)."""
+    from test_flank_forms_validation import CONTACT3D
+
+    from wormsim.contact3d.runner import simulate
+
+    sets = [*CONTACT3D, "gear.wheel_teeth=40", "gear.profile_shift_coefficient=0.5", "load.torque_nm=20"]
+    sc = load_scenario(SCENARIOS / "screw_jack.yaml", sets)
+    g = derive(sc.gear)
+    assert g.a * 1e3 == pytest.approx(63.75)
+    s = simulate(sc).summary
+    assert abs(s["ratio"] / s["ratio_theory"] - 1) < 1e-3
+    assert abs(s["tangential_force_mean_n"] * g.r2 / sc.load.torque_nm - 1) < 0.02
+    assert abs(s["efficiency"] / s["efficiency_theory_at_contact_radius"] - 1) < 0.03
+    assert g.r1 < s["worm_contact_radius_mean_m"] < g.r_m1 + 0.5 * g.m_x

@@ -184,3 +184,23 @@ def test_bad_rexs_exits_2_naming_the_problem(make, match, tmp_path, capsys):
 def test_rexs_version_2_is_refused():
     with pytest.raises(ScenarioError, match="allowed: REXS 1.x"):
         rexs.parse('{"model": {"version": "2.0", "components": [], "relations": []}}', "v2.rexsj")
+
+
+@pytest.mark.parametrize("name", ["contact3d_fva"])
+def test_fva_stage_at_contact3d_with_shafts(name):
+    """The FVA stage at contact3d on its bearings (the worm shaft bending), 0.1 s: F_t2 = T2 / (d2 / 2) within
+    0.5 %, ratio, efficiency against the wedge law at the contacts' radius (3 %), the worm's axial bearing load F_a1
+    = F_t2 (measured: F_t2 3657.1 N of 3658.5, efficiency 0.7860 against 0.7866, worm deflection at the mesh 24 um)."""
+    from wormsim.contact3d.runner import simulate
+
+    sc = load_scenario(
+        FVA_JSON, ["model=contact3d", "simulation.duration_s=0.1", "drive.ramp_s=0.02", "load.ramp_s=0.02"]
+    )
+    assert sc.shafts is not None and sc.shafts.worm.bending
+    g = derive(sc.gear)
+    s = simulate(sc).summary
+    assert s["tangential_force_mean_n"] == pytest.approx(sc.load.torque_nm / g.r2, rel=5e-3)
+    assert abs(s["ratio"] / s["ratio_theory"] - 1) < 1e-3
+    assert abs(s["efficiency"] / s["efficiency_theory_at_contact_radius"] - 1) < 0.03
+    assert s["worm_bearing_axial_mean_n"] == pytest.approx(s["tangential_force_mean_n"], rel=0.01)
+    assert s["worm_deflection_mesh_um"] > 0
