@@ -157,3 +157,11 @@ def test_contact3d_on_the_shifted_1x40(name):
     assert abs(s["tangential_force_mean_n"] * g.r2 / sc.load.torque_nm - 1) < 0.02
     assert abs(s["efficiency"] / s["efficiency_theory_at_contact_radius"] - 1) < 0.03
     assert g.r1 < s["worm_contact_radius_mean_m"] < g.r_m1 + 0.5 * g.m_x
+
+
+def test_report_header_gives_the_shift():
+    from wormsim.report_header import gear_line
+
+    assert "x2" not in gear_line(_g(0.0))
+    line = gear_line(_g(0.5))
+    assert "a 63.75 mm" in line and "x2 +0.5 (d_a2 107.5 mm" in line
