@@ -204,3 +204,19 @@ def test_fva_stage_at_contact3d_with_shafts(name):
     assert abs(s["efficiency"] / s["efficiency_theory_at_contact_radius"] - 1) < 0.03
     assert s["worm_bearing_axial_mean_n"] == pytest.approx(s["tangential_force_mean_n"], rel=0.01)
     assert s["worm_deflection_mesh_um"] > 0
+
+
+def test_shipped_fva_scenario_is_the_import():
+    """scenarios/fva_worm_stage_1-4.yaml is `wormsim import tests/assets/rexs/FVA_worm_stage_1-4.rexs` as it is."""
+    shipped = Path(__file__).parents[1] / "scenarios" / "fva_worm_stage_1-4.yaml"
+    assert shipped.read_text() == rexs.to_yaml(rexs.import_file(FVA_XML))
+    assert load_scenario(shipped) == load_scenario(FVA_XML)
+
+
+def test_shafts_are_ignored_and_reported_below_contact3d():
+    from wormsim.scenario import ignored_inputs
+
+    sc = load_scenario(FVA_JSON)
+    assert sc.model == "torsional" and sc.shafts is not None
+    assert any(line.startswith("shafts: ignored") for line in ignored_inputs(sc))
+    assert not any("shafts" in line for line in ignored_inputs(load_scenario(FVA_JSON, ["model=contact3d"])))
