@@ -20,7 +20,8 @@ Relations (m_x axial module, m_n normal module, z1 starts, z2 wheel teeth, gamma
                                                         d_f2 = d2 - 2 m_x (h_f* - x2), DIN 3975-1)
     wheel tip surface: torus about the worm axis, tube radius a - r_a2 = r1 - h_a (the "throat")
     wheel root surface: torus about the worm axis, tube radius a - r_f2 = r1 + h_f
-    r_e2 = r_a2 + m_x / 2  (outside radius of the wheel rim; DIN 3975 guide d_e2 <= d_a2 + 2 m for z1 = 1)
+    r_e2 = r_a2 + m_x / 2  (outside radius of the wheel rim; DIN 3975 guide d_e2 <= d_a2 + 2 m for z1 = 1), or
+          gear.wheel_outside_diameter_mm / 2 (d_a2 <= d_e2 <= d_a2 + 2 m_x)
     b2 = 0.75 d_a1 (z1 <= 3), 0.67 d_a1 (z1 >= 4)  (default face width, DIN 3975 guide), at most 1.2 d_a1;
     q <= 40 (so also for a given lead angle); p_x <= b1 <= 4 x the default b1 (threaded length, meshgen cost);
     b2 <= 2 sqrt((a - r_f2)^2 - (a - r_e2 + 0.1 (h_a + h_f))^2)  (tooth depth left at the face edges, meshgen;
@@ -86,6 +87,8 @@ class GearData(Protocol):
     def dedendum_coef(self) -> float: ...
     @property
     def profile_shift_coefficient(self) -> float | None: ...
+    @property
+    def wheel_outside_diameter_mm(self) -> float | None: ...
 
 
 @dataclass(frozen=True)
@@ -108,6 +111,7 @@ class GearSpec:
     addendum_coef: float = 1.0
     dedendum_coef: float = 1.2
     profile_shift_coefficient: float | None = None  # x2; None: default_profile_shift(profile)
+    wheel_outside_diameter_mm: float | None = None  # d_e2; None: d_a2 + m_x
     zn_section: Literal["thread", "space"] = "thread"
     tool_diameter_mm: float | None = None
     profile_radius_mm: float | None = None
@@ -263,7 +267,13 @@ def derive(gear: GearData) -> GearGeometry:
             f"{given} (the worm root radius {r_f1 / MM:.3f} mm is too small for the reference radius {r1 / MM:.3f} mm "
             f"with dedendum_coef {gear.dedendum_coef:g})"
         )
-    r_e2 = r_a2 + 0.5 * m_x
+    d_e2 = getattr(gear, "wheel_outside_diameter_mm", None)
+    r_e2 = r_a2 + 0.5 * m_x if d_e2 is None else d_e2 * MM / 2
+    if not r_a2 <= r_e2 <= r_a2 + m_x * (1 + 1e-12):
+        raise GeometryError(
+            f"gear.wheel_outside_diameter_mm = {d_e2:g}: allowed from the throat's tip diameter d_a2 = "
+            f"{2 * r_a2 / MM:.4g} mm to d_a2 + 2 m_x = {2 * (r_a2 + m_x) / MM:.4g} mm"
+        )
     b2 = gear.face_width_mm * MM if gear.face_width_mm is not None else (0.75 if z1 <= 3 else 0.67) * 2 * r_a1
     if b2 >= 2 * (a - r_f1) * 0.999 or b2 > 2 * r_a1 * 1.2:
         given = (

@@ -62,6 +62,7 @@ def test_another_stage_other_teeth_module_form_torque_speed_centre_distance():
     assert g.m_x * 1e3 == pytest.approx(2.5, abs=1e-12)  # from the normal module and the lead angle
     assert g.x2 == pytest.approx(0.2, abs=1e-12) and g.a * 1e3 == pytest.approx(63.0, abs=1e-9)
     assert 2e3 * g.r_a2 == pytest.approx(106.0, abs=1e-9)  # d_a2 = d2 + 2 m_x (1 + x2)
+    assert 2e3 * g.r_e2 == pytest.approx(108.0, abs=1e-9)  # the file's outer_diameter_worm_wheel (default 108.5)
     # ZA: the file's 20 deg is the axial pressure angle
     assert math.degrees(g.alpha_x) == pytest.approx(20.0, abs=1e-8)
     assert (sc.drive.speed_rpm, sc.load.torque_nm) == (1400.0, 80.0)

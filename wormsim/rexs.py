@@ -401,6 +401,10 @@ def _gear_block(rd: _Reader, stage: Component, worm: Component, wheel: Component
             break
     if rd.has(worm, "length_worm_gear"):
         g["worm_length_mm"] = rd.get(worm, "length_worm_gear", "mm", "gear.worm_length_mm")
+    if rd.has(wheel, "outer_diameter_worm_wheel"):
+        g["wheel_outside_diameter_mm"] = rd.get(
+            wheel, "outer_diameter_worm_wheel", "mm", "gear.wheel_outside_diameter_mm"
+        )
     return g, gamma
 
 
@@ -776,6 +780,8 @@ def export_model(scenario, summary: dict | None = None, rating: dict | None = No
     _set(w2, "tip_diameter_worm_gear", "mm", 2 * g.r_a2 * 1e3)
     _set(w2, "root_diameter_worm_gear", "mm", 2 * g.r_f2 * 1e3)
     _set(w2, "throat_radius_worm_wheel", "mm", g.throat_radius * 1e3)
+    if gear.wheel_outside_diameter_mm is not None:
+        _set(w2, "outer_diameter_worm_wheel", "mm", gear.wheel_outside_diameter_mm)
     _set(w2, "addendum_modification_coefficient_worm_wheel", "none", g.x2)
     _set(w2, "effective_face_width_worm_wheel", "mm", g.face_width * 1e3)
     _set(w1, "length_worm_gear", "mm", g.worm_length * 1e3)

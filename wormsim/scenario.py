@@ -102,6 +102,12 @@ class Gear(_Strict):
             "x2 m_axial; the wheel is hobbed at that centre distance; default 0, ZC 0.5 (docs/geometry.md)"
         ),
     )
+    wheel_outside_diameter_mm: float | None = Field(
+        None,
+        gt=0,
+        le=20000,
+        description="d_e2, the wheel rim's outside diameter; default d_a2 + m_axial; allowed d_a2 to d_a2 + 2 m_axial",
+    )
     zn_section: Literal["thread", "space"] = Field(
         "thread", description="ZN: the straight line in the normal section of the thread (ZN1) or of the space (ZN2)"
     )
