@@ -32,7 +32,7 @@ LONG_TESTS: dict[str, set[str] | None] = {
     # contact3d on the shifted 1x40 (~2 min here with the kernel compiled) and the FVA REXS stage with its shafts
     # (~1 min); their torsional / wedge twins stay in `make test`
     "test_profile_shift.py": {"contact3d_shifted_1x40"},
-    "test_rexs.py": {"contact3d_fva"},
+    "test_rexs.py": {"contact3d_fva", "contact3d_other"},
 }
 
 
