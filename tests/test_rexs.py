@@ -44,6 +44,7 @@ def test_fva_stage_imports_as_the_file_gives_it():
     r = sc.rating
     assert (r.lubricant, r.oil_viscosity_40_mm2_s, r.oil_viscosity_100_mm2_s) == ("peg", 220.0, 37.0)
     assert r.oil_sump_temperature_c == 73.2 and r.life_h == 100000.0
+    assert r.wheel_pitting_strength_mpa is None  # the steel placeholder's 1500 MPa is not a bronze's strength
     assert any("16MnCr5" in n and "placeholder" in n for n in imp.notes)  # the steel wheel is called out
     text = rexs.to_yaml(imp)
     assert "axial_module_mm: 4.0  # worm_gear[8].axial_module = 4 mm" in text
@@ -68,6 +69,7 @@ def test_another_stage_other_teeth_module_form_torque_speed_centre_distance():
     assert (sc.drive.speed_rpm, sc.load.torque_nm) == (1400.0, 80.0)
     assert sc.shafts.worm.radial_stiffness_n_per_um == 500.0 and sc.shafts.worm.axial_stiffness_n_per_um == 300.0
     assert sc.rating.wheel_material == "CuSn12Ni2" and sc.rating.application_factor == 1.25
+    assert sc.rating.wheel_pitting_strength_mpa == 400.0  # the bronze's endurance_limit_flank
 
 
 @pytest.mark.parametrize("src", [FVA_XML, OTHER])
@@ -99,6 +101,19 @@ def test_rate_reads_the_rexs_file(tmp_path):
     assert r["inputs"]["oil_sump_temperature_given_c"] == 73.2
     assert r["oil_temperature_c"] == 73.2  # injection lubrication: the given oil temperature
     assert r["safety_pitting"] > 0 and r["safety_root"] > 0
+
+
+def test_rate_takes_the_files_pitting_strength():
+    """The second stage's bronze gives endurance_limit_flank = 400 MPa: sigma_HlimT, and S_H scales with it."""
+    from wormsim.rating.rate import rate
+
+    sc = load_scenario(OTHER)
+    r = rate(sc)
+    row = next(f for f in r["factors"] if f["key"] == "sigma_hlim_t_mpa")
+    assert row["value"] == 400.0 and "input" in row["source"]
+    table = rate(load_scenario(OTHER, ["rating.wheel_pitting_strength_mpa=null"]))
+    t_row = next(f for f in table["factors"] if f["key"] == "sigma_hlim_t_mpa")
+    assert r["safety_pitting"] / table["safety_pitting"] == pytest.approx(400.0 / t_row["value"], rel=1e-12)
 
 
 def test_import_command_writes_a_runnable_commented_scenario(tmp_path, capsys):

@@ -331,6 +331,7 @@ def import_model(model: Model, name: str = "rexs_stage") -> Imported:
         "gear": gear,
     }
     mats, wheel_designation = _materials(rd, worm, wheel, notes)
+    strength = mats.pop("_pitting_strength_mpa", None)
     if mats:
         data["materials"] = mats
     shafts, drive, load, span = _shafts_and_loads(rd, worm, wheel, notes)
@@ -338,6 +339,8 @@ def import_model(model: Model, name: str = "rexs_stage") -> Imported:
         data["shafts"] = shafts
     data["drive"], data["load"] = drive, load
     data["rating"] = _rating_block(rd, stage, wheel_designation, span, notes)
+    if strength is not None:
+        data["rating"]["wheel_pitting_strength_mpa"] = strength
     used = rd.used
     unused = [f"{c.type}[{c.id}].{a}" for c in model.components.values() for a in c.attrs if (c.id, a) not in used]
     _ = geo
@@ -470,6 +473,14 @@ def _material(rd: _Reader, gear: Component, part: str) -> tuple[dict | None, str
     designation = (
         rd.get(m, "material_designation", "raw", required=False) if rd.has(m, "material_designation") else None
     )
+    if part == "wheel":
+        category = m.attrs.get("material_category_vdi_2736_2014")
+        steel = category is not None and str(category.value) in ("steel", "cast_iron")
+        if not steel and rd.has(m, "endurance_limit_flank"):  # a bronze's pitting strength (a steel: a placeholder)
+            strength = rd.get(m, "endurance_limit_flank", "gpa", "rating.wheel_pitting_strength_mpa")
+            out["_pitting_strength_mpa"] = strength * 1e3
+        elif steel:
+            rd.get(m, "material_category_vdi_2736_2014", "raw")
     return out, designation
 
 
@@ -480,7 +491,10 @@ def _materials(rd: _Reader, worm, wheel, notes) -> tuple[dict, str | None]:
         out["worm"] = mw
     mh, desig = _material(rd, wheel, "wheel")
     if mh:
+        strength = mh.pop("_pitting_strength_mpa", None)
         out["wheel"] = mh
+        if strength is not None:
+            out["_pitting_strength_mpa"] = _r(strength)
     return out, desig
 
 
@@ -797,6 +811,8 @@ def export_model(scenario, summary: dict | None = None, rating: dict | None = No
         _set(m, "density", "kg / dm^3", mat.density_kg_m3 * 1e-3)
         if part == "wheel" and scenario.rating is not None and scenario.rating.wheel_material is not None:
             _set(m, "material_designation", "none", scenario.rating.wheel_material)
+        if part == "wheel" and scenario.rating is not None and scenario.rating.wheel_pitting_strength_mpa is not None:
+            _set(m, "endurance_limit_flank", "N / mm^2", scenario.rating.wheel_pitting_strength_mpa)
         b.rel("reference", (6 if part == "worm" else 7, "origin"), (cid, "referenced"))
     r = scenario.rating
     if r is not None:

@@ -501,6 +501,15 @@ class Rating(_Strict):
             "else CuSn12Ni2 (with a warning)"
         ),
     )
+    wheel_pitting_strength_mpa: float | None = Field(
+        None,
+        gt=0,
+        le=5000,
+        description=(
+            "sigma_HlimT of the wheel instead of rating.wheel_material's (REXS endurance_limit_flank); the material's "
+            "other values stay"
+        ),
+    )
     wheel_casting: Literal["sand", "chilled", "centrifugal"] = Field("sand", description="AGMA C_s casting method")
     ambient_c: float = Field(20.0, ge=-60, le=80, description="ambient temperature theta_0")
     roughness_worm_um: float = Field(0.5, gt=0, le=10, description="worm flank Ra1 (friction factor Y_R)")

@@ -256,9 +256,13 @@ def _pitting(f: Factors, r: Rating, mat: WheelMaterial, v_gm, a, sigma_hm) -> fl
         "z_oil", "Z_oil", Z_OIL[r.lubricant], "-", "lubricant factor (pitting)",
         "MITCalc Gear4 oil-type table, as reproduced in a public web port of the workbook",
     )  # fmt: skip
-    f.add("sigma_hlim_t_mpa", "sigma_HlimT", mat.sigma_hlim_t_mpa, "MPa", "pitting strength", mat.source)
+    given = r.wheel_pitting_strength_mpa
+    sigma_hlim = f.add(
+        "sigma_hlim_t_mpa", "sigma_HlimT", mat.sigma_hlim_t_mpa if given is None else given, "MPa", "pitting strength",
+        mat.source if given is None else "rating.wheel_pitting_strength_mpa (input)",
+    )  # fmt: skip
     sigma_hg = f.add(
-        "sigma_hg_mpa", "sigma_HG", iso.pitting_limit_mpa(mat.sigma_hlim_t_mpa, z_h, z_v, z_s, z_u, z_oil), "MPa",
+        "sigma_hg_mpa", "sigma_HG", iso.pitting_limit_mpa(sigma_hlim, z_h, z_v, z_s, z_u, z_oil), "MPa",
         "permissible mean Hertz stress", iso.PORT,
     )  # fmt: skip
     return f.add("safety_pitting", "S_H", sigma_hg / sigma_hm, "-", "sigma_HG / sigma_Hm", iso.PORT)
