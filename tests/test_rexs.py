@@ -124,6 +124,12 @@ def test_import_command_writes_a_runnable_commented_scenario(tmp_path, capsys):
     assert sc.gear.wheel_teeth == 41 and sc.shafts is not None
 
 
+def test_run_of_the_fva_file_says_the_wheel_is_a_placeholder(tmp_path, capsys):
+    out = str(tmp_path / "run")
+    assert cli.main(["run", str(FVA_XML), "--out", out, "--no-progress", "--set", "model=wedge"]) == 0
+    assert "16MnCr5" in capsys.readouterr().err
+
+
 def test_run_writes_rexs_with_results(tmp_path):
     out = tmp_path / "stage.rexs"
     code = cli.main(

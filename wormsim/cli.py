@@ -110,6 +110,11 @@ def build_parser() -> argparse.ArgumentParser:
 
 def _cmd_run(args) -> int:
     sc = load_scenario(args.scenario, args.overrides)
+    if Path(args.scenario).suffix.lower() in (".rexs", ".rexsj"):  # what the import assumed, as `wormsim import` says
+        from wormsim import rexs
+
+        for note in rexs.import_file(args.scenario).notes:
+            print(f"wormsim: {note}", file=sys.stderr)
     summary = run_scenario(sc, args.out, progress=False if args.no_progress else None)
     out = Path(args.out)
     keys = [k for k in summary if k not in ("status", "message")]
