@@ -29,6 +29,10 @@ LONG_TESTS: dict[str, set[str] | None] = {
     "test_mass_scaling.py": {"unscaled"},  # the unscaled reference run of the scaled ones (240 000 steps, ~3 min)
     # contact3d and `wormsim mesh` per flank form (ZC's stay in `make test`; torsional's of every form too)
     "test_flank_forms_validation.py": {f"{k}_{f}" for k in ("contact3d", "mesh") for f in ("ZN1", "ZN2", "ZK")},
+    # contact3d on the shifted 1x40 (~2 min here with the kernel compiled) and the FVA REXS stage with its shafts
+    # (~1 min); their torsional / wedge twins stay in `make test`
+    "test_profile_shift.py": {"contact3d_shifted_1x40"},
+    "test_rexs.py": {"contact3d_fva", "contact3d_other"},
 }
 
 

@@ -836,8 +836,56 @@ def rating_seeds_table(name: str = "rating_seeds") -> str:
     return _table(head, rows) + "\n" + _source(name)
 
 
+def rexs_stages_table(name: str = "rexs_stages") -> str:
+    """The REXS stages at every level beside F_t2 = T2 / (d2 / 2) (sweeps/rexs_stages.py)."""
+    rows = []
+    for stage, r in load(name)["stages"].items():
+        g = r["gear"]
+        gear = (
+            f"{stage}: {g['profile']} {g['z1']}/{g['z2']}, m_x {_fmt(g['m_x_mm'])}, a {_fmt(g['a_mm'])} mm, x2 "
+            f"{_fmt(g['x2'])}, {_fmt(r['speed_rpm'])} rpm, {_fmt(r['torque_nm'])} N m"
+        )
+        for level, s in r["levels"].items():
+            eff_t = s["efficiency_theory_at_contact_radius"] if level == "contact3d" else s["efficiency_theory"]
+            rows.append(
+                [
+                    gear,
+                    level,
+                    _fmt(s["ratio"], 6),
+                    f"{s['tangential_force_mean_n']:.1f} ({r['ft2_theory_n']:.1f})",
+                    f"{_fmt(s['efficiency'], 4)} ({_fmt(eff_t, 4)})",
+                    _fmt(s.get("contact_pressure_max_mpa")),
+                    _fmt(s.get("worm_deflection_mesh_um")),
+                    _fmt(s["wall_s"], 2),
+                ]
+            )
+            gear = ""
+    head = ["stage", "level", "ratio", "F_t2 [N] (T2 / r2)", "efficiency (theory)", "p_H max [MPa]"]
+    head += ["worm deflection [um]", "wall [s]"]
+    return _table(head, rows) + "\n" + _source(name)
+
+
+def rexs_rating_table(name: str = "rexs_stages") -> str:
+    """ISO/TS 14521 method B on the REXS stages (sweeps/rexs_stages.py)."""
+    keys = (
+        ("contact_stress_mean_iso_mpa", "sigma_Hm [MPa]"),
+        ("friction_iso", "mu_zm"),
+        ("efficiency_iso", "eta_z"),
+        ("safety_pitting", "S_H"),
+        ("safety_wear", "S_W"),
+        ("safety_root", "S_F"),
+        ("safety_deflection", "S_delta"),
+        ("oil_temperature_c", "theta_S [C]"),
+        ("safety_temperature", "S_T"),
+    )
+    rows = [[stage] + [_fmt(r["rating"][k]) for k, _ in keys] for stage, r in load(name)["stages"].items()]
+    return _table(["stage"] + [h for _, h in keys], rows) + "\n" + _source(name)
+
+
 TABLES: dict[str, Callable[[], str]] = {
     "torsional_seeds": torsional_seeds_table,
+    "rexs_stages": rexs_stages_table,
+    "rexs_rating": rexs_rating_table,
     "rating_seeds": rating_seeds_table,
     "torsional_samples": torsional_samples_table,
     "mesh_stiffness_seeds": mesh_stiffness_seeds_table,

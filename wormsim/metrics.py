@@ -177,11 +177,11 @@ def drive_summary(
         "worm_speed_mean_rpm": n1,
         "wheel_speed_mean_rpm": n2,
         "efficiency": eff,
-        "efficiency_theory": gt.efficiency_theory(geo.gamma, geo.alpha_n, mu, backdriving=drv.on == "wheel"),
+        "efficiency_theory": gt.efficiency_theory(geo.gamma_m, geo.alpha_n, mu, backdriving=drv.on == "wheel"),
         "friction_coefficient_mean": mu,
         # static: mu at rest (the contact's friction law at Vs = 0); dynamic: the mean mu applied over the window
         **gt.backdrive_keys(
-            geo.gamma,
+            geo.gamma_m,
             gt.virtual_friction_angle_rad(float(friction_coefficient(scenario.contact, 0.0)), geo.alpha_n),
             gt.virtual_friction_angle_rad(mu, geo.alpha_n),
         ),

@@ -139,7 +139,11 @@ KEYS: dict[str, Key] = {
     "safety_root": Key("-", C, "rating: tooth root safety S_F from tau_F (method B)"),
     "safety_deflection": Key("-", C, "rating: worm deflection safety S_delta = 0.04 sqrt(m_x) / delta_m"),
     "safety_temperature": Key("-", C, "rating: temperature safety S_T (sump temperature limit over oil_temperature_c)"),
-    "oil_temperature_c": Key("degC", C, "rating: sump temperature at the rated load (splash lubrication)"),
+    "oil_temperature_c": Key(
+        "degC",
+        C,
+        "rating: oil temperature at the rated load: splash-lubrication heat balance, or rating.oil_sump_temperature_c",
+    ),
     "agma_rated_tangential_force_n": Key(
         "N", C, "rating: AGMA 6034 rated tangential force W_t = C_s D_m^0.8 F_e C_m C_v"
     ),

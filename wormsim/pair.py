@@ -132,7 +132,7 @@ class _Binding:
         model.body_invweight0[self.wheel_body, 0] = p.inv_mass_wheel
         self.contacts = FlankContacts(bm, p.law.contacts_per_pair, merge=False)
         self.mu_of = friction_coefficient_scalar(pair.scenario.contact)
-        self.vs_per_w1 = geo.r1 / math.cos(geo.gamma)
+        self.vs_per_w1 = geo.r_m1 / math.cos(geo.gamma_m)
         self.R0 = pair._placement[:3, :3]
         self.shaft_log: shafts.ShaftLog | None = None  # WormPair.shaft_loads
         self.k0 = 0  # the pair's contacts in d.contact at the last step: [k0, k0 + n)

@@ -121,7 +121,7 @@ def friction_error(
     drv = scenario.drive
     if drv.on == "wheel" and drv.speed_rpm is not None:
         mu0 = float(friction_coefficient(scenario.contact, 0.0))
-        if gt.virtual_friction_angle_rad(mu0, geo.alpha_n) >= geo.gamma:
+        if gt.virtual_friction_angle_rad(mu0, geo.alpha_n) >= geo.gamma_m:
             err = locked_error(t, w2, rpm_to_rad_s(drv.speed_rpm), bm, scenario)
             return type(err)(f"{err} (caught by the friction guard: {what}; the back-driving is not physical)")
     pieces = " or run contact.geometry=pieces (friction rows with c_f = c_c)" if law.friction_damping_n_s_per_m else ""

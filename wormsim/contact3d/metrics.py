@@ -74,7 +74,7 @@ def radial_force_check(S: dict, drive_on: str, geo, sl: slice) -> dict:
     ft = abs(float(np.mean(S["tangential_force_n"][sl])))
     return {
         "radial_force_line_of_centres_mean_n": abs(float(np.mean(S["radial_force_line_of_centres_n"][sl]))),
-        "radial_force_theory_n": gt.radial_force_n(ft, geo.alpha_n, geo.gamma, s * rho),
+        "radial_force_theory_n": gt.radial_force_n(ft, geo.alpha_n, geo.gamma_m, s * rho),
     }
 
 

@@ -232,7 +232,7 @@ def nominal_normal_force_n(wheel_torque_nm: float, geo: GearGeometry) -> float:
     gear_theory.working_wheel_torque_of). Sets the friction rows' hardness (wormsim.contact3d.law (3)); with T2 = 0
     impratio fell to 1 and a self-locking pair crept back at ~110 rpm instead of 0.2 rpm
     (docs/stability_backlash_locking.md)."""
-    return gt.normal_force_n(wheel_torque_nm, geo.r2, geo.alpha_n, geo.gamma)
+    return gt.normal_force_n(wheel_torque_nm, geo.r2, geo.alpha_n, geo.gamma_m)
 
 
 def nominal_sliding_speed_m_s(worm_speed_rad_s: float | None, geo: GearGeometry) -> float:
@@ -240,7 +240,7 @@ def nominal_sliding_speed_m_s(worm_speed_rad_s: float | None, geo: GearGeometry)
     (gear_theory.worm_speed_command_rad_s); 0 for a torque drive (None: speed not known before the run)."""
     if worm_speed_rad_s is None:
         return 0.0
-    return worm_speed_rad_s * geo.r1 / math.cos(geo.gamma)
+    return worm_speed_rad_s * geo.r_m1 / math.cos(geo.gamma_m)
 
 
 def expected_direction(geo: GearGeometry) -> int:
@@ -300,10 +300,10 @@ def prepare(scenario: Scenario, gs: GearSet | None = None) -> Prepared:
     duty = gt.duty(scenario, direction)
     drv, load = duty.drive, duty.load
     w1 = gt.worm_speed_command_rad_s(drv, geo.ratio)
-    t_drive = gt.expected_drive_torque_of(drv, load, geo.ratio, geo.gamma, geo.alpha_n, mu1)
+    t_drive = gt.expected_drive_torque_of(drv, load, geo.ratio, geo.gamma_m, geo.alpha_n, mu1)
     t2 = gt.working_wheel_torque_of(drv, load, geo.ratio)
     kv = gt.servo_gain_of(drv, t_drive) if duty.speed_driven else None
-    arm1, arm2 = gt.mesh_arms_m(geo.r1, geo.r2, geo.alpha_n, geo.gamma)
+    arm1, arm2 = gt.mesh_arms_m(geo.r_m1, geo.r2, geo.alpha_n, geo.gamma_m)
     e_star = gt.effective_modulus_pa(scenario.materials)
     f_n, v_s = nominal_normal_force_n(t2, geo), nominal_sliding_speed_m_s(w1, geo)
     # driven-machine inertia J on the loaded shaft (joint armature) belongs to that shaft's effective mass

@@ -140,7 +140,7 @@ def _sample(src, bm: BuiltModel, d, guards, S_all, rlog, store, rec: int, slog, 
     w1, w2 = float(qv[bm.worm_dof]), float(qv[bm.wheel_dof])
     t = float(d.time)
     te = guards.state(d, t, th1, th2, w1, w2)
-    mu = mu_of(abs(w1) * geo.r1 / math.cos(geo.gamma), bm.plan.mu_params)  # at the sliding speed Vs
+    mu = mu_of(abs(w1) * geo.r_m1 / math.cos(geo.gamma_m), bm.plan.mu_params)  # at the sliding speed Vs
     # each contact's force turned about the worm axis onto the line of centres: the radial force DIN 3975's
     # single pitch-point contact means; the force-weighted contact radius and efficiency there (contact_sums)
     nteeth, pen, fr_lc, r_c = src.sample(i, th2, mu, rlog, store)

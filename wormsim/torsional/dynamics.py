@@ -237,10 +237,10 @@ class _Mesh:
         """(T2m, T1m): the worm's torque through the wedge law (module docstring)."""
         side = 1.0 if T2m > 0.0 else -1.0
         g = self.g
-        vs = w1 * g.r1 / math.cos(g.gamma)
+        vs = w1 * g.r_m1 / math.cos(g.gamma_m)  # at the worm's operating radius (r1 unshifted)
         rho = gt.virtual_friction_angle_rad(self.mu(vs), g.alpha_n)
         s = side * g.hand * math.tanh(vs / self.v_sign)
-        return T2m, gt.worm_torque_nm(T2m, g.hand, g.r1, g.r2, g.gamma, s * rho)
+        return T2m, gt.worm_torque_nm(T2m, g.hand, g.r_m1, g.r2, g.gamma_m, s * rho)
 
     def outputs(self, th1, w1, th2, w2) -> dict:
         """Vectorised over samples: forces on the wheel and the mesh state."""
@@ -250,7 +250,7 @@ class _Mesh:
         for i in range(n):
             T2m[i], T1m[i] = self.torques(th1[i], w1[i], th2[i], w2[i])
         e = self.hz * th1 - th2
-        vs = w1 * g.r1 / math.cos(g.gamma)
+        vs = w1 * g.r_m1 / math.cos(g.gamma_m)
         mu = np.array([self.mu(float(v)) for v in vs])
         rho = gt.virtual_friction_angle_rad(mu, g.alpha_n)
         s = np.sign(T2m) * g.hand * np.tanh(vs / self.v_sign)
@@ -274,8 +274,8 @@ class _Mesh:
             deflection = self.arm0 * np.maximum(np.maximum(e - gf, -e - gr), 0.0)
         return {
             "tangential_force_n": ft,
-            "axial_force_n": gt.axial_force_n(ft, g.gamma, s * rho),
-            "radial_force_n": gt.radial_force_n(np.abs(ft), g.alpha_n, g.gamma, s * rho),
+            "axial_force_n": gt.axial_force_n(ft, g.gamma_m, s * rho),
+            "radial_force_n": gt.radial_force_n(np.abs(ft), g.alpha_n, g.gamma_m, s * rho),
             "mesh_torque_worm_nm": T1m,
             "friction_coefficient": mu,
             "transmission_error_rad": -e,
@@ -424,7 +424,7 @@ def simulate(scenario: Scenario, progress=None, method: str = "implicit") -> Res
     cmds = gt.commands(scenario, g.hand)
     speed_driven = drv.speed_rpm is not None
     kv = (
-        gt.servo_gain_nm_s(scenario, g.ratio, g.gamma, g.alpha_n, float(friction_coefficient(scenario.contact, 1.0)))
+        gt.servo_gain_nm_s(scenario, g.ratio, g.gamma_m, g.alpha_n, float(friction_coefficient(scenario.contact, 1.0)))
         if speed_driven
         else 0.0
     )
@@ -541,7 +541,7 @@ def _guards(scenario, g, t, w1, w2, out, cmd) -> None:
     if dmax > lim:
         i = int(np.argmax(out["mesh_deflection_m"] > lim))
         why = "raise contact.stiffness_n_per_m or lower load.torque_nm"
-        vs = abs(float(w1[i])) * g.r1 / math.cos(g.gamma)
+        vs = abs(float(w1[i])) * g.r_m1 / math.cos(g.gamma_m)
         if drv.on == "wheel" and vs < 10 * scenario.contact.transition_velocity_m_s:
             rho = gt.virtual_friction_angle_rad(float(out["friction_coefficient"][i]), g.alpha_n)
             why = (
