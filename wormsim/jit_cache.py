@@ -6,9 +6,9 @@ Here every wormsim process points numba at one folder per (code, CPU, numba, Pyt
 
     $WORMSIM_JIT_CACHE (default: $WORMSIM_CACHE/numba, i.e. ~/.cache/wormsim/numba) / KEY /
 
-KEY hashes the text of every module whose code or constants the compiled functions use (`SOURCES`: the packages
-wormsim.tooth and wormsim.contact3d, every other wormsim / meshgen module that imports numba, and the modules whose
-constants they read; this module's own text is not part of it), the CPU (model name and flags), numba's and Python's
+KEY hashes the text of every module whose code or constants the compiled functions use (every wormsim / meshgen
+module that imports numba, and `SOURCES`: the modules whose constants they read; this module's own text is not part
+of it), the CPU (model name and flags), numba's and Python's
 versions. A NUMBA_CACHE_DIR set by the user wins. numba's own index, inside the folder, still checks each source
 file's time stamp and the CPU.
 
@@ -43,16 +43,17 @@ LAST_NAME = "last_compile.json"  # in the root: the last full compile's seconds 
 DEFAULT_COMPILE_S = 60.0
 _ROOT = Path(__file__).resolve().parents[1]
 _IMPORTS_NUMBA = re.compile(r"^\s*(import numba|from numba)", re.MULTILINE)
-# the modules whose text the compiled code depends on, relative to the repository / site-packages root: folders
-# (every .py in them) and files; every other wormsim / meshgen module that imports numba is added (_sources)
+# the modules whose constants the compiled code reads, relative to the repository / site-packages root; every
+# wormsim / meshgen module that imports numba is added (_sources; tests/test_jit_cache.py checks that each constant
+# a compiled module imports comes from one of them)
 SOURCES = (
-    "wormsim/tooth",
-    "wormsim/contact3d",
     "wormsim/friction.py",
     "wormsim/units.py",
     "wormsim/gear_theory.py",
+    "wormsim/contact3d/diagnosis.py",
+    "wormsim/contact3d/timestep.py",
+    "wormsim/tooth/grid.py",
     "meshgen/worm_forms.py",
-    "meshgen/worm_forms_jit.py",
 )
 # the warm-up runs: scenario (a seed shipped in wormsim.scenarios) and overrides; together they call every compiled
 # entry point with the signatures a run uses (tests/test_jit_cache.py checks that a later run compiles nothing)
@@ -60,7 +61,10 @@ WARM_STEPS = 40
 WARM_RUNS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("screw_jack", ()),
     ("screw_jack", ("contact.geometry=pieces",)),
-    ("screw_jack", ("shafts.worm.radial_stiffness_n_per_um=300",)),
+    (
+        "screw_jack",
+        ("shafts.worm.bearings_mm=[-40, 40]", "shafts.worm.radial_stiffness_n_per_um=300", "shafts.worm.bending=true"),
+    ),
 )
 
 WAIT_NOTE = "another process is compiling the contact3d kernels; waiting to load them"
@@ -71,13 +75,7 @@ _listener_installed = False
 
 
 def _sources() -> list[Path]:
-    files: set[Path] = set()
-    for rel in SOURCES:
-        p = _ROOT / rel
-        if p.is_dir():
-            files.update(p.glob("*.py"))
-        elif p.is_file():
-            files.add(p)
+    files = {_ROOT / rel for rel in SOURCES if (_ROOT / rel).is_file()}
     for pkg in ("wormsim", "meshgen"):
         for p in (_ROOT / pkg).rglob("*.py"):
             if p not in files and p.name != "jit_cache.py" and _IMPORTS_NUMBA.search(p.read_text(errors="replace")):
@@ -290,6 +288,11 @@ def warm_runs(runs: tuple[tuple[str, tuple[str, ...]], ...] = WARM_RUNS) -> None
     from wormsim.scenario import load_scenario
 
     seeds = files("wormsim.scenarios")
+    if runs == WARM_RUNS:  # the flank grid's own compiled trim (a run whose grid is cached never calls it)
+        from wormsim.geometry import derive
+        from wormsim.tooth import grid
+
+        grid._flank_grid(derive(load_scenario(seeds / "screw_jack.yaml").gear), 2, 6)
     for name, overrides in runs:
         sc = load_scenario(seeds / f"{name}.yaml", ["model=contact3d", *overrides])
         sc.simulation.duration_s = WARM_STEPS * (sc.simulation.timestep_s or 1e-4)
@@ -316,7 +319,7 @@ def ensure_warm(note: Callable[[str], None] | None = None) -> bool:
             c0 = compile_seconds()
             error = None
             try:
-                _install_listener_now()
+                listen()
                 warm_runs()
             except Exception as exc:  # (the run compiles for itself)
                 error = f"{exc.__class__.__name__}: {exc}"
@@ -336,7 +339,8 @@ def ensure_warm(note: Callable[[str], None] | None = None) -> bool:
         _in_warm = False
 
 
-def _install_listener_now() -> None:
+def listen() -> None:
+    """Count this process's compile seconds from now on (compile_seconds; imports numba)."""
     import numba  # noqa: F401  (the listener needs numba's event module)
 
     _install_listener()

@@ -35,6 +35,7 @@ CSV_NAME, JSON_NAME, PNG_NAME, RUNS_DIR = "sweep.csv", "sweep.json", "sweep.png"
 SCHEDULER_ENV = "DASK_SCHEDULER_ADDRESS"
 CONNECT_TIMEOUT_S = 20.0  # to reach an existing scheduler
 WORKER_WAIT_S = 60.0  # for the first worker of an existing cluster
+MAX_CHUNK = 4  # points per task at most (chunk_size)
 _FIRST = ("point",)
 _AFTER_SWEPT = ("status", "message")
 _LAST = ("wall_time_s", "scenario_hash")
@@ -94,11 +95,37 @@ def run_point(scenario: dict, keep_files: bool) -> dict:
             **base,
             "wall_time_s": time.perf_counter() - t0,
         }
+    from wormsim import jit_cache
+
+    jit = jit_cache.dispatcher_stats()
     return {
         "summary": summary,
         "files": files,
-        "timing": {"worker": _worker_name(), "start": t_start, "end": time.time(), "setup_s": t_setup},
+        "timing": {
+            "worker": _worker_name(),
+            "start": t_start,
+            "end": time.time(),
+            "setup_s": t_setup,
+            # this worker process's totals so far: seconds compiling, signatures compiled / loaded (wormsim.jit_cache)
+            "compile_s": jit_cache.compile_seconds(),
+            "jit_misses": jit["misses"],
+            "jit_hits": jit["hits"],
+        },
     }
+
+
+def run_points(scenarios: list[dict], keep_files: bool) -> list[dict]:
+    """Several points in one task (run_sweep's chunks of short points): run_point on each, in order."""
+    return [run_point(sc, keep_files) for sc in scenarios]
+
+
+def chunk_size(n_points: int, threads: int) -> int:
+    """Points per task: 1, or up to MAX_CHUNK where there are at least 8 points per worker thread. A task's points
+    share one scheduler round trip and one hand-back (the worker waits for its next task only once per chunk);
+    a worker that dies fails the points of its chunk. 16 points on 2 workers: 2 per task."""
+    if n_points < 8 * threads:
+        return 1
+    return max(1, min(MAX_CHUNK, n_points // (4 * threads)))
 
 
 def _worker_name() -> str:
@@ -470,49 +497,59 @@ def run_sweep(
             futures = {}
             queue = list(todo)
 
+            threads = _free_threads(client)
+            chunk = chunk_size(len(todo), threads)
+            cluster_info["points_per_task"] = chunk
+
             def submit_next():
-                p = queue.pop(0)
-                fut = client.submit(
-                    run_point,
-                    p.scenario.model_dump(mode="json"),
-                    keep_runs,
-                    pure=False,
-                    key=f"wormsim-point-{p.index}-{p.scenario_hash}",
-                )
-                futures[fut] = (p, time.time())
+                ps = queue[:chunk]
+                del queue[:chunk]
+                scs = [p.scenario.model_dump(mode="json") for p in ps]
+                key = f"wormsim-point-{ps[0].index}-{ps[0].scenario_hash}"
+                if chunk == 1:
+                    fut = client.submit(run_point, scs[0], keep_runs, pure=False, key=key)
+                else:
+                    fut = client.submit(run_points, scs, keep_runs, pure=False, key=f"{key}-{len(ps)}")
+                futures[fut] = (ps, time.time())
                 return fut
 
-            pending = as_completed([submit_next() for _ in range(min(len(queue), _free_threads(client)))])
+            pending = as_completed([submit_next() for _ in range(min(-(-len(queue) // chunk), threads))])
             png.start()  # matplotlib's import while the points run (this thread waits on them)
             for fut in pending:
                 if queue:
                     pending.add(submit_next())
-                p, t_submit = futures[fut]
+                ps, t_submit = futures[fut]
                 try:
-                    res = fut.result()
+                    out_ = fut.result()
+                    results = [out_] if chunk == 1 else out_
                 except Exception as exc:  # (the worker died or the task could not run)
-                    res = {
-                        "summary": {
-                            "status": "failed",
-                            "wall_time_s": None,
-                            "model": p.scenario.model,
-                            "message": f"worker lost: {exc.__class__.__name__}: {exc}",
-                        },
-                        "files": {},
-                        "timing": None,
+                    results = [
+                        {
+                            "summary": {
+                                "status": "failed",
+                                "wall_time_s": None,
+                                "model": p.scenario.model,
+                                "message": f"worker lost: {exc.__class__.__name__}: {exc}",
+                            },
+                            "files": {},
+                            "timing": None,
+                        }
+                        for p in ps
+                    ]
+                received = time.time()
+                for p, res in zip(ps, results):
+                    summary = res["summary"]
+                    if keep_runs and res["files"]:
+                        _write_run_dir(out / RUNS_DIR / _run_dir_name(p), res["files"], summary)
+                    rows[p.index] = row_of(p, summary)
+                    timing[p.index] = {
+                        **(res["timing"] or {}),
+                        "submitted": t_submit,
+                        "received": received,
+                        "result_bytes": sum(len(b) for b in res["files"].values()),
                     }
-                summary = res["summary"]
-                if keep_runs and res["files"]:
-                    _write_run_dir(out / RUNS_DIR / _run_dir_name(p), res["files"], summary)
-                rows[p.index] = row_of(p, summary)
-                timing[p.index] = {
-                    **(res["timing"] or {}),
-                    "submitted": t_submit,
-                    "received": time.time(),
-                    "result_bytes": sum(len(b) for b in res["files"].values()),
-                }
+                    bar.point_done(summary.get("status") != "ok")
                 flush_csv()
-                bar.point_done(summary.get("status") != "ok")
     except KeyboardInterrupt:
         interrupted = True
     finally:
