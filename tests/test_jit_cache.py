@@ -136,6 +136,15 @@ class _Log(io.StringIO):
         return False
 
 
+@pytest.mark.parametrize("enabled", [None, True])
+def test_restart_clock_after_a_warm_up(enabled):
+    bar = progress.Progress(1.0, label="run", stream=_Log(), enabled=enabled)
+    bar.compiling("compiling")
+    bar.restart_clock()
+    bar.update(0.5)
+    bar.close()
+
+
 def test_progress_says_compiling_once_and_leaves_the_compile_out_of_its_estimate(monkeypatch):
     clock = [1000.0]
     monkeypatch.setattr(progress.time, "perf_counter", lambda: clock[0])

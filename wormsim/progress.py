@@ -66,7 +66,8 @@ class Progress:
         """The simulation starts now: the estimate's clock from here (after a warm-up that compiled)."""
         self._t0 = time.perf_counter()
         self._c0 = jit_cache.compile_seconds()
-        self._bar.start_t = self._bar.last_print_t = self._bar._time()
+        if not self._bar.disable:  # (a disabled tqdm has no clock)
+            self._bar.start_t = self._bar.last_print_t = self._bar._time()
 
     def wall_s(self) -> float:
         """Seconds since the clock started, less the seconds numba spent compiling in them."""
