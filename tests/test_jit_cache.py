@@ -236,3 +236,46 @@ def test_watchers_are_told_in_the_compiling_thread():
 
         _f(3)
     assert [s for s, _ in seen] == [True, False] and seen[0][1] == threading.current_thread().name
+
+
+@pytest.mark.long
+def test_a_two_worker_sweep_on_a_fresh_cache_compiles_once(tmp_path):
+    """`wormsim sweep` of 4 short contact3d points on 2 workers, empty cache: one worker compiles (its plugin), the
+    other waits and loads; the compile seconds summed over the workers are one process's."""
+    sweep = tmp_path / "s.yaml"
+    sweep.write_text(
+        f"name: fresh\nbase: {ROOT / 'scenarios' / 'screw_jack.yaml'}\n"
+        "set: {model: contact3d, simulation.duration_s: 0.004}\n"
+        "grid:\n  drive.speed_rpm: [1000, 1200, 1400, 1600]\n"
+    )
+    env = {k: v for k, v in os.environ.items() if k not in ("NUMBA_CACHE_DIR", jit_cache._OURS)}
+    env.update({jit_cache.ENV: str(tmp_path / "jit"), "WORMSIM_NO_PROGRESS": "1"})
+    env.pop("DASK_SCHEDULER_ADDRESS", None)
+    out = subprocess.run(
+        [
+            str(Path(sys.executable).parent / "wormsim"),
+            "sweep",
+            str(sweep),
+            "--out",
+            str(tmp_path / "o"),
+            "--workers",
+            "2",
+        ],
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=1500,
+    )
+    assert out.returncode == 0, out.stderr
+    doc = json.loads((tmp_path / "o" / "sweep.json").read_text())
+    assert all(p["status"] == "ok" for p in doc["points"])
+    per_worker: dict[str, dict] = {}
+    for p in doc["points"]:
+        t = p["timing"]
+        w = per_worker.setdefault(t["worker"], {"compile_s": 0.0, "misses": 0})
+        w["compile_s"] = max(w["compile_s"], t["compile_s"])
+        w["misses"] = max(w["misses"], t["jit_misses"])
+    assert len(per_worker) == 2, per_worker
+    compiled = sorted(per_worker.values(), key=lambda w: w["compile_s"])
+    assert compiled[0]["misses"] == 0 and compiled[0]["compile_s"] == 0.0, per_worker  # loaded only
+    assert compiled[1]["misses"] > 5 and compiled[1]["compile_s"] > 5.0, per_worker  # compiled once, for both
