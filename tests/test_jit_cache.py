@@ -44,6 +44,18 @@ def test_key_follows_the_compiled_code_and_not_the_rest(tmp_path, monkeypatch):
     assert jit_cache.cache_key() == k0
 
 
+def test_the_key_is_remembered_by_the_files_stamps(tmp_path, monkeypatch):
+    monkeypatch.setattr(jit_cache, "_ROOT", _copy_tree(tmp_path / "src"))
+    root = tmp_path / "jit"
+    root.mkdir()
+    k0 = jit_cache._key_memo(root)
+    assert k0 == jit_cache.cache_key() and json.loads((root / "keys.json").read_text()) == {jit_cache._stamp(): k0}
+    f = tmp_path / "src" / "wormsim" / "friction.py"
+    f.write_text(f.read_text() + "\n# changed\n")
+    k1 = jit_cache._key_memo(root)
+    assert k1 != k0 and k1 == jit_cache.cache_key() and len(json.loads((root / "keys.json").read_text())) == 2
+
+
 def _imported_constants(path: Path) -> set[str]:
     """Modules of wormsim / meshgen from which `path` imports an UPPER_CASE name (a constant numba freezes into the
     compiled code)."""

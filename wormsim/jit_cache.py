@@ -94,20 +94,53 @@ def _cpu() -> str:
         return f"{platform.machine()}|{platform.processor()}"
 
 
-def cache_key() -> str:
-    """16 hex digits of the SHA-256 of SOURCES' text, the CPU, numba's and Python's versions."""
+def _machine() -> str:
     from importlib import metadata
 
-    h = hashlib.sha256()
     try:
         numba_version = metadata.version("numba")
     except metadata.PackageNotFoundError:
         numba_version = "?"
-    h.update(f"{numba_version}|{sys.version}|{platform.machine()}|{_cpu()}".encode())
+    return f"{numba_version}|{sys.version}|{platform.machine()}|{_cpu()}"
+
+
+def cache_key() -> str:
+    """16 hex digits of the SHA-256 of the sources' text (_sources), the CPU, numba's and Python's versions."""
+    h = hashlib.sha256(_machine().encode())
     for p in _sources():
         h.update(str(p.relative_to(_ROOT)).encode())
         h.update(p.read_bytes())
     return h.hexdigest()[:16]
+
+
+def _stamp() -> str:
+    """A hash of every wormsim / meshgen module's path, size and time stamp, and of _machine(): where it is the same,
+    so is cache_key() (reading the files costs ~0.1 s at each start; a stat of each costs ~2 ms)."""
+    h = hashlib.sha256(_machine().encode())
+    for pkg in ("wormsim", "meshgen"):
+        for p in sorted((_ROOT / pkg).rglob("*.py")):
+            st = p.stat()
+            h.update(f"{p}|{st.st_size}|{st.st_mtime_ns}".encode())
+    return h.hexdigest()
+
+
+def _key_memo(root: Path) -> str:
+    """cache_key(), remembered in root/keys.json by _stamp() (the last 32 stamps)."""
+    stamp, memo_path = _stamp(), root / "keys.json"
+    try:
+        memo = json.loads(memo_path.read_text())
+    except (OSError, ValueError):
+        memo = {}
+    if not isinstance(memo, dict):
+        memo = {}
+    key = memo.get(stamp)
+    if isinstance(key, str):
+        return key
+    key = cache_key()
+    memo = dict(list(memo.items())[-31:])
+    memo[stamp] = key
+    _write_json(memo_path, memo)
+    return key
 
 
 def cache_root() -> Path:
@@ -138,9 +171,11 @@ def configure() -> Path | None:
     user = os.environ.get("NUMBA_CACHE_DIR")
     if user and user != os.environ.get(_OURS):  # the user's own choice
         return Path(user)
-    path = cache_root() / cache_key()
+    root = cache_root()
     try:
-        path.mkdir(parents=True, exist_ok=True)
+        root.mkdir(parents=True, exist_ok=True)
+        path = root / _key_memo(root)
+        path.mkdir(exist_ok=True)
     except OSError:  # no writable cache: numba's default
         return None
     _dir = path
