@@ -332,6 +332,23 @@ def warm_runs(runs: tuple[tuple[str, tuple[str, ...]], ...] = WARM_RUNS) -> None
         sc = load_scenario(seeds / f"{name}.yaml", ["model=contact3d", *overrides])
         sc.simulation.duration_s = WARM_STEPS * (sc.simulation.timestep_s or 1e-4)
         simulate(sc)
+    if runs == WARM_RUNS:  # the friction check, due later in a run than the warm-up's steps
+        _warm_friction_check()
+
+
+def _warm_friction_check() -> None:
+    """friction_guard.friction_alignment on MuJoCo's contact arrays (a box resting on a plane: 4 contacts)."""
+    import mujoco
+
+    from wormsim.contact3d.friction_guard import friction_alignment
+
+    m = mujoco.MjModel.from_xml_string(
+        "<mujoco><worldbody><geom type='plane' size='1 1 .1'/><body pos='0 0 .09'><freejoint/>"
+        "<geom type='box' size='.1 .1 .1'/></body></worldbody></mujoco>"
+    )
+    d = mujoco.MjData(m)
+    mujoco.mj_forward(m, d)
+    friction_alignment(d, 1e-3)
 
 
 def ensure_warm(note: Callable[[str], None] | None = None) -> bool:
