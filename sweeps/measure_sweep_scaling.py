@@ -11,8 +11,9 @@ Per command, from its wall time and sweep.json's timing records (worker and clie
 - point_wall_median_s: a point's simulate() on its worker (sweep.csv wall_time_s); step_wall_us: its loop's step;
 - idle_per_point_s: span_s x workers less the points' task time, per point (hand-back, dispatch, imbalance);
 - first_point_extra_s: each worker's first point less the median of its others.
-The model (docs/sweeps.md, "Scaling"): T(N) = fixed_s + ceil(P / N) x (t_point g(N) + idle_per_point_s), g(N) the
-step's growth with N busy cores (g(2) measured here).
+The model (docs/sweeps.md, "Scaling"): T(N) = fixed_s + ceil(P / N) x t_point x g(N), t_point the 1-worker run's
+span per point (the point and its idle time), g(N) the step's growth with N busy cores (g(2) measured here).
+`--model-only` recomputes the model of an existing record from its runs.
 """
 
 from __future__ import annotations
@@ -89,9 +90,19 @@ def measure(out: Path, workers: int) -> dict:
 
 
 def model(runs: dict, workers: int, g: float) -> float:
-    """T(N) = fixed_s + ceil(P / N) x (t_point g + idle_per_point_s), from the 1-worker run (module docstring)."""
+    """T(N) = fixed_s + ceil(P / N) x t_point x g, from the 1-worker run (module docstring)."""
     r1 = runs["1"]
-    return r1["fixed_s"] + math.ceil(r1["points"] / workers) * (r1["point_wall_median_s"] * g + r1["idle_per_point_s"])
+    return r1["fixed_s"] + math.ceil(r1["points"] / workers) * r1["span_s"] / r1["points"] * g
+
+
+def models(runs: dict, g2: float) -> dict:
+    return {
+        "t_point_s": runs["1"]["span_s"] / runs["1"]["points"],
+        "T_1_s": model(runs, 1, 1.0),
+        "T_2_s": model(runs, 2, g2),
+        "T_16_s_no_growth": model(runs, 16, 1.0),
+        "T_16_s_growth_1.31": model(runs, 16, 1.31),
+    }
 
 
 def main() -> None:
@@ -100,7 +111,13 @@ def main() -> None:
     ap.add_argument("--points", type=int, default=16)
     ap.add_argument("--duration", type=float, default=0.3)
     ap.add_argument("--record", default=str(ROOT / "docs" / "data" / "sweep_scaling.json"))
+    ap.add_argument("--model-only", action="store_true", help="recompute the model of the existing record")
     args = ap.parse_args()
+    if args.model_only:
+        rec = json.loads(Path(args.record).read_text())
+        rec["model"] = models(rec["runs"], rec["step_growth_2"])
+        Path(args.record).write_text(json.dumps(rec, indent=1) + "\n")
+        return
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     (out / "scaling.yaml").write_text(
@@ -118,12 +135,7 @@ def main() -> None:
         "speedup_command": runs["1"]["command_wall_s"] / runs["2"]["command_wall_s"],
         "speedup_span": runs["1"]["span_s"] / runs["2"]["span_s"],
         "step_growth_2": g2,
-        "model": {
-            "T_1_s": model(runs, 1, 1.0),
-            "T_2_s": model(runs, 2, g2),
-            "T_16_s_no_growth": model(runs, 16, 1.0),
-            "T_16_s_growth_1.31": model(runs, 16, 1.31),
-        },
+        "model": models(runs, g2),
     }
     Path(args.record).write_text(json.dumps(rec, indent=1) + "\n")
     print(json.dumps({k: v for k, v in rec.items() if k != "runs"}, indent=1))
