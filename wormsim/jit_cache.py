@@ -60,7 +60,7 @@ SOURCES = (
 WARM_STEPS = 40
 WARM_RUNS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("screw_jack", ()),
-    ("screw_jack", ("contact.geometry=pieces",)),
+    ("screw_jack", ("contact.geometry=pieces", "simulation.resolution=coarse")),  # coarse: fewer pieces to build
     (
         "screw_jack",
         ("shafts.worm.bearings_mm=[-40, 40]", "shafts.worm.radial_stiffness_n_per_um=300", "shafts.worm.bending=true"),
