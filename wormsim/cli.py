@@ -208,15 +208,27 @@ def _cmd_bench(args) -> int:
 
 def _cmd_sweep(args) -> int:
     from wormsim.sweep import load_sweep, run_sweep
+    from wormsim.sweep.runner import ClusterStart
 
-    sw = load_sweep(args.sweep)
+    if args.workers is not None and args.workers < 1:
+        raise ScenarioError(f"--workers {args.workers}: allowed an integer >= 1")
+    started: list[ClusterStart] = []  # the cluster starts while the points are validated
+
+    def start() -> None:
+        started.append(ClusterStart(args.scheduler, args.workers))
+
+    try:
+        sw = load_sweep(args.sweep, on_parsed=start)
+    except BaseException:
+        for s in started:
+            s.close()
+        raise
     c = run_sweep(
         sw,
         args.out,
-        scheduler=args.scheduler,
-        workers=args.workers,
         keep_runs=args.keep_runs,
         progress=False if args.no_progress else None,
+        started=started[0] if started else None,
     )
     out = Path(args.out)
     print(

@@ -217,6 +217,58 @@ def sweep_speedup_table(name: str = "sweep_speedup") -> str:
     return text + "\n" + _source(name)
 
 
+def sweep_scaling_table(name: str = "sweep_scaling") -> str:
+    """A contact3d sweep as `wormsim sweep` commands on 1 and 2 workers, and the scaling model
+    (sweeps/measure_sweep_scaling.py)."""
+    r = load(name)
+    rows = []
+    for n, x in sorted(r["runs"].items(), key=lambda kv: int(kv[0])):
+        rows.append(
+            [
+                n,
+                f"{x['command_wall_s']:.1f}",
+                f"{x['span_s']:.1f}",
+                f"{x['fixed_s']:.1f}",
+                f"{x['cluster_start_s']:.1f}",
+                "-" if x.get("warm_s") is None else f"{x['warm_s']:.1f}",
+                f"{x['point_wall_median_s']:.2f}",
+                f"{x['step_wall_us_median']:.0f}",
+                f"{x['idle_per_point_s']:.2f}",
+                ", ".join(f"{v:.2f}" for v in x["first_point_extra_s"]) or "-",
+                ", ".join(f"{v:.1f}" for v in x["compile_s_per_worker"]),
+                str(x.get("points_per_task")),
+            ]
+        )
+    head = [
+        "workers",
+        "command s",
+        "points' span s",
+        "fixed s",
+        "cluster start s",
+        "warm-up s",
+        "point median s",
+        "step us",
+        "idle per point s",
+        "first point extra s",
+        "compile s per worker",
+        "points per task",
+    ]
+    m = r["model"]
+    text = _table(head, rows)
+    text += (
+        f"\n{r['what']}. Speed-up 1 -> 2 workers: {r['speedup_command']:.2f}x for the whole command, "
+        f"{r['speedup_span']:.2f}x over the points' span; the step grows {r['step_growth_2']:.2f}x with 2 busy "
+        f"workers. Load average after: {', '.join(f'{v:.1f}' for v in r['load_average_after'])} "
+        f"({r['cpu_count']} CPUs).\n\n"
+        f"Model T(N) = fixed + ceil(P / N) t_point g(N), t_point = {m['t_point_s']:.1f} s the 1-worker span per "
+        "point: "
+        f"T(1) {m['T_1_s']:.1f} s, T(2) {m['T_2_s']:.1f} s (with the measured g(2)), "
+        f"T(16) {m['T_16_s_no_growth']:.1f} s with no step growth and {m['T_16_s_growth_1.31']:.1f} s "
+        "with g(16) 1.31.\n"
+    )
+    return text + "\n" + _source(name)
+
+
 def _study_value(v) -> str:
     """The error's value: a number, or the pitch deviations of every other tooth as one phrase."""
     if v in (None, ""):
@@ -899,6 +951,7 @@ TABLES: dict[str, Callable[[], str]] = {
     "flank_speed": flank_speed_table,
     "seat_motor_20s": seat_motor_20s_table,
     "sweep_speedup": sweep_speedup_table,
+    "sweep_scaling": sweep_scaling_table,
     "errors_study": errors_study_table,
     "wedge_seed000": wedge_seed000_table,
     "mass_scaling": mass_scaling_table,
