@@ -91,6 +91,22 @@ KEYS: dict[str, Key] = {
         "back-driving efficiency tan(gamma - rho') / tan(gamma) with the sliding friction (DIN 3975-2); 0 when "
         "self_locking_dynamic",
     ),
+    "locked": Key(
+        "bool",
+        GEAR,
+        "the speed-driven wheel could not back-drive the self-locking pair (rho' at rest >= gamma): the wheel stalled, "
+        "the mesh held and the run ended there with status ok (the means are over the run up to then); false in "
+        "every other run (wormsim.locking)",
+    ),
+    "holding_torque_nm": Key(
+        "N m",
+        GEAR,
+        "with `locked`: the largest |wheel drive torque| the mesh held (the stalled drive pushed up to it; what was "
+        "held, not a breaking limit); null when not locked",
+    ),
+    "creep_speed_rpm": Key(
+        "rpm", GEAR, "with `locked`: the worm's mean |speed| while the wheel was stalled; null when not locked"
+    ),
     "friction_angle_static_deg": Key("deg", ALL, "rho' at rest used for `self_locking`"),
     "friction_angle_dynamic_deg": Key(
         "deg", ALL, "rho' while sliding used for `self_locking_dynamic` and `efficiency_backdrive`"

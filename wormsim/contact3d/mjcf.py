@@ -54,6 +54,7 @@ from wormsim.contact3d.mass_scaling import ScalingCheck
 from wormsim.contact3d.timestep import timestep_for
 from wormsim.friction import friction_coefficient
 from wormsim.geometry import derive, displaced_pair, gear_set, solid_set
+from wormsim.locking import backdrive_self_locks, stall_torque_nm
 from wormsim.scenario import Scenario, ScenarioError, Simulation
 from wormsim.tooth.grid import SLICES_MASS_SCALED, FlankGrid, default_slices, flank_grid
 from wormsim.tooth.window import slot_quat, window_size, window_teeth_at
@@ -302,6 +303,8 @@ def prepare(scenario: Scenario, gs: GearSet | None = None) -> Prepared:
     w1 = gt.worm_speed_command_rad_s(drv, geo.ratio)
     t_drive = gt.expected_drive_torque_of(drv, load, geo.ratio, geo.gamma, geo.alpha_n, mu1)
     t2 = gt.working_wheel_torque_of(drv, load, geo.ratio)
+    if backdrive_self_locks(scenario, geo.gamma, geo.alpha_n):  # the mesh holds the stalled wheel servo's torque
+        t2 = max(t2, stall_torque_nm(t_drive))  # (wormsim.locking): the friction rows' hardness for that force
     kv = gt.servo_gain_of(drv, t_drive) if duty.speed_driven else None
     arm1, arm2 = gt.mesh_arms_m(geo.r1, geo.r2, geo.alpha_n, geo.gamma)
     e_star = gt.effective_modulus_pa(scenario.materials)
