@@ -100,3 +100,27 @@ def test_contact3d_backdrive_of_a_self_locking_pair_is_held_exit_0(tmp_path, cap
     assert s["holding_torque_nm"] == pytest.approx(stall, rel=0.05)
     assert s["creep_speed_rpm"] < 1e-3 * WHEEL_RPM * s["ratio_theory"]
     assert "soft" not in err and "penetration" not in err
+
+
+def test_torsional_torque_driven_wheel_held_from_rest_is_locked():
+    """A torque on the wheel (2 N m over 10 ms), the worm free, mu 0.1: the pair holds from rest (the worm slides
+    below contact.transition_velocity_m_s), `locked` true with the 2 N m as the holding torque; at mu 0.07 the worm
+    runs back and `locked` is false."""
+    base = [
+        "model=torsional",
+        "drive.on=wheel",
+        "drive.speed_rpm=null",
+        "drive.torque_nm=2.0",
+        "drive.ramp_s=0.01",
+        "load.on=worm",
+        "load.torque_nm=0",
+        "load.ramp_s=0",
+        "contact.friction_static=null",
+        "contact.friction_dynamic=null",
+        "simulation.duration_s=0.1",
+    ]
+    held = simulate(load_scenario(DEMO, [*base, "contact.friction=0.1"])).summary
+    assert held["locked"] is True and held["holding_torque_nm"] == 2.0
+    assert held["creep_speed_rpm"] < 1.0
+    runs = simulate(load_scenario(DEMO, [*base, "contact.friction=0.07"])).summary
+    assert runs["locked"] is False and runs["creep_speed_rpm"] is None

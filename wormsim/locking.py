@@ -18,6 +18,8 @@ stuck with rho' < gamma, or the worm stuck) stays a failure (LockedError, exit 3
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from wormsim import gear_theory as gt
@@ -43,6 +45,25 @@ def backdrive_self_locks(scenario: Scenario, lead_angle_rad: float, alpha_n_rad:
     return gt.self_locking(lead_angle_rad, gt.virtual_friction_angle_rad(mu0, alpha_n_rad))
 
 
+def run_keys(scenario: Scenario, geo, t_s: np.ndarray, worm_speed_rpm: np.ndarray) -> dict:
+    """`locked`, `holding_torque_nm`, `creep_speed_rpm` of a run that ended normally: a torque-driven wheel against a
+    pair that self-locks at rest holds when the worm's mean |speed| over the run's last fifth slides slower than
+    contact.transition_velocity_m_s (static friction's reach); the holding torque is then the wheel's torque
+    command. Every other run: NOT_LOCKED."""
+    drv = scenario.drive
+    if drv.on != "wheel" or drv.torque_nm is None or not len(t_s):
+        return dict(NOT_LOCKED)
+    mu0 = float(friction_coefficient(scenario.contact, 0.0))
+    if not gt.self_locking(geo.gamma, gt.virtual_friction_angle_rad(mu0, geo.alpha_n)):
+        return dict(NOT_LOCKED)
+    k = t_s >= t_s[-1] - 0.2 * (t_s[-1] - t_s[0])
+    creep = float(np.mean(np.abs(worm_speed_rpm[k])))
+    vs = creep * 2 * math.pi / 60 * geo.r1 / math.cos(geo.gamma)
+    if vs >= scenario.contact.transition_velocity_m_s:
+        return dict(NOT_LOCKED)
+    return {"locked": True, "holding_torque_nm": abs(float(drv.torque_nm)), "creep_speed_rpm": creep}
+
+
 def stall_torque_nm(expected_drive_torque_nm: float) -> float:
     """The torque a stalled speed servo pushes with: kv omega_cmd = T_expected / SPEED_DROOP
     (gear_theory.servo_gain_of). contact3d takes it as the held mesh's working torque for the friction rows' hardness
@@ -50,6 +71,21 @@ def stall_torque_nm(expected_drive_torque_nm: float) -> float:
     the held pair crept back through the soft cone's viscous branch (measured: 65 rpm of the worm, 6 % of the wheel
     command times the ratio, on the seat motor demo gear at mu 0.1)."""
     return expected_drive_torque_nm / gt.SPEED_DROOP
+
+
+def wheel_start_rad(scenario: Scenario, backlash_m: float, r2_m: float, perfect_pair: bool) -> float:
+    """The wheel's starting angle at contact3d: a torque-driven wheel (a holding or back-driving run) starts on its
+    loaded flank, turned by the half backlash j / (2 r2) (the flank grid's backlash, wormsim.tooth.grid) towards its
+    torque; every other run starts centred in its backlash (0). Holding from rest needs the pair at rest in contact:
+    started centred, the wheel crossed the backlash under its torque and the impact kicked the 4 g worm of the seat
+    motor demo past contact.transition_velocity_m_s, so friction was the dynamic value from the first contact on
+    (measured: the worm ran back at 3.2 % of its free speed; from flank contact with a 20 ms ramp it holds, 0.09 rpm,
+    docs/stability_backlash_locking.md). Only the exact flanks (contact.geometry flanks) of a perfect pair: the
+    pieces' bulge and displaced flanks (errors:, shafts:) have their own play."""
+    drv = scenario.drive
+    if drv.on != "wheel" or drv.torque_nm is None or scenario.contact.geometry != "flanks" or not perfect_pair:
+        return 0.0
+    return math.copysign(backlash_m / (2.0 * r2_m), drv.torque_nm) if drv.torque_nm else 0.0
 
 
 NOT_LOCKED = {"locked": False, "holding_torque_nm": None, "creep_speed_rpm": None}
@@ -67,4 +103,4 @@ def held_keys(t_s: np.ndarray, worm_speed_rpm: np.ndarray, wheel_torque_nm: np.n
     }
 
 
-__all__ = ["Held", "NOT_LOCKED", "backdrive_self_locks", "held_keys"]
+__all__ = ["Held", "NOT_LOCKED", "backdrive_self_locks", "held_keys", "run_keys", "stall_torque_nm", "wheel_start_rad"]

@@ -54,7 +54,7 @@ from wormsim.contact3d.mass_scaling import ScalingCheck
 from wormsim.contact3d.timestep import timestep_for
 from wormsim.friction import friction_coefficient
 from wormsim.geometry import derive, displaced_pair, gear_set, solid_set
-from wormsim.locking import backdrive_self_locks, stall_torque_nm
+from wormsim.locking import backdrive_self_locks, stall_torque_nm, wheel_start_rad
 from wormsim.scenario import Scenario, ScenarioError, Simulation
 from wormsim.tooth.grid import SLICES_MASS_SCALED, FlankGrid, default_slices, flank_grid
 from wormsim.tooth.window import slot_quat, window_size, window_teeth_at
@@ -429,6 +429,10 @@ def build_model(
     if kv is not None:
         meta["drive_kv_nm_s"] = kv
     meta["load_inertia_kg_m2"] = scenario.load.inertia_kg_m2
+    # a torque-driven wheel starts on its loaded flank (wormsim.locking.wheel_start_rad): the hinge's initial angle
+    meta["wheel_start_rad"] = wheel_start_rad(scenario, geo.backlash, geo.r2, dev is None and sups is None)
+    jw = model.jnt_qposadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, "wheel_hinge")]
+    model.qpos0[jw] += meta["wheel_start_rad"]
     meta["mass_scaling"] = p.scaling.factor
     meta["mass_scaling_check"] = p.scaling
     if sups is not None:  # the shafts' joints (wormsim.contact3d.shafts): the kernel takes the poses from the data

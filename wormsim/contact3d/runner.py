@@ -41,7 +41,7 @@ from wormsim.contact3d.series import SERIES, column
 from wormsim.contact3d.shafts import ShaftLog
 from wormsim.contact3d.sources import FlankSource, PieceSource
 from wormsim.friction import friction_mode
-from wormsim.locking import NOT_LOCKED, Held, held_keys
+from wormsim.locking import Held, held_keys, run_keys
 from wormsim.result import Result
 from wormsim.scenario import Scenario
 from wormsim.units import RPM
@@ -102,7 +102,7 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
         S, scenario, bm, rec, guards.turn_max, len(src.coll), 1e6 * wall / max(n_rec * rec, 1), flanks=flanks
     )
     summary.update(
-        NOT_LOCKED
+        run_keys(scenario, bm.geometry, S["t_s"], S["worm_speed_rpm"])
         if held is None
         else held_keys(S["t_s"], S["worm_speed_rpm"], S["wheel_torque_nm"], held.stuck_since_s or held.t_s)
     )

@@ -83,7 +83,7 @@ from wormsim import gear_theory as gt
 from wormsim.errors import DivergedError, LockedError, PenetrationError, SimulationError
 from wormsim.friction import friction_coefficient, friction_coefficient_scalar, friction_mode
 from wormsim.geometry import derive, displaced_pair
-from wormsim.locking import NOT_LOCKED, Held, backdrive_self_locks, held_keys
+from wormsim.locking import Held, backdrive_self_locks, held_keys, run_keys
 from wormsim.metrics import dominant_frequency, drive_summary, mean_speeds_rpm, window_of
 from wormsim.result import Result
 from wormsim.scenario import Scenario
@@ -494,7 +494,7 @@ def simulate(scenario: Scenario, progress=None, method: str = "implicit") -> Res
     }
     summary = torsional_summary(S, scenario, g, ms)
     summary.update(
-        NOT_LOCKED
+        run_keys(scenario, g, t, S["worm_speed_rpm"])
         if held is None
         else held_keys(t, S["worm_speed_rpm"], S["wheel_torque_nm"], held.stuck_since_s or held.t_s)
     )
