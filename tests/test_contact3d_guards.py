@@ -66,9 +66,11 @@ def _rho_deg(mu: float, alpha_n_deg: float) -> float:
                 strict=True,
                 reason=(
                     "exit 0 and locked, but the worm creeps at 9.68 rpm (0.73 % of 55 rpm x 24; sliding speed "
-                    "12.7 mm/s, 13 x contact.transition_velocity_m_s): the flank contacts slide in the held mesh "
-                    "where the pieces hold (under 0.1 %); the seat motor demo gear's flanks hold (0.079 rpm, "
-                    "tests/test_locking.py). Not resolved: noslip / elliptic-cone / impratio study (issue 31 item 4)"
+                    "12.7 mm/s, 13 x contact.transition_velocity_m_s) while the stalled servo winds the held mesh up "
+                    "to 24 kN m (T_expected / SPEED_DROOP): the flank contacts slide in the held mesh where the "
+                    "pieces hold (under 0.1 %); the seat motor demo gear's flanks hold (0.079 rpm at 1 N m, "
+                    "tests/test_locking.py); the friction rows' damping at c_c (no sliding speed) and impratio "
+                    "1.2e6 did not change it. Not resolved (issue 31 item 4)"
                 ),
             ),
         ),

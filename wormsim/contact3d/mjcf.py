@@ -303,12 +303,15 @@ def prepare(scenario: Scenario, gs: GearSet | None = None) -> Prepared:
     w1 = gt.worm_speed_command_rad_s(drv, geo.ratio)
     t_drive = gt.expected_drive_torque_of(drv, load, geo.ratio, geo.gamma, geo.alpha_n, mu1)
     t2 = gt.working_wheel_torque_of(drv, load, geo.ratio)
-    if backdrive_self_locks(scenario, geo.gamma, geo.alpha_n):  # the mesh holds the stalled wheel servo's torque
-        t2 = max(t2, stall_torque_nm(t_drive))  # (wormsim.locking): the friction rows' hardness for that force
+    held = backdrive_self_locks(scenario, geo.gamma, geo.alpha_n)
+    if held:  # the mesh holds the stalled wheel servo's torque (wormsim.locking): the friction rows' hardness for it
+        t2 = max(t2, stall_torque_nm(t_drive))
     kv = gt.servo_gain_of(drv, t_drive) if duty.speed_driven else None
     arm1, arm2 = gt.mesh_arms_m(geo.r1, geo.r2, geo.alpha_n, geo.gamma)
     e_star = gt.effective_modulus_pa(scenario.materials)
     f_n, v_s = nominal_normal_force_n(t2, geo), nominal_sliding_speed_m_s(w1, geo)
+    if held:  # the worm stands: no sliding speed to size the friction rows' damping by (law (4): c_f = c_c)
+        v_s = 0.0
     # driven-machine inertia J on the loaded shaft (joint armature) belongs to that shaft's effective mass
     I1 = ine.worm_inertia_kg_m2 + ine.worm_load_inertia_kg_m2
     I2 = ine.wheel_inertia_kg_m2 + ine.wheel_load_inertia_kg_m2
