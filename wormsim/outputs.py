@@ -91,6 +91,23 @@ KEYS: dict[str, Key] = {
         "back-driving efficiency tan(gamma - rho') / tan(gamma) with the sliding friction (DIN 3975-2); 0 when "
         "self_locking_dynamic",
     ),
+    "locked": Key(
+        "bool",
+        GEAR,
+        "the wheel could not back-drive the self-locking pair (rho' at rest >= gamma): a speed-driven wheel stalled, "
+        "the mesh held and the run ended there with status ok (the means are over the run up to then); a "
+        "torque-driven wheel held with the worm sliding slower than contact.transition_velocity_m_s over the run's "
+        "last fifth; false in every other run (wormsim.locking)",
+    ),
+    "holding_torque_nm": Key(
+        "N m",
+        GEAR,
+        "with `locked`: the largest |wheel drive torque| the mesh held (a stalled speed drive pushed up to it; a "
+        "torque drive's command; what was held, not a breaking limit); null when not locked",
+    ),
+    "creep_speed_rpm": Key(
+        "rpm", GEAR, "with `locked`: the worm's mean |speed| while the wheel was held; null when not locked"
+    ),
     "friction_angle_static_deg": Key("deg", ALL, "rho' at rest used for `self_locking`"),
     "friction_angle_dynamic_deg": Key(
         "deg", ALL, "rho' while sliding used for `self_locking_dynamic` and `efficiency_backdrive`"
