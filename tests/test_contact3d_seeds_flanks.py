@@ -84,7 +84,9 @@ def test_flanks_efficiency_within_3_percent_at_the_contact_radius(name):
 @pytest.mark.parametrize("name", SEEDS)
 def test_flanks_radial_force_on_the_line_of_centres_is_din_3975(name):
     s = run(name)["summary"]
-    assert abs(s["radial_force_line_of_centres_mean_n"] / s["radial_force_theory_n"] - 1) < 0.03
+    assert abs(s["radial_force_mean_n"] / s["radial_force_theory_n"] - 1) < 0.03
+    # the resultant's radial component is the smaller one: the contacts sit around the worm (docs/outputs.md)
+    assert s["radial_force_resultant_mean_n"] < 0.97 * s["radial_force_mean_n"]
 
 
 # ----------------------------------------------------------------------------- independent references of the forces
@@ -123,11 +125,12 @@ AXIAL_XFAIL = {
 
 @pytest.mark.parametrize("name", [_xf(AXIAL_XFAIL, n) for n in SEEDS])
 def test_flanks_axial_force_is_worm_torque_over_contact_radius(name):
-    """F_a2 = F_t1 = T1 / r (DIN 3975-2, with the contacts' force-weighted worm radius r_c for r1), within 3 % (the
-    issue's tolerance for the DIN 3975 forces)."""
+    """The resultant's axial component against F_t1 = T1 / r (DIN 3975-2, with the contacts' force-weighted worm
+    radius r_c for r1), within 3 % (the issue's tolerance for the DIN 3975 forces); the headline F_a2 is DIN's
+    T1 / r1 (docs/outputs.md, "Force keys")."""
     s = run(name)["summary"]
     expected = s["worm_torque_mean_nm"] / s["worm_contact_radius_mean_m"]
-    assert abs(s["axial_force_mean_n"] / expected - 1) < 0.03, (s["axial_force_mean_n"], expected)
+    assert abs(s["axial_force_resultant_mean_n"] / expected - 1) < 0.03, (s["axial_force_resultant_mean_n"], expected)
 
 
 # ----------------------------------------------------------------------------- torsional against contact3d
@@ -152,7 +155,7 @@ CROSS = {
     "tangential_force_mean_n": ("tangential_force_mean_n", 0.01),
     "efficiency": ("efficiency", 0.03),
     "worm_torque_mean_nm": ("worm_torque_mean_nm", 0.03),
-    "radial_force_line_of_centres_mean_n": ("radial_force_mean_n", 0.03),
+    "radial_force_mean_n": ("radial_force_mean_n", 0.03),
     "axial_force_mean_n": ("axial_force_mean_n", 0.03),
     "transmission_error_p2p_urad": ("transmission_error_p2p_urad", 0.10),
 }

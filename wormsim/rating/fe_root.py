@@ -589,6 +589,12 @@ def add_fe_root_stress(scenario, result: dict) -> dict:
         result["safety_root_sim"] = limit / fe["root_stress_max_mpa"]
         if r.root_stress_limit_mpa is None:
             result["warnings"].append(f"safety_root_sim: {why}; give rating.root_stress_limit_mpa to use another limit")
+        if fe["root_stress_max_mpa"] > limit:
+            result["warnings"].append(
+                f"root stress {fe['root_stress_max_mpa']:.4g} MPa above its limit {limit:.4g} MPa (safety_root_sim "
+                f"{limit / fe['root_stress_max_mpa']:.3g} < 1): the wheel teeth break at this load; lower the load or "
+                "choose a larger module, a wider face or a stronger wheel material"
+            )
     else:
         result["safety_root_sim"] = None
         result["warnings"].append(f"safety_root_sim not given: {why}; give rating.root_stress_limit_mpa")
