@@ -70,9 +70,12 @@ KEYS: dict[str, Key] = {
     "warnings": Key(
         "list",
         ALL,
-        "results that need care, one line each (also on stderr and in report.png's header): a tangential-force "
-        "fluctuation above half its mean, contact force outside the wheel flanks (wormsim.run_warnings); with "
-        "`rating:`, the rating's validity warnings follow; empty when none",
+        "results that need care, one line each (also on stderr and in report.png's header; wormsim.run_warnings): a "
+        "tangential-force fluctuation above half its mean, contact force outside the wheel flanks, a steady window "
+        "of fewer than 5 mesh periods or no meshing line near z1 n1 / 60, a contact pressure above the wheel "
+        "material's pitting strength, a runaway (1.5 x the speed command, or a torque drive still accelerating), "
+        "power flowing from the wheel into a worm-driven pair (overhauling), a pair that does not turn; with "
+        "`rating:`, the rating's warnings follow (a root stress above its limit among them); empty when none",
     ),
     "ignored_inputs": Key(
         "list",
