@@ -13,7 +13,9 @@ from wormsim.units import rad_s_to_rpm
 
 
 def gear_lines(sc: Scenario) -> list[str]:
-    """The derived sizes of gear: (mm, deg), one per line."""
+    """The derived sizes of gear: (mm, deg), one per line; none without a gear: block (a wedge: block's scenario)."""
+    if sc.gear is None:
+        return []
     g = derive(sc.gear)
     mm = 1e3
     return [
@@ -36,10 +38,11 @@ def torsional_timestep_s(sc: Scenario) -> float:
 
     if sc.simulation.timestep_s:
         return sc.simulation.timestep_s
+    assert sc.gear is not None and sc.drive is not None  # the gear levels need both (Scenario's validation)
     g = derive(sc.gear)
     drv = sc.drive
     speed_driven = drv.speed_rpm is not None
-    w = abs(drv.speed_rpm) * math.pi / 30 if speed_driven else 2 * math.pi
+    w = abs(drv.speed_rpm or 0.0) * math.pi / 30 if speed_driven else 2 * math.pi
     w1 = w * (g.ratio if (speed_driven and drv.on == "wheel") else 1.0)
     ms = SimpleNamespace(period_rad=2 * math.pi / g.z1, samples=sc.simulation.mesh_stiffness_samples)
     return default_timestep(g, ms, w1, sc.simulation.duration_s)  # type: ignore[arg-type]
@@ -57,7 +60,9 @@ def level_lines(sc: Scenario) -> list[str]:
     from wormsim.contact3d.timestep import timestep_for
 
     p = prepare(sc)
-    h, src = timestep_for(sc.simulation.timestep_s, p.worm_speed_rad_s, p.law, p.scaling.factor)
+    h, src = timestep_for(
+        sc.simulation.timestep_s, p.worm_speed_rad_s, p.law, p.scaling.factor if p.scaling is not None else 1.0
+    )
     out = [
         f"timestep: {h:.3g} s ({src}), {sc.simulation.duration_s / h:.0f} steps; stable limit "
         f"{p.law.stable_limit_s:.3g} s",
