@@ -91,6 +91,7 @@ def dominant_frequency(
 
 MESH_BAND = 0.25  # half-width of the meshing line's search band, a share of z1 n1 / 60 (the 2nd harmonic at +100 %)
 MESH_PAD = 8  # zero-padding factor of the spectrum the line is first located on
+MESH_PAD_MAX = 1 << 22  # ... up to this many points (32 MiB of float64)
 MIN_MESH_CYCLES = 5.0  # mesh periods a window needs: Hann main lobes +-2 bins, so the 1st and 2nd lines part at > 4
 MESH_HARMONICS = 4  # harmonics whose amplitudes the summary carries
 
@@ -120,7 +121,8 @@ def mesh_line(t: np.ndarray, x: np.ndarray, f_theory_hz: float) -> dict:
     w = np.hanning(n)
     y = (x - np.polyval(np.polyfit(tt, x, 1), tt)) * w
     wsum = float(w.sum())
-    nfft = MESH_PAD * (1 << int(math.ceil(math.log2(n))))
+    base = 1 << int(math.ceil(math.log2(n)))
+    nfft = max(base, min(MESH_PAD * base, MESH_PAD_MAX))  # long records: less padding (the refinement is exact)
     spec = np.abs(np.fft.rfft(y, nfft)) * 2.0 / max(wsum, 1e-300)
     freqs = np.fft.rfftfreq(nfft, dt)
     lo, hi = f_theory_hz * (1 - MESH_BAND), min(f_theory_hz * (1 + MESH_BAND), freqs[-1])
