@@ -200,7 +200,8 @@ def runaway_warning(result: Result, scenario) -> str | None:
 
 
 def power_flow_warning(summary: dict, scenario) -> str | None:
-    """Power flowing from the wheel into a worm-driven pair (overhauling), or a pair that does not turn."""
+    """Power flowing against the drive (an overhauling load: from the wheel into a worm-driven pair, or from the
+    worm into a wheel-driven one), or a pair that does not turn."""
     flow = summary.get("power_flow")
     if flow == "none":
         n1, n2 = (_num(summary, k) or 0.0 for k in ("worm_speed_mean_rpm", "wheel_speed_mean_rpm"))
@@ -208,11 +209,21 @@ def power_flow_warning(summary: dict, scenario) -> str | None:
             f"the pair does not turn over the steady window (worm {n1:.3g} rpm, wheel {n2:.3g} rpm): ratio and "
             "efficiency are not defined and reported as null"
         )
-    if flow == "wheel to worm" and scenario is not None and scenario.drive is not None and scenario.drive.on == "worm":
+    drive_on = scenario.drive.on if scenario is not None and scenario.drive is not None else None
+    eff, eff_theory = (
+        v if (v := _num(summary, k)) is not None else float("nan") for k in ("efficiency", "efficiency_theory")
+    )
+    if flow == "wheel to worm" and drive_on == "worm":
         return (
             f"power flows from the wheel to the worm: the load on the wheel overhauls the drive, efficiency "
-            f"{summary.get('efficiency', float('nan')):.3g} is worm power out / wheel power in (theory "
-            f"tan(gamma - rho') / tan(gamma) = {summary.get('efficiency_theory', float('nan')):.3g})"
+            f"{eff:.3g} is worm power out / wheel power in (theory "
+            f"tan(gamma - rho') / tan(gamma) = {eff_theory:.3g})"
+        )
+    if flow == "worm to wheel" and drive_on == "wheel":
+        return (
+            f"power flows from the worm to the wheel: the load on the worm overhauls the wheel's drive, efficiency "
+            f"{eff:.3g} is wheel power out / worm power in (theory "
+            f"tan(gamma) / tan(gamma + rho') = {eff_theory:.3g})"
         )
     return None
 
