@@ -264,6 +264,9 @@ def _cmd_check(args) -> int:
     for line in ignored_inputs(sc):
         print(f"wormsim: {line}", file=sys.stderr)
     print(yaml.safe_dump(sc.model_dump(mode="json", exclude_none=True), sort_keys=False), end="")
+    from wormsim.check_cmd import derived_text
+
+    print(derived_text(sc), end="")  # the sizes, timestep and slices the run takes, as YAML comments
     return EXIT_OK
 
 

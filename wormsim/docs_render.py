@@ -365,7 +365,9 @@ def ci_seeds_table(name: str = "ci_seeds_flanks") -> str:
                 f"{s['ratio']:.5f} ({s['ratio_theory']:g})",
                 f"{s['mesh_frequency_hz']:.4f} ({s['mesh_frequency_theory_hz']:.4f}) Hz",
                 f"{s['tangential_force_mean_n']:.1f} ({s['tangential_force_theory_n']:.1f}) N",
-                f"{s['radial_force_line_of_centres_mean_n']:.1f} ({s['radial_force_theory_n']:.1f}) N",
+                # older records carry DIN's F_r2 (the line of centres') as radial_force_line_of_centres_mean_n
+                f"{s.get('radial_force_line_of_centres_mean_n', s['radial_force_mean_n']):.1f} "
+                f"({s['radial_force_theory_n']:.1f}) N",
                 f"{s['efficiency']:.4f} ({s['efficiency_theory_at_contact_radius']:.4f})",
                 f"{s['tangential_force_p2p_n']:.3g} N",
                 f"{s['transmission_error_p2p_urad']:.4g} urad",

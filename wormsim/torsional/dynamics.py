@@ -66,7 +66,7 @@ follows the motion and the quasi-static mesh force at steps of one k(theta) samp
 (default_timestep) and damps the kHz modes. scipy solve_ivp (LSODA, BDF, Radau; `simulate(..., method=)`)
 resolves them and serves as the accuracy reference; it is 20-500x slower (docs/torsional.md).
 Summary keys and their computation: those of contact3d (wormsim.metrics: steady window, FFT peak), except
-that mesh_frequency_hz is the FFT peak of the transmission error, not of the tangential force (see
+that mesh_frequency_hz is the meshing line of the transmission error, not of the tangential force (see
 torsional_summary; the force's peak is reported as force_peak_full_band_hz).
 """
 
@@ -84,7 +84,7 @@ from wormsim.errors import DivergedError, LockedError, PenetrationError, Simulat
 from wormsim.friction import friction_coefficient, friction_coefficient_scalar, friction_mode
 from wormsim.geometry import derive, displaced_pair
 from wormsim.locking import Held, backdrive_self_locks, held_keys, run_keys
-from wormsim.metrics import dominant_frequency, drive_summary, mean_speeds_rpm, window_of
+from wormsim.metrics import dominant_frequency, drive_summary, mean_speeds_rpm, mesh_line_keys, window_of
 from wormsim.result import Result
 from wormsim.scenario import Scenario
 from wormsim.tooth.mesh_stiffness import MeshStiffness, mesh_stiffness, per_length_stiffness
@@ -599,20 +599,18 @@ def _locked_guard(scenario, g, t, w1, w2, cmd) -> Held | None:
 
 def torsional_summary(S: dict, scenario: Scenario, g: GearGeometry, ms: MeshStiffness) -> dict:
     """contact3d's summary keys, computed by the same functions (wormsim.metrics), with one difference:
-    the meshing frequency is the FFT peak of the transmission error. The mesh force element's tangential
-    force is quasi-static: its fluctuation is the inertial part, the 2nd time derivative of the
+    the meshing line is taken from the transmission error (wormsim.metrics.mesh_line). The mesh force element's
+    tangential force is quasi-static: its fluctuation is the inertial part, the 2nd time derivative of the
     transmission error, which weights the harmonics of k(theta)'s tooth-entry kinks by n^2 and puts the
     force's peak on a harmonic (reported as force_peak_full_band_hz)."""
     t = S["t_s"]
     i0, i1, _ = window_of(S, scenario, g)
     sl = slice(i0, i1)
     n1, n2 = mean_speeds_rpm(S, i0, i1)
-    f_peak, df, _, _ = dominant_frequency(t[sl], S["transmission_error_rad"][sl])
     f_force, _, _, _ = dominant_frequency(t[sl], S["tangential_force_n"][sl])
     return {
         **drive_summary(S, scenario, g, i0, i1, n1, n2),
-        "mesh_frequency_hz": f_peak,
-        "mesh_frequency_resolution_hz": df,
+        **mesh_line_keys(t, S, sl, g.z1 * n1 / 60.0, "transmission_error_rad"),
         "mesh_frequency_source": "transmission error",
         "force_peak_full_band_hz": f_force,
         "mesh_deflection_mean_um": float(np.mean(S["mesh_deflection_m"][sl]) * 1e6),
