@@ -568,17 +568,18 @@ def parse_dat(dat: Path) -> dict:
         elif head.startswith("stresses"):
             out["stress"][t] = np.array([[float(v) for v in r[:8]] for r in rows if len(r) >= 8])
         elif head.startswith("statistics for slave set"):
-            name = head.split("slave set", 1)[1].split()[0]
-            body = b.strip()
-            mom = re.search(
-                r"moment about the origin\(mx,my,mz\)\s*(" + _NUM + r")\s+(" + _NUM + r")\s+(" + _NUM + ")", body
-            )
-            frc = re.search(
-                r"total surface force \(fx,fy,fz\)\s*(" + _NUM + r")\s+(" + _NUM + r")\s+(" + _NUM + ")", body
-            )
+            # "statistics for slave set NAME, master set ... and time t", then under "total surface force (fx,fy,fz)
+            # and moment about the origin (mx,my,mz)" one line of six numbers (N, N mm)
+            name = head.split("slave set", 1)[1].split()[0].rstrip(",")
+            body = [ln for ln in b.strip().split("\n")[1:] if ln.strip()]
+            vals = None
+            for i, ln in enumerate(body[:-1]):
+                if ln.strip().startswith("total surface force"):
+                    vals = [float(v) for v in body[i + 1].split()[:6]]
+                    break
             out["cf"].setdefault(t, {})[name] = {
-                "force": [float(frc.group(i)) for i in (1, 2, 3)] if frc else None,
-                "moment": [float(mom.group(i)) for i in (1, 2, 3)] if mom else None,
+                "force": vals[:3] if vals else None,
+                "moment": vals[3:] if vals else None,
             }
     return out
 
