@@ -34,13 +34,16 @@ GEARS = {
 C_GUESS_N_PER_MM_UM = 15.0  # the lag that gives about the scenario torque: T / (c b2 arm0^2), ISO 6336's order
 
 
-def ltca_values(g, materials, torque_nm: float, angles: int) -> dict:
+def ltca_values(g, materials, torque_nm: float, angles: int, side: int) -> dict:
     """The LTCA at the check's worm angles (samples = 4 x angles over the cycle, every 4th), or why not."""
     try:
         from wormsim.tooth import ltca
     except ImportError as e:
         return {"available": False, "reason": f"wormsim.tooth.ltca not importable ({e})"}
-    res = ltca.loaded_contact(g, materials, torque_nm, samples=4 * angles)
+    import inspect
+
+    kw = {"side": side} if "side" in inspect.signature(ltca.loaded_contact).parameters else {}
+    res = ltca.loaded_contact(g, materials, torque_nm, samples=4 * angles, **kw)
     rows = []
     for i in range(angles):
         j = 4 * i
@@ -54,7 +57,7 @@ def ltca_values(g, materials, torque_nm: float, angles: int) -> dict:
                 "teeth_in_contact": float(res.teeth_in_contact[j]),
             }
         )
-    return {"available": True, "torque_nm": torque_nm, "angles": rows, "summary": res.summary()}
+    return {"available": True, "torque_nm": torque_nm, "side": side, "angles": rows, "summary": res.summary()}
 
 
 def fe_root_value(g, sc, side: int, torque_nm: float) -> dict:
@@ -132,7 +135,7 @@ def one_gear(name: str, path: Path, angles: int, density: float, threads: int, w
     cp = out["iso6336"]["c_prime_n_per_mm_um"]
     out["iso6336"]["c_gamma_n_per_mm_um"] = cp * (0.75 * eps + 0.25)  # ISO 6336-1: c_gamma = c' (0.75 eps + 0.25)
     out["iso6336"]["eps_calculix_teeth_loaded"] = eps
-    out["ltca"] = ltca_values(g, m, t_mean, angles)
+    out["ltca"] = ltca_values(g, m, t_mean, angles, side)
     out["fe_root"] = fe_root_value(g, sc, side, torque)
     if out["ltca"]["available"]:
         kl = np.array([a["mesh_stiffness_n_per_m"] for a in out["ltca"]["angles"]])

@@ -56,7 +56,7 @@ BORE_MX = 1.2  # worm bore below the worm root, axial modules
 WEDGE_MARGIN_MX = 1.0  # worm wedge beyond the wheel's face width, axial modules (at the pitch radius)
 PENALTY_FACTOR = 50.0  # contact penalty K = PENALTY_FACTOR E_wheel / h_fine
 INCREMENTS = 2  # equal rotation increments (the tangent stiffness from the last two)
-SNAP_MX = 0.03  # nodes within this many m_x of an exact flank are moved onto it
+SNAP_MX = 0.05  # nodes within this many m_x of an exact flank are moved onto it
 
 
 def ccx_path() -> str | None:
@@ -374,9 +374,13 @@ def build_case(g: GearGeometry, side: int, theta1_rad: float, density: float = 1
     Rinv = np.linalg.inv(Rw)
     cw = assembly.transform_points(Rinv, cent)
     rho, psi, zeta = np.hypot(cw[:, 0], cw[:, 1]), np.arctan2(cw[:, 1], cw[:, 0]), cw[:, 2]
-    psi_ex, interior = _wheel_flank_psi(g, rho, zeta, side)
+    psi_ex, _ = _wheel_flank_psi(g, rho, zeta, side)
     k_of = np.round((psi - psi_ex) / pitch)
-    on_flank = (np.abs(rho * (psi - psi_ex - k_of * pitch)) < SNAP_MX * g.m_x) & interior
+    # a face of the working flank has all six nodes on it (moved there by _snap_wheel); a face's corner centroid is
+    # no test: on a coarse face it lies off the curved flank by more than a node does
+    on_node = np.zeros(len(Pw), dtype=bool)
+    on_node[snapped["wheel"].pop("on_flank_nodes")] = True
+    on_flank = np.all(on_node[fn], axis=1)
     tooth_of = (k_of + (0 if side > 0 else -1)).astype(int)
     slave = {}
     for k in teeth:
@@ -439,7 +443,8 @@ def _snap_wheel(g: GearGeometry, side: int, P: np.ndarray, T10: np.ndarray, thet
     moved = new[move]
     P[nodes[move]] = assembly.transform_points(R, moved)
     shift = np.abs(rho * (psi - target))[move]
-    return P, {"nodes": int(move.sum()), "max_shift_um": float(shift.max() * 1e6) if move.any() else 0.0}
+    info = {"nodes": int(move.sum()), "max_shift_um": float(shift.max() * 1e6) if move.any() else 0.0}
+    return P, {**info, "on_flank_nodes": nodes[move]}
 
 
 def _snap_worm(g: GearGeometry, P: np.ndarray, T10: np.ndarray, theta1_rad: float, M: np.ndarray):
