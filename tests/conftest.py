@@ -30,6 +30,8 @@ LONG_TESTS: dict[str, set[str] | None] = {
     # contact3d and `wormsim mesh` per flank form (ZC's stay in `make test`; torsional's of every form too)
     "test_flank_forms_validation.py": {f"{k}_{f}" for k in ("contact3d", "mesh") for f in ("ZN1", "ZN2", "ZK")},
     "test_calculix.py": None,  # the CalculiX contact solve of a small case (minutes on one core)
+    # the tooth compliance's FE on the seeds other than the screw jack (~15 s each cold; test_ltca.py marks its own)
+    "test_tooth_compliance.py": {"involute_41", "seat_motor"},
 }
 
 
