@@ -5,7 +5,7 @@ wheel torque, against
 * the loaded tooth contact analysis wormsim.tooth.ltca (when importable) at the same worm angles and torque:
   mesh stiffness along the line of action and the load share per wheel tooth;
 * the FE root stress of `wormsim rate --fe` (wormsim.rating.fe_root) at the same torque;
-* ISO 6336-1's single stiffness c' of the wheel's virtual spur gear (wormsim.tooth.calculix.iso6336_c_prime).
+* ISO 6336-1's c' and c_gamma of the wheel's virtual spur gear (wormsim.tooth.compliance.iso6336_stiffness).
 Writes the record docs/data/calculix_check.json. CPU bound (gmsh + ccx): about 5 min per case on 1 core.
 
     .venv/bin/python sweeps/calculix_check.py [--angles 3] [--density 1.0] [--threads 1]
@@ -25,6 +25,7 @@ from wormsim.geometry import derive
 from wormsim.provenance import record
 from wormsim.scenario import load_scenario
 from wormsim.tooth import calculix as cx
+from wormsim.tooth.compliance import iso6336_stiffness
 
 ROOT = Path(__file__).resolve().parents[1]
 GEARS = {
@@ -129,12 +130,8 @@ def one_gear(name: str, path: Path, angles: int, density: float, threads: int, w
             "root_stress_max_mpa_at_scenario_torque": root_at_t if roots else None,
             "torque_balance_max": float(max(abs(c["torque_balance"]) for c in cases)),
         },
-        "iso6336": cx.iso6336_c_prime(g, m.worm.youngs_modulus_gpa * 1e9, m.wheel.youngs_modulus_gpa * 1e9),
+        "iso6336": iso6336_stiffness(g, m),
     }
-    eps = float(np.mean([c["teeth_loaded"] for c in cases]))
-    cp = out["iso6336"]["c_prime_n_per_mm_um"]
-    out["iso6336"]["c_gamma_n_per_mm_um"] = cp * (0.75 * eps + 0.25)  # ISO 6336-1: c_gamma = c' (0.75 eps + 0.25)
-    out["iso6336"]["eps_calculix_teeth_loaded"] = eps
     out["ltca"] = ltca_values(g, m, t_mean, angles, side)
     out["fe_root"] = fe_root_value(g, sc, side, torque)
     if out["ltca"]["available"]:

@@ -926,7 +926,7 @@ def calculix_check_table(name: str = "calculix_check") -> str:
                 "-",
                 f"{m['torque_nm']:.3g}",
                 f"**{m['mesh_stiffness_mean_n_per_m']:.3g}** ({m['mesh_stiffness_per_width_n_per_mm_um']:.3g} "
-                f"N/(mm um); ISO c' {iso['c_prime_n_per_mm_um']:.3g}, c_gamma {iso['c_gamma_n_per_mm_um']:.3g})",
+                f"N/(mm um); ISO c' {iso['c_prime']:.3g}, c_gamma {iso['c_gamma']:.3g})",
                 (
                     f"**{lt['summary']['mesh_stiffness_mean_n_per_m']:.3g}** (CalculiX / LTCA {ratio:.3f})"
                     if lt.get("available") and ratio is not None

@@ -736,19 +736,3 @@ def summarise(case: Case, res: dict, lag_rad: float, t_mesh: float, t_ccx: float
         "mesh_wall_s": t_mesh,
         "ccx_wall_s": t_ccx,
     }
-
-
-E_STEEL_PA = 206e9  # ISO 6336-1's reference modulus of steel
-C_M = 0.8  # ISO 6336-1 correction factor of solid gears (theoretical -> measured single stiffness)
-
-
-def iso6336_c_prime(g: GearGeometry, e_worm_pa: float, e_wheel_pa: float) -> dict:
-    """ISO 6336-1 method B single stiffness c' of the wheel's virtual spur gear, N/(mm um) of face width: the worm
-    as the rack (z_n1 -> infinity), z_n2 = z2 / cos^3 gamma, no profile shift, q' = C1 + C3 / z_n2 (C1 0.04723,
-    C3 0.25791 mm um / N), c'_th = 1 / q', c' = c'_th C_M C_R C_B cos(beta) E / E_st with C_R = C_B = 1, beta = gamma
-    and E = 2 E1 E2 / (E1 + E2) (the material ratio of ISO 6336-1 for other materials than steel on steel)."""
-    zn2 = g.z2 / math.cos(g.gamma) ** 3
-    q = 0.04723 + 0.25791 / zn2
-    e_eq = 2 * e_worm_pa * e_wheel_pa / (e_worm_pa + e_wheel_pa)
-    c = (1.0 / q) * C_M * math.cos(g.gamma) * e_eq / E_STEEL_PA
-    return {"z_n2": zn2, "c_prime_th_steel_n_per_mm_um": 1.0 / q, "c_prime_n_per_mm_um": c, "e_eq_gpa": e_eq / 1e9}
