@@ -8,7 +8,8 @@ wheel torque, against
 * ISO 6336-1's c' and c_gamma of the wheel's virtual spur gear (wormsim.tooth.compliance.iso6336_stiffness).
 Writes the record docs/data/calculix_check.json. CPU bound (gmsh + ccx): about 5 min per case on 1 core.
 
-    .venv/bin/python sweeps/calculix_check.py [--angles 3] [--density 1.0] [--threads 1]
+    .venv/bin/python sweeps/calculix_check.py [--angles 3] [--density 1.0] [--threads 1]  (about 1 h)
+    .venv/bin/python sweeps/calculix_check.py --reread   (the record again from out/calculix_check's files)
 """
 
 from __future__ import annotations
@@ -145,6 +146,34 @@ def one_gear(name: str, path: Path, angles: int, density: float, threads: int, w
     return out
 
 
+def convergence(a, gears: dict) -> dict:
+    """The h-refinement check: the screw jack's first angle at density --fine (element sizes / fine) beside the
+    sweep's density."""
+    sc = load_scenario(GEARS["screw_jack"])
+    g = derive(sc.gear)
+    m = sc.materials
+    side = gear_theory.working_flank(sc, g.hand)
+    lag = abs(sc.load.torque_nm) / (C_GUESS_N_PER_MM_UM * 1e9 * g.face_width * cx.arm0_m(g) ** 2)
+    where = Path(a.workdir) / "screw_jack_fine"
+    if a.reread:
+        fine = cx.reread(where, 0.0)
+    else:
+        fine = cx.solve(
+            g, m.wheel.youngs_modulus_gpa * 1e9, m.wheel.poisson_ratio, m.worm.youngs_modulus_gpa * 1e9,
+            m.worm.poisson_ratio, side, 0.0, lag, density=a.fine, workdir=where, threads=a.threads,
+        )  # fmt: skip
+    coarse = gears["screw_jack"]["calculix"][0]
+    keys = ("mesh_stiffness_n_per_m", "load_share", "root_stress_max_mpa", "torque_nm", "nodes", "h_fine_mm")
+    return {
+        "gear": "screw_jack",
+        "theta1_deg": 0.0,
+        "density": a.fine,
+        "coarse": {k: coarse.get(k) for k in keys},
+        "fine": {k: fine.get(k) for k in keys},
+        "mesh_stiffness_change": fine["mesh_stiffness_n_per_m"] / coarse["mesh_stiffness_n_per_m"] - 1.0,
+    }
+
+
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--angles", type=int, default=3)
@@ -152,6 +181,7 @@ def main() -> None:
     ap.add_argument("--threads", type=int, default=1)
     ap.add_argument("--gears", default=",".join(GEARS))
     ap.add_argument("--workdir", default=str(ROOT / "out" / "calculix_check"))
+    ap.add_argument("--fine", type=float, default=1.4, help="density of the h-refinement check (screw jack, angle 0)")
     ap.add_argument("--reread", action="store_true", help="the results of an earlier run's files (no solve)")
     a = ap.parse_args()
     if cx.ccx_path() is None and not a.reread:
@@ -159,7 +189,8 @@ def main() -> None:
     gears = {}
     for name in a.gears.split(","):
         gears[name] = one_gear(name, GEARS[name], a.angles, a.density, a.threads, Path(a.workdir), a.reread)
-    data = {
+    data = {"convergence": convergence(a, gears)} if "screw_jack" in gears else {}
+    data |= {
         "model": {
             "h_fine_mx": cx.H_FINE_MX / a.density,
             "h_max_mx": cx.H_MAX_MX / a.density,

@@ -941,7 +941,19 @@ def calculix_check_table(name: str = "calculix_check") -> str:
         )
     head = ["gear", "theta1 [deg]", "T2 [N m]", "k CalculiX [N/m]", "k LTCA [N/m]", "shares CalculiX",
             "shares LTCA", "torque balance", "root stress [MPa]"]  # fmt: skip
-    return _table(head, rows) + "\n" + _source(name)
+    conv = rec.get("convergence")
+    note = ""
+    if conv:
+        c, f = conv["coarse"], conv["fine"]
+        note = (
+            f"\nh-refinement ({conv['gear']}, theta1 {conv['theta1_deg']:.0f} deg): element size at the contact lines "
+            f"{c['h_fine_mm']:.3g} -> {f['h_fine_mm']:.3g} mm ({c['nodes']} -> {f['nodes']} nodes): k "
+            f"{c['mesh_stiffness_n_per_m']:.3g} -> {f['mesh_stiffness_n_per_m']:.3g} N/m "
+            f"({conv['mesh_stiffness_change'] * 100:+.1f} %), shares {_shares(c['load_share'])} -> "
+            f"{_shares(f['load_share'])}, root stress {_fmt(c['root_stress_max_mpa'])} -> "
+            f"{_fmt(f['root_stress_max_mpa'])} MPa.\n"
+        )
+    return _table(head, rows) + note + "\n" + _source(name)
 
 
 TABLES: dict[str, Callable[[], str]] = {
