@@ -364,9 +364,14 @@ def build_case(g: GearGeometry, side: int, theta1_rad: float, density: float = 1
     Ps, Ts = tet_mesh_sized(Vs, Fs, size_at)
     Ps, Ts = quadratic(Ps, Ts)
     snapped = {}
-    # move the flank nodes onto the exact surfaces
+    # move the flank nodes onto the exact surfaces (not where that would turn an element inside out)
+    Pw0, Ps0 = Pw, Ps
     Pw, snapped["wheel"] = _snap_wheel(g, side, Pw, Tw, theta2_touch, pitch)
     Ps, snapped["worm"] = _snap_worm(g, Ps, Ts, theta1_rad, Mw)
+    Pw, back_w = keep_positive(Pw0, Pw, Tw)
+    Ps, back_s = keep_positive(Ps0, Ps, Ts)
+    snapped["wheel"]["reverted"], snapped["worm"]["reverted"] = len(back_w), len(back_s)
+    snapped["wheel"]["on_flank_nodes"] = np.setdiff1d(snapped["wheel"]["on_flank_nodes"], back_w)
     # sets
     el, fc = boundary_faces(Tw)
     fn = face_nodes(Tw, el, fc)
@@ -415,6 +420,42 @@ def build_case(g: GearGeometry, side: int, theta1_rad: float, density: float = 1
         rim_nodes=rim, bore_nodes=bore + n_w, root_elements=root_el, contact_points=lines_a, h_fine_m=h_fine,
         snapped=snapped,
     )  # fmt: skip
+
+
+_GAUSS_A, _GAUSS_B = 0.5854101966249685, 0.1381966011250105  # the 4-point rule of C3D10
+
+
+def min_jacobian(P: np.ndarray, T10: np.ndarray) -> np.ndarray:
+    """Per C3D10 element the smallest Jacobian determinant at its four integration points (where CalculiX checks it)."""
+    a, b = _GAUSS_A, _GAUSS_B
+    dL = np.array([[-1.0, -1.0, -1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]])  # dL_i / d(xi, eta, zeta)
+    X = P[T10]  # (m, 10, 3)
+    out = np.full(len(T10), np.inf)
+    for l2, l3, l4 in ((b, b, b), (a, b, b), (b, a, b), (b, b, a)):
+        L = np.array([1 - l2 - l3 - l4, l2, l3, l4])
+        dN = [(4 * L[i] - 1) * dL[i] for i in range(4)]
+        dN += [4 * (L[i] * dL[j] + L[j] * dL[i]) for i, j in EDGES]
+        J = np.einsum("mnk,nl->mkl", X, np.array(dN))
+        out = np.minimum(out, np.linalg.det(J))
+    return out
+
+
+def keep_positive(P0: np.ndarray, P: np.ndarray, T10: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """P with the moves P0 -> P undone at the nodes of elements whose Jacobian turned nonpositive (repeated until
+    none); and the nodes put back."""
+    P = P.copy()
+    back = [np.zeros(0, dtype=np.int64)]
+    for _ in range(10):
+        bad = min_jacobian(P, T10) <= 0
+        if not bad.any():
+            break
+        nodes = np.unique(T10[bad])
+        moved = nodes[(P[nodes] != P0[nodes]).any(axis=1)]
+        if len(moved) == 0:
+            break
+        P[moved] = P0[moved]
+        back.append(moved)
+    return P, np.concatenate(back)
 
 
 def _rim_depth() -> float:
