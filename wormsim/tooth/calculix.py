@@ -728,7 +728,10 @@ def reread(workdir: Path, theta1_rad: float) -> dict:
     base = workdir / case_name(theta1_rad)
     with open(base.with_suffix(".pkl"), "rb") as fh:
         saved = pickle.load(fh)
-    return summarise(saved["case"], parse_dat(base.with_suffix(".dat")), saved["lag_rad"], saved["mesh_wall_s"], 0.0)
+    log = base.with_suffix(".log")
+    hit = re.search(r"Total CalculiX Time:\s*(" + _NUM + ")", log.read_text()) if log.exists() else None
+    t_ccx = float(hit.group(1)) if hit else 0.0  # ccx's own wall time of that solve
+    return summarise(saved["case"], parse_dat(base.with_suffix(".dat")), saved["lag_rad"], saved["mesh_wall_s"], t_ccx)
 
 
 def summarise(case: Case, res: dict, lag_rad: float, t_mesh: float, t_ccx: float) -> dict:
