@@ -138,6 +138,7 @@ def one_gear(name: str, path: Path, angles: int, density: float, threads: int, w
     if out["ltca"]["available"]:
         kl = np.array([a["mesh_stiffness_n_per_m"] for a in out["ltca"]["angles"]])
         out["comparison"] = {
+            "ltca_mesh_stiffness_mean_at_angles_n_per_m": float(kl.mean()),
             "mesh_stiffness_ratio_calculix_to_ltca": float(k.mean() / kl.mean()),
             "load_share_max_difference": float(
                 max(abs(c["load_share_max"] - a["load_share_max"]) for c, a in zip(cases, out["ltca"]["angles"]))

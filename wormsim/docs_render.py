@@ -913,7 +913,7 @@ def calculix_check_table(name: str = "calculix_check") -> str:
                     f"{a['mesh_stiffness_n_per_m']:.3g}" if a else "-",
                     _shares(c["load_share"]),
                     _shares(a["load_share"]) if a else "-",
-                    f"{c['torque_balance'] * 100:+.2f} %",
+                    f"{c['torque_balance']:+.0e}",
                     _fmt(c.get("root_stress_max_mpa")),
                 ]
             )
@@ -928,19 +928,20 @@ def calculix_check_table(name: str = "calculix_check") -> str:
                 f"**{m['mesh_stiffness_mean_n_per_m']:.3g}** ({m['mesh_stiffness_per_width_n_per_mm_um']:.3g} "
                 f"N/(mm um); ISO c' {iso['c_prime']:.3g}, c_gamma {iso['c_gamma']:.3g})",
                 (
-                    f"**{lt['summary']['mesh_stiffness_mean_n_per_m']:.3g}** (CalculiX / LTCA {ratio:.3f})"
+                    f"**{cmp['ltca_mesh_stiffness_mean_at_angles_n_per_m']:.3g}** (CalculiX / LTCA {ratio:.3f}; "
+                    f"12 samples: {lt['summary']['mesh_stiffness_mean_n_per_m']:.3g})"
                     if lt.get("available") and ratio is not None
                     else "LTCA not available"
                 ),  # fmt: skip
                 f"max {m['load_share_max']:.2f}",
                 (f"max diff {cmp['load_share_max_difference']:.3f}" if "load_share_max_difference" in cmp else "-"),
-                f"max {m['torque_balance_max'] * 100:.2f} %",
+                f"max {m['torque_balance_max']:.0e}",
                 f"{_fmt(m['root_stress_max_mpa_at_scenario_torque'])} at {d['torque_scenario_nm']:.3g} N m "
                 f"(rate --fe: {_fmt(d['fe_root']['root_stress_max_mpa'])})",
             ]
         )
     head = ["gear", "theta1 [deg]", "T2 [N m]", "k CalculiX [N/m]", "k LTCA [N/m]", "shares CalculiX",
-            "shares LTCA", "torque balance", "root stress [MPa]"]  # fmt: skip
+            "shares LTCA", "torque balance (rel.)", "root stress [MPa]"]  # fmt: skip
     conv = rec.get("convergence")
     note = ""
     if conv:
