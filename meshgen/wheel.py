@@ -143,7 +143,7 @@ def check_wheel(g: GearGeometry, n: int = 25) -> None:
 
     Pointed: tooth thickness at the tip (throat, anywhere across the face) below 0.05 m_x.
     Undercut: on the mid-plane, the hob tip edge (not the conjugate flank) cuts the flank above the
-    reach of the worm tip, rho > r2 - h_a + 0.05 m_x, i.e. into the working depth.
+    reach of the worm tip, rho > r2 + x2 m_x - h_a + 0.05 m_x, i.e. into the working depth.
     """
     zeta = np.linspace(-g.face_width / 2, g.face_width / 2, n)
     rt = tip_rho(g, zeta)
@@ -161,6 +161,7 @@ def check_wheel(g: GearGeometry, n: int = 25) -> None:
             f"the working flank below the reference circle (limit {100 * UNDERCUT_LIMIT:.0f} %); raise "
             f"gear.normal_pressure_angle_deg (now {math.degrees(g.alpha_n):.2f}) or gear.wheel_teeth (now {g.z2})"
             + (f", or gear.profile_radius_mm (now {g.profile_radius * 1e3:.4g})" if g.profile == "ZC" else "")
+            + f", or gear.profile_shift_coefficient (now {g.x2:g})"
         )
 
 
@@ -168,15 +169,18 @@ UNDERCUT_LIMIT = 0.6
 
 
 def undercut_fraction(g: GearGeometry, n: int = 41) -> float:
-    """Undercut on the mid-plane: fraction of the working depth below the reference circle, r2 - h_a .. r2,
-    where the flank is cut by the hob tip edge instead of being the conjugate envelope (0: none).
+    """Undercut on the mid-plane: fraction of the working depth below the worm's reference line, from the worm tip's
+    reach a - r_a1 = r2 + x2 m_x - h_a up to a - r1 = r2 + x2 m_x (r2 - h_a .. r2 unshifted), where the flank is cut
+    by the hob tip edge instead of being the conjugate envelope (0: none).
 
-    Classical rack theory (z2 < 2 h_f / sin^2(alpha) undercuts) in the worm's mid-plane; the generated tooth
-    never interferes with the worm, but an undercut flank loses its conjugate contact there.
+    Classical rack theory (z2 < 2 (h_f - x2 m_x) / sin^2(alpha) undercuts: a positive profile shift x2 moves the
+    hob's reference line out and lifts the undercut out of the working depth) in the worm's mid-plane; the generated
+    tooth never interferes with the worm, but an undercut flank loses its conjugate contact there.
     """
-    rho = np.linspace(g.r2 - g.h_a, g.r2, n)
+    lo = g.r2 + g.shift - g.h_a  # r2 - h_a bit for bit when x2 = 0
+    rho = np.linspace(lo, g.r2 + g.shift, n)
     sol = space_flank(g, rho, np.zeros_like(rho), +1)
     if np.all(sol.interior):
         return 0.0
     top = rho[~sol.interior].max()
-    return float((top - (g.r2 - g.h_a)) / g.h_a)
+    return float((top - lo) / g.h_a)

@@ -81,6 +81,7 @@ Gear = Any  # a meshgen.geometry.GearGeometry (not imported: meshgen.geometry im
 
 DEFAULT_TOOL_DIAMETER_MM = 100.0  # ZK, ZC disc (docs/flank_forms.md)
 DEFAULT_PROFILE_RADIUS_MODULES = 5.5  # ZC tool arc radius / m_x (docs/flank_forms.md)
+DEFAULT_ZC_PROFILE_SHIFT = 0.5  # ZC wheel profile shift x2 (docs/flank_forms.md)
 
 N_CHEB = 40  # Chebyshev terms of the H(r) table
 TABLE_TOL_M = 1e-9  # the table's largest allowed deviation from the exact H(r) (form_table's check)
@@ -88,11 +89,19 @@ FORMS = ("ZA", "ZN", "ZI", "ZK", "ZC")
 TABLE_FORMS = ("ZN", "ZK", "ZC")  # the forms evaluated by the table (ZA, ZI: closed forms in meshgen.worm)
 __all__ = [
     "DEFAULT_PROFILE_RADIUS_MODULES",
+    "DEFAULT_ZC_PROFILE_SHIFT",
     "DEFAULT_TOOL_DIAMETER_MM",
     "FormTable",
     "exact_half_thickness",
     "form_table",
 ]
+
+
+def default_profile_shift(profile: str) -> float:
+    """The wheel's profile shift x2 when gear.profile_shift_coefficient is not given: 0, and for ZC the
+    DEFAULT_ZC_PROFILE_SHIFT of ZC practice, with which ZC's default arc radius leaves a 20 deg wheel uncut
+    (docs/flank_forms.md has the sources and the undercut it removes)."""
+    return DEFAULT_ZC_PROFILE_SHIFT if profile == "ZC" else 0.0
 
 
 def _geom(g: Gear):

@@ -38,7 +38,8 @@ FORMS = {
     "ZK": [],
     # the default arc radius 5.5 m_x undercuts these unshifted wheels (docs/flank_forms.md): 10 m_x (the screw jack's
     # 25 mm, the INTERFACE example) is the smallest of 5.5, 8, 10 m_x that the undercut check passes
-    "ZC": ["gear.profile_radius_mm=25"],
+    # unshifted wheels (ZC's default profile shift 0.5 turned off): the study compares the forms on the same wheel
+    "ZC": ["gear.profile_radius_mm=25", "gear.profile_shift_coefficient=0"],
 }
 GEARS = ("screw_jack", "seat_motor")
 KEYS = (

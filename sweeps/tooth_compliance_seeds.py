@@ -36,6 +36,7 @@ MATERIALS = {
     "PA66": (2.8, 0.4, "typical dry PA66 datasheet value, an assumption (no source in the repository)"),
 }
 GRID_FINE = (13, 7)  # the flank grid's refinement check
+LOAD_FACTORS = (0.25, 4.0)  # the load dependence (the flattening) on the screw jack, x its 12 N m
 
 
 def main() -> None:
@@ -89,6 +90,9 @@ def main() -> None:
     finally:
         compliance.GRID_FACE, compliance.GRID_PROFILE = saved
     parts["mesh_stiffness_grid_13x7_n_per_m"] = float(np.mean(fine.mesh_stiffness_n_per_m))
+    for factor in LOAD_FACTORS:
+        r = ltca.loaded_contact(g, sc.materials, 12.0 * factor)
+        parts[f"mesh_stiffness_at_{factor:g}x_load_n_per_m"] = r.summary()["mesh_stiffness_mean_n_per_m"]
     print(parts, flush=True)
     mats = {}
     for name, (e_gpa, nu, source) in MATERIALS.items():

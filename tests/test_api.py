@@ -49,13 +49,16 @@ def template(tmp_path_factory):
     return write_template(tmp_path_factory.mktemp("init") / "my_gear.yaml")
 
 
+SHORT_RAMPS = ["drive.ramp_s=0.02", "load.ramp_s=0.02"]  # the template's 0.05 s ramps, shortened for CI-sized runs
+
+
 @pytest.mark.parametrize(
     "level, sets",
     [
         ("wedge", []),
-        ("torsional", ["simulation.duration_s=0.05"]),
+        ("torsional", ["simulation.duration_s=0.05", *SHORT_RAMPS]),
         # a few mesh periods of the 2-start worm at 1500 rpm (50 Hz): the start-up and a short window
-        ("contact3d", ["simulation.duration_s=0.03", "contact.slices=8"]),
+        ("contact3d", ["simulation.duration_s=0.03", "contact.slices=8", *SHORT_RAMPS]),
     ],
 )
 def test_the_template_runs_at_every_level(template, tmp_path, level, sets):

@@ -117,23 +117,24 @@ def test_compiled_samples_equal_the_python_path(case, monkeypatch):
     assert pa.keys() == pb.keys() and all(_same(pa[k], pb[k]) for k in pa)
 
 
+HELD = (
+    JACK,
+    [
+        "drive.on=wheel",
+        "drive.speed_rpm=55",
+        "drive.ramp_s=0.01",
+        "load.on=worm",
+        "load.torque_nm=0.1",
+        "load.ramp_s=0.01",
+        "contact.friction_static=null",
+        "contact.friction_dynamic=null",
+        "simulation.resolution=coarse",
+        "contact.friction=0.2",
+        "simulation.duration_s=0.085",
+    ],
+)  # a wheel back-driving a self-locking pair: the run ends held (wormsim.locking)
+
 GUARDS = {
-    "friction guard (locked)": (
-        JACK,
-        [
-            "drive.on=wheel",
-            "drive.speed_rpm=55",
-            "drive.ramp_s=0.01",
-            "load.on=worm",
-            "load.torque_nm=0.1",
-            "load.ramp_s=0.01",
-            "contact.friction_static=null",
-            "contact.friction_dynamic=null",
-            "simulation.resolution=coarse",
-            "contact.friction=0.2",
-            "simulation.duration_s=0.085",
-        ],
-    ),
     "penetration": (
         DEMO,
         ["drive.speed_rpm=0", "drive.ramp_s=0", "load.ramp_s=0", "load.torque_nm=700", "simulation.duration_s=0.001"],
@@ -145,6 +146,17 @@ GUARDS = {
     "diverged": (DEMO, ["simulation.timestep_s=1e-4", "simulation.duration_s=0.005"]),
     "bad qacc": (DEMO, ["simulation.duration_s=0.004", "load.torque_nm=100", "load.ramp_s=0", "drive.ramp_s=0"]),
 }
+
+
+def test_held_run_ends_alike_on_the_compiled_and_the_python_path(monkeypatch):
+    """The held back-drive (tests/test_contact3d_guards.py, before: the friction guard's locked error): the run ends
+    at the same sample with the same locked keys either way."""
+    fast = _run(*HELD, True, monkeypatch)
+    slow = _run(*HELD, False, monkeypatch)
+    assert fast.summary["locked"] is True and slow.summary["locked"] is True
+    assert fast.sim_time_s == slow.sim_time_s and len(fast.series["t_s"]) == len(slow.series["t_s"])
+    for k in ("holding_torque_nm", "creep_speed_rpm"):
+        assert fast.summary[k] == slow.summary[k], k
 
 
 @pytest.mark.parametrize("case", list(GUARDS))

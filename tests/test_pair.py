@@ -203,3 +203,54 @@ def test_pair_with_shafts_on_a_compliant_housing_meshes():
     loads = pair.shaft_loads(data)
     assert abs(abs(loads["worm_bearing_axial_n"]) / abs(pair.mesh_forces(data)[0]) - 1) < 0.03, loads
     assert loads["worm_deflection_mesh_x_m"] != 0.0
+
+
+def test_pair_forces_and_efficiency_match_contact3d_on_the_same_gear():
+    """Issue 31: WormPair's F_r, F_a and efficiency against contact3d's on the same gear and working point (screw
+    jack, 8 slices, worm at 30 rad/s, 12 N m on the wheel, both ramped over 0.02 s, timestep 1e-5 s, means over
+    0.03-0.06 s). Both step the same exact-flank contacts (measured: F_r 134.41 / 134.43 N, F_a 58.70 / 58.73 N,
+    efficiency 0.6389 / 0.6388, pair / contact3d); 0.5 % allows for the machine's velocity servo (kv = 1 against
+    contact3d's stiffer one). F_a2 also against DIN 3975's F_t2 tan(gamma + rho') at the mesh's mean friction, 5 %."""
+    from meshgen.geometry import derive
+    from wormsim import gear_theory as gt
+    from wormsim.run import simulate
+
+    sc = _jack()
+    pair = wormsim.WormPair.from_scenario(sc)
+    model, data = _machine([pair], (12.0,))
+    h = model.opt.timestep
+    am = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, "motor0")
+    al = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, "load0")
+    steps = 6000
+    rows = np.zeros((steps, 5))  # F_t, F_r, F_a, worm power, wheel power
+    for k in range(steps):
+        s = min(1.0, (data.time + h) / 0.02)
+        data.ctrl[am], data.ctrl[al] = 30.0 * s, -12.0 * s
+        wormsim.step(model, data, [pair])
+        w1, w2 = pair.worm_speed_rad_s(data), pair.wheel_speed_rad_s(data)
+        rows[k] = (*pair.mesh_forces(data), data.actuator_force[am] * w1, data.actuator_force[al] * w2)
+    m = rows[steps // 2 :].mean(axis=0)
+    eta_pair = -m[4] / m[3]
+
+    c3 = load_scenario(
+        ROOT / "scenarios/screw_jack.yaml",
+        [
+            "contact.slices=8",
+            f"drive.speed_rpm={30.0 * 60 / (2 * np.pi)}",
+            "drive.ramp_s=0.02",
+            "load.ramp_s=0.02",
+            "simulation.timestep_s=1e-5",
+            "simulation.duration_s=0.06",
+        ],
+    )
+    S = simulate(c3).series
+    k = S["t_s"] >= 0.03
+    ft3, fr3, fa3 = (float(np.mean(S[n][k])) for n in ("tangential_force_n", "radial_force_n", "axial_force_n"))
+    eta3 = float(-np.mean(S["wheel_power_w"][k]) / np.mean(S["worm_power_w"][k]))
+    assert m[1] == pytest.approx(fr3, rel=0.005)
+    assert m[2] == pytest.approx(fa3, rel=0.005)
+    assert eta_pair == pytest.approx(eta3, rel=0.005)
+    g = derive(sc.gear)
+    mu = float(np.mean(S["friction_coefficient"][k]))
+    rho = gt.virtual_friction_angle_rad(mu, g.alpha_n)
+    assert m[2] == pytest.approx(float(gt.axial_force_n(m[0], g.gamma, rho)), rel=0.05)

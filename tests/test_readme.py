@@ -32,3 +32,18 @@ def test_readme_template_is_a_valid_scenario(tmp_path):
     path.write_text(block)
     sc = load_scenario(path)
     assert sc.name == "my_gear" and sc.gear.worm_starts == 2 and sc.gear.wheel_teeth == 30
+
+
+def test_readme_template_is_what_wormsim_init_writes(tmp_path, monkeypatch):
+    """`wormsim init my_gear.yaml` writes the README's template character for character, and its profile comment
+    names all five flank forms."""
+    from wormsim.init_cmd import write_template
+
+    block = README.split("```yaml\n", 1)[1].split("```", 1)[0]
+    monkeypatch.chdir(tmp_path)
+    path = write_template("my_gear.yaml")
+    assert path.read_text() == block
+    profile = block.split("profile:", 1)[1].split("\n  hand:", 1)[0]
+    for form in ("ZA", "ZN", "ZI", "ZK", "ZC"):
+        assert form in profile, form
+    assert "model: torsional" in block and "duration_s: 0.5" in block

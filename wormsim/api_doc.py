@@ -8,8 +8,36 @@ import sys
 
 import wormsim
 
-# what docs/api.md documents, in reading order (wormsim.__all__, plus the output-key table)
-ORDER = ("load_scenario", "Scenario", "simulate", "Result", "run_scenario", "ScenarioError", "SimulationError")
+# what docs/api.md documents, in reading order: every name of wormsim.__all__ but LEVELS (a line of the header)
+ORDER = (
+    "load_scenario",
+    "Scenario",
+    "simulate",
+    "Result",
+    "run_scenario",
+    "ScenarioError",
+    "SimulationError",
+    "WormPair",
+    "step",
+)
+
+
+METHODS = ("WormPair",)  # classes whose public methods and properties docs/api.md lists
+
+
+def _members(cls) -> list[str]:
+    """One list item per public method and property defined on cls: its signature and its docstring's first line."""
+    out = []
+    for name, obj in vars(cls).items():
+        if name.startswith("_"):
+            continue
+        fn = obj.__func__ if isinstance(obj, classmethod | staticmethod) else obj
+        doc = inspect.cleandoc(getattr(fn, "__doc__", None) or "").split("\n\n")[0].replace("\n", " ")
+        if isinstance(obj, property):
+            out.append(f"- `{name}` (property): {doc}")
+        elif callable(fn):
+            out.append(f"- `{name}{_signature(fn)}`: {doc}")
+    return out
 
 
 def _signature(obj) -> str:
@@ -66,6 +94,8 @@ def markdown() -> str:
             sig = ""
         lines += [f"## `wormsim.{name}`", "", "```python", f"{kind} {name}{sig}", "```", ""]
         lines += [*_sections(inspect.cleandoc(obj.__doc__ or "")), ""]
+        if name in METHODS:
+            lines += ["**Methods and properties**", "", *_members(obj), ""]
     return "\n".join(lines).rstrip() + "\n"
 
 

@@ -48,6 +48,12 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("run", help="run one scenario: summary.json, timeseries.npz, recording.rrd, report.png")
     _add_scenario_args(p)
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p.add_argument(
+        "--rexs", metavar="OUT.rexs", help="also write the stage and its results as REXS (.rexs XML, .rexsj JSON)"
+    )
+    p = sub.add_parser("import", help="a worm stage from a REXS file (.rexs, .rexsj) as a commented scenario YAML")
+    p.add_argument("rexs_file", help="REXS model (XML .rexs or JSON .rexsj, REXS 1.x) with one worm stage")
+    p.add_argument("--out", required=True, help="the scenario YAML to write")
     p = sub.add_parser("mesh", help="geometry only: worm.stl, wheel.stl, assembly.json, recording.rrd, section.png")
     _add_scenario_args(p)
     p = sub.add_parser(
@@ -104,6 +110,11 @@ def build_parser() -> argparse.ArgumentParser:
 
 def _cmd_run(args) -> int:
     sc = load_scenario(args.scenario, args.overrides)
+    if Path(args.scenario).suffix.lower() in (".rexs", ".rexsj"):  # what the import assumed, as `wormsim import` says
+        from wormsim import rexs
+
+        for note in rexs.import_file(args.scenario).notes:
+            print(f"wormsim: {note}", file=sys.stderr)
     summary = run_scenario(sc, args.out, progress=False if args.no_progress else None)
     out = Path(args.out)
     keys = [k for k in summary if k not in ("status", "message")]
@@ -115,6 +126,40 @@ def _cmd_run(args) -> int:
     print(f"recording: {out / 'recording.rrd'}  (view with: rerun {out / 'recording.rrd'})")
     for w in summary.get("warnings") or []:  # also in summary.json (wormsim.run_warnings)
         print(f"warning: {w}", file=sys.stderr)
+    if args.rexs:
+        _write_rexs(sc, summary, args.rexs)
+    return EXIT_OK
+
+
+def _write_rexs(sc, summary: dict, path: str) -> None:
+    """The stage with the run's results and its rating (where the gear can be rated) as REXS."""
+    from wormsim import rexs
+    from wormsim.rating.rate import rate
+
+    rating = None
+    if sc.gear is not None and summary.get("status") == "ok":
+        try:
+            rating = rate(sc)
+        except ScenarioError as exc:  # e.g. no load torque: the run's results only
+            print(f"wormsim: REXS export without the rating: {exc}", file=sys.stderr)
+    written = rexs.write_model(rexs.export_model(sc, summary, rating), path)
+    print(f"wrote {written} (REXS {'JSON' if written.suffix.lower() == '.rexsj' else 'XML'})")
+
+
+def _cmd_import(args) -> int:
+    from wormsim import rexs
+    from wormsim.output import check_writable_file, write_text_atomic
+
+    imp = rexs.import_file(args.rexs_file)
+    text = rexs.to_yaml(imp)
+    from wormsim.scenario import scenario_from_dict
+
+    scenario_from_dict(imp.data, args.rexs_file)  # the imported stage validates (exit 2 naming the key otherwise)
+    out = check_writable_file(args.out)
+    write_text_atomic(out, text)
+    for n in imp.notes:
+        print(f"wormsim: {n}", file=sys.stderr)
+    print(f"wrote {out}: run it with: wormsim run {out} --out out/{Path(out).stem}")
     return EXIT_OK
 
 
@@ -163,15 +208,27 @@ def _cmd_bench(args) -> int:
 
 def _cmd_sweep(args) -> int:
     from wormsim.sweep import load_sweep, run_sweep
+    from wormsim.sweep.runner import ClusterStart
 
-    sw = load_sweep(args.sweep)
+    if args.workers is not None and args.workers < 1:
+        raise ScenarioError(f"--workers {args.workers}: allowed an integer >= 1")
+    started: list[ClusterStart] = []  # the cluster starts while the points are validated
+
+    def start() -> None:
+        started.append(ClusterStart(args.scheduler, args.workers))
+
+    try:
+        sw = load_sweep(args.sweep, on_parsed=start)
+    except BaseException:
+        for s in started:
+            s.close()
+        raise
     c = run_sweep(
         sw,
         args.out,
-        scheduler=args.scheduler,
-        workers=args.workers,
         keep_runs=args.keep_runs,
         progress=False if args.no_progress else None,
+        started=started[0] if started else None,
     )
     out = Path(args.out)
     print(
@@ -207,6 +264,9 @@ def _cmd_check(args) -> int:
     for line in ignored_inputs(sc):
         print(f"wormsim: {line}", file=sys.stderr)
     print(yaml.safe_dump(sc.model_dump(mode="json", exclude_none=True), sort_keys=False), end="")
+    from wormsim.check_cmd import derived_text
+
+    print(derived_text(sc), end="")  # the sizes, timestep and slices the run takes, as YAML comments
     return EXIT_OK
 
 
@@ -228,6 +288,7 @@ COMMANDS = {
     "schema": _cmd_schema,
     "check": _cmd_check,
     "init": _cmd_init,
+    "import": _cmd_import,
 }
 
 

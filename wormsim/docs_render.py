@@ -217,6 +217,58 @@ def sweep_speedup_table(name: str = "sweep_speedup") -> str:
     return text + "\n" + _source(name)
 
 
+def sweep_scaling_table(name: str = "sweep_scaling") -> str:
+    """A contact3d sweep as `wormsim sweep` commands on 1 and 2 workers, and the scaling model
+    (sweeps/measure_sweep_scaling.py)."""
+    r = load(name)
+    rows = []
+    for n, x in sorted(r["runs"].items(), key=lambda kv: int(kv[0])):
+        rows.append(
+            [
+                n,
+                f"{x['command_wall_s']:.1f}",
+                f"{x['span_s']:.1f}",
+                f"{x['fixed_s']:.1f}",
+                f"{x['cluster_start_s']:.1f}",
+                "-" if x.get("warm_s") is None else f"{x['warm_s']:.1f}",
+                f"{x['point_wall_median_s']:.2f}",
+                f"{x['step_wall_us_median']:.0f}",
+                f"{x['idle_per_point_s']:.2f}",
+                ", ".join(f"{v:.2f}" for v in x["first_point_extra_s"]) or "-",
+                ", ".join(f"{v:.1f}" for v in x["compile_s_per_worker"]),
+                str(x.get("points_per_task")),
+            ]
+        )
+    head = [
+        "workers",
+        "command s",
+        "points' span s",
+        "fixed s",
+        "cluster start s",
+        "warm-up s",
+        "point median s",
+        "step us",
+        "idle per point s",
+        "first point extra s",
+        "compile s per worker",
+        "points per task",
+    ]
+    m = r["model"]
+    text = _table(head, rows)
+    text += (
+        f"\n{r['what']}. Speed-up 1 -> 2 workers: {r['speedup_command']:.2f}x for the whole command, "
+        f"{r['speedup_span']:.2f}x over the points' span; the step grows {r['step_growth_2']:.2f}x with 2 busy "
+        f"workers. Load average after: {', '.join(f'{v:.1f}' for v in r['load_average_after'])} "
+        f"({r['cpu_count']} CPUs).\n\n"
+        f"Model T(N) = fixed + ceil(P / N) t_point g(N), t_point = {m['t_point_s']:.1f} s the 1-worker span per "
+        "point: "
+        f"T(1) {m['T_1_s']:.1f} s, T(2) {m['T_2_s']:.1f} s (with the measured g(2)), "
+        f"T(16) {m['T_16_s_no_growth']:.1f} s with no step growth and {m['T_16_s_growth_1.31']:.1f} s "
+        "with g(16) 1.31.\n"
+    )
+    return text + "\n" + _source(name)
+
+
 def _study_value(v) -> str:
     """The error's value: a number, or the pitch deviations of every other tooth as one phrase."""
     if v in (None, ""):
@@ -313,7 +365,9 @@ def ci_seeds_table(name: str = "ci_seeds_flanks") -> str:
                 f"{s['ratio']:.5f} ({s['ratio_theory']:g})",
                 f"{s['mesh_frequency_hz']:.4f} ({s['mesh_frequency_theory_hz']:.4f}) Hz",
                 f"{s['tangential_force_mean_n']:.1f} ({s['tangential_force_theory_n']:.1f}) N",
-                f"{s['radial_force_line_of_centres_mean_n']:.1f} ({s['radial_force_theory_n']:.1f}) N",
+                # older records carry DIN's F_r2 (the line of centres') as radial_force_line_of_centres_mean_n
+                f"{s.get('radial_force_line_of_centres_mean_n', s['radial_force_mean_n']):.1f} "
+                f"({s['radial_force_theory_n']:.1f}) N",
                 f"{s['efficiency']:.4f} ({s['efficiency_theory_at_contact_radius']:.4f})",
                 f"{s['tangential_force_p2p_n']:.3g} N",
                 f"{s['transmission_error_p2p_urad']:.4g} urad",
@@ -731,6 +785,11 @@ def tooth_compliance_seeds_table(name: str = "tooth_compliance_seeds") -> str:
     )
     if "mesh_stiffness_grid_13x7_n_per_m" in parts:
         note += f", the flank grid 13 x 7 instead of 9 x 5 {parts['mesh_stiffness_grid_13x7_n_per_m'] / base:.3f} x"
+    if "mesh_stiffness_at_4x_load_n_per_m" in parts:
+        note += (
+            f"; at a quarter of its 12 N m {parts['mesh_stiffness_at_0.25x_load_n_per_m'] / base:.3f} x, at 4 times "
+            f"{parts['mesh_stiffness_at_4x_load_n_per_m'] / base:.3f} x (the flattening)"
+        )
     return _table(head, rows) + note + ".\n\n" + _source(name)
 
 
@@ -957,9 +1016,57 @@ def calculix_check_table(name: str = "calculix_check") -> str:
     return _table(head, rows) + note + "\n" + _source(name)
 
 
+def rexs_stages_table(name: str = "rexs_stages") -> str:
+    """The REXS stages at every level beside F_t2 = T2 / (d2 / 2) (sweeps/rexs_stages.py)."""
+    rows = []
+    for stage, r in load(name)["stages"].items():
+        g = r["gear"]
+        gear = (
+            f"{stage}: {g['profile']} {g['z1']}/{g['z2']}, m_x {_fmt(g['m_x_mm'])}, a {_fmt(g['a_mm'])} mm, x2 "
+            f"{_fmt(g['x2'])}, {_fmt(r['speed_rpm'])} rpm, {_fmt(r['torque_nm'])} N m"
+        )
+        for level, s in r["levels"].items():
+            eff_t = s["efficiency_theory_at_contact_radius"] if level == "contact3d" else s["efficiency_theory"]
+            rows.append(
+                [
+                    gear,
+                    level,
+                    _fmt(s["ratio"], 6),
+                    f"{s['tangential_force_mean_n']:.1f} ({r['ft2_theory_n']:.1f})",
+                    f"{_fmt(s['efficiency'], 4)} ({_fmt(eff_t, 4)})",
+                    _fmt(s.get("contact_pressure_max_mpa")),
+                    _fmt(s.get("worm_deflection_mesh_um")),
+                    _fmt(s["wall_s"], 2),
+                ]
+            )
+            gear = ""
+    head = ["stage", "level", "ratio", "F_t2 [N] (T2 / r2)", "efficiency (theory)", "p_H max [MPa]"]
+    head += ["worm deflection [um]", "wall [s]"]
+    return _table(head, rows) + "\n" + _source(name)
+
+
+def rexs_rating_table(name: str = "rexs_stages") -> str:
+    """ISO/TS 14521 method B on the REXS stages (sweeps/rexs_stages.py)."""
+    keys = (
+        ("contact_stress_mean_iso_mpa", "sigma_Hm [MPa]"),
+        ("friction_iso", "mu_zm"),
+        ("efficiency_iso", "eta_z"),
+        ("safety_pitting", "S_H"),
+        ("safety_wear", "S_W"),
+        ("safety_root", "S_F"),
+        ("safety_deflection", "S_delta"),
+        ("oil_temperature_c", "theta_S [C]"),
+        ("safety_temperature", "S_T"),
+    )
+    rows = [[stage] + [_fmt(r["rating"][k]) for k, _ in keys] for stage, r in load(name)["stages"].items()]
+    return _table(["stage"] + [h for _, h in keys], rows) + "\n" + _source(name)
+
+
 TABLES: dict[str, Callable[[], str]] = {
     "calculix_check": calculix_check_table,
     "torsional_seeds": torsional_seeds_table,
+    "rexs_stages": rexs_stages_table,
+    "rexs_rating": rexs_rating_table,
     "rating_seeds": rating_seeds_table,
     "torsional_samples": torsional_samples_table,
     "mesh_stiffness_seeds": mesh_stiffness_seeds_table,
@@ -975,6 +1082,7 @@ TABLES: dict[str, Callable[[], str]] = {
     "flank_speed": flank_speed_table,
     "seat_motor_20s": seat_motor_20s_table,
     "sweep_speedup": sweep_speedup_table,
+    "sweep_scaling": sweep_scaling_table,
     "errors_study": errors_study_table,
     "wedge_seed000": wedge_seed000_table,
     "mass_scaling": mass_scaling_table,

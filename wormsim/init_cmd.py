@@ -1,6 +1,7 @@
 """`wormsim init [PATH]`: write a commented scenario template a drive engineer fills in (docs/scenario.md has every
-key). The template is a 2-start ZA worm gear, 30 teeth, axial module 3 mm, q 11, steel on bronze, 1500 rpm, 60 N m;
-it runs as written at every level (tests/test_api.py)."""
+key). The template is README.md's (tests/test_readme.py keeps the two the same): a 2-start ZA worm gear, 30 teeth,
+axial module 3 mm, q 11, steel on bronze, 1500 rpm, 60 N m, torsional for 0.5 s; it runs as written at every level
+(tests/test_api.py)."""
 
 from __future__ import annotations
 
@@ -10,46 +11,39 @@ from pathlib import Path
 from wormsim.errors import ScenarioError
 
 TEMPLATE = """\
-# wormsim scenario: fill in your gear, then
-#   wormsim run {path} --out out/{name}                      # 3D tooth contact (contact3d)
-#   wormsim run {path} --out out/{name}_t --set model=torsional   # seconds: 2-DOF torsional
-#   wormsim run {path} --out out/{name}_w --set model=wedge       # instant: reduced wedge
-# Units are in the key names (mm, deg, rpm, N m, s). Every key: docs/scenario.md; every output: docs/outputs.md.
-name: {name}                  # lower case, digits, _ or -; used in outputs
-description: 2-start ZA worm gear, steel on bronze
-model: contact3d              # contact3d | torsional | wedge
-
-gear:                         # DIN 3975 names
-  profile: ZA                 # ZA (straight-sided axial profile) | ZI (involute helicoid)
-  hand: right                 # right | left
-  worm_starts: 2              # z1
-  wheel_teeth: 30             # z2; ratio z2 / z1
-  axial_module_mm: 3.0        # m_x (or normal_module_mm: m_n, not both)
-  diameter_quotient: 11       # q = d1 / m_x (or lead_angle_deg: gamma at d1, not both)
+# {path}: a 2-start ZA worm gear. Units are in the key names; docs/scenario.md lists every key.
+#   wormsim check {path}                        # validate; prints the defaults and the derived sizes
+#   wormsim run {path} --out out/{name}           # torsional: a few seconds
+#   wormsim run {path} --out out/{name}_3d --set model=contact3d --set simulation.duration_s=0.2  # minutes
+name: {name}
+model: torsional            # wedge | torsional | contact3d (or --set model=... on the command line)
+gear:
+  profile: ZA               # ZA | ZN | ZI | ZK | ZC (docs/flank_forms.md): ZA straight axial profile, ZN straight
+                            # normal profile (zn_section), ZI involute helicoid, ZK disc tool (tool_diameter_mm),
+                            # ZC concave arc (profile_radius_mm)
+  hand: right               # right | left
+  worm_starts: 2            # z1
+  wheel_teeth: 30           # z2: ratio z2 / z1 = 15
+  axial_module_mm: 3.0      # or normal_module_mm (exactly one)
+  diameter_quotient: 11     # q = d1 / m_x (or lead_angle_deg: exactly one)
   normal_pressure_angle_deg: 20
-  face_width_mm: 24           # wheel face width b2 (default: 0.75 x worm tip diameter)
-  backlash_mm: 0.1            # circumferential, at the wheel reference circle
-
-materials:                    # optional; these are the defaults (steel worm, bronze wheel)
-  worm:  {{youngs_modulus_gpa: 210, poisson_ratio: 0.3,  density_kg_m3: 7850}}
+  face_width_mm: 25         # b2; default 0.75 x the worm tip diameter
+  backlash_mm: 0.1          # circumferential, at the wheel reference circle
+materials:                  # E, Poisson, density; these are the defaults: steel worm, bronze wheel
+  worm:  {{youngs_modulus_gpa: 210, poisson_ratio: 0.30, density_kg_m3: 7850}}
   wheel: {{youngs_modulus_gpa: 100, poisson_ratio: 0.34, density_kg_m3: 8800}}
-
-contact:                      # optional: contact stiffness and damping default from Hertz
-  friction: 0.04              # one Coulomb coefficient; or friction_static + friction_dynamic, or friction_group
-
+contact:
+  friction: 0.04            # Coulomb mu on the flanks (or friction_static + friction_dynamic)
 drive:
-  on: worm                    # worm (forward) | wheel (back-driving: torsional, contact3d)
-  speed_rpm: 1500             # speed-controlled (or torque_nm: a torque drive)
-  ramp_s: 0.02                # STEP ramp from rest
-
+  on: worm                  # worm | wheel (back-driving)
+  speed_rpm: 1500           # or torque_nm: a torque drive
+  ramp_s: 0.05              # STEP ramp from rest
 load:
-  on: wheel                   # the other shaft
-  torque_nm: 60               # resisting torque on the wheel
-  start_s: 0.0
-  ramp_s: 0.02
-
+  on: wheel                 # the other shaft
+  torque_nm: 60             # resisting torque on the wheel
+  ramp_s: 0.05
 simulation:
-  duration_s: 0.1             # simulated time; contact3d takes minutes per 0.1 s, torsional seconds
+  duration_s: 0.5           # at contact3d, 0.2 s is a quick look
 """
 
 

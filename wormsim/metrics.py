@@ -7,13 +7,15 @@
   (when at least one fits), so periodic fluctuation does not bias the means;
 - mean speeds = |angle increment| / window duration (a mean of |speed| samples would be biased by the
   wheel's high-frequency vibration, which reverses its speed); ratio = n1 / n2; theory z2 / z1;
-- meshing frequency: dominant peak of the FFT of the tangential force over the window (mean and linear
-  trend removed, Hann window, DC bin excluded), searched below half the piece-passing frequency
-  (worm segments per turn x worm speed: the facets of the convex pieces excite the force there; the
-  full-band peak is reported as `force_peak_full_band_hz`; the same search on the radial force as
-  `mesh_frequency_radial_hz`), refined by Gaussian (log-parabolic) interpolation of
-  the peak's three bins; bin width 1 / T_window reported as `mesh_frequency_resolution_hz`; theory
-  z1 n1 / 60 with n1 the mean worm speed;
+- meshing frequency: the meshing line, the largest peak of the amplitude spectrum of the meshing signal (contact3d: the
+  tangential force; torsional: the transmission error) over the window (mean and linear trend removed, Hann window)
+  searched in the band z1 n1 / 60 x (1 +- MESH_BAND) around the theory with n1 the measured mean worm speed
+  (mesh_line): the meshing harmonics (2, 3 ... z1 n1 / 60), the contact mode's ringing and the convex pieces' facets
+  lie outside the band and are never taken for it. The spectrum is zero-padded (MESH_PAD) and the peak refined on
+  the continuous spectrum (DTFT, scipy.optimize.minimize_scalar); the harmonics' amplitudes k = 1..4 are the
+  spectrum at k f_mesh. The bin width 1 / T_window is `mesh_frequency_resolution_hz`; with fewer than
+  MIN_MESH_CYCLES periods in the window, the lines of the harmonics overlap and the run warns
+  (wormsim.run_warnings). The full band's peak of F_t2 is `force_peak_full_band_hz` (dominant_frequency);
 - forces: means and peak-to-peak (max - min) over the window, magnitudes of the means;
 - efficiency = output power / input power over the window = mean(-T_load w_load) / mean(T_drive w_drive)
   (contact3d: the series worm_power_w / wheel_power_w, T w averaged over every step of each sample);
@@ -87,6 +89,95 @@ def dominant_frequency(
     return float(f), float(df), freqs, spec
 
 
+MESH_BAND = 0.25  # half-width of the meshing line's search band, a share of z1 n1 / 60 (the 2nd harmonic at +100 %)
+MESH_PAD = 8  # zero-padding factor of the spectrum the line is first located on
+MESH_PAD_MAX = 1 << 22  # ... up to this many points (32 MiB of float64)
+MIN_MESH_CYCLES = 5.0  # mesh periods a window needs: Hann main lobes +-2 bins, so the 1st and 2nd lines part at > 4
+MESH_HARMONICS = 4  # harmonics whose amplitudes the summary carries
+
+
+def _hann_dtft_amplitude(tt: np.ndarray, y: np.ndarray, wsum: float, f: float) -> float:
+    """Amplitude of the Hann-windowed, detrended y at frequency f (the continuous spectrum, 2 |Y(f)| / sum(w)): the
+    amplitude of a sinusoid at exactly f."""
+    return float(2.0 * abs(np.dot(y, np.exp(-2j * np.pi * f * tt))) / max(wsum, 1e-300))
+
+
+def mesh_line(t: np.ndarray, x: np.ndarray, f_theory_hz: float) -> dict:
+    """The meshing line of x(t) (uniform grid) near f_theory_hz = z1 n1 / 60 (see the module docstring).
+
+    Returns {"f_hz", "resolution_hz", "cycles", "amplitudes", "found"}: the line's frequency (NaN when x is too short
+    or f_theory_hz not positive), the bin width 1 / T, the mesh periods in the window (T f_theory_hz), the amplitudes
+    of x at k f_hz for k = 1..MESH_HARMONICS (x's unit) and whether the band's largest value is an interior peak
+    (False: the largest value sits at the band's edge, no line near the theory)."""
+    from scipy.optimize import minimize_scalar
+
+    n = len(x)
+    nan = {"f_hz": float("nan"), "resolution_hz": float("nan"), "cycles": 0.0, "found": False}
+    if n < 8 or not (f_theory_hz > 0) or not np.all(np.isfinite(x)):
+        return {**nan, "amplitudes": [float("nan")] * MESH_HARMONICS}
+    tt = t - t[0]
+    dt = tt[-1] / (n - 1)
+    span = n * dt
+    w = np.hanning(n)
+    y = (x - np.polyval(np.polyfit(tt, x, 1), tt)) * w
+    wsum = float(w.sum())
+    base = 1 << int(math.ceil(math.log2(n)))
+    nfft = max(base, min(MESH_PAD * base, MESH_PAD_MAX))  # long records: less padding (the refinement is exact)
+    spec = np.abs(np.fft.rfft(y, nfft)) * 2.0 / max(wsum, 1e-300)
+    freqs = np.fft.rfftfreq(nfft, dt)
+    lo, hi = f_theory_hz * (1 - MESH_BAND), min(f_theory_hz * (1 + MESH_BAND), freqs[-1])
+    band = np.nonzero((freqs >= lo) & (freqs <= hi))[0]
+    if len(band) < 3:
+        return {
+            **nan,
+            "resolution_hz": 1.0 / span,
+            "cycles": span * f_theory_hz,
+            "amplitudes": [float("nan")] * MESH_HARMONICS,
+        }
+    k = int(band[np.argmax(spec[band])])
+    found = band[0] < k < band[-1]
+    step = freqs[1] - freqs[0]
+    a, b = max(lo, freqs[k] - step), min(hi, freqs[k] + step)
+    opt = minimize_scalar(
+        lambda f: -_hann_dtft_amplitude(tt, y, wsum, f), bounds=(a, b), method="bounded", options={"xatol": 1e-6 * a}
+    )
+    f = float(opt.x) if opt.success else float(freqs[k])
+    amps = [_hann_dtft_amplitude(tt, y, wsum, j * f) for j in range(1, MESH_HARMONICS + 1)]
+    return {"f_hz": f, "resolution_hz": 1.0 / span, "cycles": span * f_theory_hz, "amplitudes": amps, "found": found}
+
+
+def mesh_line_keys(t: np.ndarray, S: dict, sl: slice, f_theory_hz: float, source: str) -> dict:
+    """The summary's meshing-frequency keys from the meshing line of S[source] over the window sl (mesh_line), with
+    the amplitudes of the tangential force's and the transmission error's first MESH_HARMONICS meshing harmonics at
+    that line's multiples."""
+    line = mesh_line(t[sl], S[source][sl], f_theory_hz)
+    out = {
+        "mesh_frequency_hz": line["f_hz"],
+        "mesh_frequency_resolution_hz": line["resolution_hz"],
+        "mesh_frequency_line_found": bool(line["found"]),
+        "steady_window_mesh_cycles": line["cycles"],
+    }
+    for key, unit, scale in (("tangential_force_n", "n", 1.0), ("transmission_error_rad", "urad", 1e6)):
+        if key not in S:
+            continue
+        amps = line["amplitudes"] if key == source else _harmonic_amplitudes(t[sl], S[key][sl], line["f_hz"])
+        base = key.rsplit("_", 1)[0]
+        for j, a in enumerate(amps, 1):
+            out[f"{base}_harmonic{j}_{unit}"] = float(a) * scale
+    return out
+
+
+def _harmonic_amplitudes(t: np.ndarray, x: np.ndarray, f_hz: float) -> list[float]:
+    """Amplitudes of x(t) (detrended, Hann window) at k f_hz, k = 1..MESH_HARMONICS."""
+    n = len(x)
+    if n < 8 or not np.isfinite(f_hz):
+        return [float("nan")] * MESH_HARMONICS
+    tt = t - t[0]
+    w = np.hanning(n)
+    y = (x - np.polyval(np.polyfit(tt, x, 1), tt)) * w
+    return [_hann_dtft_amplitude(tt, y, float(w.sum()), j * f_hz) for j in range(1, MESH_HARMONICS + 1)]
+
+
 def window_of(S: dict, scenario, geo) -> tuple[int, int, float]:
     """window_after the scenario's ramps (gear_theory.ramps_end_s) with its drive."""
     return window_after(S, scenario.drive.on, gt.ramps_end_s(scenario), geo)
@@ -146,7 +237,7 @@ def drive_summary(
     shaft_powers_w: (worm, wheel) power series where the level has better ones than the samples' T w (contact3d:
     interval means over every step)."""
     t = S["t_s"]
-    drv, load = scenario.drive, scenario.load
+    load = scenario.load
     sl = slice(i0, i1)
     ft = S["tangential_force_n"][sl]
     T1, T2 = S["worm_torque_nm"][sl], S["wheel_torque_nm"][sl]
@@ -155,14 +246,13 @@ def drive_summary(
     else:
         p1 = float(np.mean(T1 * S["worm_speed_rpm"][sl] * RPM))
         p2 = float(np.mean(T2 * S["wheel_speed_rpm"][sl] * RPM))
-    if drv.on == "worm":
-        eff = -p2 / p1 if p1 > 0 else float("nan")
-    else:
-        eff = -p1 / p2 if p2 > 0 else float("nan")
+    flow = power_flow(n1, n2, geo.ratio, p1, p2)
+    eff = flow_efficiency(flow, p1, p2)
     mu = float(np.mean(S["friction_coefficient"][sl]))
     w2 = S["wheel_speed_rpm"]
     return {
-        "ratio": n1 / n2 if n2 > 0 else float("inf"),
+        "ratio": n1 / n2 if flow != "none" else float("nan"),
+        "power_flow": flow,
         "ratio_theory": geo.ratio,
         "mesh_frequency_theory_hz": geo.z1 * n1 / 60.0,
         "tangential_force_mean_n": abs(float(np.mean(ft))),
@@ -177,11 +267,13 @@ def drive_summary(
         "worm_speed_mean_rpm": n1,
         "wheel_speed_mean_rpm": n2,
         "efficiency": eff,
-        "efficiency_theory": gt.efficiency_theory(geo.gamma, geo.alpha_n, mu, backdriving=drv.on == "wheel"),
+        "efficiency_theory": gt.efficiency_theory(geo.gamma_m, geo.alpha_n, mu, backdriving=flow == "wheel to worm")
+        if flow != "none"
+        else float("nan"),
         "friction_coefficient_mean": mu,
         # static: mu at rest (the contact's friction law at Vs = 0); dynamic: the mean mu applied over the window
         **gt.backdrive_keys(
-            geo.gamma,
+            geo.gamma_m,
             gt.virtual_friction_angle_rad(float(friction_coefficient(scenario.contact, 0.0)), geo.alpha_n),
             gt.virtual_friction_angle_rad(mu, geo.alpha_n),
         ),
@@ -190,6 +282,35 @@ def drive_summary(
         "wheel_speed_fluctuation": float(np.ptp(w2[sl]) / n2) if n2 > 0 else float("nan"),
         "wheel_speed_std_rpm": float(np.std(w2[sl])),
     }
+
+
+STANDSTILL_RPM = (
+    0.01  # a worm slower than this over the window (3.6 deg a minute) does not turn: no ratio, no efficiency
+)
+
+
+def power_flow(n1_rpm: float, n2_rpm: float, ratio: float, p1_w: float, p2_w: float) -> str:
+    """The direction power flows through the mesh over the window: "worm to wheel" (the worm's shaft puts power in,
+    p1 > 0), "wheel to worm" (the wheel's shaft puts power in: back-driving, or an overhauling load that drives a
+    worm-driven pair) or "none" (either shaft below STANDSTILL_RPM (the wheel: over the ratio), or no shaft puts
+    power in): then the ratio and the efficiency are not defined."""
+    if not (n1_rpm >= STANDSTILL_RPM and n2_rpm >= STANDSTILL_RPM / max(ratio, 1e-12)):
+        return "none"
+    if p1_w > 0 and p1_w >= p2_w:
+        return "worm to wheel"
+    if p2_w > 0:
+        return "wheel to worm"
+    return "none"
+
+
+def flow_efficiency(flow: str, p1_w: float, p2_w: float) -> float:
+    """Output power / input power in the direction of the power flow (power_flow): -p2 / p1 worm to wheel, -p1 / p2
+    wheel to worm; NaN when no power flows."""
+    if flow == "worm to wheel":
+        return -p2_w / p1_w
+    if flow == "wheel to worm":
+        return -p1_w / p2_w
+    return float("nan")
 
 
 def p2p_below(t: np.ndarray, x: np.ndarray, f_max_hz: float) -> float:

@@ -21,11 +21,26 @@ GW = ALL  # the gear levels, and wedge when derived from gear: (no wedge: block)
 
 FORCE_SIGNS = {
     "tangential": "F_t2 along the wheel's positive sense of rotation (right-hand rule about the wheel axis +z): "
-    "positive when a right-hand worm turning positive drives the wheel (INTERFACE.md, geometry frames)",
+    "positive when a right-hand worm turning positive drives the wheel (the project's interface contract, geometry "
+    "frames)",
     "radial": "F_r2 along the line of centres, positive towards the wheel axis (the separating force of the mesh)",
     "axial": "F_a2 along the wheel axis times -1 for a right-hand worm (+1 left-hand), so that F_a2 = F_t2 "
     "tan(gamma + rho') holds with signs (DIN 3975-2): positive together with F_t2 when the worm drives",
 }
+FORCE_KEYS = (
+    "`tangential_force_mean_n`, `radial_force_mean_n` and `axial_force_mean_n` are F_t2, F_r2 and F_a2 as DIN 3975-2 "
+    "defines them at every level: the forces of one contact at the pitch point on the line of centres, F_t2 = 2 T2 / "
+    "d2, F_a2 = F_t1 = 2 T1 / d1 and F_r2 = F_t2 tan(alpha_n) cos(rho') / cos(gamma + rho'), the forces a bearing "
+    "calculation after DIN 3975 or ISO/TS 14521 takes. Wedge and torsional compute them so. contact3d takes F_t2 "
+    "from the resultant contact force's tangential component (its mean is the contact torque over r2), F_r2 from "
+    "each contact's force turned about the worm axis onto the line of centres, and F_a2 from the worm torque over "
+    "r1. The 3D contacts sit around the worm at angles phi about its axis (force-weighted |phi| about 28 deg on the "
+    "seeds) and above the worm's pitch radius, where the lead angle is smaller: the resultant contact force's "
+    "radial component is below DIN's F_r2 by about <cos phi> (about 10 %) and its axial component below "
+    "T1 / r1 (5-8 % on the seeds). Those resultant components, the forces on the wheel's own bearings, are "
+    "`radial_force_resultant_mean_n` and `axial_force_resultant_mean_n` (contact3d only); with a `shafts:` block "
+    "the bearing keys follow the resultant"
+)
 SIGN_NOTE = (
     "The time series `tangential_force_n`, `radial_force_n`, `axial_force_n` (and contact3d's "
     "`radial_force_line_of_centres_n`), the report's force panel and the recording's `/series/` carry these signs. "
@@ -55,9 +70,12 @@ KEYS: dict[str, Key] = {
     "warnings": Key(
         "list",
         ALL,
-        "results that need care, one line each (also on stderr and in report.png's header): a tangential-force "
-        "fluctuation above half its mean, contact force outside the wheel flanks (wormsim.run_warnings); with "
-        "`rating:`, the rating's validity warnings follow; empty when none",
+        "results that need care, one line each (also on stderr and in report.png's header; wormsim.run_warnings): a "
+        "tangential-force fluctuation above half its mean, contact force outside the wheel flanks, a steady window "
+        "of fewer than 5 mesh periods or no meshing line near z1 n1 / 60, a contact pressure above the wheel "
+        "material's pitting strength, a runaway (1.5 x the speed command, or a torque drive still accelerating), "
+        "power flowing from the wheel into a worm-driven pair (overhauling), a pair that does not turn; with "
+        "`rating:`, the rating's warnings follow (a root stress above its limit among them); empty when none",
     ),
     "ignored_inputs": Key(
         "list",
@@ -90,6 +108,23 @@ KEYS: dict[str, Key] = {
         ALL,
         "back-driving efficiency tan(gamma - rho') / tan(gamma) with the sliding friction (DIN 3975-2); 0 when "
         "self_locking_dynamic",
+    ),
+    "locked": Key(
+        "bool",
+        GEAR,
+        "the wheel could not back-drive the self-locking pair (rho' at rest >= gamma): a speed-driven wheel stalled, "
+        "the mesh held and the run ended there with status ok (the means are over the run up to then); a "
+        "torque-driven wheel held with the worm sliding slower than contact.transition_velocity_m_s over the run's "
+        "last fifth; false in every other run (wormsim.locking)",
+    ),
+    "holding_torque_nm": Key(
+        "N m",
+        GEAR,
+        "with `locked`: the largest |wheel drive torque| the mesh held (a stalled speed drive pushed up to it; a "
+        "torque drive's command; what was held, not a breaking limit); null when not locked",
+    ),
+    "creep_speed_rpm": Key(
+        "rpm", GEAR, "with `locked`: the worm's mean |speed| while the wheel was held; null when not locked"
     ),
     "friction_angle_static_deg": Key("deg", ALL, "rho' at rest used for `self_locking`"),
     "friction_angle_dynamic_deg": Key(
@@ -139,7 +174,11 @@ KEYS: dict[str, Key] = {
     "safety_root": Key("-", C, "rating: tooth root safety S_F from tau_F (method B)"),
     "safety_deflection": Key("-", C, "rating: worm deflection safety S_delta = 0.04 sqrt(m_x) / delta_m"),
     "safety_temperature": Key("-", C, "rating: temperature safety S_T (sump temperature limit over oil_temperature_c)"),
-    "oil_temperature_c": Key("degC", C, "rating: sump temperature at the rated load (splash lubrication)"),
+    "oil_temperature_c": Key(
+        "degC",
+        C,
+        "rating: oil temperature at the rated load: splash-lubrication heat balance, or rating.oil_sump_temperature_c",
+    ),
     "agma_rated_tangential_force_n": Key(
         "N", C, "rating: AGMA 6034 rated tangential force W_t = C_s D_m^0.8 F_e C_m C_v"
     ),
@@ -177,18 +216,61 @@ KEYS: dict[str, Key] = {
     "backdrive_probe_wheel_speed_rpm": Key("rpm", C, "simulation.backdrive_probe: the wheel's speed command"),
     "backdrive_probe_worm_torque_nm": Key("N m", C, "simulation.backdrive_probe: the worm's load torque"),
     # ------------------------------------------------------------------ gear levels: drive
-    "ratio": Key("-", GW, "mean worm speed / mean wheel speed over the steady window (from the angle increments)"),
+    "ratio": Key(
+        "-",
+        GW,
+        "mean worm speed / mean wheel speed over the steady window (from the angle increments); null when the pair "
+        "does not turn (power_flow none)",
+    ),
     "ratio_theory": Key("-", GW, "z2 / z1"),
     "tangential_force_mean_n": Key("N", GW, "F_t2 on the wheel, magnitude of its steady-window mean", _F),
     "tangential_force_p2p_n": Key("N", GW, "peak-to-peak (max - min) of F_t2 over the steady window", _F),
     "tangential_force_theory_n": Key("N", GW, "T_load / r2 (DIN 3975-2); null when the load is on the worm"),
-    "radial_force_mean_n": Key("N", GW, "F_r2 on the wheel, magnitude of its steady-window mean", _F),
-    "axial_force_mean_n": Key("N", GW, "F_a2 on the wheel, magnitude of its steady-window mean", _F),
+    "radial_force_mean_n": Key(
+        "N",
+        GW,
+        "F_r2 as DIN 3975-2 defines it (see Force keys), magnitude of its steady-window mean; contact3d: each "
+        "contact's force turned about the worm axis onto the line of centres",
+        _F,
+    ),
+    "axial_force_mean_n": Key(
+        "N",
+        GW,
+        "F_a2 as DIN 3975-2 defines it, F_a2 = F_t1 = 2 T1 / d1 (see Force keys), magnitude of its steady-window mean; "
+        "contact3d: worm_torque_mean_nm / r1",
+        _F,
+    ),
+    "radial_force_resultant_mean_n": Key(
+        "N",
+        C,
+        "the resultant contact force's component along the line of centres, magnitude of its steady-window mean: "
+        "what the wheel's bearings carry radially (see Force keys)",
+        _F,
+    ),
+    "axial_force_resultant_mean_n": Key(
+        "N",
+        C,
+        "the resultant contact force's component along the wheel axis, magnitude of its steady-window mean: what "
+        "the wheel's locating bearing carries (see Force keys)",
+        _F,
+    ),
     "worm_torque_mean_nm": Key("N m", GW, "magnitude of the mean torque applied to the worm shaft (drive or load)"),
     "wheel_torque_mean_nm": Key("N m", GW, "magnitude of the mean torque applied to the wheel shaft (drive or load)"),
     "worm_speed_mean_rpm": Key("rpm", GW, "mean worm speed over the steady window (angle increment / time)"),
     "wheel_speed_mean_rpm": Key("rpm", GW, "mean wheel speed over the steady window (angle increment / time)"),
-    "efficiency": Key("-", GW, "output power / input power, means over the steady window"),
+    "efficiency": Key(
+        "-",
+        GW,
+        "output power / input power, means over the steady window, in the direction of `power_flow` (an overhauling "
+        "load that drives a worm-driven pair: worm power out / wheel power in, and the run warns); null when the "
+        "pair does not turn",
+    ),
+    "power_flow": Key(
+        "text",
+        GEAR,
+        '"worm to wheel", "wheel to worm" (back-driving, or an overhauling load) or "none" (a shaft slower than '
+        "0.01 rpm at the worm: ratio, efficiency and efficiency_theory are null, and the run warns)",
+    ),
     "efficiency_theory": Key(
         "-",
         GW,
@@ -206,22 +288,43 @@ KEYS: dict[str, Key] = {
     "mesh_frequency_hz": Key(
         "Hz",
         GEAR,
-        "dominant FFT peak of the meshing signal over the steady window (contact3d: F_t2 below half the "
-        "piece-passing frequency; torsional: see mesh_frequency_source)",
+        "the meshing line: the largest peak of the meshing signal's spectrum over the steady window within +-25 % of "
+        "z1 n1 / 60 (n1 the measured mean worm speed; contact3d: F_t2, torsional: see mesh_frequency_source), "
+        "refined on the continuous spectrum; never a meshing harmonic or the contact mode's ringing, which lie "
+        "outside the band (wormsim.metrics.mesh_line). A window of fewer than 5 mesh periods warns",
     ),
     "mesh_frequency_theory_hz": Key("Hz", GW, "z1 n1 / 60 with n1 the mean worm speed"),
-    "mesh_frequency_resolution_hz": Key("Hz", GEAR, "FFT bin width 1 / T_window"),
+    "mesh_frequency_resolution_hz": Key(
+        "Hz", GEAR, "FFT bin width 1 / T_window: the lines of a window of few mesh periods are this wide or wider"
+    ),
+    "mesh_frequency_line_found": Key(
+        "bool",
+        GEAR,
+        "the band's largest value is an interior peak; false: it sits at the band's edge, no meshing line near "
+        "z1 n1 / 60 (the run warns)",
+    ),
+    "steady_window_mesh_cycles": Key(
+        "-", GEAR, "mesh periods in the steady window, T_window z1 n1 / 60 (fewer than 5: the run warns)"
+    ),
+    **{
+        f"tangential_force_harmonic{k}_n": Key(
+            "N", GEAR, f"amplitude of F_t2 at {k} x mesh_frequency_hz over the steady window (Hann window)"
+        )
+        for k in range(1, 5)
+    },
+    **{
+        f"transmission_error_harmonic{k}_urad": Key(
+            "urad", GEAR, f"amplitude of the transmission error at {k} x mesh_frequency_hz over the steady window"
+        )
+        for k in range(1, 5)
+    },
     "mesh_frequency_source": Key("text", T, "the signal the torsional meshing frequency is taken from"),
-    "mesh_frequency_search_max_hz": Key("Hz", C, "upper end of the meshing-frequency search"),
-    "mesh_frequency_radial_hz": Key("Hz", C, "the same search on F_r2"),
+    "mesh_frequency_radial_hz": Key("Hz", C, "the meshing line of F_r2, the same search"),
     "force_peak_full_band_hz": Key("Hz", GEAR, "dominant FFT peak of F_t2 over the whole band"),
     "teeth_in_contact_mean": Key("-", GEAR, "mean number of wheel teeth in contact"),
     # ------------------------------------------------------------------ contact3d: contacts and forces
     "contacts_mean": Key("-", C, "mean number of MuJoCo contacts between worm and wheel"),
     "max_penetration_um": Key("um", C, "largest contact penetration over the steady window"),
-    "radial_force_line_of_centres_mean_n": Key(
-        "N", C, "magnitude of the mean of each contact's force turned about the worm axis onto the line of centres", _F
-    ),
     "radial_force_theory_n": Key("N", C, "F_r2 = |F_t2| tan(alpha_n) cos(rho') / cos(gamma + rho') (DIN 3975-2)"),
     "worm_contact_radius_mean_m": Key("m", C, "force-weighted mean radius of the contacts on the worm"),
     "efficiency_theory_at_contact_radius": Key(
@@ -415,7 +518,19 @@ def markdown() -> str:
         "",
     ]
     lines += [f"- **{k}**: {v}." for k, v in FORCE_SIGNS.items()]
-    lines += ["", SIGN_NOTE, "", "## Keys", "", "| key | unit | levels | meaning |", "| --- | --- | --- | --- |"]
+    lines += [
+        "",
+        SIGN_NOTE,
+        "",
+        "## Force keys",
+        "",
+        FORCE_KEYS + ".",
+        "",
+        "## Keys",
+        "",
+        "| key | unit | levels | meaning |",
+        "| --- | --- | --- | --- |",
+    ]
     for name, k in KEYS.items():
         lv = "".join(x[0].upper() for x in ALL if x in k.levels)
         sign = f" Sign: {k.sign}." if k.sign else ""

@@ -132,7 +132,7 @@ class _Binding:
         model.body_invweight0[self.wheel_body, 0] = p.inv_mass_wheel
         self.contacts = FlankContacts(bm, p.law.contacts_per_pair, merge=False)
         self.mu_of = friction_coefficient_scalar(pair.scenario.contact)
-        self.vs_per_w1 = geo.r1 / math.cos(geo.gamma)
+        self.vs_per_w1 = geo.r_m1 / math.cos(geo.gamma_m)
         self.R0 = pair._placement[:3, :3]
         self.shaft_log: shafts.ShaftLog | None = None  # WormPair.shaft_loads
         self.k0 = 0  # the pair's contacts in d.contact at the last step: [k0, k0 + n)
@@ -362,7 +362,9 @@ class WormPair:
         (wormsim.outputs.FORCE_SIGNS, as contact3d's series tangential_force_n, radial_force_n, axial_force_n):
         tangential along +x (the wheel's positive sense at the pitch point on the line of centres), radial positive
         towards the wheel axis (+y, the separating force), axial along -hand z (F_a2 = F_t2 tan(gamma + rho') with
-        its sign); the summary's *_force_mean_n are the magnitudes of their means."""
+        its sign); contact3d's tangential_force_mean_n, radial_force_resultant_mean_n and axial_force_resultant_mean_n
+        are the magnitudes of their means (the headline radial_force_mean_n and axial_force_mean_n are DIN 3975's,
+        docs/outputs.md "Force keys")."""
         b = self._bound()
         F = np.zeros(3)
         con = data.contact

@@ -1,5 +1,8 @@
 """Progress of a run: a tqdm bar on a terminal (shown after 2 s); without a terminal (logs, CI, nohup) one line per
-10 % of the simulated time once the run has taken LOG_AFTER_S of wall time, so a long run is never silent."""
+10 % of the simulated time once the run has taken LOG_AFTER_S of wall time, so a long run is never silent.
+
+While numba compiles (wormsim.jit_cache: the first contact3d run on a machine) the line says so, once, and the time
+estimate leaves the compiling seconds out: the rate is the simulation's, not the compiler's."""
 
 from __future__ import annotations
 
@@ -9,7 +12,7 @@ import time
 
 from tqdm import tqdm
 
-from wormsim import interrupt
+from wormsim import interrupt, jit_cache
 
 LOG_AFTER_S = 10.0  # no log lines for runs shorter than this (wall time)
 LOG_STEP = 0.1  # fraction of the simulated time between log lines
@@ -39,6 +42,36 @@ class Progress:
         self._last = 0.0
         self._t0 = time.perf_counter()
         self._next_log = LOG_STEP
+        self._c0 = jit_cache.compile_seconds()
+        self._compiling_said = False
+        jit_cache.add_watcher(self._on_compile)
+
+    def _on_compile(self, started: bool) -> None:
+        """numba starts (True) or ends (False) a compile (wormsim.jit_cache.watch)."""
+        if started:
+            self._bar.set_description_str(f"{self._label}: compiling", refresh=not self._bar.disable)
+            if not self._compiling_said:
+                self._compiling_said = True
+                self.note(f"{self._label}: {jit_cache.compiling_note()}")
+        else:
+            self._bar.set_description_str(self._label, refresh=False)
+
+    def compiling(self, text: str) -> None:
+        """A warm-up is about to compile (wormsim.jit_cache.ensure_warm): say so once."""
+        if not self._compiling_said:
+            self._compiling_said = True
+            self.note(f"{self._label}: {text}")
+
+    def restart_clock(self) -> None:
+        """The simulation starts now: the estimate's clock from here (after a warm-up that compiled)."""
+        self._t0 = time.perf_counter()
+        self._c0 = jit_cache.compile_seconds()
+        if not self._bar.disable:  # (a disabled tqdm has no clock)
+            self._bar.start_t = self._bar.last_print_t = self._bar._time()
+
+    def wall_s(self) -> float:
+        """Seconds since the clock started, less the seconds numba spent compiling in them."""
+        return time.perf_counter() - self._t0 - (jit_cache.compile_seconds() - self._c0)
 
     def update(self, t_s: float) -> None:
         interrupt.check()  # an interrupt that a library swallowed ends the run here (wormsim.interrupt)
@@ -50,7 +83,7 @@ class Progress:
             frac = t_s / self._duration
             wall = time.perf_counter() - self._t0
             if wall >= LOG_AFTER_S:
-                left = max(0.0, wall * (1 - frac) / max(frac, 1e-9))
+                left = max(0.0, self.wall_s() * (1 - frac) / max(frac, 1e-9))  # the compiling seconds left out
                 print(
                     f"{self._label}: {100 * frac:3.0f} % ({t_s:.4g} of {self._duration:.4g} s simulated), "
                     f"{wall / 60:.1f} min elapsed, about {left / 60:.1f} min left",
@@ -67,6 +100,7 @@ class Progress:
             print(text, file=self._stream, flush=True)
 
     def close(self) -> None:
+        jit_cache.remove_watcher(self._on_compile)
         self._bar.close()
 
     def __enter__(self):

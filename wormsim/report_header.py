@@ -30,6 +30,11 @@ def gear_line(geo) -> str:
         f"d1 {geo.d1 * 1e3:.4g} mm, d2 {geo.d2 * 1e3:.4g} mm, a {geo.a * 1e3:.4g} mm, "
         f"gamma {math.degrees(geo.gamma):.3g} deg, alpha_n {math.degrees(geo.alpha_n):.3g} deg, "
         f"b2 {geo.face_width * 1e3:.3g} mm"
+        + (
+            f", x2 {geo.x2:+.3g} (d_a2 {2 * geo.r_a2 * 1e3:.4g} mm, gamma_m {math.degrees(geo.gamma_m):.3g} deg)"
+            if geo.x2
+            else ""
+        )
     )
 
 
@@ -55,11 +60,11 @@ def self_locking_text(summary: dict, geo) -> str:
     if mu is None or geo is None:
         return ""
     rho = gt.virtual_friction_angle_rad(mu, geo.alpha_n)
-    locks = rho >= geo.gamma
+    locks = rho >= geo.gamma_m
     rel = ">=" if locks else "<"
     return (
         f"self-locking: {'yes' if locks else 'no'} (rho' {math.degrees(rho):.3g} deg {rel} gamma "
-        f"{math.degrees(geo.gamma):.3g} deg at mu {mu:.3g})"
+        f"{math.degrees(geo.gamma_m):.3g} deg at mu {mu:.3g})"
     )
 
 

@@ -51,7 +51,7 @@ def simulate(scenario: Scenario, progress: Progress | None = None) -> Result:
         SimulationError: the simulation failed, with a diagnosis (diverged, teeth jumped, locked...; exit 3).
     """
     res = model_module(scenario.model).simulate(scenario, progress=progress)
-    res.summary["warnings"] = run_warnings(res)
+    res.summary["warnings"] = run_warnings(res, scenario)
     return res
 
 
@@ -95,7 +95,7 @@ def run_scenario(scenario: Scenario, out_dir: str | Path, progress: bool | None 
         ) as bar:
             res = simulate_level(scenario, progress=bar)
         wall = time.perf_counter() - t0
-        res.summary["warnings"] = run_warnings(res)  # results to read with care (F_t p2p, off-flank contacts)
+        res.summary["warnings"] = run_warnings(res, scenario)  # results to read with care (F_t p2p, off-flank contacts)
         rated = {} if rating is None else rating_summary_keys(scenario, rating, res.summary)
         warm.release()
         np.savez_compressed(rd.path("timeseries.npz"), **res.series)

@@ -93,6 +93,21 @@ class Gear(_Strict):
     )
     addendum_coef: float = Field(1.0, gt=0, le=1.5, description="h_a / m_axial")
     dedendum_coef: float = Field(1.2, gt=0, le=2.0, description="h_f / m_axial")
+    profile_shift_coefficient: float | None = Field(
+        None,
+        ge=-1.5,
+        le=1.5,
+        description=(
+            "x2, the wheel's profile shift (DIN 3975): a = (d1 + d2) / 2 + x2 m_axial, wheel tip and root move out by "
+            "x2 m_axial; the wheel is hobbed at that centre distance; default 0, ZC 0.5 (docs/geometry.md)"
+        ),
+    )
+    wheel_outside_diameter_mm: float | None = Field(
+        None,
+        gt=0,
+        le=20000,
+        description="d_e2, the wheel rim's outside diameter; default d_a2 + m_axial; allowed d_a2 to d_a2 + 2 m_axial",
+    )
     zn_section: Literal["thread", "space"] = Field(
         "thread", description="ZN: the straight line in the normal section of the thread (ZN1) or of the space (ZN2)"
     )
@@ -469,11 +484,30 @@ class Rating(_Strict):
     application_factor: float = Field(1.0, ge=1, le=4, description="K_A: the nominal wheel torque times this")
     lubricant: Literal["mineral", "pao", "peg"] = Field("mineral", description="oil base: friction, Z_oil, theta_Slim")
     oil_viscosity_40_mm2_s: float = Field(320.0, gt=0, le=10000, description="ISO VG of the oil (reported)")
+    oil_viscosity_100_mm2_s: float | None = Field(None, gt=0, le=10000, description="oil viscosity at 100 C (reported)")
+    oil_sump_temperature_c: float | None = Field(
+        None,
+        ge=-60,
+        le=250,
+        description=(
+            "given oil temperature (injection lubrication with a cooler; REXS temperature_lubricant): the rating "
+            "uses it for theta_S instead of the splash-lubrication heat balance"
+        ),
+    )
     wheel_material: Literal["CuSn12Ni2", "CuSn12", "CuAl10Fe5Ni5", "GJS-400", "GJL-250", "POM"] | None = Field(
         None,
         description=(
             "wheel material (table with sources: docs/rating.md); default POM when materials.wheel has E <= 10 GPa, "
             "else CuSn12Ni2 (with a warning)"
+        ),
+    )
+    wheel_pitting_strength_mpa: float | None = Field(
+        None,
+        gt=0,
+        le=5000,
+        description=(
+            "sigma_HlimT of the wheel instead of rating.wheel_material's (REXS endurance_limit_flank); the material's "
+            "other values stay"
         ),
     )
     wheel_casting: Literal["sand", "chilled", "centrifugal"] = Field("sand", description="AGMA C_s casting method")
@@ -545,7 +579,8 @@ class Scenario(_Strict):
 
     @model_validator(mode="after")
     def _blocks(self) -> "Scenario":
-        if self.shafts is not None and (self.model != "contact3d" or self.contact.geometry != "flanks"):
+        # torsional and wedge have rigid shafts: a shafts: block is ignored there (ignored_inputs says so)
+        if self.shafts is not None and self.model == "contact3d" and self.contact.geometry != "flanks":
             raise ValueError(
                 "shafts: the shafts on bearings are modelled by contact3d with contact.geometry flanks; allowed: "
                 "model contact3d with contact.geometry flanks, or no shafts: block"
@@ -638,6 +673,8 @@ def ignored_inputs(sc: Scenario) -> list[str]:
             )
     elif sc.wedge is not None:
         out.append(f"wedge: ignored: model {sc.model} uses gear:, drive:, load:")
+    if sc.shafts is not None and sc.model != "contact3d":
+        out.append(f"shafts: ignored: model {sc.model} has rigid shafts (the shafts on bearings run at contact3d)")
     if sc.model != "wedge" or sc.wedge is None:
         by_level: dict[tuple[str, ...], list[str]] = {}
         for k, levels in LEVEL_KEYS.items():
@@ -965,6 +1002,11 @@ def load_scenario(path: str | Path, overrides: list[str] | None = None) -> Scena
             value and what is allowed, one line per problem (exit 2 at the CLI).
     """
     path = Path(path)
+    if path.suffix.lower() in (".rexs", ".rexsj"):  # a REXS worm stage, imported in memory (wormsim.rexs)
+        from wormsim import rexs
+
+        imp = rexs.import_file(path)
+        return scenario_from_dict(imp.data, str(path.name), overrides)
     if not path.is_file():
         raise ScenarioError(f"{path}: no such scenario file")
     try:

@@ -13,20 +13,33 @@ from pydantic_core import PydanticUndefined
 
 from wormsim import scenario as S
 
-BLOCKS = [
-    ("(top level)", S.Scenario),
-    ("gear", S.Gear),
-    ("materials", S.Materials),
-    ("materials.worm / materials.wheel", S.Material),
-    ("contact", S.Contact),
-    ("drive", S.Drive),
-    ("load", S.Load),
-    ("simulation", S.Simulation),
-    ("wedge", S.Wedge),
-    ("wedge.motor", S.WedgeMotor),
-    ("wedge.load", S.WedgeLoad),
-    ("rating", S.Rating),
-]
+
+def _models(ann) -> list[type[BaseModel]]:
+    """The pydantic models an annotation holds (a block, an optional block, a list of blocks)."""
+    if isinstance(ann, type) and issubclass(ann, BaseModel):
+        return [ann]
+    return [m for a in typing.get_args(ann) for m in _models(a)]
+
+
+def blocks(root: type[BaseModel] = S.Scenario) -> list[tuple[str, type[BaseModel]]]:
+    """Every block of the scenario, (dotted title, model) depth-first from the top level; a model met under several
+    keys (materials.worm, materials.wheel) once, titled with all of them."""
+    found: dict[type[BaseModel], list[str]] = {}
+
+    def walk(title: str, model: type[BaseModel]) -> None:
+        if model in found:
+            found[model].append(title)
+            return
+        found[model] = [title]
+        for name, f in model.model_fields.items():
+            for sub in _models(f.annotation):
+                walk(name if title == "(top level)" else f"{title}.{name}", sub)
+
+    walk("(top level)", root)
+    return [(" / ".join(titles), model) for model, titles in found.items()]
+
+
+BLOCKS = blocks()
 
 
 def _type_name(ann) -> str:

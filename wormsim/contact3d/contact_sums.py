@@ -64,6 +64,12 @@ class RadiusLog:
         self.m += n
         return fr, radius_mean(W, wr)
 
+    def truncate(self, n: int) -> None:
+        """Drop the rows of samples n and later (a run that ended early: wormsim.locking)."""
+        keep = self.buf[: self.m][self.buf[: self.m, 0] < n]
+        self.buf[: len(keep)] = keep
+        self.m = len(keep)
+
     def efficiency(self, mu: np.ndarray, geo, worm_drives: bool) -> np.ndarray:
         """Per sample the force-weighted efficiency at the contacts' radii, mu the samples' friction coefficients."""
         n = len(mu)

@@ -91,8 +91,8 @@ def locked_error(t: float, w_drive: float, w_cmd: float, bm: BuiltModel, scenari
     )
     mu0 = float(friction_coefficient(scenario.contact, 0.0))
     rho = gt.virtual_friction_angle_rad(mu0, geo.alpha_n)
-    if scenario.drive.on == "wheel" and rho >= geo.gamma:
-        mu_max = math.tan(geo.gamma) * math.cos(geo.alpha_n)
+    if scenario.drive.on == "wheel" and rho >= geo.gamma_m:
+        mu_max = math.tan(geo.gamma_m) * math.cos(geo.alpha_n)
         return LockedError(
             f"{head}: the pair is self-locking (rho' = atan(mu / cos alpha_n) = {math.degrees(rho):.2f} deg at "
             f"standstill friction mu = {mu0:.3g} >= lead angle gamma = {math.degrees(geo.gamma):.2f} deg), so the "

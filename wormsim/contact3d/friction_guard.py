@@ -14,9 +14,9 @@ and the self-locking worm was back-driven at 700-900 rpm; with c_f = c_c (the pi
 
 The guard: after the ramps, the friction-weighted mean of cos(f_t, -v_t) over the contacts that slide (on the
 cone, slip faster than contact.transition_velocity_m_s, above which law (3) makes friction Coulomb's) must stay at or
-above ALIGN_MIN; below it for HOLD_S the run stops (SimulationError; LockedError where the wheel drives a pair that
-is self-locking, the cause of the overload). Valid runs measured at 1.000 (screw jack, seat demo, involute_41
-forward; the back-driven screw jack at mu 0.02).
+above ALIGN_MIN; below it for HOLD_S the run stops (SimulationError; where a speed-driven wheel drives a pair that
+is self-locking, the cause of the overload, the run ends held instead: wormsim.locking). Valid runs measured at
+1.000 (screw jack, seat demo, involute_41 forward; the back-driven screw jack at mu 0.02).
 """
 
 from __future__ import annotations
@@ -30,6 +30,7 @@ from wormsim import gear_theory as gt
 from wormsim.contact3d.diagnosis import locked_error
 from wormsim.errors import SimulationError
 from wormsim.friction import friction_coefficient
+from wormsim.locking import Held, backdrive_self_locks
 from wormsim.units import rad_s_to_rpm, rpm_to_rad_s
 
 ALIGN_MIN = 0.5  # friction-weighted cos(f_t, -v_t) of the sliding contacts below this ...
@@ -99,6 +100,11 @@ class FrictionGuard:
             return
         self.since = t if self.since is None else self.since
         if t - self.since > self.hold:
+            geo = self.bm.geometry
+            if backdrive_self_locks(
+                self.scenario, geo.gamma_m, geo.alpha_n
+            ):  # the held mesh's overload (wormsim.locking)
+                raise Held(t, self.since)
             raise friction_error(t, cos, fn, w1, w2, self.f_nominal, self.bm, self.scenario, self.hold)
 
 
@@ -121,7 +127,7 @@ def friction_error(
     drv = scenario.drive
     if drv.on == "wheel" and drv.speed_rpm is not None:
         mu0 = float(friction_coefficient(scenario.contact, 0.0))
-        if gt.virtual_friction_angle_rad(mu0, geo.alpha_n) >= geo.gamma:
+        if gt.virtual_friction_angle_rad(mu0, geo.alpha_n) >= geo.gamma_m:
             err = locked_error(t, w2, rpm_to_rad_s(drv.speed_rpm), bm, scenario)
             return type(err)(f"{err} (caught by the friction guard: {what}; the back-driving is not physical)")
     pieces = " or run contact.geometry=pieces (friction rows with c_f = c_c)" if law.friction_damping_n_s_per_m else ""

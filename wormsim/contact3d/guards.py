@@ -24,6 +24,7 @@ from wormsim.contact3d.diagnosis import (
 from wormsim.contact3d.friction_guard import FrictionGuard
 from wormsim.contact3d.mjcf import BuiltModel
 from wormsim.contact3d.timestep import MAX_WORM_TURN_PER_STEP_RAD, OVERSPEED_GUARD
+from wormsim.locking import Held, backdrive_self_locks
 from wormsim.scenario import Scenario
 from wormsim.units import rad_s_to_rpm
 
@@ -80,6 +81,7 @@ class Guards:
         self.lock_hold = max(gt.LOCK_HOLD_S, 20 * rec * self.dt)
         self.speed_driven = plan.speed_driven
         self.locked_since: float | None = None
+        self.self_locking_backdrive = backdrive_self_locks(scenario, geo.gamma_m, geo.alpha_n)
         self.turn_max = 0.0
         # sliding contacts' friction against their slip (wormsim.contact3d.friction_guard)
         self.friction = FrictionGuard(bm, rec * self.dt, scenario)
@@ -103,16 +105,27 @@ class Guards:
         self.friction.check(d, t, w1, w2)
         return te
 
-    def contact(self, t: float, pen: float, w_drive: float, cmd: float) -> None:
-        """Penetration beyond the limit; a speed-driven drive stuck below half its command (locked) for lock_hold."""
+    def _creeping(self, w_worm: float) -> bool:
+        """The worm's sliding speed below 10 transition velocities (the static friction's reach)."""
+        geo = self.bm.geometry
+        return abs(w_worm) * geo.r_m1 / math.cos(geo.gamma_m) < 10 * self.scenario.contact.transition_velocity_m_s
+
+    def contact(self, t: float, pen: float, w_drive: float, cmd: float, w_worm: float = 0.0) -> None:
+        """Penetration beyond the limit; a speed-driven drive stuck below half its command (locked) for lock_hold.
+        A wheel back-driving a self-locking pair ends the run as held (wormsim.locking.Held) when it stalls, or when
+        its servo pushes the held mesh past the penetration limit while the worm (speed w_worm) creeps."""
         code = contact_event(
             t, pen, self.pen_lim, w_drive, cmd, self.speed_driven, self.lock_start, gt.LOCK_SPEED_FRACTION
         )
         if code == PENETRATED:
+            if self.self_locking_backdrive and self._creeping(w_worm):  # the stalled wheel's servo pushed on
+                raise Held(t, self.locked_since)
             raise penetration_error(t, pen, self.pen_lim, self.dt, self.bm)
         if code == STUCK:
             self.locked_since = t if self.locked_since is None else self.locked_since
             if t - self.locked_since > self.lock_hold:
+                if self.self_locking_backdrive:  # the answer, not a failure (wormsim.locking)
+                    raise Held(t, self.locked_since)
                 raise locked_error(t, w_drive, cmd, self.bm, self.scenario)
         elif code == RUNNING:
             self.locked_since = None

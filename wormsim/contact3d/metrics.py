@@ -1,13 +1,13 @@
-"""contact3d summary metrics: the common drive summary (wormsim.metrics) plus the meshing frequency searched below
-half the piece-passing frequency, contact statistics, the radial force on the line of centres, the efficiency theory
-at the contacts' radius and the start-up peak."""
+"""contact3d summary metrics: the common drive summary (wormsim.metrics) plus the meshing line of the tangential
+force near z1 n1 / 60, contact statistics, the radial and axial forces as DIN 3975 defines them and as resultants,
+the efficiency theory at the contacts' radius and the start-up peak."""
 
 from __future__ import annotations
 
 import numpy as np
 
 from wormsim import gear_theory as gt
-from wormsim.metrics import dominant_frequency, drive_summary, mean_speeds_rpm, window_after
+from wormsim.metrics import dominant_frequency, drive_summary, mean_speeds_rpm, mesh_line, mesh_line_keys, window_after
 
 
 def contact3d_summary(S: dict, scenario, bm) -> dict:
@@ -18,24 +18,21 @@ def contact3d_summary(S: dict, scenario, bm) -> dict:
     i0, i1, _ = window_after(S, duty.drive.on, duty.ramps_end_s, geo)
     sl = slice(i0, i1)
     n1, n2 = mean_speeds_rpm(S, i0, i1)
-    # the convex pieces' facets excite the force at (segments per turn) x (worm speed): search below half that
-    segs = bm.pieces.resolution.worm_segments_per_turn
-    f_max = 0.5 * segs * n1 / 60.0 if segs else float("inf")
-    f_peak, df, _, _ = dominant_frequency(t[sl], S["tangential_force_n"][sl], f_max)
+    f_theory = geo.z1 * n1 / 60.0
     f_full, _, _, _ = dominant_frequency(t[sl], S["tangential_force_n"][sl])
-    f_rad, _, _, _ = dominant_frequency(t[sl], S["radial_force_n"][sl], f_max)
+    # shaft powers: the interval means of T w over every step (the runner's worm_power_w, wheel_power_w)
+    drive = drive_summary(S, scenario, geo, i0, i1, n1, n2, shaft_powers_w=(S["worm_power_w"], S["wheel_power_w"]))
     return {
-        # shaft powers: the interval means of T w over every step (the runner's worm_power_w, wheel_power_w)
-        **drive_summary(S, scenario, geo, i0, i1, n1, n2, shaft_powers_w=(S["worm_power_w"], S["wheel_power_w"])),
-        "mesh_frequency_hz": f_peak,
-        "mesh_frequency_resolution_hz": df,
-        "mesh_frequency_search_max_hz": f_max,
+        **drive,
+        # the meshing line near z1 n1 / 60 (wormsim.metrics.mesh_line): the pieces' facets, the contact mode's ringing
+        # and the meshing harmonics lie outside its band
+        **mesh_line_keys(t, S, sl, f_theory, "tangential_force_n"),
         "force_peak_full_band_hz": f_full,
-        "mesh_frequency_radial_hz": f_rad,
+        "mesh_frequency_radial_hz": mesh_line(t[sl], S["radial_force_n"][sl], f_theory)["f_hz"],
         "contacts_mean": float(np.mean(S["contacts"][sl])),
         "teeth_in_contact_mean": float(np.mean(S["teeth_in_contact"][sl])),
         "max_penetration_um": float(np.max(S["max_penetration_m"][sl]) * 1e6),
-        **radial_force_check(S, duty.drive.on, geo, sl),
+        **din_forces(S, duty.drive.on, geo, sl, drive["worm_torque_mean_nm"]),
         **contact_radius_check(S, sl),
         **startup_peak(S, i0, i1),
     }
@@ -58,24 +55,35 @@ def contact_radius_check(S: dict, sl: slice) -> dict:
     }
 
 
-def radial_force_check(S: dict, drive_on: str, geo, sl: slice) -> dict:
-    """DIN 3975's radial force F_r2 = F_t2 tan(alpha_n) cos(rho') / cos(gamma + s rho') (s = +1 worm driving, -1
-    back-driving, rho' = atan(mu / cos alpha_n)) assumes one contact at the pitch point on the line of centres. The
-    3D contacts sit around the worm at angles phi (about its axis, from the line of centres), which turn their
-    radial components partly into the wheel's axial direction: radial_force_mean_n (the resultant's component) is
-    below DIN's by about <cos phi>. radial_force_line_of_centres_mean_n turns each contact's force back onto the line
-    of centres (wormsim.contact3d.runner) and is the one to compare with radial_force_theory_n (measured: screw jack,
-    medium: 147.8 against 147.2 N, while the resultant gives 128.9 N; force-weighted |phi| 28 deg)."""
-    if "radial_force_line_of_centres_n" not in S or not len(S["tangential_force_n"][sl]):
+def din_forces(S: dict, drive_on: str, geo, sl: slice, worm_torque_mean_nm: float) -> dict:
+    """The headline radial and axial forces as DIN 3975-2 defines them, with the resultant's components as their own
+    keys (docs/outputs.md, "Force keys").
+
+    DIN 3975's F_r2 = F_t2 tan(alpha_n) cos(rho') / cos(gamma + s rho') (s = +1 worm driving, -1 back-driving, rho' =
+    atan(mu / cos alpha_n)) and F_a2 = F_t1 = 2 T1 / d1 assume one contact at the pitch point on the line of centres.
+    The 3D contacts sit around the worm at angles phi (about its axis, from the line of centres), which turn their
+    radial components partly into the wheel's axial direction, and at worm radii r_c above r1, where the lead angle is
+    smaller: the resultant's radial component is below DIN's F_r2 by about <cos phi> (measured: screw jack, medium:
+    128.9 against 147.2 N, force-weighted |phi| 28 deg) and its axial component below T1 / r1 (seeds: -5 to -8 %).
+    radial_force_mean_n turns each contact's force back onto the line of centres (wormsim.contact3d.runner; screw
+    jack 147.8 against 147.2 N) and axial_force_mean_n is the worm torque over r1, F_t1 = T1 / r1: the forces a
+    bearing calculation after DIN 3975 takes. The resultant's components are radial_force_resultant_mean_n and
+    axial_force_resultant_mean_n: the forces on the wheel's bearings."""
+    if not len(S["tangential_force_n"][sl]):
         return {}
     mu = float(np.mean(S["friction_coefficient"][sl]))
     rho = gt.virtual_friction_angle_rad(mu, geo.alpha_n)
     s = -1.0 if drive_on == "wheel" else 1.0
     ft = abs(float(np.mean(S["tangential_force_n"][sl])))
-    return {
-        "radial_force_line_of_centres_mean_n": abs(float(np.mean(S["radial_force_line_of_centres_n"][sl]))),
-        "radial_force_theory_n": gt.radial_force_n(ft, geo.alpha_n, geo.gamma, s * rho),
+    out = {
+        "radial_force_resultant_mean_n": abs(float(np.mean(S["radial_force_n"][sl]))),
+        "axial_force_resultant_mean_n": abs(float(np.mean(S["axial_force_n"][sl]))),
+        "axial_force_mean_n": worm_torque_mean_nm / geo.r_m1,
+        "radial_force_theory_n": gt.radial_force_n(ft, geo.alpha_n, geo.gamma_m, s * rho),
     }
+    if "radial_force_line_of_centres_n" in S:
+        out["radial_force_mean_n"] = abs(float(np.mean(S["radial_force_line_of_centres_n"][sl])))
+    return out
 
 
 def startup_peak(S: dict, i0: int, i1: int) -> dict:

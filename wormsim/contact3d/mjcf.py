@@ -54,6 +54,7 @@ from wormsim.contact3d.mass_scaling import ScalingCheck
 from wormsim.contact3d.timestep import timestep_for
 from wormsim.friction import friction_coefficient
 from wormsim.geometry import derive, displaced_pair, gear_set, solid_set
+from wormsim.locking import backdrive_self_locks, stall_torque_nm, wheel_start_rad
 from wormsim.scenario import Scenario, ScenarioError, Simulation
 from wormsim.tooth.grid import SLICES_MASS_SCALED, FlankGrid, default_slices, flank_grid
 from wormsim.tooth.window import slot_quat, window_size, window_teeth_at
@@ -232,7 +233,7 @@ def nominal_normal_force_n(wheel_torque_nm: float, geo: GearGeometry) -> float:
     gear_theory.working_wheel_torque_of). Sets the friction rows' hardness (wormsim.contact3d.law (3)); with T2 = 0
     impratio fell to 1 and a self-locking pair crept back at ~110 rpm instead of 0.2 rpm
     (docs/stability_backlash_locking.md)."""
-    return gt.normal_force_n(wheel_torque_nm, geo.r2, geo.alpha_n, geo.gamma)
+    return gt.normal_force_n(wheel_torque_nm, geo.r2, geo.alpha_n, geo.gamma_m)
 
 
 def nominal_sliding_speed_m_s(worm_speed_rad_s: float | None, geo: GearGeometry) -> float:
@@ -240,7 +241,7 @@ def nominal_sliding_speed_m_s(worm_speed_rad_s: float | None, geo: GearGeometry)
     (gear_theory.worm_speed_command_rad_s); 0 for a torque drive (None: speed not known before the run)."""
     if worm_speed_rad_s is None:
         return 0.0
-    return worm_speed_rad_s * geo.r1 / math.cos(geo.gamma)
+    return worm_speed_rad_s * geo.r_m1 / math.cos(geo.gamma_m)
 
 
 def expected_direction(geo: GearGeometry) -> int:
@@ -300,12 +301,17 @@ def prepare(scenario: Scenario, gs: GearSet | None = None) -> Prepared:
     duty = gt.duty(scenario, direction)
     drv, load = duty.drive, duty.load
     w1 = gt.worm_speed_command_rad_s(drv, geo.ratio)
-    t_drive = gt.expected_drive_torque_of(drv, load, geo.ratio, geo.gamma, geo.alpha_n, mu1)
+    t_drive = gt.expected_drive_torque_of(drv, load, geo.ratio, geo.gamma_m, geo.alpha_n, mu1)
     t2 = gt.working_wheel_torque_of(drv, load, geo.ratio)
+    held = backdrive_self_locks(scenario, geo.gamma_m, geo.alpha_n)
+    if held:  # the mesh holds the stalled wheel servo's torque (wormsim.locking): the friction rows' hardness for it
+        t2 = max(t2, stall_torque_nm(t_drive))
     kv = gt.servo_gain_of(drv, t_drive) if duty.speed_driven else None
-    arm1, arm2 = gt.mesh_arms_m(geo.r1, geo.r2, geo.alpha_n, geo.gamma)
+    arm1, arm2 = gt.mesh_arms_m(geo.r_m1, geo.r2, geo.alpha_n, geo.gamma_m)
     e_star = gt.effective_modulus_pa(scenario.materials)
     f_n, v_s = nominal_normal_force_n(t2, geo), nominal_sliding_speed_m_s(w1, geo)
+    if held:  # the worm stands: no sliding speed to size the friction rows' damping by (law (4): c_f = c_c)
+        v_s = 0.0
     # driven-machine inertia J on the loaded shaft (joint armature) belongs to that shaft's effective mass
     I1 = ine.worm_inertia_kg_m2 + ine.worm_load_inertia_kg_m2
     I2 = ine.wheel_inertia_kg_m2 + ine.wheel_load_inertia_kg_m2
@@ -426,6 +432,10 @@ def build_model(
     if kv is not None:
         meta["drive_kv_nm_s"] = kv
     meta["load_inertia_kg_m2"] = scenario.load.inertia_kg_m2
+    # a torque-driven wheel starts on its loaded flank (wormsim.locking.wheel_start_rad): the hinge's initial angle
+    meta["wheel_start_rad"] = wheel_start_rad(scenario, geo.backlash, geo.r2, dev is None and sups is None)
+    jw = model.jnt_qposadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, "wheel_hinge")]
+    model.qpos0[jw] += meta["wheel_start_rad"]
     meta["mass_scaling"] = p.scaling.factor
     meta["mass_scaling_check"] = p.scaling
     if sups is not None:  # the shafts' joints (wormsim.contact3d.shafts): the kernel takes the poses from the data

@@ -28,7 +28,7 @@ import time
 import mujoco
 import numpy as np
 
-from wormsim import prewarm
+from wormsim import jit_cache, prewarm
 from wormsim.contact3d import jit_warmup, mass_scaling
 from wormsim.contact3d.contact_sums import RadiusLog
 from wormsim.contact3d.diagnosis import diverged_error
@@ -41,6 +41,7 @@ from wormsim.contact3d.series import SERIES, column
 from wormsim.contact3d.shafts import ShaftLog
 from wormsim.contact3d.sources import FlankSource, PieceSource
 from wormsim.friction import friction_mode
+from wormsim.locking import Held, held_keys, run_keys
 from wormsim.result import Result
 from wormsim.scenario import Scenario
 from wormsim.units import RPM
@@ -80,12 +81,30 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
     src = FlankSource(bm, d, io, guards, rec, S_all, store, slog) if flanks else PieceSource(bm, d, io, rec)
     t_wall = time.perf_counter()
     prewarm.loop_started()  # the writers' warm-up thread goes now, beside the GIL-free loop (wormsim.prewarm)
-    _loop(src, bm, d, guards, S_all, rlog, store, rec, progress, slog)
+    held = None
+    try:
+        _loop(src, bm, d, guards, S_all, rlog, store, rec, progress, slog)
+    except Held as h:  # a self-locking pair held the back-driving wheel: the run ends there (wormsim.locking)
+        held = h
+        n_done = int(np.count_nonzero(S_all[0] > 0.0))  # samples written (t_s > 0); the held one is not
+        S_all = S_all[:, :n_done]
+        S = dict(zip(SERIES, S_all))
+        store = tuple(a[:n_done] for a in store)
+        rlog.truncate(n_done)
+        if flanks:
+            src.pattern.truncate(n_done)
+        if slog is not None:
+            slog.truncate(n_done)
     force_signs(S, bm.geometry.hand)  # into docs/outputs.md's convention
     S["efficiency_theory_at_contact_radius"][:] = rlog.efficiency(S["friction_coefficient"], bm.geometry, worm_is_drive)
     wall = time.perf_counter() - t_wall
     summary = _run_summary(
         S, scenario, bm, rec, guards.turn_max, len(src.coll), 1e6 * wall / max(n_rec * rec, 1), flanks=flanks
+    )
+    summary.update(
+        run_keys(scenario, bm.geometry, S["t_s"], S["worm_speed_rpm"])
+        if held is None
+        else held_keys(S["t_s"], S["worm_speed_rpm"], S["wheel_torque_nm"], held.stuck_since_s or held.t_s)
     )
     extra = {"points_tooth0": store[0], "points_world": store[2], "forces_world": store[1], "built": bm}
     src.finish(S, summary, extra)
@@ -99,9 +118,8 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
     if bm.kinematic_tca is not None:  # errors: the displaced exact flanks' kinematic TE and play
         kin = bm.kinematic_tca.summary(bm.geometry, bm.plan.duty.working_flank)
         summary.update({k: v for k, v in kin.items() if not k.startswith("contact_pattern")})
-    return Result(
-        model="contact3d", summary=summary, series=S, steps=n_rec * rec, sim_time_s=float(d.time), extra=extra
-    )
+    steps = n_rec * rec if held is None else S_all.shape[1] * rec
+    return Result(model="contact3d", summary=summary, series=S, steps=steps, sim_time_s=float(d.time), extra=extra)
 
 
 def _loop(src, bm: BuiltModel, d, guards, S_all, rlog, store, rec: int, progress, slog) -> None:
@@ -140,11 +158,11 @@ def _sample(src, bm: BuiltModel, d, guards, S_all, rlog, store, rec: int, slog, 
     w1, w2 = float(qv[bm.worm_dof]), float(qv[bm.wheel_dof])
     t = float(d.time)
     te = guards.state(d, t, th1, th2, w1, w2)
-    mu = mu_of(abs(w1) * geo.r1 / math.cos(geo.gamma), bm.plan.mu_params)  # at the sliding speed Vs
+    mu = mu_of(abs(w1) * geo.r_m1 / math.cos(geo.gamma_m), bm.plan.mu_params)  # at the sliding speed Vs
     # each contact's force turned about the worm axis onto the line of centres: the radial force DIN 3975's
     # single pitch-point contact means; the force-weighted contact radius and efficiency there (contact_sums)
     nteeth, pen, fr_lc, r_c = src.sample(i, th2, mu, rlog, store)
-    guards.contact(t, pen, w1 if bm.plan.drive_on == "worm" else w2, cmd)
+    guards.contact(t, pen, w1 if bm.plan.drive_on == "worm" else w2, cmd, w1)
     if slog is not None:
         slog.record(i, d)
     S_all[:, i] = column(t, th1, th2, w1, w2, cmd, sums, rec, nteeth, pen, mu, te, fr_lc, r_c, RPM)
@@ -204,6 +222,11 @@ def _run_summary(
 
 def simulate(scenario: Scenario, progress=None) -> Result:
     """Build the model (its timestep chosen before the build) and run it."""
+    t0 = time.perf_counter()
+    jit_cache.listen()  # the compile seconds counted (the progress line, a sweep's timing)
+    jit_cache.ensure_warm(getattr(progress, "compiling", None))  # compiled once per machine (wormsim.jit_cache)
+    if progress is not None and time.perf_counter() - t0 > 0.5:  # the estimate's clock starts after the compile
+        progress.restart_clock()
     jit_warmup.start()  # numba's start-up beside MuJoCo's model compilation (wormsim.contact3d.jit_warmup)
     bm = build_model(scenario)
     if progress is not None and scenario.simulation.mass_scaling != 1:

@@ -334,6 +334,11 @@ class ShaftLog:
             mujoco.mj_rnePostConstraint(self.model, d)
         gather(self.addresses(d), self.raw, i)
 
+    def truncate(self, n: int) -> None:
+        """Keep the first n samples (a run that ended early: wormsim.locking)."""
+        self.raw = self.raw[:n]
+        self.n = n
+
     def series(self) -> dict[str, np.ndarray]:
         """The outputs per sample (shaft frame: z the axis, x and y across it as the rigid model's part frame at hinge
         angle 0): the displacements and the bearings' forces on the shaft."""

@@ -107,13 +107,14 @@ def rate(scenario: Scenario) -> dict:
     n1 = worm_speed_rpm(scenario, r, ratio)
     mat = wheel_material(scenario, r, warnings)
 
-    # geometry in the public formulas' units (mm); no profile shift in meshgen: x2 = 0, d_m = d
+    # geometry in the public formulas' units (mm); with the wheel's profile shift x2 the worm meshes on its mean
+    # diameter d_m1 = d1 + 2 x2 m_x at the lead angle gamma_m (DIN 3975-1; d1 and gamma when x2 = 0)
     a = geo.a * MM_PER_M
-    d1, d2 = geo.d1 * MM_PER_M, geo.d2 * MM_PER_M
+    d1, d2 = 2.0 * geo.r_m1 * MM_PER_M, geo.d2 * MM_PER_M
     m_x, q, z2, u = geo.m_x * MM_PER_M, geo.q, geo.z2, geo.z2 / geo.z1
     b2h = geo.face_width * MM_PER_M
-    gamma = geo.gamma
-    x2 = 0.0
+    gamma = geo.gamma_m
+    x2 = geo.x2
     t2 = r.application_factor * t2_nom
     inputs = {
         "wheel_torque_nominal_nm": t2_nom,
@@ -123,6 +124,8 @@ def rate(scenario: Scenario) -> dict:
         "life_h": r.life_h,
         "lubricant": r.lubricant,
         "oil_viscosity_40_mm2_s": r.oil_viscosity_40_mm2_s,
+        "oil_viscosity_100_mm2_s": r.oil_viscosity_100_mm2_s,
+        "oil_sump_temperature_given_c": r.oil_sump_temperature_c,
         "wheel_material": mat.name,
         "wheel_material_designation": mat.designation,
         "wheel_material_source": mat.source,
@@ -130,13 +133,15 @@ def rate(scenario: Scenario) -> dict:
         "ambient_c": r.ambient_c,
         "roughness_worm_um": r.roughness_worm_um,
         "centre_distance_mm": a,
-        "worm_diameter_mm": d1,
+        "worm_diameter_mm": geo.d1 * MM_PER_M,
+        "worm_mean_diameter_mm": d1,
         "wheel_diameter_mm": d2,
         "axial_module_mm": m_x,
         "diameter_quotient": q,
         "worm_starts": geo.z1,
         "wheel_teeth": z2,
-        "lead_angle_deg": math.degrees(gamma),
+        "lead_angle_deg": math.degrees(geo.gamma),
+        "lead_angle_mean_deg": math.degrees(gamma),
         "normal_pressure_angle_deg": math.degrees(geo.alpha_n),
         "face_width_mm": b2h,
         "profile_shift_x2": x2,
@@ -251,9 +256,13 @@ def _pitting(f: Factors, r: Rating, mat: WheelMaterial, v_gm, a, sigma_hm) -> fl
         "z_oil", "Z_oil", Z_OIL[r.lubricant], "-", "lubricant factor (pitting)",
         "MITCalc Gear4 oil-type table, as reproduced in a public web port of the workbook",
     )  # fmt: skip
-    f.add("sigma_hlim_t_mpa", "sigma_HlimT", mat.sigma_hlim_t_mpa, "MPa", "pitting strength", mat.source)
+    given = r.wheel_pitting_strength_mpa
+    sigma_hlim = f.add(
+        "sigma_hlim_t_mpa", "sigma_HlimT", mat.sigma_hlim_t_mpa if given is None else given, "MPa", "pitting strength",
+        mat.source if given is None else "rating.wheel_pitting_strength_mpa (input)",
+    )  # fmt: skip
     sigma_hg = f.add(
-        "sigma_hg_mpa", "sigma_HG", iso.pitting_limit_mpa(mat.sigma_hlim_t_mpa, z_h, z_v, z_s, z_u, z_oil), "MPa",
+        "sigma_hg_mpa", "sigma_HG", iso.pitting_limit_mpa(sigma_hlim, z_h, z_v, z_s, z_u, z_oil), "MPa",
         "permissible mean Hertz stress", iso.PORT,
     )  # fmt: skip
     return f.add("safety_pitting", "S_H", sigma_hg / sigma_hm, "-", "sigma_HG / sigma_Hm", iso.PORT)
@@ -353,10 +362,16 @@ def _temperature(f: Factors, r: Rating, a, n1, d1, t2, u, eta) -> tuple:
         "heat_transfer_w_m2k", "h_CR", agma.heat_transfer_coefficient(n1) * agma.HEAT_TRANSFER_SI, "W/(m^2 K)",
         "housing heat transfer, no fan", agma.SHIGLEY,
     )  # fmt: skip
-    theta_s = f.add(
-        "oil_temperature_c", "theta_S", agma.sump_temperature_c(r.ambient_c, p_v0 + p_vd + p_vz, h_cr, area), "C",
-        "oil sump temperature, splash lubrication", agma.SHIGLEY,
-    )  # fmt: skip
+    if r.oil_sump_temperature_c is not None:
+        theta_s = f.add(
+            "oil_temperature_c", "theta_S", r.oil_sump_temperature_c, "C",
+            "oil temperature as given (injection lubrication)", "rating.oil_sump_temperature_c (input)",
+        )  # fmt: skip
+    else:
+        theta_s = f.add(
+            "oil_temperature_c", "theta_S", agma.sump_temperature_c(r.ambient_c, p_v0 + p_vd + p_vz, h_cr, area), "C",
+            "oil sump temperature, splash lubrication", agma.SHIGLEY,
+        )  # fmt: skip
     theta_lim = f.add(
         "theta_slim_c", "theta_Slim", THETA_SLIM_C[r.lubricant], "C", "permissible sump temperature", iso.PORT
     )
@@ -365,16 +380,16 @@ def _temperature(f: Factors, r: Rating, a, n1, d1, t2, u, eta) -> tuple:
 
 def _agma(out: dict, f: Factors, geo, n1: float, t2: float, r: Rating, mat: WheelMaterial, warnings: list[str]):
     """AGMA 6034 allowable tangential force, friction and efficiency (bronze wheels only)."""
-    d1_in = geo.d1 * MM_PER_M * agma.IN_PER_MM
+    d1_in = 2.0 * geo.r_m1 * MM_PER_M * agma.IN_PER_MM  # the worm's mean diameter d_m1 (d1 unshifted)
     d2_in = geo.d2 * MM_PER_M * agma.IN_PER_MM
     c_in = geo.a * MM_PER_M * agma.IN_PER_MM
     v_s = f.add(
-        "agma_sliding_speed_ft_min", "V_s", agma.sliding_speed_ft_min(d1_in, n1, geo.gamma), "ft/min",
+        "agma_sliding_speed_ft_min", "V_s", agma.sliding_speed_ft_min(d1_in, n1, geo.gamma_m), "ft/min",
         "sliding speed", agma.SHIGLEY,
     )  # fmt: skip
     fr = out["agma_friction"] = f.add("agma_friction", "f", agma.friction(v_s), "-", "friction", agma.SHIGLEY)
     out["agma_efficiency"] = f.add(
-        "agma_efficiency", "e_W", agma.efficiency_worm_driving(geo.alpha_n, geo.gamma, fr), "-",
+        "agma_efficiency", "e_W", agma.efficiency_worm_driving(geo.alpha_n, geo.gamma_m, fr), "-",
         "efficiency, worm driving", agma.SHIGLEY,
     )  # fmt: skip
     if mat.kind not in ("bronze", "al_bronze"):

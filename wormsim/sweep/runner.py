@@ -35,6 +35,7 @@ CSV_NAME, JSON_NAME, PNG_NAME, RUNS_DIR = "sweep.csv", "sweep.json", "sweep.png"
 SCHEDULER_ENV = "DASK_SCHEDULER_ADDRESS"
 CONNECT_TIMEOUT_S = 20.0  # to reach an existing scheduler
 WORKER_WAIT_S = 60.0  # for the first worker of an existing cluster
+MAX_CHUNK = 4  # points per task at most (chunk_size)
 _FIRST = ("point",)
 _AFTER_SWEPT = ("status", "message")
 _LAST = ("wall_time_s", "scenario_hash")
@@ -94,11 +95,37 @@ def run_point(scenario: dict, keep_files: bool) -> dict:
             **base,
             "wall_time_s": time.perf_counter() - t0,
         }
+    from wormsim import jit_cache
+
+    jit = jit_cache.dispatcher_stats()
     return {
         "summary": summary,
         "files": files,
-        "timing": {"worker": _worker_name(), "start": t_start, "end": time.time(), "setup_s": t_setup},
+        "timing": {
+            "worker": _worker_name(),
+            "start": t_start,
+            "end": time.time(),
+            "setup_s": t_setup,
+            # this worker process's totals so far: seconds compiling, signatures compiled / loaded (wormsim.jit_cache)
+            "compile_s": jit_cache.compile_seconds(),
+            "jit_misses": jit["misses"],
+            "jit_hits": jit["hits"],
+        },
     }
+
+
+def run_points(scenarios: list[dict], keep_files: bool) -> list[dict]:
+    """Several points in one task (run_sweep's chunks of short points): run_point on each, in order."""
+    return [run_point(sc, keep_files) for sc in scenarios]
+
+
+def chunk_size(n_points: int, threads: int) -> int:
+    """Points per task: 1, or up to MAX_CHUNK where there are at least 8 points per worker thread. A task's points
+    share one scheduler round trip and one hand-back (the worker waits for its next task only once per chunk);
+    a worker that dies fails the points of its chunk. 16 points on 2 workers: 2 per task."""
+    if n_points < 8 * threads:
+        return 1
+    return max(1, min(MAX_CHUNK, n_points // (4 * threads)))
 
 
 def _worker_name() -> str:
@@ -252,7 +279,10 @@ def default_workers() -> int:
 
 
 def open_client(scheduler: str | None, workers: int | None):
-    """(client, cluster or None, info). scheduler None: a LocalCluster of `workers` single-threaded processes."""
+    """(client, cluster or None, info). scheduler None: a LocalCluster of `workers` single-threaded processes.
+    Raises ScenarioError for a bad --workers or a scheduler that does not answer."""
+    if workers is not None and workers < 1:
+        raise ScenarioError(f"--workers {workers}: allowed an integer >= 1")
     from distributed import Client, LocalCluster
 
     t0 = time.perf_counter()
@@ -293,6 +323,63 @@ def open_client(scheduler: str | None, workers: int | None):
         ],
     }
     return client, cluster, info
+
+
+def warm_workers(client, info: dict) -> None:
+    """Every worker loads (the machine's first compiles, once) the contact3d kernels before the points go out
+    (wormsim.sweep.warm.WarmKernels; also on workers that join later). info gets "warm_s"."""
+    from wormsim.sweep.warm import WarmKernels
+
+    t0 = time.perf_counter()
+    try:
+        client.register_plugin(WarmKernels())
+    except Exception:  # (a worker that cannot warm compiles or loads in its first point)
+        pass
+    info["warm_s"] = time.perf_counter() - t0
+
+
+class ClusterStart:
+    """open_client in a thread, started before the sweep file is validated (the cluster's start overlaps it);
+    `get()` waits for it (and re-raises its error), `close()` closes what it opened."""
+
+    def __init__(self, scheduler: str | None, workers: int | None):
+        import threading
+
+        self._result: tuple | None = None
+        self._error: BaseException | None = None
+        scheduler = scheduler or os.environ.get(SCHEDULER_ENV) or None
+        self._thread = threading.Thread(
+            target=self._run, args=(scheduler, workers), name="wormsim-cluster-start", daemon=True
+        )
+        self._thread.start()
+
+    def _run(self, scheduler, workers) -> None:
+        try:
+            self._result = open_client(scheduler, workers)
+        except BaseException as exc:  # (re-raised by get in the main thread)
+            self._error = exc
+
+    def get(self):
+        self._thread.join()
+        if self._error is not None:
+            raise self._error
+        assert self._result is not None
+        return self._result
+
+    def close(self) -> None:
+        self._thread.join()
+        if self._result is not None:
+            _close(self._result[0], self._result[1])
+
+
+def _close(client, cluster) -> None:
+    try:
+        if client is not None:
+            client.close()
+        if cluster is not None:
+            cluster.close()
+    except Exception:  # (closing a cluster after Ctrl-C may fail; the tables are written)
+        pass
 
 
 def _free_threads(client) -> int:
@@ -339,12 +426,14 @@ def run_sweep(
     workers: int | None = None,
     keep_runs: bool = False,
     progress: bool | None = None,
+    started: ClusterStart | None = None,
 ) -> dict:
     """Run (or resume) the sweep into out_dir. Returns counts {points, ok, failed, resumed, ran}.
+    started: a cluster started earlier (ClusterStart; scheduler and workers are then its); run_sweep closes it.
     KeyboardInterrupt propagates after sweep.csv / sweep.json hold the finished points."""
-    from wormsim.sweep.plot import write_sweep_png
-
     if workers is not None and workers < 1:
+        if started is not None:
+            started.close()
         raise ScenarioError(f"--workers {workers}: allowed an integer >= 1")
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -387,10 +476,15 @@ def run_sweep(
     client = cluster = cluster_info = None
     interrupted = False
     t_sweep = time.perf_counter()
+    png = _PlotImport()
     try:
         if todo:
-            scheduler = scheduler or os.environ.get(SCHEDULER_ENV) or None
-            client, cluster, cluster_info = open_client(scheduler, workers)
+            if started is None:
+                started = ClusterStart(scheduler, workers)
+            client, cluster, cluster_info = started.get()
+            started = None
+            if any(p.scenario.model == "contact3d" for p in todo):
+                warm_workers(client, cluster_info)
             bar.say(
                 f"sweep {sweep.spec.name}: {len(sweep.points)} points, {resumed} done earlier, {len(todo)} to run "
                 f"on {cluster_info['workers']} workers ({cluster_info['kind']} {cluster_info['scheduler']})"
@@ -403,66 +497,83 @@ def run_sweep(
             futures = {}
             queue = list(todo)
 
+            threads = _free_threads(client)
+            chunk = chunk_size(len(todo), threads)
+            cluster_info["points_per_task"] = chunk
+
             def submit_next():
-                p = queue.pop(0)
-                fut = client.submit(
-                    run_point,
-                    p.scenario.model_dump(mode="json"),
-                    keep_runs,
-                    pure=False,
-                    key=f"wormsim-point-{p.index}-{p.scenario_hash}",
-                )
-                futures[fut] = (p, time.time())
+                ps = queue[:chunk]
+                del queue[:chunk]
+                scs = [p.scenario.model_dump(mode="json") for p in ps]
+                key = f"wormsim-point-{ps[0].index}-{ps[0].scenario_hash}"
+                if chunk == 1:
+                    fut = client.submit(run_point, scs[0], keep_runs, pure=False, key=key)
+                else:
+                    fut = client.submit(run_points, scs, keep_runs, pure=False, key=f"{key}-{len(ps)}")
+                futures[fut] = (ps, time.time())
                 return fut
 
-            pending = as_completed([submit_next() for _ in range(min(len(queue), _free_threads(client)))])
+            pending = as_completed([submit_next() for _ in range(min(-(-len(queue) // chunk), threads))])
+            png.start()  # matplotlib's import while the points run (this thread waits on them)
             for fut in pending:
                 if queue:
                     pending.add(submit_next())
-                p, t_submit = futures[fut]
+                ps, t_submit = futures[fut]
                 try:
-                    res = fut.result()
+                    out_ = fut.result()
+                    results = [out_] if chunk == 1 else out_
                 except Exception as exc:  # (the worker died or the task could not run)
-                    res = {
-                        "summary": {
-                            "status": "failed",
-                            "wall_time_s": None,
-                            "model": p.scenario.model,
-                            "message": f"worker lost: {exc.__class__.__name__}: {exc}",
-                        },
-                        "files": {},
-                        "timing": None,
+                    results = [
+                        {
+                            "summary": {
+                                "status": "failed",
+                                "wall_time_s": None,
+                                "model": p.scenario.model,
+                                "message": f"worker lost: {exc.__class__.__name__}: {exc}",
+                            },
+                            "files": {},
+                            "timing": None,
+                        }
+                        for p in ps
+                    ]
+                received = time.time()
+                for p, res in zip(ps, results):
+                    summary = res["summary"]
+                    if keep_runs and res["files"]:
+                        _write_run_dir(out / RUNS_DIR / _run_dir_name(p), res["files"], summary)
+                    rows[p.index] = row_of(p, summary)
+                    timing[p.index] = {
+                        **(res["timing"] or {}),
+                        "submitted": t_submit,
+                        "received": received,
+                        "result_bytes": sum(len(b) for b in res["files"].values()),
                     }
-                summary = res["summary"]
-                if keep_runs and res["files"]:
-                    _write_run_dir(out / RUNS_DIR / _run_dir_name(p), res["files"], summary)
-                rows[p.index] = row_of(p, summary)
-                timing[p.index] = {
-                    **(res["timing"] or {}),
-                    "submitted": t_submit,
-                    "received": time.time(),
-                    "result_bytes": sum(len(b) for b in res["files"].values()),
-                }
+                    bar.point_done(summary.get("status") != "ok")
                 flush_csv()
-                bar.point_done(summary.get("status") != "ok")
     except KeyboardInterrupt:
         interrupted = True
     finally:
         bar.close()
+        if started is not None:  # (no point to run, or an error before the cluster was taken)
+            started.close()
         state.update(
             finished=time.strftime("%Y-%m-%dT%H:%M:%S%z"), interrupted=interrupted, wall_s=time.perf_counter() - t_sweep
         )
-        try:
-            if client is not None:
-                client.close()
-            if cluster is not None:
-                cluster.close()
-        except Exception:  # (closing a cluster after Ctrl-C may fail; the tables are written)
-            pass
         write_json_atomic(out / JSON_NAME, _json_doc(sweep, rows, timing, machine, cluster_info, state))
+        # the results are safe: the cluster closes in a thread while sweep.png is drawn
+        import threading
+
+        closing = threading.Thread(target=_close, args=(client, cluster), name="wormsim-cluster-close", daemon=True)
+        closing.start()
         ordered = [rows[i] for i in sorted(rows)]
-        if not interrupted:
-            write_sweep_png(ordered, swept, sweep.spec.plot, out / PNG_NAME, title=sweep.spec.name)
+        try:
+            png.join()
+            if not interrupted:
+                from wormsim.sweep.plot import write_sweep_png
+
+                write_sweep_png(ordered, swept, sweep.spec.plot, out / PNG_NAME, title=sweep.spec.name)
+        finally:
+            closing.join()
     if interrupted:
         raise KeyboardInterrupt
     n_ok = sum(1 for r in rows.values() if r.get("status") == "ok")
@@ -474,6 +585,32 @@ def run_sweep(
         "ran": len(todo),
         "cluster": cluster_info,
     }
+
+
+class _PlotImport:
+    """matplotlib's import (wormsim.prewarm's) in a thread while the points run; a failure is dropped (the plot
+    imports for itself)."""
+
+    def __init__(self):
+        self._thread = None
+
+    def start(self) -> None:
+        import threading
+
+        from wormsim import prewarm
+
+        def work():
+            try:
+                prewarm._import_writers()
+            except Exception:
+                pass
+
+        self._thread = threading.Thread(target=work, name="wormsim-sweep-plot-import", daemon=True)
+        self._thread.start()
+
+    def join(self) -> None:
+        if self._thread is not None:
+            self._thread.join(60.0)
 
 
 def _write_run_dir(path: Path, files: dict[str, bytes], summary: dict) -> None:

@@ -28,6 +28,7 @@ import hashlib
 import itertools
 import json
 import re
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -303,8 +304,10 @@ def _yaml12_numbers(obj):
     return obj
 
 
-def load_sweep(path: str | Path, max_errors: int = 5) -> Sweep:
-    """Read, expand and validate a sweep file; ScenarioError (exit 2) on the first problems found."""
+def load_sweep(path: str | Path, max_errors: int = 5, on_parsed: Callable[[], None] | None = None) -> Sweep:
+    """Read, expand and validate a sweep file; ScenarioError (exit 2) on the first problems found. on_parsed() is
+    called once the file and its base scenario have been read, before the points are validated (`wormsim sweep`
+    starts its cluster there, so the start overlaps the validation)."""
     path = Path(path)
     if not path.is_file():
         raise ScenarioError(f"{path}: no such sweep file")
@@ -334,6 +337,8 @@ def load_sweep(path: str | Path, max_errors: int = 5) -> Sweep:
         raise ScenarioError(f"{path.name}: base = {spec.base}: the top level must be a mapping")
     for p, v in spec.set.items():
         set_path(base, p.split("."), v, f"{path.name}: set.{p}")
+    if on_parsed is not None:
+        on_parsed()
 
     points, errors = [], []
     for i, values in enumerate(expand(spec)):

@@ -225,6 +225,12 @@ class PatternLog:
         while self.m + n > len(self.buf):
             self.buf = np.concatenate([self.buf, np.zeros_like(self.buf)])
 
+    def truncate(self, n: int) -> None:
+        """Drop the rows of samples n and later (a run that ended early: wormsim.locking)."""
+        keep = self.buf[: self.m][self.buf[: self.m, 0] < n]
+        self.buf[: len(keep)] = keep
+        self.m = len(keep)
+
     def table(self) -> np.ndarray:
         """The log as float64 rows (i, sigma, j, f, F_n, p_H, zeta, rho): zeta the slice centre, rho the flank radius
         at the contact's profile position."""

@@ -16,19 +16,23 @@ Seireg, J. Eng. Ind. 93 (1971) 1115):
     sum_i arm_i F_i = T2                                     (the wheel torque; rigid-body balance)
 
 F_i the segment's normal force, g_i the kinematic gap (0 for the perfect pair: conjugate flanks touch along the whole
-line), C_ij the wheel tooth's influence coefficients between segments (wormsim.tooth.compliance, bilinear from its
-flank grid, the same tooth or a neighbour), w_loc the local approach (the worm thread's per-length compliance and
-both bodies' Weber-Banaschek flattening at line load q_i = F_i / ds_i, wormsim.tooth.compliance (1), (2)). The
-flattening is nonlinear in q: (1) is solved with its secant compliance w_loc(q_i) / F_i, FLATTENING_ITERATIONS
-times from the uniform load. Each linear problem is solved by an active set (the loaded segments; the one that
-would pull most is dropped, the one that would penetrate most is added, until neither is left): a dense linear
-system of the loaded segments with the torque row, unknowns F and e. C is not symmetric (the load acts on the flank,
-the displacement is read on the centre line), so this is an LCP rather than a QP.
+line; with assembly errors and pitch deviations, meshgen.displaced.Deviations, the clearance of each segment to the
+displaced worm thread when the first one touches, kinematic_gaps_rad less the perfect pair's at the same points,
+along the nominal contact lines, over the mesh cycle from theta1 = 0), C_ij the wheel tooth's influence coefficients
+between segments (wormsim.tooth.compliance, bilinear from its flank grid, the same tooth or a neighbour), w_loc the
+local approach (the worm thread's per-length compliance and both bodies' Weber-Banaschek flattening at line load
+q_i = F_i / ds_i, wormsim.tooth.compliance (1), (2)). The flattening is nonlinear in q: (1) is solved with its
+secant compliance w_loc(q_i) / F_i, FLATTENING_ITERATIONS times from the uniform load. Each linear problem is solved
+by an active set (the loaded segments; the one that would pull most is dropped, the one that would penetrate most is
+added, until neither is left): a dense linear system of the loaded segments with the torque row, unknowns F and e.
+C is not symmetric (the load acts on the flank, the displacement is read on the centre line), so this is an LCP
+rather than a QP.
 
-Outputs: te_loaded = e(theta1) (rad; the kinematic TE of the perfect pair is 0); the mesh stiffness along the line of
-action k = T2 / (e arm0^2), arm0 = r2 cos(alpha_n) cos(gamma) (wormsim.tooth.mesh_stiffness's convention), at that
-torque (the flattening makes k grow slowly with load); the load share of each tooth (its sum of F_i arm_i over T2);
-the line load q_i and the Hertz pressure p_H = sqrt(q E* / (pi rho')) (wormsim.tooth.hertz) per segment.
+Outputs: te_loaded = e(theta1) plus the kinematic lag to the first touch (rad; 0 for the perfect pair); the mesh
+stiffness along the line of action k = T2 / (e arm0^2) (e from the first touch), arm0 = r2 cos(alpha_n) cos(gamma)
+(wormsim.tooth.mesh_stiffness's convention), at that torque (the flattening makes k grow slowly with load); the load
+share of each tooth (its sum of F_i arm_i over T2); the line load q_i and the Hertz pressure
+p_H = sqrt(q E* / (pi rho')) (wormsim.tooth.hertz) per segment.
 """
 
 from __future__ import annotations
@@ -41,19 +45,22 @@ import numpy as np
 
 from meshgen import wheel
 from meshgen.cache import cached
+from meshgen.displaced import Deviations
 from meshgen.geometry import GearGeometry
 
-CODE_VERSION = "ltca-2"
+CODE_VERSION = "ltca-4"
 SEGMENTS_PER_WIDTH = 24  # contact-line segments per face width
 FLATTENING_ITERATIONS = 6  # secant iterations of the nonlinear flattening
+GAP_PROBE_MX = 0.01  # wheel-angle step (as an arc at r2, in axial modules) of the clearance's closing rate
 MIN_PIECE_WIDTHS = 0.01  # contact-line pieces shorter than this share of b2 are left out
 
 
 @dataclass(frozen=True)
 class Contacts:
-    """The loaded segments at one worm angle (wheel frame, the flank of space k: wormsim.tooth.mesh_stiffness)."""
+    """The loaded segments at one worm angle, in the wheel-fixed frame (meshgen.wheel's: tooth k is tooth 0 turned by
+    2 pi k / z2; the wheel itself stands at theta2 then)."""
 
-    points_m: np.ndarray  # (k, 3)
+    points_m: np.ndarray  # (k, 3) on the flank of space k (wormsim.tooth.mesh_stiffness)
     tooth: np.ndarray  # (k,) space index k
     length_m: np.ndarray  # (k,) ds
     arm_m: np.ndarray  # (k,)
@@ -70,7 +77,7 @@ class LTCAResult:
     te_loaded_rad: np.ndarray  # (N,)
     mesh_stiffness_n_per_m: np.ndarray  # (N,)
     load_share: np.ndarray  # (N, T) per wheel tooth (columns: teeth[] below)
-    teeth: np.ndarray  # (T,) the space index k of each column at theta1 = 0
+    teeth: np.ndarray  # (T,) the wheel-fixed space index k of each column (space k's flank carries)
     teeth_in_contact: np.ndarray  # (N,)
     contacts: tuple  # (N,) Contacts
     arm0_m: float
@@ -116,6 +123,35 @@ def _segments(g: GearGeometry, fld, gen, theta2: float, side: int):
     return [np.concatenate(x) for x in zip(*rows)]
 
 
+def kinematic_gaps_rad(g: GearGeometry, dev, side: int, theta1: float, P: np.ndarray, k: np.ndarray) -> np.ndarray:
+    """Per segment, the wheel rotation (rad, towards flank `side`) that closes its clearance to the displaced worm
+    thread at the conjugate wheel angle (meshgen.kinematic_tca (1) at these points): the field's space-0 point P
+    turned onto space k's flank with the backlash and tooth k's pitch deviation (meshgen.displaced), placed by both
+    mounts, its normal distance d to the thread (meshgen.worm.thread_gap) over its closing rate r = -dd/dtheta2."""
+    from meshgen import assembly, displaced, worm
+
+    pitch = 2 * math.pi / g.z2
+    dj = g.backlash / (2 * g.r2)
+    tooth = k if side > 0 else k - 1  # space k's flank +1 is tooth k's flank a, flank -1 tooth k - 1's flank b
+    rot = k * pitch + (dj if side > 0 else -dj) + dev.tooth_angle_shift(g, tooth)
+    B = np.column_stack(
+        [P[:, 0] * np.cos(rot) - P[:, 1] * np.sin(rot), P[:, 0] * np.sin(rot) + P[:, 1] * np.cos(rot), P[:, 2]]
+    )
+    Mw, Ew = displaced.worm_mount(g, dev)
+    Mg, Eg = displaced.wheel_mount(g, dev)
+    Tw_inv = np.linalg.inv(Mw @ assembly._rz(theta1) @ Ew)
+    th2c = g.hand * theta1 * g.z1 / g.z2
+    h = GAP_PROBE_MX * g.m_x / g.r2
+
+    def gap(th2: float) -> np.ndarray:
+        T = Tw_inv @ Mg @ assembly._rz(th2) @ Eg
+        return worm.thread_gap(g, B @ T[:3, :3].T + T[:3, 3])
+
+    d0 = gap(th2c)
+    rate = (d0 - gap(th2c - side * h)) / h
+    return d0 / rate
+
+
 def _solve(A: np.ndarray, arm: np.ndarray, gap: np.ndarray, torque: float) -> tuple[np.ndarray, float]:
     """The active-set solution of the linear problem (1): (F, e)."""
     n = len(arm)
@@ -145,10 +181,11 @@ def _solve(A: np.ndarray, arm: np.ndarray, gap: np.ndarray, torque: float) -> tu
     return F, e
 
 
-def _at_angle(g, comp, fld, gen, theta2: float, torque: float, side: int, e_star: float):
-    """(F, e, segments, q, p_H) at one wheel angle."""
+def _at_angle(g, comp, fld, gen, theta1: float, torque: float, side: int, e_star: float, dev=None):
+    """(F, e, segments, q, p_H, the kinematic lag to the first touch) at one worm angle."""
     from wormsim.tooth.hertz import curvature_at, hertz_line_pressure_pa
 
+    theta2 = g.hand * theta1 * g.z1 / g.z2
     seg = _segments(g, fld, gen, theta2, side)
     if seg is None:
         raise ValueError("no contact line at this angle")
@@ -163,6 +200,14 @@ def _at_angle(g, comp, fld, gen, theta2: float, torque: float, side: int, e_star
     beta = c + psi  # the assembly angle of the contact (wormsim.tooth.mesh_stiffness (1))
     r_worm = np.hypot(g.a + rho * np.sin(beta), zeta)
     gap = np.zeros(len(arm))
+    first = 0.0
+    if dev is not None:
+        # less the perfect pair's: the points are interpolated onto the contact lines, and the quadratic valley of
+        # the clearance across a line turns their offset into a clearance of its own (screw jack: +-2 urad of
+        # 1333 urad backlash, 7 % of k): the difference keeps only the deviations' part
+        ang = kinematic_gaps_rad(g, dev, side, theta1, P, k) - kinematic_gaps_rad(g, Deviations(), side, theta1, P, k)
+        first = float(ang.min())
+        gap = arm * (ang - first)  # the clearance left when the first point touches, along each normal
     q = np.full(len(arm), torque / float(np.sum(arm * ds)))
     for _ in range(FLATTENING_ITERATIONS):
         w = comp.local_m(q, inv_rho, h_wheel, r_worm)
@@ -170,11 +215,11 @@ def _at_angle(g, comp, fld, gen, theta2: float, torque: float, side: int, e_star
         F, e = _solve(A, arm, gap, torque)
         q = np.maximum(F / ds, 1e-6 * torque / float(np.sum(arm * ds)))
     q = F / ds
-    return F, e, (P, arm, ds, k), q, hertz_line_pressure_pa(q, e_star, inv_rho)
+    return F, e, (P, arm, ds, k), q, hertz_line_pressure_pa(q, e_star, inv_rho), first
 
 
 def compute(
-    g: GearGeometry, materials, torque_nm: float, samples: int, side: int, density: int, comp=None
+    g: GearGeometry, materials, torque_nm: float, samples: int, side: int, density: int, comp=None, dev=None
 ) -> LTCAResult:
     """(1) at `samples` worm angles over one mesh cycle (module docstring); comp: a ToothCompliance to use instead of
     tooth_compliance(g, materials, density) (for studies of its parts)."""
@@ -191,21 +236,24 @@ def compute(
     period = 2 * math.pi / g.z1
     th1 = np.arange(samples) * period / samples
     arm0 = g.r2 * math.cos(g.alpha_n) * math.cos(g.gamma)
-    te, shares, contacts, n_teeth = [], [], [], []
+    te, te_kin, shares, contacts, n_teeth = [], [], [], [], []
     for t1 in th1:
-        theta2 = g.hand * t1 * g.z1 / g.z2
-        F, e, (P, arm, ds, k), q, p = _at_angle(g, comp, fld, gen, theta2, torque_nm, side, e_star)
+        F, e, (P, arm, ds, k), q, p, first = _at_angle(g, comp, fld, gen, t1, torque_nm, side, e_star, dev)
         te.append(e)
-        # the tooth of space k at theta1 is the tooth of space k + n at theta1 + n periods: label by k at theta1 = 0
+        te_kin.append(first)
         share = {int(kk): float(np.sum((F * arm)[k == kk]) / torque_nm) for kk in np.unique(k)}
         shares.append(share)
         n_teeth.append(sum(1 for v in share.values() if v > 0))
-        contacts.append(Contacts(P, k, ds, arm, q, p))
+        turn = k * 2 * math.pi / g.z2  # the field's space-0 point -> the same point of space k
+        Pk = np.stack(
+            [P[:, 0] * np.cos(turn) - P[:, 1] * np.sin(turn), P[:, 0] * np.sin(turn) + P[:, 1] * np.cos(turn)]
+        )
+        contacts.append(Contacts(np.column_stack([Pk.T, P[:, 2]]), k, ds, arm, q, p))
     teeth = np.array(sorted({kk for sh in shares for kk in sh}))
     load_share = np.array([[sh.get(int(kk), 0.0) for kk in teeth] for sh in shares])
     te_arr = np.array(te)
     return LTCAResult(
-        theta1_rad=th1, torque_nm=float(torque_nm), te_loaded_rad=te_arr,
+        theta1_rad=th1, torque_nm=float(torque_nm), te_loaded_rad=te_arr + np.array(te_kin),
         mesh_stiffness_n_per_m=torque_nm / te_arr / arm0**2, load_share=load_share, teeth=teeth,
         teeth_in_contact=np.array(n_teeth), contacts=tuple(contacts), arm0_m=arm0, side=side,
         face_width_m=g.face_width,
@@ -213,7 +261,7 @@ def compute(
 
 
 @functools.lru_cache(maxsize=32)
-def _loaded_contact(g, moduli, materials, torque_nm, samples, side, density) -> LTCAResult:
+def _loaded_contact(g, moduli, materials, torque_nm, samples, side, density, dev) -> LTCAResult:
     from wormsim.tooth import compliance
 
     parts = {
@@ -223,21 +271,23 @@ def _loaded_contact(g, moduli, materials, torque_nm, samples, side, density) -> 
         "n": samples,
         "side": side,
         "density": density,
+        "dev": None if dev is None else asdict(dev),
         "v": (CODE_VERSION, compliance.CODE_VERSION, SEGMENTS_PER_WIDTH, FLATTENING_ITERATIONS),
     }
-    return cached("ltca", parts, lambda: compute(g, materials, torque_nm, samples, side, density))
+    return cached("ltca", parts, lambda: compute(g, materials, torque_nm, samples, side, density, dev=dev))
 
 
 def loaded_contact(
     g: GearGeometry, materials, torque_nm: float, samples: int = 16, deviations=None, side: int = 1, density: int = 1
 ) -> LTCAResult:
     """compute(), cached in process and on disk (meshgen.cache). torque_nm: the wheel torque (its magnitude);
-    side: the loaded flank (+1 forward drive, wormsim.tooth.mesh_stiffness). deviations: not modelled yet (the
-    perfect pair's kinematic gaps, 0); anything but None is refused."""
+    side: the loaded flank (+1 forward drive, wormsim.tooth.mesh_stiffness). deviations: a
+    meshgen.displaced.Deviations (assembly errors, pitch deviations), or None for the perfect pair (gaps 0)."""
     from wormsim.tooth.compliance import _Frozen, _moduli
 
-    if deviations is not None:
-        raise NotImplementedError("loaded_contact: assembly deviations are not in the LTCA yet (kinematic gaps 0)")
+    dev = None if deviations is None or deviations.is_zero() else deviations
     if not torque_nm:
         raise ValueError("loaded_contact: torque_nm must be non-zero")
-    return _loaded_contact(g, _moduli(materials), _Frozen(materials), abs(float(torque_nm)), samples, side, density)
+    return _loaded_contact(
+        g, _moduli(materials), _Frozen(materials), abs(float(torque_nm)), samples, side, density, dev
+    )

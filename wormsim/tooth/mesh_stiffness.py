@@ -206,7 +206,7 @@ def compute(g: GearGeometry, stiffness_per_length: float, source: str, samples: 
             t2 = g.hand * t1 * g.z1 / g.z2
             I[n], L[n], T[n] = _lines_at(fld, gen, t2, pitch2)
         out[tag] = (stiffness_per_length * I, L, T)
-    arm0 = g.r2 * math.cos(g.alpha_n) * math.cos(g.gamma)
+    arm0 = g.r2 * math.cos(g.alpha_n) * math.cos(g.gamma_m)
     return MeshStiffness(
         theta1_rad=th1,
         period_rad=period,

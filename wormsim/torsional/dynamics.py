@@ -66,7 +66,7 @@ follows the motion and the quasi-static mesh force at steps of one k(theta) samp
 (default_timestep) and damps the kHz modes. scipy solve_ivp (LSODA, BDF, Radau; `simulate(..., method=)`)
 resolves them and serves as the accuracy reference; it is 20-500x slower (docs/torsional.md).
 Summary keys and their computation: those of contact3d (wormsim.metrics: steady window, FFT peak), except
-that mesh_frequency_hz is the FFT peak of the transmission error, not of the tangential force (see
+that mesh_frequency_hz is the meshing line of the transmission error, not of the tangential force (see
 torsional_summary; the force's peak is reported as force_peak_full_band_hz).
 """
 
@@ -83,7 +83,8 @@ from wormsim import gear_theory as gt
 from wormsim.errors import DivergedError, LockedError, PenetrationError, SimulationError
 from wormsim.friction import friction_coefficient, friction_coefficient_scalar, friction_mode
 from wormsim.geometry import derive, displaced_pair
-from wormsim.metrics import dominant_frequency, drive_summary, mean_speeds_rpm, window_of
+from wormsim.locking import Held, backdrive_self_locks, held_keys, run_keys
+from wormsim.metrics import dominant_frequency, drive_summary, mean_speeds_rpm, mesh_line_keys, window_of
 from wormsim.result import Result
 from wormsim.scenario import Scenario
 from wormsim.tooth.mesh_stiffness import MeshStiffness, mesh_stiffness, per_length_stiffness
@@ -237,10 +238,10 @@ class _Mesh:
         """(T2m, T1m): the worm's torque through the wedge law (module docstring)."""
         side = 1.0 if T2m > 0.0 else -1.0
         g = self.g
-        vs = w1 * g.r1 / math.cos(g.gamma)
+        vs = w1 * g.r_m1 / math.cos(g.gamma_m)  # at the worm's operating radius (r1 unshifted)
         rho = gt.virtual_friction_angle_rad(self.mu(vs), g.alpha_n)
         s = side * g.hand * math.tanh(vs / self.v_sign)
-        return T2m, gt.worm_torque_nm(T2m, g.hand, g.r1, g.r2, g.gamma, s * rho)
+        return T2m, gt.worm_torque_nm(T2m, g.hand, g.r_m1, g.r2, g.gamma_m, s * rho)
 
     def outputs(self, th1, w1, th2, w2) -> dict:
         """Vectorised over samples: forces on the wheel and the mesh state."""
@@ -250,7 +251,7 @@ class _Mesh:
         for i in range(n):
             T2m[i], T1m[i] = self.torques(th1[i], w1[i], th2[i], w2[i])
         e = self.hz * th1 - th2
-        vs = w1 * g.r1 / math.cos(g.gamma)
+        vs = w1 * g.r_m1 / math.cos(g.gamma_m)
         mu = np.array([self.mu(float(v)) for v in vs])
         rho = gt.virtual_friction_angle_rad(mu, g.alpha_n)
         s = np.sign(T2m) * g.hand * np.tanh(vs / self.v_sign)
@@ -274,8 +275,8 @@ class _Mesh:
             deflection = self.arm0 * np.maximum(np.maximum(e - gf, -e - gr), 0.0)
         return {
             "tangential_force_n": ft,
-            "axial_force_n": gt.axial_force_n(ft, g.gamma, s * rho),
-            "radial_force_n": gt.radial_force_n(np.abs(ft), g.alpha_n, g.gamma, s * rho),
+            "axial_force_n": gt.axial_force_n(ft, g.gamma_m, s * rho),
+            "radial_force_n": gt.radial_force_n(np.abs(ft), g.alpha_n, g.gamma_m, s * rho),
             "mesh_torque_worm_nm": T1m,
             "friction_coefficient": mu,
             "transmission_error_rad": -e,
@@ -424,7 +425,7 @@ def simulate(scenario: Scenario, progress=None, method: str = "implicit") -> Res
     cmds = gt.commands(scenario, g.hand)
     speed_driven = drv.speed_rpm is not None
     kv = (
-        gt.servo_gain_nm_s(scenario, g.ratio, g.gamma, g.alpha_n, float(friction_coefficient(scenario.contact, 1.0)))
+        gt.servo_gain_nm_s(scenario, g.ratio, g.gamma_m, g.alpha_n, float(friction_coefficient(scenario.contact, 1.0)))
         if speed_driven
         else 0.0
     )
@@ -465,7 +466,11 @@ def simulate(scenario: Scenario, progress=None, method: str = "implicit") -> Res
         raise DivergedError(f"torsional integration diverged (timestep {h:.3g} s); lower simulation.timestep_s")
     out = mesh.outputs(th1, w1, th2, w2)
     cmd = np.array([drive_f(x) for x in t])
-    _guards(scenario, g, t, w1, w2, out, cmd)
+    held = _guards(scenario, g, t, w1, w2, out, cmd)
+    if held is not None:  # a self-locking pair held the back-driving wheel: the run ends there (wormsim.locking)
+        n = int(np.searchsorted(t, held.t_s, side="right"))
+        t, th1, w1, th2, w2, cmd = t[:n], th1[:n], w1[:n], th2[:n], w2[:n], cmd[:n]
+        out = {k: v[:n] for k, v in out.items()}
     tq = np.array([shaft_torques(ti, a, b) for ti, a, b in zip(t, w1, w2)])
     S = {
         "t_s": t,
@@ -488,6 +493,11 @@ def simulate(scenario: Scenario, progress=None, method: str = "implicit") -> Res
         **out,
     }
     summary = torsional_summary(S, scenario, g, ms)
+    summary.update(
+        run_keys(scenario, g, t, S["worm_speed_rpm"])
+        if held is None
+        else held_keys(t, S["worm_speed_rpm"], S["wheel_torque_nm"], held.stuck_since_s or held.t_s)
+    )
     summary.update(
         {
             "scenario": scenario.name,
@@ -529,33 +539,46 @@ def simulate(scenario: Scenario, progress=None, method: str = "implicit") -> Res
     )
 
 
-def _guards(scenario, g, t, w1, w2, out, cmd) -> None:
+def _guards(scenario, g, t, w1, w2, out, cmd) -> Held | None:
     """Teeth would skip (deflection past 0.4 m_x, gear_theory.penetration_limit_m, contact3d's penetration limit);
-    a speed-driven drive stuck below half its command for 0.05 s after the ramps (locked: self-locking back-drive
-    or jam; gear_theory's lock constants)."""
+    a speed-driven drive stuck below half its command for 0.05 s after the ramps (locked: a jam, LockedError; or a
+    wheel back-driving a self-locking pair: returned as Held, the run's result, wormsim.locking). The deflection is
+    checked up to the end of the run (the hold when held)."""
     drv = scenario.drive
+    held = None
     if drv.speed_rpm is not None:
-        _locked_guard(scenario, t, w1, w2, cmd)
-    dmax = float(np.max(out["mesh_deflection_m"]))
+        held = _locked_guard(scenario, g, t, w1, w2, cmd)
+    n = len(t) if held is None else int(np.searchsorted(t, held.t_s, side="right"))
+    dmax = float(np.max(out["mesh_deflection_m"][:n]))
     lim = gt.penetration_limit_m(g.m_x)
     if dmax > lim:
         i = int(np.argmax(out["mesh_deflection_m"] > lim))
         why = "raise contact.stiffness_n_per_m or lower load.torque_nm"
-        vs = abs(float(w1[i])) * g.r1 / math.cos(g.gamma)
-        if drv.on == "wheel" and vs < 10 * scenario.contact.transition_velocity_m_s:
+        vs = abs(float(w1[i])) * g.r_m1 / math.cos(g.gamma_m)
+        creeping = drv.on == "wheel" and vs < 10 * scenario.contact.transition_velocity_m_s
+        if creeping and i > 0 and backdrive_self_locks(scenario, g.gamma_m, g.alpha_n):
+            return Held(float(t[i - 1]), _stuck_since(scenario, t, w2, cmd))  # the stalled wheel's servo pushed on
+        if creeping:
             rho = gt.virtual_friction_angle_rad(float(out["friction_coefficient"][i]), g.alpha_n)
             why = (
                 f"the pair is self-locking (rho' = {math.degrees(rho):.2f} deg > "
-                f"gamma = {math.degrees(g.gamma):.2f} "
+                f"gamma = {math.degrees(g.gamma_m):.2f} "
                 f"deg): the wheel cannot drive the worm, which creeps at Vs = {vs * 1e3:.2g} mm/s"
             )
         raise PenetrationError(
             f"mesh deflection {dmax * 1e6:.1f} um at t = {t[i]:.4g} s exceeds 0.4 m_x = {lim * 1e6:.1f} um: "
             f"the teeth would skip; {why}"
         )
+    return held
 
 
-def _locked_guard(scenario, t, w1, w2, cmd) -> None:
+def _stuck_since(scenario, t, w_drive, cmd) -> float | None:
+    """The first time after the lock check's start at which the speed-driven drive is stuck (None: never)."""
+    bad = (t > gt.lock_check_start_s(scenario)) & gt.drive_stuck(w_drive, cmd)
+    return float(t[int(np.argmax(bad))]) if bad.any() else None
+
+
+def _locked_guard(scenario, g, t, w1, w2, cmd) -> Held | None:
     w_drive = w1 if scenario.drive.on == "worm" else w2
     bad = (t > gt.lock_check_start_s(scenario)) & gt.drive_stuck(w_drive, cmd)
     if bad.any():
@@ -563,29 +586,31 @@ def _locked_guard(scenario, t, w1, w2, cmd) -> None:
         run = np.nonzero(~bad[i0:])[0]
         i1 = i0 + (int(run[0]) if len(run) else len(bad) - i0) - 1
         if t[i1] - t[i0] >= gt.LOCK_HOLD_S or (not len(run) and t[-1] - t[i0] > 0):
+            if backdrive_self_locks(scenario, g.gamma_m, g.alpha_n):  # the answer, not a failure (wormsim.locking)
+                i_end = int(np.searchsorted(t, t[i0] + gt.LOCK_HOLD_S))
+                return Held(float(t[min(i_end, i1)]), float(t[i0]))
             raise LockedError(
                 f"the drive locked at t = {t[i0]:.4g} s: {rad_s_to_rpm(float(w_drive[i0])):.3g} rpm against a "
                 f"command of {rad_s_to_rpm(float(cmd[i0])):.3g} rpm (self-locking: the wheel cannot drive the worm "
                 f"when rho' > gamma; or the load {scenario.load.torque_nm} N m is too high)"
             )
+    return None
 
 
 def torsional_summary(S: dict, scenario: Scenario, g: GearGeometry, ms: MeshStiffness) -> dict:
     """contact3d's summary keys, computed by the same functions (wormsim.metrics), with one difference:
-    the meshing frequency is the FFT peak of the transmission error. The mesh force element's tangential
-    force is quasi-static: its fluctuation is the inertial part, the 2nd time derivative of the
+    the meshing line is taken from the transmission error (wormsim.metrics.mesh_line). The mesh force element's
+    tangential force is quasi-static: its fluctuation is the inertial part, the 2nd time derivative of the
     transmission error, which weights the harmonics of k(theta)'s tooth-entry kinks by n^2 and puts the
     force's peak on a harmonic (reported as force_peak_full_band_hz)."""
     t = S["t_s"]
     i0, i1, _ = window_of(S, scenario, g)
     sl = slice(i0, i1)
     n1, n2 = mean_speeds_rpm(S, i0, i1)
-    f_peak, df, _, _ = dominant_frequency(t[sl], S["transmission_error_rad"][sl])
     f_force, _, _, _ = dominant_frequency(t[sl], S["tangential_force_n"][sl])
     return {
         **drive_summary(S, scenario, g, i0, i1, n1, n2),
-        "mesh_frequency_hz": f_peak,
-        "mesh_frequency_resolution_hz": df,
+        **mesh_line_keys(t, S, sl, g.z1 * n1 / 60.0, "transmission_error_rad"),
         "mesh_frequency_source": "transmission error",
         "force_peak_full_band_hz": f_force,
         "mesh_deflection_mean_um": float(np.mean(S["mesh_deflection_m"][sl]) * 1e6),

@@ -44,9 +44,10 @@ def params_from_gear(scenario) -> tuple[WedgeParams, dict]:
     """(WedgeParams, what was derived: summary keys) of a gear scenario (module docstring)."""
     g = derive(scenario.gear)
     I1, I2 = gt.shaft_inertias_kg_m2(scenario, g.r1, g.worm_length, g.r2, g.face_width)
-    m1, m2 = I1 / g.r1**2, I2 / g.r2**2
-    gamma, tg = g.gamma, math.tan(g.gamma)
-    v = rpm_to_rad_s(scenario.drive.speed_rpm) * g.r1
+    # the worm meshes at its operating radius r_m1 and lead angle gamma_m (r1, gamma unshifted; DIN 3975-1)
+    m1, m2 = I1 / g.r_m1**2, I2 / g.r2**2
+    gamma, tg = g.gamma_m, math.tan(g.gamma_m)
+    v = rpm_to_rad_s(scenario.drive.speed_rpm) * g.r_m1
     mu = float(friction_coefficient(scenario.contact, v / math.cos(gamma)))
     rho = gt.virtual_friction_angle_rad(mu, g.alpha_n)
     F2 = -scenario.load.torque_nm / g.r2
@@ -104,8 +105,8 @@ def simulate_derived(scenario, progress=None) -> Result:
     ft = -S["S2_n"]
     S["tangential_force_n"] = ft
     S["axial_force_n"] = S["S1_n"]
-    S["radial_force_n"] = gt.radial_force_n(np.abs(ft), g.alpha_n, g.gamma, s * rho)
-    S["worm_speed_rpm"] = rad_s_to_rpm(S["v1_m_s"] / g.r1)
+    S["radial_force_n"] = gt.radial_force_n(np.abs(ft), g.alpha_n, g.gamma_m, s * rho)
+    S["worm_speed_rpm"] = rad_s_to_rpm(S["v1_m_s"] / g.r_m1)
     S["wheel_speed_rpm"] = rad_s_to_rpm(S["v2_m_s"] / g.r2)
     S["friction_coefficient"] = np.tan(rho) * p.cos_alpha_n
 
@@ -129,12 +130,12 @@ def simulate_derived(scenario, progress=None) -> Result:
             "tangential_force_theory_n": gt.tangential_force_n(abs(T_load), g.r2),
             "radial_force_mean_n": abs(mean(S["radial_force_n"])),
             "axial_force_mean_n": abs(mean(S["axial_force_n"])),
-            "worm_torque_mean_nm": abs(mean(S["F1_n"])) * g.r1,
+            "worm_torque_mean_nm": abs(mean(S["F1_n"])) * g.r_m1,
             "wheel_torque_mean_nm": abs(mean(S["F2_n"])) * g.r2,
             "worm_speed_mean_rpm": n1,
             "wheel_speed_mean_rpm": n2,
             "efficiency": p_out / p_in if p_in > 0 else float("nan"),
-            "efficiency_theory": gt.efficiency_theory(g.gamma, g.alpha_n, mu),
+            "efficiency_theory": gt.efficiency_theory(g.gamma_m, g.alpha_n, mu),
             "friction_coefficient_mean": mu,
             "friction": friction_mode(scenario.contact),
             **d,

@@ -1,0 +1,94 @@
+"""Is the default slice count converged? (issue 31, item 2; docs/contact3d.md, "Default slice count"): each case at
+its default `contact.slices` (wormsim.tooth.grid.default_slices) and at twice that, F_t p2p over the steady window
+(whole and below 1 kHz, the meshing band) and the largest Hertz pressure p_H max, and their change from S to 2 S.
+The cases: the variety gears (tests/test_contact3d_variety.py FLANK_GEARS), three random gears
+(tests/test_contact3d_random_forces.py) and the seeds' CI runs with flanks (tests/test_contact3d_seeds.py CI).
+Writes docs/data/slice_convergence_default.json after each case (a long sweep can be cut).
+
+    .venv/bin/python sweeps/slice_convergence_default.py [--cases left-ZA random0 screw_jack ...] [--medium]
+        [--record NAME]
+
+--medium runs the variety and random gears at simulation.resolution medium (the default resolution; their test
+configurations are coarse, 8 slices).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "tests"))
+
+from conftest import SCENARIOS  # noqa: E402
+from test_contact3d_random_forces import GEARS, _scenario  # noqa: E402
+from test_contact3d_seeds import CI  # noqa: E402
+from test_contact3d_variety import FAST, FLANK_GEARS, GEAR  # noqa: E402
+
+from wormsim.contact3d.mjcf import flank_slices  # noqa: E402
+from wormsim.contact3d.runner import simulate  # noqa: E402
+from wormsim.metrics import p2p_below  # noqa: E402
+from wormsim.provenance import record  # noqa: E402
+from wormsim.scenario import Scenario, load_scenario  # noqa: E402
+
+BAND_HZ = 1000.0  # F_t's meshing band (sweeps/slice_convergence.py)
+CASES = [*FLANK_GEARS, *(f"random{i}" for i in range(len(GEARS))), "screw_jack", "involute_41", "seat_motor"]
+
+
+def scenario(name: str, slices: int | None, medium: bool = False) -> Scenario:
+    extra = [] if slices is None else [f"contact.slices={slices}"]
+    if name in CI:
+        return load_scenario(SCENARIOS / f"{name}.yaml", [*CI[name], "contact.geometry=flanks", *extra])
+    if name.startswith("random"):
+        d = _scenario(GEARS[int(name[6:])]).model_dump()
+        if medium:
+            d["simulation"]["resolution"] = "medium"
+        if slices is not None:
+            d["contact"]["slices"] = slices
+        return Scenario.model_validate(d)
+    res = ["simulation.resolution=medium"] if medium else []
+    return load_scenario(GEAR, [*FAST, *FLANK_GEARS[name], *res, *extra])
+
+
+def measure(sc: Scenario) -> dict:
+    t0 = time.perf_counter()
+    res = simulate(sc)
+    r, S = res.summary, res.series
+    t = S["t_s"]
+    m = (t >= r["steady_window_s"][0]) & (t <= r["steady_window_s"][1])
+    return {
+        "slices": r["flank_slices"],
+        "ft_p2p_n": r["tangential_force_p2p_n"],
+        "ft_p2p_band_n": float(p2p_below(t[m], S["tangential_force_n"][m], BAND_HZ)),
+        "ph_max_mpa": r.get("contact_pressure_max_mpa"),
+        "ft_mean_n": r["tangential_force_mean_n"],
+        "wall_s": time.perf_counter() - t0,
+    }
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--cases", nargs="+", default=CASES)
+    ap.add_argument("--medium", action="store_true")
+    ap.add_argument("--record", default="slice_convergence_default")
+    a = ap.parse_args()
+    out: dict = {"band_hz": BAND_HZ, "medium": a.medium, "cases": {}}
+    for name in a.cases:
+        s0 = flank_slices(scenario(name, None, a.medium))
+        runs = [measure(scenario(name, s, a.medium)) for s in (s0, 2 * s0)]
+        ch = {
+            k: (runs[0][k] / runs[1][k] - 1) if runs[1][k] else None
+            for k in ("ft_p2p_n", "ft_p2p_band_n", "ph_max_mpa")
+        }
+        out["cases"][name] = {"default_slices": s0, "runs": runs, "change_default_vs_double": ch}
+        print(name, s0, {k: None if v is None else round(100 * v, 1) for k, v in ch.items()}, flush=True)
+        record(a.record, out)
+
+
+if __name__ == "__main__":
+    np.seterr(all="ignore")
+    main()

@@ -1,0 +1,62 @@
+"""`wormsim sweep` with several points per task (wormsim.sweep.runner.chunk_size): every point a row of its own with
+its own timing, the same rows as one point per task; and the cluster started while the points are validated
+(an invalid point still exits 2)."""
+
+from __future__ import annotations
+
+import csv
+import json
+from pathlib import Path
+
+import pytest
+
+from wormsim import cli
+from wormsim.sweep import load_sweep, run_sweep
+from wormsim.sweep.runner import MAX_CHUNK, chunk_size
+
+ROOT = Path(__file__).resolve().parents[1]
+SWEEP = """name: chunks
+base: {base}
+set: {{model: torsional, simulation.duration_s: 0.01}}
+grid:
+  load.torque_nm: {{linspace: [4, 12, {n}]}}
+"""
+
+
+@pytest.fixture(autouse=True)
+def _quiet(monkeypatch):
+    monkeypatch.delenv("DASK_SCHEDULER_ADDRESS", raising=False)
+    monkeypatch.setenv("WORMSIM_NO_PROGRESS", "1")
+
+
+def test_chunk_size():
+    assert chunk_size(3, 2) == 1 and chunk_size(15, 2) == 1  # fewer than 8 points per thread: one per task
+    assert chunk_size(16, 2) == 2 and chunk_size(16, 1) == 4 and chunk_size(1000, 4) == MAX_CHUNK
+    assert chunk_size(16, 16) == 1
+
+
+@pytest.mark.long
+def test_points_in_chunks_are_rows_of_their_own(tmp_path):
+    f = tmp_path / "s.yaml"
+    f.write_text(SWEEP.format(base=ROOT / "scenarios" / "screw_jack.yaml", n=8))
+    res = run_sweep(load_sweep(f), tmp_path / "o", workers=1, progress=False)
+    assert res["ok"] == 8 and res["cluster"]["points_per_task"] == 2
+    with (tmp_path / "o" / "sweep.csv").open(newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    assert [int(r["point"]) for r in rows] == list(range(8)) and {r["status"] for r in rows} == {"ok"}
+    # each row is its own point's: the mean tangential force rises with the load torque, point by point
+    forces = [float(r["tangential_force_mean_n"]) for r in rows]
+    assert all(b > a for a, b in zip(forces, forces[1:])), forces
+    doc = json.loads((tmp_path / "o" / "sweep.json").read_text())
+    tim = [p["timing"] for p in doc["points"]]
+    assert all(t["end"] >= t["start"] for t in tim)
+    assert len({t["submitted"] for t in tim}) == 4  # 4 tasks of 2 points
+    assert all("compile_s" in t and "jit_misses" in t for t in tim)
+
+
+@pytest.mark.long
+def test_an_invalid_point_exits_2_with_the_cluster_started(tmp_path, capsys):
+    f = tmp_path / "s.yaml"
+    f.write_text(SWEEP.format(base=ROOT / "scenarios" / "screw_jack.yaml", n=2) + "  gear.wheel_teeth: [30, 5]\n")
+    code = cli.main(["sweep", str(f), "--out", str(tmp_path / "o"), "--workers", "1"])
+    assert code == 2 and "gear.wheel_teeth = 5" in capsys.readouterr().err

@@ -1,0 +1,36 @@
+"""The sweep's worker plugin: each dask worker loads the compiled contact3d kernels before its first point.
+
+`WarmKernels.setup` runs on every worker that joins (distributed's WorkerPlugin, registered by the sweep when its
+points include contact3d runs) in a thread of the worker, so the worker's event loop keeps answering the scheduler:
+wormsim.jit_cache.ensure_warm (the machine's first worker compiles, holding the cache's lock; the others wait for it
+and load), then one short run (jit_cache.WARM_RUNS' first, WARM_STEPS steps) that loads every compiled function,
+numba's start-up and the imports into the worker process. A worker's first point then costs what its others cost.
+A failure is dropped: the point compiles or loads for itself.
+"""
+
+from __future__ import annotations
+
+import asyncio
+
+from distributed.diagnostics.plugin import WorkerPlugin
+
+
+def warm_worker() -> dict:
+    """ensure_warm and the short run in this process; returns {"compiled": bool, "error": str | None}."""
+    from wormsim import jit_cache
+
+    try:
+        compiled = jit_cache.ensure_warm()
+        jit_cache.warm_runs(jit_cache.WARM_RUNS[:1])
+    except Exception as exc:  # (the points compile or load for themselves)
+        return {"compiled": False, "error": f"{exc.__class__.__name__}: {exc}"}
+    return {"compiled": compiled, "error": None}
+
+
+class WarmKernels(WorkerPlugin):
+    """Loads (or, first on a machine, compiles) the contact3d kernels when a worker starts (module docstring)."""
+
+    name = "wormsim-warm-kernels"
+
+    async def setup(self, worker) -> None:
+        await asyncio.get_running_loop().run_in_executor(None, warm_worker)
