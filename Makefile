@@ -16,6 +16,9 @@ $(STAMP): pyproject.toml
 	$(BIN)/python -m pip install --quiet --upgrade pip
 	$(BIN)/python -m pip install --quiet -e '.[test]'
 	$(BIN)/python -c 'import sys, wormsim.jit_cache as j; sys.exit(j.main())'
+	@# CalculiX (the FE contact check, wormsim.tooth.calculix): Debian's calculix-ccx, installed when missing and root
+	command -v ccx >/dev/null 2>&1 || { [ "$$(id -u)" = 0 ] && apt-get update -qq && apt-get install -y -qq calculix-ccx; } \
+	  || echo "note: CalculiX (ccx) not installed (not root?): apt-get install calculix-ccx; its tests skip without it"
 	touch $(STAMP)
 
 install: $(STAMP)

@@ -947,6 +947,75 @@ def rating_seeds_table(name: str = "rating_seeds") -> str:
     return _table(head, rows) + "\n" + _source(name)
 
 
+def _shares(d) -> str:
+    """Load shares, largest first, as 'a / b / c'."""
+    vals = sorted(d.values() if isinstance(d, dict) else d, reverse=True)
+    return " / ".join(f"{v:.2f}" for v in vals if v > 0.005) or "-"
+
+
+def calculix_check_table(name: str = "calculix_check") -> str:
+    """The CalculiX contact check (sweeps/calculix_check.py): per gear and worm angle the CalculiX mesh stiffness and
+    load shares beside the LTCA's, the mean per gear with ISO 6336-1's c' and c_gamma, the root stress beside
+    `wormsim rate --fe`'s."""
+    rec = load(name)
+    rows = []
+    for gear, d in rec["gears"].items():
+        lt = d["ltca"]
+        la = lt["angles"] if lt.get("available") else [None] * len(d["calculix"])
+        for c, a in zip(d["calculix"], la):
+            rows.append(
+                [
+                    gear,
+                    f"{c['theta1_deg']:.1f}",
+                    f"{c['torque_nm']:.3g}",
+                    f"{c['mesh_stiffness_n_per_m']:.3g}",
+                    f"{a['mesh_stiffness_n_per_m']:.3g}" if a else "-",
+                    _shares(c["load_share"]),
+                    _shares(a["load_share"]) if a else "-",
+                    f"{c['torque_balance']:+.0e}",
+                    _fmt(c.get("root_stress_max_mpa")),
+                ]
+            )
+        m, iso = d["calculix_mean"], d["iso6336"]
+        cmp = d.get("comparison", {})
+        ratio = cmp.get("mesh_stiffness_ratio_calculix_to_ltca")
+        rows.append(
+            [
+                f"**{gear} mean**",
+                "-",
+                f"{m['torque_nm']:.3g}",
+                f"**{m['mesh_stiffness_mean_n_per_m']:.3g}** ({m['mesh_stiffness_per_width_n_per_mm_um']:.3g} "
+                f"N/(mm um); ISO c' {iso['c_prime']:.3g}, c_gamma {iso['c_gamma']:.3g})",
+                (
+                    f"**{cmp['ltca_mesh_stiffness_mean_at_angles_n_per_m']:.3g}** (CalculiX / LTCA {ratio:.3f}; "
+                    f"12 samples: {lt['summary']['mesh_stiffness_mean_n_per_m']:.3g})"
+                    if lt.get("available") and ratio is not None
+                    else "LTCA not available"
+                ),  # fmt: skip
+                f"max {m['load_share_max']:.2f}",
+                (f"max diff {cmp['load_share_max_difference']:.3f}" if "load_share_max_difference" in cmp else "-"),
+                f"max {m['torque_balance_max']:.0e}",
+                f"{_fmt(m['root_stress_max_mpa_at_scenario_torque'])} at {d['torque_scenario_nm']:.3g} N m "
+                f"(rate --fe: {_fmt(d['fe_root']['root_stress_max_mpa'])})",
+            ]
+        )
+    head = ["gear", "theta1 [deg]", "T2 [N m]", "k CalculiX [N/m]", "k LTCA [N/m]", "shares CalculiX",
+            "shares LTCA", "torque balance (rel.)", "root stress [MPa]"]  # fmt: skip
+    conv = rec.get("convergence")
+    note = ""
+    if conv:
+        c, f = conv["coarse"], conv["fine"]
+        note = (
+            f"\nh-refinement ({conv['gear']}, theta1 {conv['theta1_deg']:.0f} deg): element size at the contact lines "
+            f"{c['h_fine_mm']:.3g} -> {f['h_fine_mm']:.3g} mm ({c['nodes']} -> {f['nodes']} nodes): k "
+            f"{c['mesh_stiffness_n_per_m']:.3g} -> {f['mesh_stiffness_n_per_m']:.3g} N/m "
+            f"({conv['mesh_stiffness_change'] * 100:+.1f} %), shares {_shares(c['load_share'])} -> "
+            f"{_shares(f['load_share'])}, root stress {_fmt(c['root_stress_max_mpa'])} -> "
+            f"{_fmt(f['root_stress_max_mpa'])} MPa.\n"
+        )
+    return _table(head, rows) + note + "\n" + _source(name)
+
+
 def rexs_stages_table(name: str = "rexs_stages") -> str:
     """The REXS stages at every level beside F_t2 = T2 / (d2 / 2) (sweeps/rexs_stages.py)."""
     rows = []
@@ -994,6 +1063,7 @@ def rexs_rating_table(name: str = "rexs_stages") -> str:
 
 
 TABLES: dict[str, Callable[[], str]] = {
+    "calculix_check": calculix_check_table,
     "torsional_seeds": torsional_seeds_table,
     "rexs_stages": rexs_stages_table,
     "rexs_rating": rexs_rating_table,
