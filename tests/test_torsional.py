@@ -204,7 +204,7 @@ def test_speed_driven_wheel_of_self_locking_pair_fails_with_a_diagnosis():
 def _ms(name, samples=32):
     sc = scen(name)
     g = derive(sc.gear)
-    kp, src = M.per_length_stiffness(sc.contact.stiffness_n_per_m, g.face_width, effective_modulus_pa(sc.materials))
+    kp, src = M.per_length_stiffness(sc.contact, g, sc.materials)
     return g, kp, src, M.compute(g, kp, src, samples)
 
 

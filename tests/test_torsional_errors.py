@@ -29,7 +29,7 @@ CONTACT3D = {
 def _pair(name: str, sets=()):
     sc = load_scenario(SCEN / f"{name}.yaml", ["model=torsional", *sets])
     g = derive(sc.gear)
-    kp, src = per_length_stiffness(sc.contact.stiffness_n_per_m, g.face_width, gt.effective_modulus_pa(sc.materials))
+    kp, src = per_length_stiffness(sc.contact, g, sc.materials)
     return sc, g, kp, src
 
 

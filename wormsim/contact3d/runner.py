@@ -159,6 +159,23 @@ def force_signs(S: dict, hand: int) -> None:
     S["axial_force_n"] *= -float(hand)
 
 
+def _stiffness_outputs(scenario: Scenario, bm: BuiltModel) -> dict:
+    """wormsim.tooth.mesh_stiffness.stiffness_outputs with the law's k' (K = k' b2): the same keys as torsional's, from
+    the TCA table at the default sample count (simulation.mesh_stiffness_samples is torsional's)."""
+    from wormsim import gear_theory as gt
+    from wormsim.geometry import displaced_pair
+    from wormsim.scenario import Simulation
+    from wormsim.tooth.mesh_stiffness import mesh_stiffness, per_length_stiffness, stiffness_outputs
+
+    g = bm.geometry
+    kp, source = per_length_stiffness(scenario.contact, g, scenario.materials)
+    ms = mesh_stiffness(g, kp, source, Simulation.model_fields["mesh_stiffness_samples"].default)
+    pair = displaced_pair(scenario.errors, g)
+    return stiffness_outputs(
+        ms, g, scenario.materials, gt.working_wheel_torque_nm(scenario, g.ratio), pair[0] if pair else None
+    )
+
+
 def _run_summary(
     S: dict,
     scenario: Scenario,
@@ -174,6 +191,7 @@ def _run_summary(
     law = bm.law
     return {
         **contact3d_summary(S, scenario, bm),
+        **_stiffness_outputs(scenario, bm),
         "scenario": scenario.name,
         "timestep_s": bm.timestep_s,
         "timestep_stable_limit_s": law.stable_limit_s,

@@ -22,10 +22,16 @@ s in [0, 1] spanning rho from the worm tip's reach a - sqrt(r_a1^2 - zeta^2) to 
 Conjugate flanks touch along the whole line at once (line contact, no ease-off), so a line's load is
 spread uniformly along it: a linear stiffness k' per unit length.
 
-Stiffness per unit line length k':
-    contact.stiffness_n_per_m = K given:  k' = K / b2   (K is one tooth pair whose contact line spans the
-                                          face width, as contact3d reads it: wormsim.contact3d.law)
-    not given (Hertz, seed 001):          k' = pi E* / 4  (K = pi L E* / 4 per length L)
+Stiffness per unit line length k' (per_length_stiffness: the one place every level takes it from; its source is
+reported as mesh_stiffness_source / contact_stiffness_source):
+    contact.stiffness_n_per_m = K given:  k' = K / b2   "scenario" (K is one tooth pair whose contact line spans
+                                          the face width, as contact3d reads it: wormsim.contact3d.law; an override
+                                          of the teeth's stiffness, docs/decisions/0029-contact-stiffness-override.md)
+    not given (contact.stiffness_model):  "teeth" (the default): k' = wormsim.tooth.compliance.line_stiffness_n_per_m2,
+                                          the teeth's bending, shear and rim compliance with the contact flattening,
+                                          so that this module's mean k_mesh is the loaded TCA's (wormsim.tooth.ltca);
+                                          "hertz": k' = pi E* / 4 (Hertz line contact of seed 001, rigid teeth;
+                                          K = pi L E* / 4 per length L)
 
 Projection on the line of action. A wheel lag angle e (worm held) closes the normal gap at a contact point by
 arm * e, arm = moment arm of the flank normal about the wheel axis. With the flank written as
@@ -60,6 +66,8 @@ import numpy as np
 from meshgen import wheel
 from meshgen.cache import cached
 from meshgen.geometry import GearGeometry
+from wormsim.gear_theory import effective_modulus_pa
+from wormsim.scenario import Contact, Materials
 
 CODE_VERSION = "mesh-stiffness-2"
 GRID_ZETA = 121  # TCA grid across the face width (mean k within ~1.5 % of a 241 x 161 grid)
@@ -82,7 +90,7 @@ class MeshStiffness:
     teeth_rev: np.ndarray
     arm0_m: float  # r2 cos(alpha_n) cos(gamma)
     stiffness_per_length_n_per_m2: float  # k'
-    stiffness_source: str  # "scenario" | "hertz"
+    stiffness_source: str  # STIFFNESS_SOURCES: "teeth" | "scenario" | "hertz"
     samples: int
 
     def summary(self) -> dict:
@@ -97,11 +105,32 @@ class MeshStiffness:
         }
 
 
-def per_length_stiffness(stiffness_n_per_m: float | None, face_width_m: float, e_star_pa: float) -> tuple[float, str]:
-    """k' (N/m per m of contact line): K / b2 when the scenario gives K, else Hertz pi E* / 4 (seed 001)."""
-    if stiffness_n_per_m is not None:
-        return stiffness_n_per_m / face_width_m, "scenario"
-    return math.pi * e_star_pa / 4.0, "hertz"
+STIFFNESS_SOURCES = ("teeth", "scenario", "hertz")
+
+
+def hertz_per_length_n_per_m2(materials: Materials) -> float:
+    """k' = pi E* / 4 (Hertz line contact of two cylinders, seed 001; E* = wormsim.gear_theory.effective_modulus_pa)."""
+    return math.pi * effective_modulus_pa(materials) / 4.0
+
+
+def per_length_stiffness(contact: Contact, g: GearGeometry, materials: Materials) -> tuple[float, str]:
+    """(k' in N/m per m of contact line, its source): K / b2 when the scenario gives contact.stiffness_n_per_m
+    ("scenario"), else by contact.stiffness_model the teeth's compliance ("teeth",
+    wormsim.tooth.compliance.line_stiffness_n_per_m2) or Hertz pi E* / 4 ("hertz"); module docstring."""
+    if contact.stiffness_n_per_m is not None:
+        return contact.stiffness_n_per_m / g.face_width, "scenario"
+    if contact.stiffness_model == "hertz":
+        return hertz_per_length_n_per_m2(materials), "hertz"
+    from wormsim.tooth.compliance import line_stiffness_n_per_m2
+
+    return float(line_stiffness_n_per_m2(g, materials)), "teeth"
+
+
+def pair_stiffness_n_per_m(contact: Contact, g: GearGeometry, materials: Materials) -> tuple[float, str]:
+    """(K = k' b2, the stiffness of one tooth pair whose contact line spans the face width, as contact3d's law reads
+    it; its source): per_length_stiffness over the face width."""
+    kp, source = per_length_stiffness(contact, g, materials)
+    return kp * g.face_width, source
 
 
 @dataclass(frozen=True)
@@ -243,3 +272,28 @@ def mesh_stiffness(
         "grid": (GRID_ZETA, GRID_S),
     }
     return cached("meshk", parts, lambda: compute(g, stiffness_per_length, source, samples), use_cache)
+
+
+def stiffness_outputs(
+    ms: MeshStiffness, g: GearGeometry, materials: Materials, wheel_torque_nm: float, deviations=None
+) -> dict:
+    """The summary keys of the tooth pair's stiffness and load sharing (wormsim.outputs), the same at torsional and
+    contact3d: mesh_stiffness_source and _mean_n_per_m (this TCA with the k' the run uses), the mean per face width in
+    N/(mm um) (ISO 6336-1's unit of c' and c_gamma), and from the loaded tooth contact analysis of the teeth's
+    compliance at the working wheel torque (wormsim.tooth.ltca.loaded_contact) the loaded TE p2p and the largest share
+    of one tooth. The LTCA's keys are null where the run's stiffness is not the teeth's (source scenario or hertz)."""
+    k_mean = float(np.mean(ms.k_mesh_fwd_n_per_m))
+    out = {
+        "mesh_stiffness_source": ms.stiffness_source,
+        "mesh_stiffness_mean_n_per_m": k_mean,
+        "mesh_stiffness_per_width_n_per_mm_um": k_mean / (g.face_width * 1e9),  # N/m / (b2 mm) -> N/(mm um)
+        "transmission_error_loaded_p2p_urad": None,
+        "load_share_max": None,
+    }
+    if ms.stiffness_source == "teeth" and wheel_torque_nm != 0:
+        from wormsim.tooth.ltca import loaded_contact
+
+        lt = loaded_contact(g, materials, abs(wheel_torque_nm), deviations=deviations).summary()
+        out["transmission_error_loaded_p2p_urad"] = lt["transmission_error_loaded_p2p_urad"]
+        out["load_share_max"] = lt["load_share_max"]
+    return out

@@ -86,7 +86,7 @@ from wormsim.geometry import derive, displaced_pair
 from wormsim.metrics import dominant_frequency, drive_summary, mean_speeds_rpm, window_of
 from wormsim.result import Result
 from wormsim.scenario import Scenario
-from wormsim.tooth.mesh_stiffness import MeshStiffness, mesh_stiffness, per_length_stiffness
+from wormsim.tooth.mesh_stiffness import MeshStiffness, mesh_stiffness, per_length_stiffness, stiffness_outputs
 from wormsim.units import rad_s_to_rpm, step
 
 CHORD_ITER = 4  # backward Euler: Newton iterations that reuse the first Jacobian of a step
@@ -402,9 +402,7 @@ def simulate(scenario: Scenario, progress=None, method: str = "implicit") -> Res
     if scipy_method is None and method != "implicit":
         raise ValueError(f"torsional method {method!r}: allowed implicit, {', '.join(SCIPY_METHODS.values())}")
     g = derive(scenario.gear)
-    kp, src = per_length_stiffness(
-        scenario.contact.stiffness_n_per_m, g.face_width, gt.effective_modulus_pa(scenario.materials)
-    )
+    kp, src = per_length_stiffness(scenario.contact, g, scenario.materials)
     t_ms = time.perf_counter()
     ms = mesh_stiffness(g, kp, src, scenario.simulation.mesh_stiffness_samples)
     t_ms = time.perf_counter() - t_ms
@@ -507,6 +505,9 @@ def simulate(scenario: Scenario, progress=None, method: str = "implicit") -> Res
             "backlash_angle_rad": 2 * mesh.gap,
             "friction": friction_mode(scenario.contact),
             **ms.summary(),
+            **stiffness_outputs(
+                ms, g, scenario.materials, gt.working_wheel_torque_nm(scenario, g.ratio), pair[0] if pair else None
+            ),
         }
     )
     if kin is not None:
