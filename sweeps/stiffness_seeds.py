@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+import time
 from pathlib import Path
 
 from wormsim.contact3d.runner import simulate as simulate_c3d
@@ -58,8 +59,6 @@ C3D_KEYS = (
     "timestep_s",
     "timestep_stable_limit_s",
     "step_wall_us",
-    "wall_time_s",
-    "sim_time_s",
     "steps",
 )
 TOR_KEYS = (
@@ -79,9 +78,15 @@ TOR_KEYS = (
 
 
 def _c3d(name: str, sets: list[str]) -> dict:
-    s = simulate_c3d(load_scenario(ROOT / "scenarios" / f"{name}.yaml", sets)).summary
+    sc = load_scenario(ROOT / "scenarios" / f"{name}.yaml", sets)
+    t0 = time.perf_counter()
+    res = simulate_c3d(sc)
+    wall = time.perf_counter() - t0
+    s = res.summary
     out = {k: s.get(k) for k in C3D_KEYS}
-    out["wall_s_per_simulated_s"] = s["wall_time_s"] / s["sim_time_s"]
+    out["sim_time_s"] = res.sim_time_s
+    out["wall_s"] = wall  # build, stepping and summary
+    out["wall_s_per_simulated_s"] = s["step_wall_us"] * 1e-6 * res.steps / res.sim_time_s  # the stepping loop
     return out
 
 

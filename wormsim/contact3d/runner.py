@@ -87,7 +87,10 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
     summary = _run_summary(
         S, scenario, bm, rec, guards.turn_max, len(src.coll), 1e6 * wall / max(n_rec * rec, 1), flanks=flanks
     )
+    st_keys, ms, lt = _stiffness_outputs(scenario, bm)  # the tooth pair's stiffness and load sharing (torsional's)
+    summary.update(st_keys)
     extra = {"points_tooth0": store[0], "points_world": store[2], "forces_world": store[1], "built": bm}
+    extra.update({"mesh_stiffness": ms, "ltca": lt})
     src.finish(S, summary, extra)
     if slog is not None:  # the shafts' deflections and bearing forces
         S.update(slog.series())
@@ -159,9 +162,10 @@ def force_signs(S: dict, hand: int) -> None:
     S["axial_force_n"] *= -float(hand)
 
 
-def _stiffness_outputs(scenario: Scenario, bm: BuiltModel) -> dict:
+def _stiffness_outputs(scenario: Scenario, bm: BuiltModel) -> tuple[dict, object, object | None]:
     """wormsim.tooth.mesh_stiffness.stiffness_outputs with the law's k' (K = k' b2): the same keys as torsional's, from
-    the TCA table at the default sample count (simulation.mesh_stiffness_samples is torsional's)."""
+    the TCA table at the default sample count (simulation.mesh_stiffness_samples is torsional's); with the TCA and the
+    LTCA (None unless the teeth's stiffness is used) for the report."""
     from wormsim import gear_theory as gt
     from wormsim.geometry import displaced_pair
     from wormsim.scenario import Simulation
@@ -171,9 +175,10 @@ def _stiffness_outputs(scenario: Scenario, bm: BuiltModel) -> dict:
     kp, source = per_length_stiffness(scenario.contact, g, scenario.materials)
     ms = mesh_stiffness(g, kp, source, Simulation.model_fields["mesh_stiffness_samples"].default)
     pair = displaced_pair(scenario.errors, g)
-    return stiffness_outputs(
+    keys, lt = stiffness_outputs(
         ms, g, scenario.materials, gt.working_wheel_torque_nm(scenario, g.ratio), pair[0] if pair else None
     )
+    return keys, ms, lt
 
 
 def _run_summary(
@@ -191,7 +196,6 @@ def _run_summary(
     law = bm.law
     return {
         **contact3d_summary(S, scenario, bm),
-        **_stiffness_outputs(scenario, bm),
         "scenario": scenario.name,
         "timestep_s": bm.timestep_s,
         "timestep_stable_limit_s": law.stable_limit_s,

@@ -486,6 +486,8 @@ def simulate(scenario: Scenario, progress=None, method: str = "implicit") -> Res
         **out,
     }
     summary = torsional_summary(S, scenario, g, ms)
+    t2_work = gt.working_wheel_torque_nm(scenario, g.ratio)
+    st_keys, lt_teeth = stiffness_outputs(ms, g, scenario.materials, t2_work, pair[0] if pair else None)
     summary.update(
         {
             "scenario": scenario.name,
@@ -505,9 +507,7 @@ def simulate(scenario: Scenario, progress=None, method: str = "implicit") -> Res
             "backlash_angle_rad": 2 * mesh.gap,
             "friction": friction_mode(scenario.contact),
             **ms.summary(),
-            **stiffness_outputs(
-                ms, g, scenario.materials, gt.working_wheel_torque_nm(scenario, g.ratio), pair[0] if pair else None
-            ),
+            **st_keys,
         }
     )
     if kin is not None:
@@ -526,7 +526,7 @@ def simulate(scenario: Scenario, progress=None, method: str = "implicit") -> Res
         series=S,
         steps=len(t) - 1,
         sim_time_s=float(t[-1]),
-        extra={"mesh_stiffness": ms, "geometry": g},
+        extra={"mesh_stiffness": ms, "geometry": g, "ltca": lt_teeth},
     )
 
 
