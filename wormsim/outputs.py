@@ -314,13 +314,14 @@ KEYS: dict[str, Key] = {
         "urad",
         GEAR,
         "loaded transmission error p2p over a mesh cycle from the loaded tooth contact analysis of the teeth's "
-        "compliance at the working wheel torque (quasi-static; null unless mesh_stiffness_source is teeth)",
+        "compliance at the working wheel torque on the working flank (quasi-static; null unless mesh_stiffness_source is "
+        "teeth, and with errors:)",
     ),
     "load_share_max": Key(
         "-",
         GEAR,
         "largest share of the load on one wheel tooth over a mesh cycle, from the same loaded tooth contact analysis "
-        "(null unless mesh_stiffness_source is teeth)",
+        "(null unless mesh_stiffness_source is teeth, and with errors:)",
     ),
     "mesh_stiffness_min_n_per_m": Key("N/m", T, "smallest mesh stiffness over a mesh cycle"),
     "mesh_stiffness_max_n_per_m": Key("N/m", T, "largest mesh stiffness over a mesh cycle"),

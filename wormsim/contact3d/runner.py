@@ -174,9 +174,13 @@ def _stiffness_outputs(scenario: Scenario, bm: BuiltModel) -> tuple[dict, object
     g = bm.geometry
     kp, source = per_length_stiffness(scenario.contact, g, scenario.materials)
     ms = mesh_stiffness(g, kp, source, Simulation.model_fields["mesh_stiffness_samples"].default)
-    pair = displaced_pair(scenario.errors, g)
     keys, lt = stiffness_outputs(
-        ms, g, scenario.materials, gt.working_wheel_torque_nm(scenario, g.ratio), pair[0] if pair else None
+        ms,
+        g,
+        scenario.materials,
+        gt.working_wheel_torque_nm(scenario, g.ratio),
+        gt.working_flank(scenario, g.hand),
+        errors=displaced_pair(scenario.errors, g) is not None,
     )
     return keys, ms, lt
 

@@ -275,14 +275,20 @@ def mesh_stiffness(
 
 
 def stiffness_outputs(
-    ms: MeshStiffness, g: GearGeometry, materials: Materials, wheel_torque_nm: float, deviations=None
+    ms: MeshStiffness,
+    g: GearGeometry,
+    materials: Materials,
+    wheel_torque_nm: float,
+    side: int = 1,
+    errors: bool = False,
 ) -> tuple[dict, object | None]:
     """(summary keys, the LTCA result or None): the keys of the tooth pair's stiffness and load sharing
     (wormsim.outputs), the same at torsional and contact3d: mesh_stiffness_source and _mean_n_per_m (this TCA with the
     k' the run uses), the mean per face width in N/(mm um) (ISO 6336-1's unit of c' and c_gamma), and from the loaded
     tooth contact analysis of the teeth's compliance at the working wheel torque (wormsim.tooth.ltca.loaded_contact)
-    the loaded TE p2p and the largest share of one tooth. The LTCA runs only where the run's stiffness is the teeth's
-    (source teeth); elsewhere its keys are null."""
+    the loaded TE p2p and the largest share of one tooth, on the working flank `side`. The LTCA runs only where the
+    run's stiffness is the teeth's (source teeth) and the pair has no assembly errors (`errors`: the LTCA takes the
+    perfect pair's gaps); elsewhere its keys are null."""
     k_mean = float(np.mean(ms.k_mesh_fwd_n_per_m))
     out = {
         "mesh_stiffness_source": ms.stiffness_source,
@@ -292,10 +298,10 @@ def stiffness_outputs(
         "load_share_max": None,
     }
     lt = None
-    if ms.stiffness_source == "teeth" and wheel_torque_nm != 0:
+    if ms.stiffness_source == "teeth" and wheel_torque_nm != 0 and not errors:
         from wormsim.tooth.ltca import loaded_contact
 
-        lt = loaded_contact(g, materials, abs(wheel_torque_nm), deviations=deviations)
+        lt = loaded_contact(g, materials, abs(wheel_torque_nm), side=1 if side >= 0 else -1)
         s = lt.summary()
         out["transmission_error_loaded_p2p_urad"] = s["transmission_error_loaded_p2p_urad"]
         out["load_share_max"] = s["load_share_max"]

@@ -487,7 +487,9 @@ def simulate(scenario: Scenario, progress=None, method: str = "implicit") -> Res
     }
     summary = torsional_summary(S, scenario, g, ms)
     t2_work = gt.working_wheel_torque_nm(scenario, g.ratio)
-    st_keys, lt_teeth = stiffness_outputs(ms, g, scenario.materials, t2_work, pair[0] if pair else None)
+    st_keys, lt_teeth = stiffness_outputs(
+        ms, g, scenario.materials, t2_work, gt.working_flank(scenario, g.hand), errors=pair is not None
+    )
     summary.update(
         {
             "scenario": scenario.name,
