@@ -314,8 +314,8 @@ KEYS: dict[str, Key] = {
         "urad",
         GEAR,
         "loaded transmission error p2p over a mesh cycle from the loaded tooth contact analysis of the teeth's "
-        "compliance at the working wheel torque on the working flank (quasi-static; null unless mesh_stiffness_source is "
-        "teeth, and with errors:)",
+        "compliance at the working wheel torque on the working flank (quasi-static; null unless "
+        "mesh_stiffness_source is teeth, and with errors:)",
     ),
     "load_share_max": Key(
         "-",
