@@ -113,9 +113,9 @@ def space_middles(g: GearGeometry, zeta):
     return 0.5 * (pa + pb - pitch), 0.5 * (pa + pb + pitch)
 
 
-def section_outline(g: GearGeometry, zeta: float, c: Counts) -> np.ndarray:
-    """Closed outline (N, 2) of tooth 0 with its rim in the wheel section at axial position zeta, counter-clockwise,
-    N the same for every zeta (module docstring)."""
+def _tooth_top(g: GearGeometry, zeta: float, c: Counts) -> np.ndarray:
+    """Tooth 0's part of the section outline at axial position zeta, counter-clockwise: the root from the middle of
+    space 0, the fillets, the flanks and the tip, to the middle of space 1 (module docstring)."""
     lo = float(wheel.root_rho(g, zeta))
     hi = float(wheel.tip_rho(g, zeta))
     rho = np.linspace(lo, hi, FLANK_DENSE)
@@ -136,23 +136,40 @@ def section_outline(g: GearGeometry, zeta: float, c: Counts) -> np.ndarray:
     root_a = _arc(lo, s0, math.atan2(fa[0, 1], fa[0, 0]), c.root)
     root_b = _arc(lo, math.atan2(fb[0, 1], fb[0, 0]), s1, c.root)
     tip = _arc(hi, pa[-1], pb[-1], c.tip)
+    return np.concatenate([root_a, fa[1:], flank_a[1:], tip[1:-1], flank_b[::-1], fb[::-1][1:], root_b[1:]])
+
+
+def section_outline(g: GearGeometry, zeta: float, c: Counts, teeth: int = 1) -> np.ndarray:
+    """Closed outline (N, 2) of `teeth` wheel teeth with their rim in the wheel section at axial position zeta,
+    counter-clockwise, N the same for every zeta (module docstring): tooth 0 (teeth = 1), or tooth 0 with
+    (teeth - 1) / 2 neighbours on each side (teeth odd), each tooth k tooth 0's outline turned by k 2 pi / z2."""
+    pitch = 2 * math.pi / g.z2
+    half = (teeth - 1) // 2
+    top = _tooth_top(g, zeta, c)
+    parts = []
+    for k in range(-half, half + 1):
+        ck, sk = math.cos(k * pitch), math.sin(k * pitch)
+        turned = top @ np.array([[ck, sk], [-sk, ck]])
+        parts.append(turned if k == -half else turned[1:])
+    lo = float(wheel.root_rho(g, zeta))
+    s0, s1 = space_middles(g, zeta)
+    s0, s1 = float(s0) - half * pitch, float(s1) + half * pitch
     r_in = g.r_f2 - RIM_DEPTH_MX * g.m_x
     down = np.linspace(lo, r_in, c.radial + 1)[1:-1]
     side_b = np.stack([down * math.cos(s1), down * math.sin(s1)], -1)
-    inner = _arc(r_in, s1, s0, c.inner)
+    inner = _arc(r_in, s1, s0, c.inner + (c.inner - 1) * (teeth - 1))
     side_a = np.stack([down[::-1] * math.cos(s0), down[::-1] * math.sin(s0)], -1)
-    return np.concatenate(
-        [root_a, fa[1:], flank_a[1:], tip[1:-1], flank_b[::-1], fb[::-1][1:], root_b[1:], side_b, inner, side_a]
-    )
+    return np.concatenate(parts + [side_b, inner, side_a])
 
 
-def tooth_surface(g: GearGeometry, density: int = 1) -> tuple[np.ndarray, np.ndarray]:
-    """Watertight triangulated surface (vertices (n, 3) in m, faces (m, 3), outward) of the one-tooth sector."""
+def tooth_surface(g: GearGeometry, density: int = 1, teeth: int = 1) -> tuple[np.ndarray, np.ndarray]:
+    """Watertight triangulated surface (vertices (n, 3) in m, faces (m, 3), outward) of the sector of `teeth` teeth
+    (section_outline)."""
     import manifold3d as mf
 
     c = Counts.at(density)
     zetas = np.linspace(-g.face_width / 2, g.face_width / 2, c.zeta)
-    secs = np.stack([section_outline(g, z, c) for z in zetas])  # (nz, N, 2)
+    secs = np.stack([section_outline(g, z, c, teeth) for z in zetas])  # (nz, N, 2)
     nz, N = secs.shape[:2]
     V = np.concatenate([secs.reshape(-1, 2), np.repeat(zetas, N)[:, None]], axis=1)
     idx = np.arange(nz * N).reshape(nz, N)
@@ -234,17 +251,11 @@ def solve_elastic(
 ) -> Solution:
     """Linear elasticity on quadratic tetrahedra (scikit-fem). fixed_facet(x) -> bool mask of boundary-facet
     midpoints (3, k) that are clamped; loads: per load case (vertex indices (k,), forces (k, 3) N) at mesh vertices."""
-    from skfem import Basis, ElementTetP2, ElementVector, MeshTet, asm
-    from skfem.models.elasticity import lame_parameters, linear_elasticity
+    from skfem.models.elasticity import lame_parameters
 
-    mesh = MeshTet(points.T.copy(), tets.T.copy()).oriented()
-    ib = Basis(mesh, ElementVector(ElementTetP2()), intorder=2)
+    ib, free, solve = elastic_solver(points, tets, e_pa, nu, fixed_facet)
+    mesh = ib.mesh
     lam, mu = lame_parameters(e_pa, nu)
-    K = asm(linear_elasticity(lam, mu), ib).tocsc()
-    fixed = ib.get_dofs(lambda x: fixed_facet(x)).all()
-    free = np.setdiff1d(np.arange(ib.N), fixed)
-    Kff = K[free][:, free].tocsr()
-    solve = _solver(Kff, ib.doflocs, free)
     us, stresses, qp_stress = [], [], []
     for verts, forces in loads:
         f = np.zeros(ib.N)
@@ -268,16 +279,35 @@ def solve_elastic(
     )  # fmt: skip
 
 
+def elastic_solver(
+    points: np.ndarray, tets: np.ndarray, e_pa: float, nu: float, fixed_facet, direct_dofs_max: int | None = None
+):
+    """(basis, free dofs, solve) of linear elasticity on quadratic tetrahedra (scikit-fem): the stiffness matrix with
+    the dofs on the facets where fixed_facet(midpoints (3, k)) is true clamped, factorised once (_solver);
+    solve(f_free) -> u_free."""
+    from skfem import Basis, ElementTetP2, ElementVector, MeshTet, asm
+    from skfem.models.elasticity import lame_parameters, linear_elasticity
+
+    mesh = MeshTet(points.T.copy(), tets.T.copy()).oriented()
+    ib = Basis(mesh, ElementVector(ElementTetP2()), intorder=2)
+    lam, mu = lame_parameters(e_pa, nu)
+    K = asm(linear_elasticity(lam, mu), ib).tocsc()
+    fixed = ib.get_dofs(lambda x: fixed_facet(x)).all()
+    free = np.setdiff1d(np.arange(ib.N), fixed)
+    Kff = K[free][:, free].tocsr()
+    return ib, free, _solver(Kff, ib.doflocs, free, DIRECT_DOFS_MAX if direct_dofs_max is None else direct_dofs_max)
+
+
 DIRECT_DOFS_MAX = 30000  # above this, algebraic multigrid (pyamg) with conjugate gradients instead of SuperLU
 CG_RTOL = 1e-8  # relative residual; the stresses change by < 1e-5 relative below it (measured on involute_41)
 
 
-def _solver(Kff, doflocs: np.ndarray, free: np.ndarray):
+def _solver(Kff, doflocs: np.ndarray, free: np.ndarray, direct_dofs_max: int = DIRECT_DOFS_MAX):
     """x = solve(b) for the clamped stiffness matrix: SuperLU for small systems, else pyamg's smoothed aggregation
     with the rigid-body modes as near-null space, as the preconditioner of conjugate gradients."""
     import scipy.sparse.linalg as spla
 
-    if Kff.shape[0] <= DIRECT_DOFS_MAX:
+    if Kff.shape[0] <= direct_dofs_max:
         lu = spla.splu(Kff.tocsc(), permc_spec="MMD_AT_PLUS_A")  # symmetric ordering: 0.6 x COLAMD's fill here
         return lu.solve
     import pyamg
@@ -378,23 +408,53 @@ class ToothMesh:
     r_in: float
 
 
-def tooth_mesh(g: GearGeometry, density: int = 1, size_m: float | None = None, use_cache: bool = True) -> ToothMesh:
-    """The tetrahedral mesh of the one-tooth sector, cached by geometry (meshgen.cache). `density` d sets the element
-    sizes together (d = 1 is the default, d = 1 and 2 are an h / (h/2) pair): largest 1.5 m_x / d (or size_m),
-    smallest FILLET_COEF m_x / d (the fillet radius over d), CURVATURE_ELEMENTS d per full turn of a curved surface."""
+def tooth_mesh(
+    g: GearGeometry,
+    density: int = 1,
+    size_m: float | None = None,
+    use_cache: bool = True,
+    teeth: int = 1,
+    min_size_m: float | None = None,
+    curvature_elements: int = CURVATURE_ELEMENTS,
+) -> ToothMesh:
+    """The tetrahedral mesh of the sector of `teeth` teeth (section_outline; 1: the one-tooth sector), cached by
+    geometry (meshgen.cache). `density` d sets the element sizes together (d = 1 is the default, d = 1 and 2 are an
+    h / (h/2) pair): largest 1.5 m_x / d (or size_m), smallest FILLET_COEF m_x / d (the fillet radius over d; or
+    min_size_m / d), curvature_elements d per full turn of a curved surface (default CURVATURE_ELEMENTS)."""
     from dataclasses import asdict
 
     size = size_m if size_m is not None else 1.5 * g.m_x / density
-    min_size = min(FILLET_COEF * g.m_x / density, size)
-    curvature = CURVATURE_ELEMENTS * density
+    min_size = min((FILLET_COEF * g.m_x if min_size_m is None else min_size_m) / density, size)
+    curvature = curvature_elements * density
 
     def build() -> ToothMesh:
-        V, F = tooth_surface(g, SURFACE_DENSITY)
+        V, F = tooth_surface(g, SURFACE_DENSITY, teeth)
         P, T = tet_mesh(V, F, size, min_size, curvature)
         return ToothMesh(P, T, g.r_f2 - RIM_DEPTH_MX * g.m_x)
 
     parts = {"geometry": asdict(g), "density": density, "size_m": size, "code": CODE_VERSION}
+    if (teeth, min_size_m, curvature_elements) != (1, None, CURVATURE_ELEMENTS):
+        parts.update(teeth=teeth, min_size_m=min_size_m, curvature_elements=curvature_elements)
     return cached("fe-tooth", parts, build, use_cache=use_cache)
+
+
+def clamped_faces(g: GearGeometry, r_in: float, teeth: int = 1):
+    """fixed_facet(x) of the sector of `teeth` teeth: the rim's cut faces, i.e. the inner face (radius r_in) and the
+    two radial faces below the root at the middles of the outermost spaces."""
+    tol = 1e-3 * g.m_x
+    half = (teeth - 1) // 2
+    pitch = 2 * math.pi / g.z2
+
+    def fixed(x):
+        rho = np.hypot(x[0], x[1])
+        psi = np.arctan2(x[1], x[0])
+        s0, s1 = space_middles(g, x[2])
+        s0, s1 = s0 - half * pitch, s1 + half * pitch
+        below = rho < wheel.root_rho(g, x[2]) - tol
+        on_side = below & ((np.abs(psi - s0) * rho < tol) | (np.abs(psi - s1) * rho < tol))
+        return (rho < r_in + tol) | on_side
+
+    return fixed
 
 
 def root_stress(
@@ -429,16 +489,7 @@ def root_stress_cases(
 
     tm = tooth_mesh(g, density, size_m, use_cache)
     P, T = tm.points, tm.tets
-    tol = 1e-3 * g.m_x
-
-    def fixed(x):
-        """The rim's cut faces: the inner face and the two space-middle faces below the root."""
-        rho = np.hypot(x[0], x[1])
-        psi = np.arctan2(x[1], x[0])
-        s0, s1 = space_middles(g, x[2])
-        below = rho < wheel.root_rho(g, x[2]) - tol
-        on_side = below & ((np.abs(psi - s0) * rho < tol) | (np.abs(psi - s1) * rho < tol))
-        return (rho < tm.r_in + tol) | on_side
+    fixed = clamped_faces(g, tm.r_in)
 
     # each contact sample's force spread over the surface vertices within LOAD_RADIUS_MX (a load patch of fixed size)
     surf = np.unique(_boundary_faces(T))

@@ -142,12 +142,19 @@ class _Field:
     arm: np.ndarray  # (nz, ns) (3)
 
 
+def profile_span(g: GearGeometry, zeta):
+    """(lo, hi): the flank radii that s = 0 and s = 1 of the (zeta, s) grid stand for (module docstring): the worm
+    tip's reach (at least the wheel root) and the wheel tip."""
+    zeta = np.asarray(zeta, float)
+    lo = g.a - np.sqrt(np.maximum(g.r_a1**2 - zeta**2, 0.0))  # worm tip reach at beta = -pi/2
+    hi = wheel.tip_rho(g, zeta)
+    return np.maximum(lo, wheel.root_rho(g, zeta)), hi
+
+
 def _flank_field(g: GearGeometry, side: int) -> _Field:
     zeta = np.linspace(-g.face_width / 2, g.face_width / 2, GRID_ZETA)
     s = np.linspace(0.0, 1.0, GRID_S)
-    lo = g.a - np.sqrt(np.maximum(g.r_a1**2 - zeta**2, 0.0))  # worm tip reach at beta = -pi/2
-    hi = wheel.tip_rho(g, zeta)
-    lo = np.maximum(lo, wheel.root_rho(g, zeta))
+    lo, hi = profile_span(g, zeta)
     Z, S = np.meshgrid(zeta, s, indexing="ij")
     R = lo[:, None] + (hi - lo)[:, None] * S
     sol = wheel.space_flank(g, R, Z, side)
@@ -183,30 +190,31 @@ def _bilinear(F: np.ndarray, i: np.ndarray, j: np.ndarray) -> np.ndarray:
     )
 
 
+def contact_lines(fld: _Field, gen, theta2: float, pitch2: float):
+    """The contact lines (2) at wheel angle theta2: (k, fractional grid indices i along zeta, j along s) per line
+    piece of space k (at least 2 points)."""
+    cmin, cmax = float(fld.c.min()), float(fld.c.max())
+    for k in range(math.ceil((cmin - theta2) / pitch2), math.floor((cmax - theta2) / pitch2) + 1):
+        for ln in gen.lines(theta2 + k * pitch2):
+            if len(ln) >= 2:
+                # contourpy works in index coordinates (x = column j along s, y = row i along zeta)
+                yield k, ln[:, 1], ln[:, 0]
+
+
 def _lines_at(fld: _Field, gen, theta2: float, pitch2: float) -> tuple[float, float, int]:
     """(integral of arm^2 ds, total length, teeth) of the contact lines (2) at wheel angle theta2."""
-    cmin, cmax = float(fld.c.min()), float(fld.c.max())
-    k_lo = math.ceil((cmin - theta2) / pitch2)
-    k_hi = math.floor((cmax - theta2) / pitch2)
     integral = length = 0.0
-    teeth = 0
-    for k in range(k_lo, k_hi + 1):
-        lines = gen.lines(theta2 + k * pitch2)
-        touched = False
-        for ln in lines:
-            if len(ln) < 2:
-                continue
-            # contourpy works in index coordinates (x = column j along s, y = row i along zeta)
-            j, i = ln[:, 0], ln[:, 1]
-            P = _bilinear(fld.xyz, i, j)
-            A = _bilinear(fld.arm, i, j)
-            ds = np.linalg.norm(np.diff(P, axis=0), axis=1)
-            a2 = 0.5 * (A[1:] ** 2 + A[:-1] ** 2)
-            integral += float(np.sum(a2 * ds))
-            length += float(np.sum(ds))
-            touched = touched or float(np.sum(ds)) > 0
-        teeth += int(touched)
-    return integral, length, teeth
+    touched: set[int] = set()
+    for k, i, j in contact_lines(fld, gen, theta2, pitch2):
+        P = _bilinear(fld.xyz, i, j)
+        A = _bilinear(fld.arm, i, j)
+        ds = np.linalg.norm(np.diff(P, axis=0), axis=1)
+        a2 = 0.5 * (A[1:] ** 2 + A[:-1] ** 2)
+        integral += float(np.sum(a2 * ds))
+        length += float(np.sum(ds))
+        if float(np.sum(ds)) > 0:
+            touched.add(k)
+    return integral, length, len(touched)
 
 
 def compute(g: GearGeometry, stiffness_per_length: float, source: str, samples: int) -> MeshStiffness:

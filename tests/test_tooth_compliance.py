@@ -1,0 +1,67 @@
+"""wormsim.tooth.compliance: the wheel tooth's FE influence coefficients, the worm thread's compliance, the
+flattening law and the per-length stiffness k'_eff that the slice models use (docs/tooth_compliance.md)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from conftest import SCENARIOS
+
+from wormsim.gear_theory import effective_modulus_pa
+from wormsim.geometry import derive
+from wormsim.scenario import load_scenario
+from wormsim.tooth import compliance, mesh_stiffness
+
+
+@pytest.fixture(scope="module")
+def screw_jack():
+    sc = load_scenario(SCENARIOS / "screw_jack.yaml")
+    return sc, derive(sc.gear)
+
+
+def test_influence_coefficients_screw_jack(screw_jack):
+    """The loaded tooth's own coefficients are positive where the load acts (the centre line yields away from the
+    worm), largest near the tip (a cantilever); the neighbours move far less; the worm thread is stiffer at its
+    root than at its tip."""
+    sc, g = screw_jack
+    c = compliance.tooth_compliance(g, sc.materials)
+    n = compliance.GRID_FACE * compliance.GRID_PROFILE
+    assert c.wheel_m_per_n.shape == (3, n, n)
+    diag = np.diag(c.wheel_m_per_n[0]).reshape(compliance.GRID_FACE, compliance.GRID_PROFILE)
+    assert (diag > 0).all()
+    mid = compliance.GRID_FACE // 2
+    assert diag[mid, -1] > 2 * diag[mid, 0]  # tip vs the lowest active point
+    # a load in the middle of the flank: the same tooth's line integral vs the neighbours'
+    j = mid * compliance.GRID_PROFILE + compliance.GRID_PROFILE // 2
+    own = c.wheel_m_per_n[0][:, j].sum()
+    for m in (1, 2):
+        assert abs(c.wheel_m_per_n[m][:, j].sum()) < 0.25 * own
+    assert (np.diff(c.worm_m2_per_n) > 0).all()
+    # the cache returns the same object in process
+    assert compliance.tooth_compliance(g, sc.materials) is c
+
+
+def test_flattening_weber_banaschek():
+    """(2): linear in q up to the logarithm; zero bracket never negative; a softer body flattens more."""
+    q = np.array([1e4, 2e4])
+    w = compliance.flattening_m(q, 100e9, 0.3, 2e-3, 1 / 5e-3, 70e9)
+    assert 1.8 < w[1] / w[0] < 2.0  # 2 x q, less the log of sqrt(2) in b
+    soft = compliance.flattening_m(q, 3e9, 0.39, 2e-3, 1 / 5e-3, 3.3e9)
+    assert (soft > 10 * w).all()
+    assert compliance.flattening_m(1e12, 1e9, 0.3, 1e-6, 1.0, 1e9) == 0.0
+
+
+def test_line_stiffness_screw_jack(screw_jack):
+    """k'_eff makes the torsional TCA's mean k_mesh equal the LTCA's at the working load, and is below the
+    Hertz line-contact value pi E* / 4 (the teeth bend)."""
+    sc, g = screw_jack
+    kp = compliance.line_stiffness_n_per_m2(g, sc.materials, 12.0)
+    hertz = math.pi * effective_modulus_pa(sc.materials) / 4
+    assert 0 < kp < 0.5 * hertz
+    from wormsim.tooth import ltca
+
+    res = ltca.loaded_contact(g, sc.materials, 12.0)
+    ms = mesh_stiffness.mesh_stiffness(g, kp, "ltca", 16)
+    assert np.mean(ms.k_mesh_fwd_n_per_m) == pytest.approx(np.mean(res.mesh_stiffness_n_per_m), rel=1e-9)
