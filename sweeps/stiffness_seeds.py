@@ -11,7 +11,7 @@ in one process, so that the speeds (wall seconds per simulated second, contact3d
 The first contact3d run of a process includes the flank kernel's compile and is repeated. Writes the record
 docs/data/stiffness_seeds.json.
 
-    .venv/bin/python sweeps/stiffness_seeds.py [--modes seed,hertz,teeth]
+    .venv/bin/python sweeps/stiffness_seeds.py [--modes seed,hertz,teeth] [--seeds seat_motor,screw_jack,involute_41]
 """
 
 from __future__ import annotations
@@ -93,14 +93,17 @@ def _c3d(name: str, sets: list[str]) -> dict:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--modes", default="seed,hertz,teeth")
+    ap.add_argument("--seeds", default="seat_motor,screw_jack,involute_41")
     args = ap.parse_args()
     modes = [m for m in args.modes.split(",") if m]
+    seeds = [n for n in args.seeds.split(",") if n]
     sys.path.insert(0, str(ROOT / "tests"))
     from test_contact3d_seeds import CI
 
     runs: dict[str, dict] = {}
     warm = False
-    for name, sets in CI.items():
+    for name in seeds:
+        sets = CI[name]
         runs[name] = {}
         pinned = load_scenario(ROOT / "scenarios" / f"{name}.yaml").contact.stiffness_n_per_m is not None
         for mode in modes:
@@ -114,7 +117,7 @@ def main() -> None:
             tor = simulate_tor(load_scenario(ROOT / "scenarios" / f"{name}.yaml", [*over, "model=torsional"])).summary
             runs[name][mode] = {"overrides": over, "contact3d": c3d, "torsional": {k: tor.get(k) for k in TOR_KEYS}}
             print(name, mode, c3d["wall_s_per_simulated_s"], c3d["timestep_s"], flush=True)
-    record("stiffness_seeds", {"modes": modes, "runs": runs})
+    record("stiffness_seeds", {"modes": modes, "seeds": seeds, "runs": runs})
 
 
 if __name__ == "__main__":
