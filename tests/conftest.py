@@ -29,6 +29,8 @@ LONG_TESTS: dict[str, set[str] | None] = {
     "test_mass_scaling.py": {"unscaled"},  # the unscaled reference run of the scaled ones (240 000 steps, ~3 min)
     # contact3d and `wormsim mesh` per flank form (ZC's stay in `make test`; torsional's of every form too)
     "test_flank_forms_validation.py": {f"{k}_{f}" for k in ("contact3d", "mesh") for f in ("ZN1", "ZN2", "ZK")},
+    # the tooth compliance's FE on the seeds other than the screw jack (~15 s each cold; test_ltca.py marks its own)
+    "test_tooth_compliance.py": {"involute_41", "seat_motor"},
 }
 
 

@@ -701,6 +701,37 @@ def mesh_stiffness_seeds_table(name: str = "mesh_stiffness_seeds") -> str:
     return _table(head, rows) + "\n" + _source(name)
 
 
+def tooth_compliance_seeds_table(name: str = "tooth_compliance_seeds") -> str:
+    """The LTCA on each seed file (sweeps/tooth_compliance_seeds.py)."""
+    rows = []
+    for seed, r in load(name)["runs"].items():
+        iso = r["iso6336"]
+        rows.append(
+            [
+                f"{seed} (E2 {r['wheel_e_gpa']:g} GPa, T2 {r['torque_nm']:g} N m)",
+                f"{r['mesh_stiffness_per_width_n_per_mm_um']:.3g}",
+                f"{r['hertz_per_width_n_per_mm_um']:.3g}",
+                f"{iso['c_prime']:.3g} / {iso['c_gamma']:.3g}",
+                f"{r['teeth_in_contact_mean']:.2f}",
+                f"{r['load_share_max']:.2f}",
+                f"{r['transmission_error_loaded_p2p_urad']:.3g}",
+                f"{r['pressure_max_mpa']:.0f}",
+                f"{r['line_stiffness_n_per_m2'] / r['hertz_line_stiffness_n_per_m2']:.3f}",
+                f"{r['compliance_wall_s_uncached']:.0f} s ({r['fe_nodes']} nodes)",
+            ]
+        )
+    head = ["seed", "k_mesh / b2 LTCA", "Hertz only", "ISO c' / c_gamma", "teeth in contact", "load share max"]
+    head += ["loaded TE p2p (urad)", "p_H max (MPa)", "k'_eff / (pi E* / 4)", "FE (uncached)"]
+    parts = load(name)["screw_jack_parts"]
+    base = parts["mesh_stiffness_three_teeth_n_per_m"]
+    note = (
+        f"\nStiffness per width in N/(mm um). Screw jack, the FE model's parts: one wheel tooth instead of three "
+        f"{parts['mesh_stiffness_one_tooth_n_per_m'] / base:.3f} x the mean k_mesh, the worm thread rigid "
+        f"{parts['mesh_stiffness_worm_thread_rigid_n_per_m'] / base:.3f} x.\n"
+    )
+    return _table(head, rows) + note + "\n" + _source(name)
+
+
 def cli_wall_table(name: str = "cli_wall") -> str:
     """The whole CLI run's wall time (sweeps/measure_cli_wall.py), after a warm-up run."""
     r = load(name)
@@ -882,6 +913,7 @@ TABLES: dict[str, Callable[[], str]] = {
     "rating_seeds": rating_seeds_table,
     "torsional_samples": torsional_samples_table,
     "mesh_stiffness_seeds": mesh_stiffness_seeds_table,
+    "tooth_compliance_seeds": tooth_compliance_seeds_table,
     "contact_pattern": contact_pattern_table,
     "ci_seeds": ci_seeds_table,
     "errors_shaft_angle": errors_shaft_angle_table,

@@ -189,10 +189,10 @@ def tooth_surface(g: GearGeometry, density: int = 1, teeth: int = 1) -> tuple[np
 
 
 def tet_mesh(
-    V: np.ndarray, F: np.ndarray, size_m: float, min_size_m: float, curvature: int
+    V: np.ndarray, F: np.ndarray, size_m: float, min_size_m: float, curvature: int, angle_deg: float = 40.0
 ) -> tuple[np.ndarray, np.ndarray]:
     """Tetrahedra (gmsh) inside the closed surface (V, F): the surface is classified into patches at sharp edges
-    (40 deg), re-parametrised and re-meshed at `size_m` (refined on curvature, `curvature` elements per 2 pi of a
+    (angle_deg), re-parametrised and re-meshed at `size_m` (refined on curvature, `curvature` elements per 2 pi of a
     curve's turn, down to min_size_m: the root fillet), then the volume is meshed: (points (n, 3), tets (m, 4))."""
     import gmsh
 
@@ -204,7 +204,7 @@ def tet_mesh(
         s = gmsh.model.addDiscreteEntity(2)
         gmsh.model.mesh.addNodes(2, s, list(range(1, len(V) + 1)), (V * 1e3).ravel().tolist())  # mm
         gmsh.model.mesh.addElementsByType(s, 2, [], (F.ravel() + 1).tolist())
-        gmsh.model.mesh.classifySurfaces(math.radians(40), True, True, math.pi)
+        gmsh.model.mesh.classifySurfaces(math.radians(angle_deg), True, True, math.pi)
         gmsh.model.mesh.createGeometry()
         surfs = [e[1] for e in gmsh.model.getEntities(2)]
         loop = gmsh.model.geo.addSurfaceLoop(surfs)
@@ -416,11 +416,14 @@ def tooth_mesh(
     teeth: int = 1,
     min_size_m: float | None = None,
     curvature_elements: int = CURVATURE_ELEMENTS,
+    classify_angles_deg: tuple[float, ...] = (40.0,),
 ) -> ToothMesh:
     """The tetrahedral mesh of the sector of `teeth` teeth (section_outline; 1: the one-tooth sector), cached by
     geometry (meshgen.cache). `density` d sets the element sizes together (d = 1 is the default, d = 1 and 2 are an
     h / (h/2) pair): largest 1.5 m_x / d (or size_m), smallest FILLET_COEF m_x / d (the fillet radius over d; or
-    min_size_m / d), curvature_elements d per full turn of a curved surface (default CURVATURE_ELEMENTS)."""
+    min_size_m / d), curvature_elements d per full turn of a curved surface (default CURVATURE_ELEMENTS). gmsh's
+    surface classification (tet_mesh) at each of classify_angles_deg in turn until one meshes (its re-meshing of the
+    classified patches fails on some sectors at some angles)."""
     from dataclasses import asdict
 
     size = size_m if size_m is not None else 1.5 * g.m_x / density
@@ -429,12 +432,19 @@ def tooth_mesh(
 
     def build() -> ToothMesh:
         V, F = tooth_surface(g, SURFACE_DENSITY, teeth)
-        P, T = tet_mesh(V, F, size, min_size, curvature)
+        for k, angle in enumerate(classify_angles_deg):
+            try:
+                P, T = tet_mesh(V, F, size, min_size, curvature, angle)
+                break
+            except Exception:  # gmsh raises a bare Exception
+                if k == len(classify_angles_deg) - 1:
+                    raise
         return ToothMesh(P, T, g.r_f2 - RIM_DEPTH_MX * g.m_x)
 
     parts = {"geometry": asdict(g), "density": density, "size_m": size, "code": CODE_VERSION}
-    if (teeth, min_size_m, curvature_elements) != (1, None, CURVATURE_ELEMENTS):
+    if (teeth, min_size_m, curvature_elements, classify_angles_deg) != (1, None, CURVATURE_ELEMENTS, (40.0,)):
         parts.update(teeth=teeth, min_size_m=min_size_m, curvature_elements=curvature_elements)
+        parts.update(angles=classify_angles_deg)
     return cached("fe-tooth", parts, build, use_cache=use_cache)
 
 

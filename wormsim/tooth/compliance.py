@@ -60,7 +60,7 @@ from meshgen import wheel, worm
 from meshgen.cache import cached
 from meshgen.geometry import GearGeometry
 
-CODE_VERSION = "tooth-compliance-1"
+CODE_VERSION = "tooth-compliance-2"
 GRID_FACE = 9  # flank grid points across the face width
 GRID_PROFILE = 5  # flank grid points along the profile
 TEETH = 3  # wheel teeth in the FE model: the loaded one and a neighbour on each side
@@ -69,6 +69,7 @@ WORM_RADII = 7  # load heights of the worm model, root .. tip
 LOAD_RADIUS_MX = 0.25  # load patch radius in axial modules (as wormsim.rating.fe_root.LOAD_RADIUS_MX)
 MIN_SIZE_MX = 0.75  # smallest FE element (at density 1), axial modules: the fillet needs no stress resolution here
 CURVATURE_ELEMENTS = 2  # FE elements per full turn of a curved surface at density 1
+CLASSIFY_ANGLES_DEG = (60.0, 50.0, 40.0, 30.0)  # gmsh's feature angles, tried in turn (fe_root.tooth_mesh)
 DIRECT_DOFS_MAX = 120000  # SuperLU below this many dofs: one factorisation, GRID_FACE x GRID_PROFILE solves
 INSET_MX = 0.05  # centre line points this far inside the end faces and the tip, in axial modules
 H_NORMAL_MX = 0.02  # finite-difference step of the flank normal, in axial modules
@@ -191,6 +192,21 @@ def flank_grid(g: GearGeometry) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.
     return zeta, s, X, n, C
 
 
+def _inside(finder, P: np.ndarray, step: float, tries: int = 40) -> np.ndarray:
+    """P with each point that lies outside the tetrahedral mesh (the meshed surface is a polyline of the exact one:
+    the tip torus's chords) moved radially inwards (towards the wheel axis) by `step` until it is inside."""
+    P = P.copy()
+    for i in range(len(P)):
+        for _ in range(tries):
+            try:
+                finder(*P[i][:, None])
+                break
+            except ValueError:
+                rho = math.hypot(P[i, 0], P[i, 1])
+                P[i, :2] *= (rho - step) / rho
+    return P
+
+
 def _turn(P: np.ndarray, angle: float) -> np.ndarray:
     c, s = math.cos(angle), math.sin(angle)
     return P @ np.array([[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]])
@@ -203,7 +219,12 @@ def wheel_influence(g: GearGeometry, e_pa: float, nu: float, density: int = 1, t
     from wormsim.rating import fe_root
 
     tm = fe_root.tooth_mesh(
-        g, density, teeth=teeth, min_size_m=MIN_SIZE_MX * g.m_x, curvature_elements=CURVATURE_ELEMENTS
+        g,
+        density,
+        teeth=teeth,
+        min_size_m=MIN_SIZE_MX * g.m_x,
+        curvature_elements=CURVATURE_ELEMENTS,
+        classify_angles_deg=CLASSIFY_ANGLES_DEG,
     )
     ib, free, solve = fe_root.elastic_solver(
         tm.points, tm.tets, e_pa, nu, fe_root.clamped_faces(g, tm.r_in, teeth), DIRECT_DOFS_MAX
@@ -214,7 +235,8 @@ def wheel_influence(g: GearGeometry, e_pa: float, nu: float, density: int = 1, t
     reads = [(Cf, nf)]
     if teeth >= 3:
         reads += [(_turn(Cf, pitch), _turn(nf, pitch)), (_turn(Cf, -pitch), _turn(nf, -pitch))]
-    probes = [ib.probes(P.T.copy()).tocsr() for P, _ in reads]
+    finder = ib.mesh.element_finder()
+    probes = [ib.probes(_inside(finder, P, INSET_MX * g.m_x).T.copy()).tocsr() for P, _ in reads]
     surf = np.unique(fe_root._boundary_faces(tm.tets))
     tree = cKDTree(tm.points[surf])
     nn = len(Xf)
@@ -340,13 +362,14 @@ def _moduli(materials) -> tuple[float, float, float, float]:
     return h.youngs_modulus_gpa * 1e9, h.poisson_ratio, w.youngs_modulus_gpa * 1e9, w.poisson_ratio
 
 
-def compute(g: GearGeometry, materials, density: int = 1) -> ToothCompliance:
-    """The FE models and the grid (module docstring)."""
+def compute(g: GearGeometry, materials, density: int = 1, teeth: int = TEETH) -> ToothCompliance:
+    """The FE models and the grid (module docstring); teeth: the wheel sector's teeth (1 for the study of the
+    neighbours' effect)."""
     from wormsim.gear_theory import effective_modulus_pa
 
     t0 = time.perf_counter()
     e2, nu2, e1, nu1 = _moduli(materials)
-    wh = wheel_influence(g, e2, nu2, density)
+    wh = wheel_influence(g, e2, nu2, density, teeth)
     wo = worm_compliance(g, e1, nu1, density)
     return ToothCompliance(
         zeta_m=wh["zeta"], s=wh["s"], points_m=wh["points"], wheel_m_per_n=wh["influence"],
@@ -364,6 +387,7 @@ def _tooth_compliance(g: GearGeometry, moduli: tuple, materials, density: int) -
         "moduli": moduli,
         "density": density,
         "grid": (GRID_FACE, GRID_PROFILE, TEETH, WORM_THREADS, WORM_RADII, LOAD_RADIUS_MX),
+        "mesh": (MIN_SIZE_MX, CURVATURE_ELEMENTS, CLASSIFY_ANGLES_DEG, INSET_MX, H_NORMAL_MX),
         "v": CODE_VERSION,
     }
     return cached("tooth-compliance", parts, lambda: compute(g, materials, density))
@@ -410,3 +434,38 @@ def line_stiffness_n_per_m2(
     res = ltca.loaded_contact(g, materials, t, samples=samples, density=density)
     unit = mesh_stiffness.mesh_stiffness(g, 1.0, "unit", samples)
     return float(np.mean(res.mesh_stiffness_n_per_m) / np.mean(unit.k_mesh_fwd_n_per_m))
+
+
+# ----------------------------------------------------------------------------- ISO 6336-1's estimate (for checks)
+
+E_STEEL_PA = 206e9  # ISO 6336-1's reference modulus
+ISO_C = (0.04723, 0.15551, 0.25791, -0.00635, -0.11654, -0.00193, -0.24188, 0.00529, 0.00182)  # C1 .. C9
+C_M = 0.8  # ISO 6336-1 theoretical -> measured single stiffness
+
+
+def iso6336_stiffness(g: GearGeometry, materials) -> dict:
+    """ISO 6336-1 method B's single stiffness c' and mesh stiffness c_gamma_alpha (N/(mm um) of face width) of the
+    wheel's virtual spur gear: z_n2 = z2 / cos^3(gamma), the worm as its rack (z_n1 -> infinity), no profile shift:
+
+        q' = C1 + C3 / z_n2,  c'_th = 1 / q',  c' = c'_th C_M C_R C_B cos(beta) E / E_st
+        C_B = [1 + 0.5 (1.2 - h_fP / m_n)] [1 - 0.02 (20 deg - alpha_n)],  C_R = 1 (solid wheel body),
+        beta = gamma (the wheel's helix angle), E = 2 E1 E2 / (E1 + E2), E_st = 206 GPa,
+        c_gamma_alpha = c' (0.75 eps_alpha + 0.25),
+        eps_alpha = [sqrt(r_a^2 - r_b^2) - r sin(alpha_n) + h_a / sin(alpha_n)] / (pi m_n cos(alpha_n))
+
+    (ISO 6336-1:2019, 9.3 and 9.4; the transverse contact ratio of a gear of z_n2 teeth with its basic rack, module
+    m_n, addendum h_a of both the wheel's addendum coefficient)."""
+    e1, e2 = materials.worm.youngs_modulus_gpa * 1e9, materials.wheel.youngs_modulus_gpa * 1e9
+    zn2 = g.z2 / math.cos(g.gamma) ** 3
+    q = ISO_C[0] + ISO_C[2] / zn2
+    h_fp = g.h_f / g.m_x  # the dedendum coefficient (of m_x; m_n differs by cos(gamma) < 0.5 % here)
+    c_b = (1 + 0.5 * (1.2 - h_fp)) * (1 - 0.02 * (20 - math.degrees(g.alpha_n)))
+    e_pair = 2 * e1 * e2 / (e1 + e2)
+    c1 = (1 / q) * C_M * c_b * math.cos(g.gamma) * e_pair / E_STEEL_PA
+    r = zn2 * g.m_n / 2
+    ha = g.h_a / g.m_x * g.m_n
+    ra, rb = r + ha, r * math.cos(g.alpha_n)
+    eps = (math.sqrt(ra**2 - rb**2) - r * math.sin(g.alpha_n) + ha / math.sin(g.alpha_n)) / (
+        math.pi * g.m_n * math.cos(g.alpha_n)
+    )
+    return {"c_prime": c1, "c_gamma": c1 * (0.75 * eps + 0.25), "eps_alpha": eps, "z_n2": zn2}
