@@ -164,8 +164,12 @@ CROSS_XFAIL = {
     ("involute_41", "axial_force_mean_n"): "torsional 2285.9 N against contact3d 2149.3 N (-6.0 %; contacts at "
     "47.3 against r1 45.0 mm)",
     ("seat_motor", "transmission_error_p2p_urad"): "torsional 325.3 urad against contact3d 219.9 urad (+48 %): the "
-    "torsional k(theta) from 64 TCA samples against the kernel's contacts on the flanks at 32 slices",
-    ("screw_jack", "transmission_error_p2p_urad"): "torsional 9.67 urad against contact3d 8.58 urad (+12.7 %)",
+    "torsional k(theta) from 64 TCA samples against the kernel's contacts on the flanks at 32 slices; the seed's K "
+    "overrides the teeth (decision 0029); with the teeth's compliance 1405 against 952 urad (+47.6 %), with Hertz "
+    "+47.9 %: not the stiffness level (docs/data/stiffness_seeds.json)",
+    ("screw_jack", "transmission_error_p2p_urad"): "torsional 9.67 urad against contact3d 8.58 urad (+12.7 %) with "
+    "the seed's K; with the teeth's compliance 14.3 against 12.5 urad (+14.2 %), with Hertz +1.9 % "
+    "(docs/data/stiffness_seeds.json)",
 }
 
 
@@ -181,7 +185,8 @@ CROSS_XFAIL = {
 )
 def test_torsional_agrees_with_contact3d_on_the_same_gear(name, key):
     """Measured: mean F_t within 0.02 %, efficiency and worm torque 1.2-1.8 % (torsional at the pitch radius), radial
-    force on the line of centres 0.3-0.6 %, TE p2p involute_41 +1.2 %."""
+    force on the line of centres 0.3-0.6 %, TE p2p involute_41 +8.0 % (its default: the teeth's compliance; +1.2 % with
+    Hertz's stiffer contact)."""
     c, t = run(name)["summary"], torsional_run(name)
     tkey, rel = CROSS[key]
     assert abs(t[tkey] / c[key] - 1) < rel, (key, t[tkey], c[key])

@@ -29,7 +29,8 @@ reported as mesh_stiffness_source / contact_stiffness_source):
                                           of the teeth's stiffness, docs/decisions/0029-contact-stiffness-override.md)
     not given (contact.stiffness_model):  "teeth" (the default): k' = wormsim.tooth.compliance.line_stiffness_n_per_m2,
                                           the teeth's bending, shear and rim compliance with the contact flattening,
-                                          so that this module's mean k_mesh is the loaded TCA's (wormsim.tooth.ltca);
+                                          so that this module's mean k_mesh is the loaded TCA's (wormsim.tooth.ltca) at
+                                          ISO 6336-1's reference line load 100 N/mm (compliance.reference_torque_nm);
                                           "hertz": k' = pi E* / 4 (Hertz line contact of seed 001, rigid teeth;
                                           K = pi L E* / 4 per length L)
 
