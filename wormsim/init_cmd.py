@@ -34,7 +34,7 @@ materials:                    # optional; these are the defaults (steel worm, br
   worm:  {{youngs_modulus_gpa: 210, poisson_ratio: 0.3,  density_kg_m3: 7850}}
   wheel: {{youngs_modulus_gpa: 100, poisson_ratio: 0.34, density_kg_m3: 8800}}
 
-contact:                      # optional: contact stiffness and damping default from Hertz
+contact:                      # optional: stiffness from the teeth's compliance, damping 10 % of critical
   friction: 0.04              # one Coulomb coefficient; or friction_static + friction_dynamic, or friction_group
 
 drive:
