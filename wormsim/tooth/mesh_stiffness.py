@@ -130,6 +130,12 @@ def per_length_stiffness(contact: Contact, g: GearGeometry, materials: Materials
 def pair_stiffness_n_per_m(contact: Contact, g: GearGeometry, materials: Materials) -> tuple[float, str]:
     """(K = k' b2, the stiffness of one tooth pair whose contact line spans the face width, as contact3d's law reads
     it; its source): per_length_stiffness over the face width."""
+    # the scenario's K and Hertz's pi b2 E* / 4 as written (bit for bit: a run above the stable limit rings or not on
+    # the last bit of K, tests/test_contact3d_ringing.py), the teeth's k' b2
+    if contact.stiffness_n_per_m is not None:
+        return contact.stiffness_n_per_m, "scenario"
+    if contact.stiffness_model == "hertz":
+        return math.pi * g.face_width * effective_modulus_pa(materials) / 4.0, "hertz"
     kp, source = per_length_stiffness(contact, g, materials)
     return kp * g.face_width, source
 
