@@ -122,9 +122,16 @@ def per_length_stiffness(contact: Contact, g: GearGeometry, materials: Materials
         return contact.stiffness_n_per_m / g.face_width, "scenario"
     if contact.stiffness_model == "hertz":
         return hertz_per_length_n_per_m2(materials), "hertz"
+    from wormsim.errors import SimulationError
     from wormsim.tooth.compliance import line_stiffness_n_per_m2
 
-    return float(line_stiffness_n_per_m2(g, materials)), "teeth"
+    try:
+        return float(line_stiffness_n_per_m2(g, materials)), "teeth"
+    except Exception as exc:  # the FE mesher or solver on an unusual gear: say what to set instead (exit 3)
+        raise SimulationError(
+            f"the teeth's compliance could not be computed for this gear ({type(exc).__name__}: {exc}); set "
+            f"contact.stiffness_n_per_m (one tooth pair's stiffness, N/m) or contact.stiffness_model=hertz"
+        ) from exc
 
 
 def pair_stiffness_n_per_m(contact: Contact, g: GearGeometry, materials: Materials) -> tuple[float, str]:
