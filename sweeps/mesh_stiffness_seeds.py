@@ -1,7 +1,8 @@
 """The torsional level's mesh stiffness k(theta) on each seed file as it is (docs/torsional.md, "Mesh stiffness"):
 the tooth contact analysis' mean, min and max along the line of action, the teeth and contact-line length in
-contact, the tooth-pair stiffness K it is compared with (the scenario's, or the Hertz line contact over b2), and the
-full-band force peak of the run. Writes the record docs/data/mesh_stiffness_seeds.json.
+contact, the tooth-pair stiffness K it is compared with (wormsim.tooth.stiffness.pair_stiffness_n_per_m: the
+scenario's, the teeth's or the Hertz line contact's over b2), and the full-band force peak of the run.
+Writes the record docs/data/mesh_stiffness_seeds.json.
 
     .venv/bin/python sweeps/mesh_stiffness_seeds.py
 """
@@ -11,9 +12,9 @@ from __future__ import annotations
 from pathlib import Path
 
 from meshgen.geometry import derive
-from wormsim.contact3d.law import hertz_line_stiffness_n_per_m
 from wormsim.provenance import record
 from wormsim.scenario import load_scenario
+from wormsim.tooth.stiffness import pair_stiffness_n_per_m
 from wormsim.torsional.dynamics import simulate
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -36,7 +37,7 @@ def main() -> None:
     for seed in SEEDS:
         sc = load_scenario(ROOT / "scenarios" / f"{seed}.yaml", ["model=torsional"])
         g = derive(sc.gear)
-        pair = sc.contact.stiffness_n_per_m or hertz_line_stiffness_n_per_m(sc.materials, g.face_width)
+        pair, _ = pair_stiffness_n_per_m(sc.contact, g, sc.materials)
         s = simulate(sc).summary
         runs[seed] = {
             "pair_stiffness_n_per_m": pair,

@@ -22,6 +22,7 @@ from wormsim.gear_theory import effective_modulus_pa
 from wormsim.provenance import record
 from wormsim.scenario import load_scenario
 from wormsim.tooth import compliance, ltca, mesh_stiffness
+from wormsim.tooth import stiffness as ST
 
 ROOT = Path(__file__).resolve().parents[1]
 SEEDS = ("seat_motor", "screw_jack", "involute_41")
@@ -51,7 +52,7 @@ def main() -> None:
         res = ltca.loaded_contact(g, sc.materials, t)
         hertz_kp = math.pi * effective_modulus_pa(sc.materials) / 4
         hz = mesh_stiffness.mesh_stiffness(g, hertz_kp, "hertz", 16)
-        kp = compliance.line_stiffness_n_per_m2(g, sc.materials, t)
+        kp = ST.line_stiffness_n_per_m2(g, sc.materials, t)
         runs[seed] = {
             "torque_nm": t,
             "face_width_mm": g.face_width * 1e3,

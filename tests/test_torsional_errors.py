@@ -14,7 +14,8 @@ import pytest
 from wormsim import gear_theory as gt
 from wormsim.geometry import derive, displaced_pair
 from wormsim.scenario import load_scenario
-from wormsim.tooth.mesh_stiffness import mesh_stiffness, per_length_stiffness, stiffness_at
+from wormsim.tooth.mesh_stiffness import mesh_stiffness, stiffness_at
+from wormsim.tooth.stiffness import per_length_stiffness
 from wormsim.torsional import loaded_tca as lt
 
 SCEN = Path(__file__).resolve().parents[1] / "scenarios"
@@ -29,7 +30,7 @@ CONTACT3D = {
 def _pair(name: str, sets=()):
     sc = load_scenario(SCEN / f"{name}.yaml", ["model=torsional", *sets])
     g = derive(sc.gear)
-    kp, src = per_length_stiffness(sc.contact.stiffness_n_per_m, g.face_width, gt.effective_modulus_pa(sc.materials))
+    kp, src = per_length_stiffness(sc.contact, g, sc.materials)
     return sc, g, kp, src
 
 

@@ -1062,8 +1062,49 @@ def rexs_rating_table(name: str = "rexs_stages") -> str:
     return _table(["stage"] + [h for _, h in keys], rows) + "\n" + _source(name)
 
 
+def stiffness_seeds_table(name: str = "stiffness_seeds") -> str:
+    """The seeds' CI runs with each source of the tooth-pair stiffness (sweeps/stiffness_seeds.py): the seed's own K,
+    Hertz's rigid line contact, the teeth's compliance; contact3d's step and speed, the fluctuations, pattern and
+    pressure, and torsional's TE beside contact3d's."""
+    rec = load(name)
+    rows = []
+    for seed, modes in rec["runs"].items():
+        for mode, r in modes.items():
+            c, t = r["contact3d"], r["torsional"]
+            te_c, te_t = c["transmission_error_p2p_urad"], t["transmission_error_p2p_urad"]
+            rows.append(
+                [
+                    f"{seed}, {mode}",
+                    f"{c['contact_pair_stiffness_n_per_m']:.3g} N/m ({c['contact_stiffness_source']})",
+                    f"{_fmt(c.get('mesh_stiffness_mean_n_per_m'))} N/m; "
+                    f"{_fmt(c.get('mesh_stiffness_per_width_n_per_mm_um'))}",
+                    f"{c['timestep_s']:g} s; {c['wall_s_per_simulated_s']:.3g}",
+                    f"{c['tangential_force_mean_n']:.1f} N; {c['efficiency']:.4f}",
+                    f"{c['tangential_force_p2p_n']:.3g} N",
+                    f"{te_c:.4g} / {te_t:.4g} urad ({100 * (te_t / te_c - 1):+.1f} %)",
+                    f"{c['contact_pattern_centroid_face_mm']:.2f} / {c['contact_pattern_centroid_radius_mm']:.2f} mm",
+                    f"{c['contact_pressure_max_mpa']:.0f} MPa",
+                    f"{_fmt(c.get('transmission_error_loaded_p2p_urad'))} urad; {_fmt(c.get('load_share_max'))}",
+                ]
+            )
+    head = [
+        "seed, stiffness",
+        "tooth pair K (source)",
+        "k_mesh mean; per width N/(mm um)",
+        "contact3d step; wall s per simulated s",
+        "F_t mean; efficiency",
+        "F_t p2p",
+        "TE p2p contact3d / torsional",
+        "pattern centroid face / radius",
+        "p_H max",
+        "LTCA TE p2p; largest load share",
+    ]
+    return _table(head, rows) + "\n" + _source(name)
+
+
 TABLES: dict[str, Callable[[], str]] = {
     "calculix_check": calculix_check_table,
+    "stiffness_seeds": stiffness_seeds_table,
     "torsional_seeds": torsional_seeds_table,
     "rexs_stages": rexs_stages_table,
     "rexs_rating": rexs_rating_table,

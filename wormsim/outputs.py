@@ -358,7 +358,7 @@ KEYS: dict[str, Key] = {
     "integrator": Key("text", C, "MuJoCo integrator used"),
     "record_every": Key("-", C, "steps per stored sample"),
     "contact_pair_stiffness_n_per_m": Key("N/m", C, "stiffness of one contact pair of the contact law"),
-    "contact_stiffness_source": Key("text", C, "scenario or Hertz"),
+    "contact_stiffness_source": Key("text", C, "teeth, scenario or hertz (as mesh_stiffness_source)"),
     "contact_exponent_reported": Key("-", C, "contact law exponent e"),
     "contacts_per_pair_ref": Key("-", C, "contacts per tooth pair the stiffness is divided over"),
     "contact_damping_requested_n_s_per_m": Key("N s/m", GEAR, "contact.damping_n_s_per_m as given (or its default)"),
@@ -398,8 +398,34 @@ KEYS: dict[str, Key] = {
     "drive_kv_nm_s": Key("N m s", T, "speed servo gain of a speed-driven shaft (null for a torque drive)"),
     "backlash_angle_rad": Key("rad", T, "wheel-angle play of the mesh"),
     "mesh_stiffness_samples": Key("-", T, "k(theta) samples per mesh cycle"),
-    "mesh_stiffness_source": Key("text", T, "scenario (contact.stiffness_n_per_m) or Hertz"),
-    "mesh_stiffness_mean_n_per_m": Key("N/m", T, "mean mesh stiffness over a mesh cycle"),
+    "mesh_stiffness_source": Key(
+        "text",
+        GEAR,
+        "where the tooth pair's stiffness comes from: teeth (the teeth's compliance, bending and contact flattening: "
+        "the default), scenario (contact.stiffness_n_per_m, an override) or hertz (contact.stiffness_model: hertz)",
+    ),
+    "mesh_stiffness_mean_n_per_m": Key(
+        "N/m",
+        GEAR,
+        "mean mesh stiffness over a mesh cycle along the line of action at r2 cos(alpha_n) cos(gamma) (the TCA with "
+        "the run's stiffness per contact length; with the teeth's: bending included)",
+    ),
+    "mesh_stiffness_per_width_n_per_mm_um": Key(
+        "N/(mm um)", GEAR, "mesh_stiffness_mean_n_per_m per mm of face width b2 (ISO 6336-1's unit of c_gamma)"
+    ),
+    "transmission_error_loaded_p2p_urad": Key(
+        "urad",
+        GEAR,
+        "loaded transmission error p2p over a mesh cycle from the loaded tooth contact analysis of the teeth's "
+        "compliance at the working wheel torque on the working flank (quasi-static; null unless "
+        "mesh_stiffness_source is teeth, and with errors:)",
+    ),
+    "load_share_max": Key(
+        "-",
+        GEAR,
+        "largest share of the load on one wheel tooth over a mesh cycle, from the same loaded tooth contact analysis "
+        "(null unless mesh_stiffness_source is teeth, and with errors:)",
+    ),
     "mesh_stiffness_min_n_per_m": Key("N/m", T, "smallest mesh stiffness over a mesh cycle"),
     "mesh_stiffness_max_n_per_m": Key("N/m", T, "largest mesh stiffness over a mesh cycle"),
     "contact_line_length_mean_mm": Key("mm", T, "mean total contact line length"),

@@ -160,9 +160,27 @@ class Materials(_Strict):
 
 
 class Contact(_Strict):
-    """Tooth contact. Every key optional; defaults derived from Hertz (docs/models.md, 'Contact law')."""
+    """Tooth contact. Every key optional; the stiffness defaults to the teeth's own compliance (docs/models.md,
+    'Contact law')."""
 
-    stiffness_n_per_m: float | None = Field(None, gt=0, le=1e13, description="ADAMS IMPACT K")
+    stiffness_n_per_m: float | None = Field(
+        None,
+        gt=0,
+        le=1e13,
+        description=(
+            "ADAMS IMPACT K: one tooth pair's stiffness (contact line across the face width), an override of the "
+            "teeth's computed stiffness, as the seeds' ADAMS penalty constants ran (docs/decisions/"
+            "0034-contact-stiffness-override.md); unset: contact.stiffness_model"
+        ),
+    )
+    stiffness_model: Literal["teeth", "hertz"] = Field(
+        "teeth",
+        description=(
+            "without stiffness_n_per_m: teeth (the teeth's bending and the contact flattening, FE influence "
+            "coefficients, wormsim.tooth.compliance) | hertz (Hertz line contact pi E* / 4 per length: rigid teeth, "
+            "5-7x stiffer)"
+        ),
+    )
     exponent: float = Field(1.5, ge=1, le=3, description="ADAMS IMPACT e")
     damping_n_s_per_m: float | None = Field(None, ge=0, le=1e10, description="ADAMS IMPACT C")
     penetration_depth_m: float = Field(1e-5, gt=0, le=0.01, description="ADAMS IMPACT d (full damping depth)")
@@ -701,6 +719,7 @@ LEVEL_KEYS: dict[str, tuple[str, ...]] = {
 
 WEDGE_IGNORES_CONTACT = (
     "stiffness_n_per_m",
+    "stiffness_model",
     "exponent",
     "damping_n_s_per_m",
     "penetration_depth_m",

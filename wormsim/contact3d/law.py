@@ -38,8 +38,12 @@ A tooth pair touches along a line; the convex collision pieces turn it into seve
 number of wheel-tooth pieces across the face width per flank (`contacts_per_pair`), so a pair whose
 line contact spans the face carries K.
 
-Defaults when `stiffness_n_per_m` is absent: Hertz line contact of seed 001, K = pi L E* / 4 with
-L = wheel face width b2 and 1/E* = (1 - nu1^2)/E1 + (1 - nu2^2)/E2. Default damping: 10 % of critical.
+K is k' b2 with k' the per-length stiffness of wormsim.tooth.stiffness.per_length_stiffness, the one place
+every level takes it from: the scenario's K (an override of the teeth's stiffness, as the seeds' ADAMS penalty
+constants ran: docs/decisions/0034-contact-stiffness-override.md), else the teeth's own compliance (bending, shear,
+rim and contact flattening, wormsim.tooth.compliance: a tooth pair in MuJoCo is as stiff as the loaded TCA says), or
+with contact.stiffness_model hertz the Hertz line contact of seed 001, K = pi L E* / 4 with L = b2 and
+1/E* = (1 - nu1^2)/E1 + (1 - nu2^2)/E2. Default damping: 10 % of critical.
 
 Friction: MuJoCo has one Coulomb coefficient per contact (elliptic cone). We set it every few steps
 from the sliding speed Vs = omega1 r1 / cos(gamma) (seed 000):
@@ -92,8 +96,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from wormsim.gear_theory import DEFAULT_DAMPING_RATIO, MAX_DAMPING_RATIO, effective_modulus_pa
+from meshgen.geometry import GearGeometry
+from wormsim.gear_theory import DEFAULT_DAMPING_RATIO, MAX_DAMPING_RATIO
 from wormsim.scenario import Contact, Materials
+from wormsim.tooth.stiffness import hertz_per_length_n_per_m2, pair_stiffness_n_per_m
 
 STABLE_LIMIT_PAIRS = 3  # tooth pairs in contact at once that the stable limit allows for
 EPS_SLIP = 0.01  # (4): the sliding contact's spurious normal force, share of its static load
@@ -105,7 +111,7 @@ class ContactLaw:
     """Numbers of the mapping (1); SI units."""
 
     pair_stiffness_n_per_m: float  # K, one tooth pair (linear, secant)
-    stiffness_source: str  # "scenario" | "hertz"
+    stiffness_source: str  # "teeth" | "scenario" | "hertz" (wormsim.tooth.stiffness.STIFFNESS_SOURCES)
     exponent: float  # ADAMS e (reported, not representable)
     contacts_per_pair: int  # n_ref
     contact_stiffness_n_per_m: float  # k_c = K / n_ref
@@ -160,27 +166,20 @@ class ContactLaw:
 
 
 def hertz_line_stiffness_n_per_m(materials: Materials, contact_length_m: float) -> float:
-    """K = pi L E* / 4 (seed 001, Hertz line contact of two cylinders)."""
-    return math.pi * contact_length_m * effective_modulus_pa(materials) / 4.0
-
-
-def pair_stiffness_n_per_m(contact: Contact, materials: Materials, face_width_m: float) -> tuple[float, str]:
-    """(the tooth pair's stiffness, its source): contact.stiffness_n_per_m ("scenario"), else the Hertz line
-    stiffness over the face width ("hertz")."""
-    if contact.stiffness_n_per_m is not None:
-        return contact.stiffness_n_per_m, "scenario"
-    return hertz_line_stiffness_n_per_m(materials, face_width_m), "hertz"
+    """K = pi L E* / 4 (seed 001, Hertz line contact of two cylinders): hertz_per_length_n_per_m2 times L."""
+    return contact_length_m * hertz_per_length_n_per_m2(materials)
 
 
 def contact_law(
-    contact: Contact, materials: Materials, face_width_m: float, contacts_per_pair: int, inv_mass_hat: float
+    contact: Contact, materials: Materials, g: GearGeometry, contacts_per_pair: int, inv_mass_hat: float
 ) -> ContactLaw:
-    """Map the scenario's contact block onto per-contact solref/solimp by (1).
+    """Map the scenario's contact block onto per-contact solref/solimp by (1); K from
+    wormsim.tooth.stiffness.pair_stiffness_n_per_m (module docstring).
 
     `inv_mass_hat` is A_hat = 1 / m_eff, the constraint-space inverse mass the model assigns to every
     worm-wheel contact (wormsim.contact3d.mjcf sets body_invweight0 so that it holds).
     """
-    k_pair, source = pair_stiffness_n_per_m(contact, materials, face_width_m)
+    k_pair, source = pair_stiffness_n_per_m(contact, g, materials)
     n_ref = max(int(contacts_per_pair), 1)
     k_c = k_pair / n_ref
     m_eff = 1.0 / inv_mass_hat

@@ -316,7 +316,7 @@ def prepare(scenario: Scenario, gs: GearSet | None = None) -> Prepared:
     I1 = ine.worm_inertia_kg_m2 + ine.worm_load_inertia_kg_m2
     I2 = ine.wheel_inertia_kg_m2 + ine.wheel_load_inertia_kg_m2
     # simulation.mass_scaling (wormsim.contact3d.mass_scaling): every inertia x S before the law takes them
-    k_pair, _ = pair_stiffness_n_per_m(scenario.contact, scenario.materials, geo.face_width)
+    k_pair, _ = pair_stiffness_n_per_m(scenario.contact, geo, scenario.materials)
     scaling = mass_scaling.resolve(
         scenario.simulation.mass_scaling,
         duty,
@@ -335,7 +335,7 @@ def prepare(scenario: Scenario, gs: GearSet | None = None) -> Prepared:
         ine = Inertias(*(S * v for v in astuple(ine)))
         if flanks and not scenario.contact.slices:
             slabs = min(slabs, SLICES_MASS_SCALED)  # a scaled run keeps means only (tooth.grid.SLICES_MASS_SCALED)
-    law = contact_law(scenario.contact, scenario.materials, geo.face_width, slabs, a1 + a2)  # the law, once
+    law = contact_law(scenario.contact, scenario.materials, geo, slabs, a1 + a2)  # the law, once
     mu_max = max(mu0, mu1)
     if flanks:  # the flank contacts' own friction-row damping, law (4)
         law = replace(

@@ -11,6 +11,7 @@ wheel meshes under /assembly/worm and /assembly/wheel moved by their 4x4 transfo
 `ARROW_N_PER_MM` newtons) at up to MAX_FRAMES instants. With exact flanks: the steady-window contact
 pattern on every wheel tooth, coloured by pressure (/assembly/wheel/contact_pattern, wormsim.tooth.hertz.log_pattern),
 and in report.png the pattern as a band on the wheel flank coloured by pressure (wormsim.tooth.hertz.draw_pattern).
+Below: the mesh stiffness k(theta1) and the load share of each wheel tooth (wormsim.tooth.stiffness_plot).
 """
 
 from __future__ import annotations
@@ -71,8 +72,10 @@ def write_report(result: Result, path) -> None:
         else "",
     )
     hh = header_rows(lines, warn)
-    fig = plt.figure(figsize=(13, 8.8 + hh))
-    gs = fig.add_gridspec(3, 2, height_ratios=[hh, 4.4, 4.4])
+    ms = result.extra.get("mesh_stiffness")
+    rows = [hh, 4.4, 4.4] + ([4.4] if ms is not None else [])
+    fig = plt.figure(figsize=(13, sum(rows)))
+    gs = fig.add_gridspec(len(rows), 2, height_ratios=rows)
     ax = np.array([[fig.add_subplot(gs[i, j]) for j in range(2)] for i in (1, 2)])
     draw_header(
         fig.add_subplot(gs[0, :]),
@@ -159,6 +162,11 @@ def write_report(result: Result, path) -> None:
         lo, hi = min(geo.r_f2 * 1e3, float(rr.min())), max(geo.r_e2 * 1e3, float(rr.max()))
         a.set_ylim(lo - 0.15 * (hi - lo), hi + 0.1 * (hi - lo))
         a.set(xlabel="across the face (wheel z) [mm]", ylabel="radius [mm]", title="contact pattern on a wheel tooth")
+    if ms is not None:  # the tooth pair's stiffness and load shares (wormsim.tooth.stiffness_plot), as at torsional
+        from wormsim.tooth.stiffness_plot import draw_load_shares, draw_mesh_stiffness
+
+        draw_mesh_stiffness(fig.add_subplot(gs[3, 0]), ms, result.extra.get("ltca"))
+        draw_load_shares(fig.add_subplot(gs[3, 1]), result.extra.get("ltca"), ms.stiffness_source)
     fig.tight_layout()
     fig.set_layout_engine(None)  # tight_layout leaves a placeholder engine: savefig would draw twice
     fig.savefig(path, dpi=110)

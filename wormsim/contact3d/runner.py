@@ -106,7 +106,10 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
         if held is None
         else held_keys(S["t_s"], S["worm_speed_rpm"], S["wheel_torque_nm"], held.stuck_since_s or held.t_s)
     )
+    st_keys, ms, lt = _stiffness_outputs(scenario, bm)  # the tooth pair's stiffness and load sharing (torsional's)
+    summary.update(st_keys)
     extra = {"points_tooth0": store[0], "points_world": store[2], "forces_world": store[1], "built": bm}
+    extra.update({"mesh_stiffness": ms, "ltca": lt})
     src.finish(S, summary, extra)
     if slog is not None:  # the shafts' deflections and bearing forces
         S.update(slog.series())
@@ -175,6 +178,30 @@ def force_signs(S: dict, hand: int) -> None:
     S["radial_force_n"] *= -1.0
     S["radial_force_line_of_centres_n"] *= -1.0
     S["axial_force_n"] *= -float(hand)
+
+
+def _stiffness_outputs(scenario: Scenario, bm: BuiltModel) -> tuple[dict, object, object | None]:
+    """wormsim.tooth.stiffness.stiffness_outputs with the law's k' (K = k' b2): the same keys as torsional's, from
+    the TCA table at the default sample count (simulation.mesh_stiffness_samples is torsional's); with the TCA and the
+    LTCA (None unless the teeth's stiffness is used) for the report."""
+    from wormsim import gear_theory as gt
+    from wormsim.geometry import displaced_pair
+    from wormsim.scenario import Simulation
+    from wormsim.tooth.mesh_stiffness import mesh_stiffness
+    from wormsim.tooth.stiffness import per_length_stiffness, stiffness_outputs
+
+    g = bm.geometry
+    kp, source = per_length_stiffness(scenario.contact, g, scenario.materials)
+    ms = mesh_stiffness(g, kp, source, Simulation.model_fields["mesh_stiffness_samples"].default)
+    keys, lt = stiffness_outputs(
+        ms,
+        g,
+        scenario.materials,
+        gt.working_wheel_torque_nm(scenario, g.ratio),
+        gt.working_flank(scenario, g.hand),
+        errors=displaced_pair(scenario.errors, g) is not None,
+    )
+    return keys, ms, lt
 
 
 def _run_summary(

@@ -422,20 +422,6 @@ def reference_torque_nm(g: GearGeometry) -> float:
     return REFERENCE_LINE_LOAD_N_PER_M * g.face_width * g.r2
 
 
-def line_stiffness_n_per_m2(
-    g: GearGeometry, materials, torque_nm: float | None = None, samples: int = 16, density: int = 1
-) -> float:
-    """k'_eff (N/m per m of contact line): the per-length stiffness that makes wormsim.tooth.mesh_stiffness's mean
-    k_mesh equal the LTCA's mean mesh stiffness (wormsim.tooth.ltca) at wheel torque torque_nm (default
-    reference_torque_nm), flank side +1."""
-    from wormsim.tooth import ltca, mesh_stiffness
-
-    t = reference_torque_nm(g) if torque_nm is None else abs(torque_nm)
-    res = ltca.loaded_contact(g, materials, t, samples=samples, density=density)
-    unit = mesh_stiffness.mesh_stiffness(g, 1.0, "unit", samples)
-    return float(np.mean(res.mesh_stiffness_n_per_m) / np.mean(unit.k_mesh_fwd_n_per_m))
-
-
 # ----------------------------------------------------------------------------- ISO 6336-1's estimate (for checks)
 
 E_STEEL_PA = 206e9  # ISO 6336-1's reference modulus

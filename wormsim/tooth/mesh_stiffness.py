@@ -22,10 +22,17 @@ s in [0, 1] spanning rho from the worm tip's reach a - sqrt(r_a1^2 - zeta^2) to 
 Conjugate flanks touch along the whole line at once (line contact, no ease-off), so a line's load is
 spread uniformly along it: a linear stiffness k' per unit length.
 
-Stiffness per unit line length k':
-    contact.stiffness_n_per_m = K given:  k' = K / b2   (K is one tooth pair whose contact line spans the
-                                          face width, as contact3d reads it: wormsim.contact3d.law)
-    not given (Hertz, seed 001):          k' = pi E* / 4  (K = pi L E* / 4 per length L)
+Stiffness per unit line length k' (wormsim.tooth.stiffness.per_length_stiffness: the one place every level takes it
+from; its source is reported as mesh_stiffness_source / contact_stiffness_source):
+    contact.stiffness_n_per_m = K given:  k' = K / b2   "scenario" (K is one tooth pair whose contact line spans
+                                          the face width, as contact3d reads it: wormsim.contact3d.law; an override
+                                          of the teeth's stiffness, docs/decisions/0034-contact-stiffness-override.md)
+    not given (contact.stiffness_model):  "teeth" (the default): k' = wormsim.tooth.stiffness.line_stiffness_n_per_m2,
+                                          the teeth's bending, shear and rim compliance with the contact flattening,
+                                          so that this module's mean k_mesh is the loaded TCA's (wormsim.tooth.ltca) at
+                                          ISO 6336-1's reference line load 100 N/mm (compliance.reference_torque_nm);
+                                          "hertz": k' = pi E* / 4 (Hertz line contact of seed 001, rigid teeth;
+                                          K = pi L E* / 4 per length L)
 
 Projection on the line of action. A wheel lag angle e (worm held) closes the normal gap at a contact point by
 arm * e, arm = moment arm of the flank normal about the wheel axis. With the flank written as
@@ -82,7 +89,7 @@ class MeshStiffness:
     teeth_rev: np.ndarray
     arm0_m: float  # r2 cos(alpha_n) cos(gamma)
     stiffness_per_length_n_per_m2: float  # k'
-    stiffness_source: str  # "scenario" | "hertz"
+    stiffness_source: str  # STIFFNESS_SOURCES: "teeth" | "scenario" | "hertz"
     samples: int
 
     def summary(self) -> dict:
@@ -95,13 +102,6 @@ class MeshStiffness:
             "contact_line_length_mean_mm": float(np.mean(self.length_fwd_m) * 1e3),
             "teeth_in_contact_mean": float(np.mean(self.teeth_fwd)),
         }
-
-
-def per_length_stiffness(stiffness_n_per_m: float | None, face_width_m: float, e_star_pa: float) -> tuple[float, str]:
-    """k' (N/m per m of contact line): K / b2 when the scenario gives K, else Hertz pi E* / 4 (seed 001)."""
-    if stiffness_n_per_m is not None:
-        return stiffness_n_per_m / face_width_m, "scenario"
-    return math.pi * e_star_pa / 4.0, "hertz"
 
 
 @dataclass(frozen=True)

@@ -87,7 +87,8 @@ from wormsim.locking import Held, backdrive_self_locks, held_keys, run_keys
 from wormsim.metrics import dominant_frequency, drive_summary, mean_speeds_rpm, mesh_line_keys, window_of
 from wormsim.result import Result
 from wormsim.scenario import Scenario
-from wormsim.tooth.mesh_stiffness import MeshStiffness, mesh_stiffness, per_length_stiffness
+from wormsim.tooth.mesh_stiffness import MeshStiffness, mesh_stiffness
+from wormsim.tooth.stiffness import per_length_stiffness, stiffness_outputs
 from wormsim.units import rad_s_to_rpm, step
 
 CHORD_ITER = 4  # backward Euler: Newton iterations that reuse the first Jacobian of a step
@@ -403,9 +404,7 @@ def simulate(scenario: Scenario, progress=None, method: str = "implicit") -> Res
     if scipy_method is None and method != "implicit":
         raise ValueError(f"torsional method {method!r}: allowed implicit, {', '.join(SCIPY_METHODS.values())}")
     g = derive(scenario.gear)
-    kp, src = per_length_stiffness(
-        scenario.contact.stiffness_n_per_m, g.face_width, gt.effective_modulus_pa(scenario.materials)
-    )
+    kp, src = per_length_stiffness(scenario.contact, g, scenario.materials)
     t_ms = time.perf_counter()
     ms = mesh_stiffness(g, kp, src, scenario.simulation.mesh_stiffness_samples)
     t_ms = time.perf_counter() - t_ms
@@ -493,6 +492,10 @@ def simulate(scenario: Scenario, progress=None, method: str = "implicit") -> Res
         **out,
     }
     summary = torsional_summary(S, scenario, g, ms)
+    t2_work = gt.working_wheel_torque_nm(scenario, g.ratio)
+    st_keys, lt_teeth = stiffness_outputs(
+        ms, g, scenario.materials, t2_work, gt.working_flank(scenario, g.hand), errors=pair is not None
+    )
     summary.update(
         run_keys(scenario, g, t, S["worm_speed_rpm"])
         if held is None
@@ -517,6 +520,7 @@ def simulate(scenario: Scenario, progress=None, method: str = "implicit") -> Res
             "backlash_angle_rad": 2 * mesh.gap,
             "friction": friction_mode(scenario.contact),
             **ms.summary(),
+            **st_keys,
         }
     )
     if kin is not None:
@@ -535,7 +539,7 @@ def simulate(scenario: Scenario, progress=None, method: str = "implicit") -> Res
         series=S,
         steps=len(t) - 1,
         sim_time_s=float(t[-1]),
-        extra={"mesh_stiffness": ms, "geometry": g},
+        extra={"mesh_stiffness": ms, "geometry": g, "ltca": lt_teeth},
     )
 
 

@@ -20,13 +20,15 @@ from wormsim.report_header import (
 )
 from wormsim.result import Result
 from wormsim.tooth.mesh_stiffness import MeshStiffness
+from wormsim.tooth.stiffness_plot import draw_load_shares, draw_mesh_stiffness
 
 # ----------------------------------------------------------------------------- report, recording
 
 
 def write_report(result: Result, path) -> None:
     """report.png: a header (gear, torques, powers, efficiency, self-locking); speeds, forces, transmission error
-    (axes scaled to the steady window, the start-up peak as a number), and k(theta) over one mesh cycle."""
+    (axes scaled to the steady window, the start-up peak as a number), k(theta) over one mesh cycle and the load share
+    of each wheel tooth (wormsim.tooth.stiffness_plot)."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -40,8 +42,10 @@ def write_report(result: Result, path) -> None:
     lines = [gear_line(geo) if geo is not None else "", shafts_line(sm), results_line(sm, geo)]
     warn = warning_text(sm)
     hh = header_rows(lines, warn)
-    fig = plt.figure(figsize=(12, 7.6 + hh), constrained_layout=True)
-    gs = fig.add_gridspec(3, 2, height_ratios=[hh, 3.8, 3.8])
+    lt = result.extra.get("ltca")  # the loaded TCA of the teeth's compliance (None unless the run uses it)
+    rows = [hh, 3.8, 3.8] + ([3.8] if lt is not None else [])
+    fig = plt.figure(figsize=(12, sum(rows)), constrained_layout=True)
+    gs = fig.add_gridspec(len(rows), 2, height_ratios=rows)
     ax = np.array([[fig.add_subplot(gs[i, j]) for j in range(2)] for i in (1, 2)])
     draw_header(
         fig.add_subplot(gs[0, :]),
@@ -84,14 +88,9 @@ def write_report(result: Result, path) -> None:
     a.set_xlabel("t [s]")
     a.set_ylabel("transmission error [urad]")
     a.set_title("theta2 - hand theta1 z1/z2 (axes: steady window)")
-    a = ax[1, 1]
-    deg = np.degrees(ms.theta1_rad)
-    a.plot(deg, ms.k_mesh_fwd_n_per_m, "o-", ms=3, label="flank side +1 (forward)")
-    a.plot(deg, ms.k_mesh_rev_n_per_m, "s--", ms=3, label="flank side -1")
-    a.set_xlabel("worm angle in the mesh cycle [deg]")
-    a.set_ylabel("k on the line of action [N/m]")
-    a.set_title(f"mesh stiffness (TCA, {ms.samples} samples)")
-    a.legend(fontsize=8)
+    draw_mesh_stiffness(ax[1, 1], ms, lt)
+    if lt is not None:
+        draw_load_shares(fig.add_subplot(gs[3, :]), lt, ms.stiffness_source)
     path = Path(path)
     tmp = path.with_name(f".{path.name}.tmp.png")
     fig.savefig(tmp, dpi=100)

@@ -1,0 +1,78 @@
+"""One home for the tooth pair's stiffness (wormsim.tooth.stiffness.per_length_stiffness, issue 30): both levels
+take k' from it, report its source, and contact3d's timestep follows the stiffness it gives
+(docs/decisions/0034-contact-stiffness-override.md)."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+from conftest import SCENARIOS
+
+from meshgen.geometry import derive
+from wormsim.contact3d.mjcf import prepare
+from wormsim.contact3d.timestep import choose_timestep
+from wormsim.gear_theory import effective_modulus_pa
+from wormsim.scenario import load_scenario
+from wormsim.tooth import stiffness as ST
+
+SCREW = SCENARIOS / "screw_jack.yaml"
+UNSET = "contact.stiffness_n_per_m=null"
+
+
+def _sc(*sets):
+    return load_scenario(SCREW, list(sets))
+
+
+def test_an_explicit_stiffness_overrides_the_teeth():
+    sc = _sc()
+    g = derive(sc.gear)
+    kp, src = ST.per_length_stiffness(sc.contact, g, sc.materials)
+    assert src == "scenario"
+    assert kp * g.face_width == pytest.approx(4.39e8, rel=1e-12)  # the seed's ADAMS K, as it ran
+
+
+def test_hertz_is_pi_e_star_over_4():
+    sc = _sc(UNSET, "contact.stiffness_model=hertz")
+    kp, src = ST.per_length_stiffness(sc.contact, derive(sc.gear), sc.materials)
+    assert src == "hertz"
+    assert kp == pytest.approx(math.pi * effective_modulus_pa(sc.materials) / 4, rel=1e-12)
+
+
+def test_the_default_is_the_teeth_compliance():
+    from wormsim.tooth.stiffness import line_stiffness_n_per_m2
+
+    sc = _sc(UNSET)
+    assert sc.contact.stiffness_model == "teeth"
+    g = derive(sc.gear)
+    kp, src = ST.per_length_stiffness(sc.contact, g, sc.materials)
+    assert src == "teeth"
+    assert kp == pytest.approx(line_stiffness_n_per_m2(g, sc.materials), rel=1e-12)
+    # teeth that bend are softer than Hertz's rigid line contact (issue 30: 5-7x on steel/bronze)
+    assert kp < ST.hertz_per_length_n_per_m2(sc.materials) / 2
+
+
+@pytest.mark.parametrize(
+    "sets", [(), (UNSET, "contact.stiffness_model=hertz"), (UNSET,)], ids=["scenario", "hertz", "teeth"]
+)
+def test_contact3d_pair_stiffness_is_the_one_home_s(sets):
+    """contact3d's K = k' b2 with torsional's k', source included."""
+    sc = _sc("contact.geometry=flanks", *sets)
+    g = derive(sc.gear)
+    kp, src = ST.per_length_stiffness(sc.contact, g, sc.materials)
+    law = prepare(sc).law
+    assert law.pair_stiffness_n_per_m == pytest.approx(kp * g.face_width, rel=1e-12)
+    assert law.stiffness_source == src
+
+
+def test_the_timestep_follows_the_softer_contact():
+    """The stable limit goes as 1 / sqrt(K) at a fixed damping ratio: the teeth's K gives a larger default step."""
+    hz = _sc("contact.geometry=flanks", UNSET, "contact.stiffness_model=hertz")
+    th = _sc("contact.geometry=flanks", UNSET)
+    ph, pt = prepare(hz), prepare(th)
+    ratio = ph.law.pair_stiffness_n_per_m / pt.law.pair_stiffness_n_per_m
+    assert ratio > 2
+    assert pt.law.stable_limit_s / ph.law.stable_limit_s == pytest.approx(math.sqrt(ratio), rel=1e-9)
+    h_hertz, _ = choose_timestep(hz, derive(hz.gear), ph.law)
+    h_teeth, _ = choose_timestep(th, derive(th.gear), pt.law)
+    assert h_teeth > h_hertz
