@@ -42,6 +42,8 @@ LONG_TESTS: dict[str, set[str] | None] = {
     # (~1 min); their torsional / wedge twins stay in `make test`
     "test_profile_shift.py": {"contact3d_shifted_1x40"},
     "test_rexs.py": {"contact3d_fva", "contact3d_other"},
+    # the FE mesher's every retry on a 120-tooth wheel (a strict xfail, minutes)
+    "test_contact3d_model.py": {"test_tooth_compliance_on_a_120_tooth_wheel"},
 }
 
 

@@ -13,6 +13,7 @@ from wormsim.contact3d.mjcf import build_model, write_model
 from wormsim.contact3d.runner import simulate
 from wormsim.contact3d.slots import repose_window
 from wormsim.errors import SimulationError
+from wormsim.geometry import derive
 from wormsim.scenario import load_scenario
 
 COARSE = ["simulation.resolution=coarse"]
@@ -40,11 +41,12 @@ def test_only_tooth_contact_couples_the_shafts(seat):
 
 
 def test_window_cost_does_not_grow_with_tooth_count():
+    # the collision window, not the stiffness: Hertz's closed form keeps the FE compliance (and its mesher, which
+    # refuses the 120-tooth wheel: test_tooth_compliance_on_a_120_tooth_wheel) out of this test
     n = []
     for z2 in (40, 120):
-        bm = build_model(
-            load_scenario(SCEN / "involute_41.yaml", PIECES + [f"gear.wheel_teeth={z2}", "gear.worm_length_mm=120"])
-        )
+        over = PIECES + [f"gear.wheel_teeth={z2}", "gear.worm_length_mm=120", "contact.stiffness_model=hertz"]
+        bm = build_model(load_scenario(SCEN / "involute_41.yaml", over))
         n.append((bm.window_teeth, bm.wheel_slot_geoms.size))
     assert n[0] == n[1] and n[0][1] > 0
 
@@ -185,3 +187,18 @@ def test_too_soft_contact_stops_on_penetration_with_a_diagnosis():
     sc = load_scenario(SCEN / "seat_motor_demo.yaml", ["contact.stiffness_n_per_m=2e5", "simulation.duration_s=0.03"])
     with pytest.raises(SimulationError, match=r"penetration .* exceeds .* raise contact.stiffness_n_per_m"):
         simulate(sc)
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="gmsh refuses the 3-tooth FE sector of involute_41 with 120 wheel teeth ('Invalid boundary mesh "
+    "(overlapping facets)') through every retry of wormsim.rating.fe_root's mesher (element sizes, feature angles): "
+    "the teeth's compliance, the default stiffness, is not available on this gear, and the run exits 3 naming "
+    "contact.stiffness_n_per_m / contact.stiffness_model=hertz (issue 30, open)",
+)
+def test_tooth_compliance_on_a_120_tooth_wheel():
+    from wormsim.tooth.stiffness import per_length_stiffness
+
+    sc = load_scenario(SCEN / "involute_41.yaml", ["gear.wheel_teeth=120", "gear.worm_length_mm=120"])
+    kp, src = per_length_stiffness(sc.contact, derive(sc.gear), sc.materials)
+    assert src == "teeth" and kp > 0
