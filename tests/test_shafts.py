@@ -107,7 +107,9 @@ def test_bearing_forces_balance_the_mesh_forces():
     # the wheel shaft on two radial springs (500 N/um each) at +-30 mm, the mesh in the middle: statics give each
     # bearing half the mesh force across the axis, so the axis moves at the mesh point by |F_t2, F_r2| / (2 k)
     # (a rigid shaft on springs; the axial force's moment tilts it about the mid-plane, which leaves the mesh point)
-    f_across = math.hypot(s["tangential_force_mean_n"], s["radial_force_mean_n"])
+    # (the resultant radial force of the contacts: the force that loads the wheel shaft; radial_force_mean_n is DIN
+    # 3975's F_r2 on the line of centres, docs/outputs.md "Force keys")
+    f_across = math.hypot(s["tangential_force_mean_n"], s["radial_force_resultant_mean_n"])
     # (measured 0.42209 um against 0.42209 um; 1e-3 leaves room for the mean of a magnitude against a magnitude of
     # means)
     assert s["wheel_deflection_mesh_um"] == pytest.approx(1e6 * f_across / (2 * 500e6), rel=1e-3)
