@@ -1,5 +1,5 @@
 # Two commands do all set-up on a fresh machine: `make demo` and `make test`. The install compiles the contact3d
-# kernels once for this machine (wormsim.jit_cache.main, ~1 min; every later process loads them).
+# kernels once for this machine (wormsim.jit_cache.main with wormsim.contact3d.runner.warm_runs, ~1 min; every later process loads them).
 PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin
@@ -15,7 +15,7 @@ $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
 	$(BIN)/python -m pip install --quiet -e '.[test]'
-	$(BIN)/python -c 'import sys, wormsim.jit_cache as j; sys.exit(j.main())'
+	$(BIN)/python -c 'import sys, wormsim.jit_cache as j, wormsim.contact3d.runner as r; sys.exit(j.main(r.warm_runs))'
 	touch $(STAMP)
 
 install: $(STAMP)

@@ -103,7 +103,10 @@ def test_warm_up_runs_once_per_folder_and_waits_for_another_process(tmp_path, mo
     monkeypatch.setattr(jit_cache, "_dir", tmp_path)
     monkeypatch.setattr(jit_cache, "cache_root", lambda: tmp_path.parent)
     calls, notes = [], []
-    monkeypatch.setattr(jit_cache, "warm_runs", lambda runs=None: calls.append(1))
+
+    def work():
+        calls.append(1)
+
     # another process holds the lock: this one waits (and says so), then runs the warm-up itself
     holder = subprocess.Popen(
         [
@@ -118,14 +121,14 @@ def test_warm_up_runs_once_per_folder_and_waits_for_another_process(tmp_path, mo
     )
     assert holder.stdout.readline().strip() == "held"
     t0 = time.perf_counter()
-    assert jit_cache.ensure_warm(notes.append) is True
+    assert jit_cache.ensure_warm(work, notes.append) is True
     waited = time.perf_counter() - t0
     holder.wait(10)
     assert waited > 0.3 and notes[0] == jit_cache.WAIT_NOTE and notes[1].startswith("compiling the contact3d kernels")
     assert calls == [1] and jit_cache.is_warm()
     rec = json.loads((tmp_path / jit_cache.WARM_NAME).read_text())
     assert rec["error"] is None and rec["runs"] == [[n, list(o)] for n, o in jit_cache.WARM_RUNS]
-    assert jit_cache.ensure_warm(notes.append) is False and calls == [1]  # warm: nothing again
+    assert jit_cache.ensure_warm(work, notes.append) is False and calls == [1]  # warm: nothing again
 
 
 def test_a_failed_warm_up_is_recorded_and_not_retried(tmp_path, monkeypatch):
@@ -133,14 +136,13 @@ def test_a_failed_warm_up_is_recorded_and_not_retried(tmp_path, monkeypatch):
     monkeypatch.setattr(jit_cache, "cache_root", lambda: tmp_path.parent)
     calls = []
 
-    def boom(runs=None):
+    def boom():
         calls.append(1)
         raise RuntimeError("no LLVM")
 
-    monkeypatch.setattr(jit_cache, "warm_runs", boom)
-    assert jit_cache.ensure_warm() is True
+    assert jit_cache.ensure_warm(boom) is True
     assert json.loads((tmp_path / jit_cache.WARM_NAME).read_text())["error"] == "RuntimeError: no LLVM"
-    assert jit_cache.ensure_warm() is False and calls == [1]
+    assert jit_cache.ensure_warm(boom) is False and calls == [1]
 
 
 class _Log(io.StringIO):

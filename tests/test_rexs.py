@@ -13,6 +13,7 @@ import pytest
 
 from wormsim import cli, rexs
 from wormsim.geometry import derive
+from wormsim.output import write_rexs
 from wormsim.scenario import ScenarioError, load_scenario, scenario_from_dict
 
 ASSETS = Path(__file__).parent / "assets" / "rexs"
@@ -77,7 +78,7 @@ def test_another_stage_other_teeth_module_form_torque_speed_centre_distance():
 def test_round_trip_import_export_import_is_identical(src, suffix, tmp_path):
     first = rexs.import_file(src)
     sc = scenario_from_dict(first.data)
-    out = rexs.write_model(rexs.export_model(sc), tmp_path / f"back{suffix}")
+    out = write_rexs(rexs.export_model(sc), tmp_path / f"back{suffix}")
     second = rexs.import_file(out)
     assert _core(second.data) == _core(first.data)
 

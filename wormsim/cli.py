@@ -134,6 +134,7 @@ def _cmd_run(args) -> int:
 def _write_rexs(sc, summary: dict, path: str) -> None:
     """The stage with the run's results and its rating (where the gear can be rated) as REXS."""
     from wormsim import rexs
+    from wormsim.output import write_rexs
     from wormsim.rating.rate import rate
 
     rating = None
@@ -142,7 +143,7 @@ def _write_rexs(sc, summary: dict, path: str) -> None:
             rating = rate(sc)
         except ScenarioError as exc:  # e.g. no load torque: the run's results only
             print(f"wormsim: REXS export without the rating: {exc}", file=sys.stderr)
-    written = rexs.write_model(rexs.export_model(sc, summary, rating), path)
+    written = write_rexs(rexs.export_model(sc, summary, rating), path)
     print(f"wrote {written} (REXS {'JSON' if written.suffix.lower() == '.rexsj' else 'XML'})")
 
 

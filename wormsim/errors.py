@@ -1,10 +1,8 @@
-"""Exceptions that the CLI maps to exit codes (INTERFACE.md): ScenarioError exit 2, SimulationError exit 3.
+"""Exceptions that the CLI maps to exit codes: ScenarioError exit 2, SimulationError exit 3.
 
 Each guard of a run raises its own subclass of SimulationError, so that callers (the bench's stability edge)
 sort failures by type, not by the wording of the message.
 """
-
-from wormsim.scenario import ScenarioError
 
 __all__ = [
     "ScenarioError",
@@ -16,6 +14,10 @@ __all__ = [
     "OverspeedError",
     "RingingError",
 ]
+
+
+class ScenarioError(ValueError):
+    """Invalid input: the message names the field, the value and what is allowed (exit code 2 at the CLI)."""
 
 
 class SimulationError(RuntimeError):

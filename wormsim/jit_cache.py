@@ -13,8 +13,9 @@ versions. A NUMBA_CACHE_DIR set by the user wins. numba's own index, inside the 
 file's time stamp and the CPU.
 
 The folder is filled once per machine (`ensure_warm`): the first contact3d run, `make install` or a sweep's
-worker plugin runs the short contact3d runs of `WARM_RUNS` (compiling every entry point with the signatures the
-runs use) while holding the folder's lock, then writes `warm.json`. A process that finds the lock held waits and then
+worker plugin runs the short contact3d runs of `WARM_RUNS` (wormsim.contact3d.runner.warm_runs, handed to ensure_warm:
+this module imports no level), compiling every entry point with the signatures the runs use, while holding the
+folder's lock, then writes `warm.json`. A process that finds the lock held waits and then
 loads what the other compiled: a sweep of N workers on a fresh machine compiles once, not N times.
 
 `watch` tells a progress line when numba compiles (the "numba:compile" event, numba.core.event) and how many
@@ -315,46 +316,11 @@ def _lock(path: Path, waiting: Callable[[], None] | None = None) -> Iterator[Non
             fcntl.flock(fh, fcntl.LOCK_UN)
 
 
-def warm_runs(runs: tuple[tuple[str, tuple[str, ...]], ...] = WARM_RUNS) -> None:
-    """The short contact3d runs of `runs` (default WARM_RUNS, module docstring)."""
-    from importlib.resources import files
-
-    from wormsim.contact3d.runner import simulate
-    from wormsim.scenario import load_scenario
-
-    seeds = files("wormsim.scenarios")
-    if runs == WARM_RUNS:  # the flank grid's own compiled trim (a run whose grid is cached never calls it)
-        from wormsim.geometry import derive
-        from wormsim.tooth import grid
-
-        grid._flank_grid(derive(load_scenario(seeds / "screw_jack.yaml").gear), 2, 6)
-    for name, overrides in runs:
-        sc = load_scenario(seeds / f"{name}.yaml", ["model=contact3d", *overrides])
-        sc.simulation.duration_s = WARM_STEPS * (sc.simulation.timestep_s or 1e-4)
-        simulate(sc)
-    if runs == WARM_RUNS:  # the friction check, due later in a run than the warm-up's steps
-        _warm_friction_check()
-
-
-def _warm_friction_check() -> None:
-    """friction_guard.friction_alignment on MuJoCo's contact arrays (a box resting on a plane: 4 contacts)."""
-    import mujoco
-
-    from wormsim.contact3d.friction_guard import friction_alignment
-
-    m = mujoco.MjModel.from_xml_string(
-        "<mujoco><worldbody><geom type='plane' size='1 1 .1'/><body pos='0 0 .09'><freejoint/>"
-        "<geom type='box' size='.1 .1 .1'/></body></worldbody></mujoco>"
-    )
-    d = mujoco.MjData(m)
-    mujoco.mj_forward(m, d)
-    friction_alignment(d, 1e-3)
-
-
-def ensure_warm(note: Callable[[str], None] | None = None) -> bool:
-    """Compile (or load) every contact3d kernel once per machine (module docstring). note(text) is told before a
-    compile. Returns True when this call ran the warm-up. A failed warm-up is recorded (no retry by every run):
-    the runs then compile what they call."""
+def ensure_warm(work: Callable[[], None], note: Callable[[str], None] | None = None) -> bool:
+    """Compile (or load) every contact3d kernel once per machine (module docstring): work() runs the short runs of
+    WARM_RUNS (wormsim.contact3d.runner.warm_runs, passed in so that this module imports no level). note(text) is
+    told before a compile. Returns True when this call ran the warm-up. A failed warm-up is recorded (no retry by
+    every run): the runs then compile what they call."""
     global _in_warm
     d = cache_path()
     if _in_warm or d is None or is_warm():
@@ -372,7 +338,7 @@ def ensure_warm(note: Callable[[str], None] | None = None) -> bool:
             error = None
             try:
                 listen()
-                warm_runs()
+                work()
             except Exception as exc:  # (the run compiles for itself)
                 error = f"{exc.__class__.__name__}: {exc}"
             wall = time.perf_counter() - t0
@@ -407,13 +373,13 @@ def _write_json(path: Path, doc: dict) -> None:
         tmp.unlink(missing_ok=True)
 
 
-def main() -> int:
-    """Warm this machine's cache and say where it is (`make install`)."""
+def main(work: Callable[[], None]) -> int:
+    """Warm this machine's cache with work() (ensure_warm) and say where it is (`make install`)."""
     path = cache_path()
     if path is None:
         print("wormsim: no writable numba cache folder; runs compile for themselves", file=sys.stderr)
         return 0
-    ran = ensure_warm(lambda text: print(text, file=sys.stderr, flush=True))
+    ran = ensure_warm(work, lambda text: print(text, file=sys.stderr, flush=True))
     doc = json.loads((path / WARM_NAME).read_text()) if (path / WARM_NAME).is_file() else {}
     state = "compiled" if ran else "already warm"
     print(f"wormsim: contact3d kernels {state} in {path} ({doc.get('compile_s', 0):.0f} s compiling)")

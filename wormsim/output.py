@@ -123,6 +123,18 @@ def check_writable_file(path: str | Path) -> Path:
     return path
 
 
+def write_rexs(model, path: str | Path) -> Path:
+    """A REXS model (wormsim.rexs.Model) written atomically as XML (.rexs) or JSON (.rexsj) by the suffix."""
+    from wormsim import rexs
+
+    path = Path(path)
+    if path.suffix.lower() not in (".rexs", ".rexsj"):
+        raise OutputPathError(f"--rexs {path}: the file name must end in .rexs (XML) or .rexsj (JSON)")
+    text = rexs.to_json(model) if path.suffix.lower() == ".rexsj" else rexs.to_xml(model)
+    write_text_atomic(check_writable_file(path), text)
+    return path
+
+
 def _holder(lock_path: Path) -> str:
     try:
         pid = lock_path.read_text().split()[0]

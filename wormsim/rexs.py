@@ -35,7 +35,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from wormsim.scenario import ScenarioError
+from wormsim.errors import ScenarioError
 
 REXS_MAX_BYTES = 64 * 2**20  # a whole gear unit is a few MB
 RIGID_N_PER_M = 1e12  # a REXS bearing stiffness at or above this is rigid (FVA Workbench writes 1e20)
@@ -952,15 +952,3 @@ def to_json(model: Model) -> str:
         }
     }
     return json.dumps(doc, indent=2) + "\n"
-
-
-def write_model(model: Model, path: str | Path) -> Path:
-    """Write as XML (.rexs) or JSON (.rexsj) by the suffix."""
-    from wormsim.output import check_writable_file, write_text_atomic
-
-    path = Path(path)
-    if path.suffix.lower() not in (".rexs", ".rexsj"):
-        raise ScenarioError(f"--rexs {path}: the file name must end in .rexs (XML) or .rexsj (JSON)")
-    text = to_json(model) if path.suffix.lower() == ".rexsj" else to_xml(model)
-    write_text_atomic(check_writable_file(path), text)
-    return path

@@ -20,9 +20,7 @@ from typing import Annotated, Any, Literal
 import yaml
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
-
-class ScenarioError(ValueError):
-    """Invalid input: the message names the field, the value and what is allowed (exit code 2 at the CLI)."""
+from wormsim.errors import ScenarioError  # (the name stays importable from here: every loader's callers use it)
 
 
 class _Strict(BaseModel):

@@ -224,7 +224,9 @@ def simulate(scenario: Scenario, progress=None) -> Result:
     """Build the model (its timestep chosen before the build) and run it."""
     t0 = time.perf_counter()
     jit_cache.listen()  # the compile seconds counted (the progress line, a sweep's timing)
-    jit_cache.ensure_warm(getattr(progress, "compiling", None))  # compiled once per machine (wormsim.jit_cache)
+    jit_cache.ensure_warm(
+        warm_runs, getattr(progress, "compiling", None)
+    )  # compiled once per machine (wormsim.jit_cache)
     if progress is not None and time.perf_counter() - t0 > 0.5:  # the estimate's clock starts after the compile
         progress.restart_clock()
     jit_warmup.start()  # numba's start-up beside MuJoCo's model compilation (wormsim.contact3d.jit_warmup)
@@ -237,3 +239,39 @@ def simulate(scenario: Scenario, progress=None) -> Result:
 
         res.summary.update(probe(scenario, res.summary, simulate))
     return res
+
+
+def warm_runs(runs: tuple[tuple[str, tuple[str, ...]], ...] = jit_cache.WARM_RUNS) -> None:
+    """The short contact3d runs of `runs` (default wormsim.jit_cache.WARM_RUNS, the machine's warm-up: every
+    compiled entry point with the signatures the runs use)."""
+    from importlib.resources import files
+
+    from wormsim.scenario import load_scenario
+
+    seeds = files("wormsim.scenarios")
+    if runs == jit_cache.WARM_RUNS:  # the flank grid's own compiled trim (a run whose grid is cached never calls it)
+        from wormsim.geometry import derive
+        from wormsim.tooth import grid
+
+        grid._flank_grid(derive(load_scenario(seeds / "screw_jack.yaml").gear), 2, 6)
+    for name, overrides in runs:
+        sc = load_scenario(seeds / f"{name}.yaml", ["model=contact3d", *overrides])
+        sc.simulation.duration_s = jit_cache.WARM_STEPS * (sc.simulation.timestep_s or 1e-4)
+        simulate(sc)
+    if runs == jit_cache.WARM_RUNS:  # the friction check, due later in a run than the warm-up's steps
+        _warm_friction_check()
+
+
+def _warm_friction_check() -> None:
+    """friction_guard.friction_alignment on MuJoCo's contact arrays (a box resting on a plane: 4 contacts)."""
+    import mujoco
+
+    from wormsim.contact3d.friction_guard import friction_alignment
+
+    m = mujoco.MjModel.from_xml_string(
+        "<mujoco><worldbody><geom type='plane' size='1 1 .1'/><body pos='0 0 .09'><freejoint/>"
+        "<geom type='box' size='.1 .1 .1'/></body></worldbody></mujoco>"
+    )
+    d = mujoco.MjData(m)
+    mujoco.mj_forward(m, d)
+    friction_alignment(d, 1e-3)

@@ -18,10 +18,11 @@ from distributed.diagnostics.plugin import WorkerPlugin
 def warm_worker() -> dict:
     """ensure_warm and the short run in this process; returns {"compiled": bool, "error": str | None}."""
     from wormsim import jit_cache
+    from wormsim.contact3d.runner import warm_runs
 
     try:
-        compiled = jit_cache.ensure_warm()
-        jit_cache.warm_runs(jit_cache.WARM_RUNS[:1])
+        compiled = jit_cache.ensure_warm(warm_runs)
+        warm_runs(jit_cache.WARM_RUNS[:1])
     except Exception as exc:  # (the points compile or load for themselves)
         return {"compiled": False, "error": f"{exc.__class__.__name__}: {exc}"}
     return {"compiled": compiled, "error": None}
