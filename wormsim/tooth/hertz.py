@@ -190,7 +190,9 @@ def _rows(i, adr, efc_force, meta, weight, inv_rho, line_len, e_star, out, m):
         L = weight[c] * _lerp(line_len, sg, j, f)
         o = out[m]
         o[0], o[1], o[2], o[3], o[4] = i, sg, j, f, fn
-        o[5] = math.sqrt(max(fn, 0.0) / L * e_star * max(k, 0.0) / math.pi)
+        # a contact whose slice has no contact-line length left (L = 0: a steep flank's slice at the active profile's
+        # end) has no line load: its p_H is nan, left out of the pressure keys
+        o[5] = math.sqrt(max(fn, 0.0) / L * e_star * max(k, 0.0) / math.pi) if L > 0.0 else math.nan
         m += 1
     return m
 
@@ -265,13 +267,14 @@ class PatternLog:
         fn, p, z, r = sel[:, 4], sel[:, 5], sel[:, 6], sel[:, 7]
         W = fn.sum()
         imax = int(np.nanargmax(np.where(fn >= PRESSURE_MIN_FORCE_SHARE * fn.mean(), p, -np.inf)))
+        ok = np.isfinite(p)  # (_rows: no line length, no p_H)
         keys.update(
             {
                 "contact_pattern_centroid_face_mm": float((fn * z).sum() / W * 1e3),
                 "contact_pattern_centroid_radius_mm": float((fn * r).sum() / W * 1e3),
                 "contact_pattern_extent_face_mm": float(self.extent_face_m(sel) * 1e3),
                 "contact_pressure_max_mpa": float(p[imax] * 1e-6),
-                "contact_pressure_mean_mpa": float((fn * p).sum() / W * 1e-6),
+                "contact_pressure_mean_mpa": float((fn[ok] * p[ok]).sum() / fn[ok].sum() * 1e-6),
                 "contact_pressure_max_face_mm": float(z[imax] * 1e3),
                 "contact_pressure_max_radius_mm": float(r[imax] * 1e3),
             }
@@ -303,7 +306,7 @@ class PatternLog:
             i = np.clip(np.rint(T[:, 3]).astype(int), 0, N - 1)
             np.add.at(load, (sg, j, i), T[:, 4])
             if len(T):  # the pressure of the contacts the summary's maximum counts (module docstring)
-                k = T[:, 4] >= PRESSURE_MIN_FORCE_SHARE * T[:, 4].mean()
+                k = (T[:, 4] >= PRESSURE_MIN_FORCE_SHARE * T[:, 4].mean()) & np.isfinite(T[:, 5])
                 np.maximum.at(pmax, (sg[k], j[k], i[k]), T[k, 5])
         return {
             "load": load,
