@@ -13,6 +13,7 @@ import time
 from pathlib import Path
 
 from wormsim.provenance import record
+from wormsim.rating.rate import RATING_KEYS
 
 ROOT = Path(__file__).resolve().parents[1]
 STAGES = {
@@ -36,18 +37,8 @@ RUN_KEYS = (
     "worm_deflection_mesh_um",
     "worm_bearing_axial_mean_n",
 )
-RATING_KEYS = (
-    "contact_stress_mean_iso_mpa",
-    "friction_iso",
-    "efficiency_iso",
-    "sliding_speed_m_s",
-    "safety_pitting",
-    "safety_wear",
-    "safety_root",
-    "safety_deflection",
-    "safety_temperature",
-    "oil_temperature_c",
-)
+# ISO/TS 14521 method B: the rating keys of wormsim.rating.rate before its AGMA keys, warnings and sources
+ISO_KEYS = RATING_KEYS[: RATING_KEYS.index("agma_rated_tangential_force_n")]
 
 
 def main() -> None:
@@ -87,7 +78,7 @@ def main() -> None:
             rec["levels"][level] = {k: s.get(k) for k in RUN_KEYS} | {"wall_s": time.perf_counter() - t0}
             print(name, level, f"F_t2 {s['tangential_force_mean_n']:.1f} N", flush=True)
         r = rate(sc)
-        rec["rating"] = {k: r.get(k) for k in RATING_KEYS} | {"warnings": r["warnings"]}
+        rec["rating"] = {k: r.get(k) for k in ISO_KEYS} | {"warnings": r["warnings"]}
         out[name] = rec
     record("rexs_stages", {"stages": out})
 
