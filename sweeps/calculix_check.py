@@ -1,6 +1,6 @@
 """The independent FE contact check of the tooth compliance (issue 30, item 7; docs/validation.md, "CalculiX contact
 check"): CalculiX (wormsim.tooth.calculix) at ANGLES worm angles over one mesh cycle on a seed gear (screw_jack: steel
-worm, cast-iron wheel) and on a steel/bronze 2x31 ZI gear (sweeps/calculix_zi_2x31.yaml), each at its scenario's
+worm, cast-iron wheel) and on a steel/bronze 2x31 ZI gear (scenarios/calculix_zi_2x31.yaml), each at its scenario's
 wheel torque, against
 * the loaded tooth contact analysis wormsim.tooth.ltca (when importable) at the same worm angles and torque:
   mesh stiffness along the line of action and the load share per wheel tooth;
@@ -31,7 +31,7 @@ from wormsim.tooth.compliance import iso6336_stiffness
 ROOT = Path(__file__).resolve().parents[1]
 GEARS = {
     "screw_jack": ROOT / "scenarios" / "screw_jack.yaml",
-    "zi_2x31_bronze": ROOT / "sweeps" / "calculix_zi_2x31.yaml",
+    "zi_2x31_bronze": ROOT / "scenarios" / "calculix_zi_2x31.yaml",
 }
 C_GUESS_N_PER_MM_UM = 15.0  # the lag that gives about the scenario torque: T / (c b2 arm0^2), ISO 6336's order
 

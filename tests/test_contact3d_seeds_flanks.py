@@ -24,16 +24,11 @@ def run(name: str) -> dict:
     return _CACHE[name]
 
 
-# seat motor and screw jack pass (involute_41 with Hertz's contact too; with the teeth's, its default: MESH_XFAIL) since
-# contacts leave at zero load (wormsim.tooth.kernel, docs/contact3d.md): F_t peaks at
-# 29.97 / 22.14 / 24.14 Hz (before: the 3rd harmonic, 89.9 / 66.4 Hz, from half a slice's load dropped at once; and
-# involute_41's mesh mode at 1087 Hz with p2p 55 kN, now 292 N on 13.8 kN)
-MESH_XFAIL: dict[str, str] = {
-    "involute_41": "F_t peaks at 772.56 Hz = 32.0 x z1 n1 / 60 (24.14 Hz), F_t p2p 437 N on 13.8 kN: with the teeth's "
-    "compliance (its default, 1.01e9 N/m per tooth pair against Hertz's 5.41e9) the contact mode falls from about "
-    "1.3-1.8 kHz to near the 32nd meshing harmonic, which it amplifies; with Hertz the peak was 24.14 Hz, p2p 148 N "
-    "(docs/data/stiffness_seeds.json)",
-}
+# mesh_frequency_hz is the meshing line near z1 n1 / 60 (wormsim.metrics.mesh_line): 29.97 / 22.14 / 24.14 Hz. The
+# largest F_t peak is not always there: involute_41 with the teeth's compliance (1.01e9 N/m per tooth pair against
+# Hertz's 5.41e9) has its contact mode near the 32nd meshing harmonic (772.56 Hz), which it amplifies (F_t p2p 437 N on
+# 13.8 kN; with Hertz 148 N; docs/data/stiffness_seeds.json)
+MESH_XFAIL: dict[str, str] = {}
 
 
 def _xf(table, n):
