@@ -37,7 +37,7 @@ LONG_TESTS: dict[str, set[str] | None] = {
     "test_flank_forms_validation.py": {f"{k}_{f}" for k in ("contact3d", "mesh") for f in ("ZN1", "ZN2", "ZK")},
     "test_calculix.py": None,  # the CalculiX contact solve of a small case (minutes on one core)
     # the tooth compliance's FE on the seeds other than the screw jack (~15 s each cold; test_ltca.py marks its own)
-    "test_tooth_compliance.py": {"involute_41", "seat_motor"},
+    "test_tooth_compliance.py": {"involute_41", "seat_motor", "test_random_gears_compliance_is_computed"},
     # contact3d on the shifted 1x40 (~2 min here with the kernel compiled) and the FVA REXS stage with its shafts
     # (~1 min); their torsional / wedge twins stay in `make test`
     "test_profile_shift.py": {"contact3d_shifted_1x40"},

@@ -132,6 +132,14 @@ def test_invalid_sweep_file_exits_2_naming_the_field(case, tmp_path, capsys):
     assert not out.exists()  # nothing ran
 
 
+def test_a_scenario_given_as_sweep_file_is_named_as_such(tmp_path, capsys):
+    f = _write(tmp_path / "gear.yaml", SCREW_JACK.read_text())
+    assert cli.main(["sweep", str(f), "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    assert "gear.yaml: a scenario, not a sweep file" in err and "wormsim run gear.yaml" in err
+    assert err.count("\n") == 1 and "did you mean" not in err
+
+
 # ----------------------------------------------------------------------------- running
 
 

@@ -99,3 +99,43 @@ def test_iso6336_steel_reference():
     iso = compliance.iso6336_stiffness(g, SimpleNamespace(worm=steel, wheel=steel))
     assert 13.0 < iso["c_prime"] < 15.5
     assert 1.5 < iso["eps_alpha"] < 2.0
+
+
+def test_random_gears_compliance_is_computed():
+    """Any valid steel/bronze gear gets the teeth's compliance (the FE mesher's last resort meshes the surface as
+    it is), and its mean mesh stiffness per face width lies in test_iso6336_bracket's band. Six gears of a seeded
+    generator over the schema's ranges (starts 1-4, z2 20-80, m_x 0.5-12 mm, q 6-16, alpha_n 10-25 deg, ZI / ZA)."""
+    from wormsim.scenario import scenario_from_dict
+    from wormsim.tooth import ltca
+
+    rng = np.random.default_rng(30)
+    for _ in range(6):
+        gear = {
+            "worm_starts": int(rng.integers(1, 5)),
+            "wheel_teeth": int(rng.integers(20, 81)),
+            "axial_module_mm": float(rng.uniform(0.5, 12)),
+            "diameter_quotient": float(rng.uniform(6, 16)),
+            "normal_pressure_angle_deg": float(rng.uniform(10, 25)),
+            "profile": str(rng.choice(["ZI", "ZA"])),
+        }
+        m = gear["axial_module_mm"]
+        sc = scenario_from_dict(
+            {
+                "name": "random",
+                "model": "torsional",
+                "gear": {**gear, "backlash_mm": 0.05 * m},
+                "materials": {
+                    "worm": {"youngs_modulus_gpa": 210, "poisson_ratio": 0.3, "density_kg_m3": 7850},
+                    "wheel": {"youngs_modulus_gpa": 100, "poisson_ratio": 0.34, "density_kg_m3": 8800},
+                },
+                "drive": {"speed_rpm": 1500},
+                "load": {"torque_nm": 0.04 * m**3 * gear["wheel_teeth"]},
+            },
+            "random.yaml",
+        )
+        g = derive(sc.gear)
+        kp, src = ST.per_length_stiffness(sc.contact, g, sc.materials)
+        assert src == "teeth" and 0 < kp < math.pi * effective_modulus_pa(sc.materials) / 4, gear
+        iso = compliance.iso6336_stiffness(g, sc.materials)
+        k = ltca.loaded_contact(g, sc.materials, sc.load.torque_nm).summary()["mesh_stiffness_per_width_n_per_mm_um"]
+        assert iso["c_prime"] <= k <= ISO_BRACKET * iso["c_gamma"], (gear, k, iso)

@@ -920,7 +920,8 @@ def _did_you_mean(loc: tuple) -> str:
         model = Scenario
     if model is None or not isinstance(loc[-1], str):
         return ""
-    close = difflib.get_close_matches(loc[-1], list(model.model_fields), n=2, cutoff=0.6)
+    # a key of another file kind (a scenario's `gear` in a sweep file) is no misspelling of itself
+    close = [c for c in difflib.get_close_matches(loc[-1], list(model.model_fields), n=2, cutoff=0.6) if c != loc[-1]]
     return f" (did you mean {' or '.join(repr(c) for c in close)}?)" if close else ""
 
 

@@ -190,11 +190,13 @@ def tooth_surface(g: GearGeometry, density: int = 1, teeth: int = 1) -> tuple[np
 
 
 def tet_mesh(
-    V: np.ndarray, F: np.ndarray, size_m: float, min_size_m: float, curvature: int, angle_deg: float = 40.0
+    V: np.ndarray, F: np.ndarray, size_m: float, min_size_m: float, curvature: int, angle_deg: float | None = 40.0
 ) -> tuple[np.ndarray, np.ndarray]:
     """Tetrahedra (gmsh) inside the closed surface (V, F): the surface is classified into patches at sharp edges
     (angle_deg), re-parametrised and re-meshed at `size_m` (refined on curvature, `curvature` elements per 2 pi of a
-    curve's turn, down to min_size_m: the root fillet), then the volume is meshed: (points (n, 3), tets (m, 4))."""
+    curve's turn, down to min_size_m: the root fillet), then the volume is meshed: (points (n, 3), tets (m, 4)).
+    angle_deg None: no re-meshing, the triangles (V, F) are the boundary and only the volume is meshed (interior
+    elements up to size_m): nothing to refuse for a closed surface, at the surface's own resolution."""
     import gmsh
 
     gmsh.initialize(["-noenv"], readConfigFiles=False)
@@ -205,8 +207,9 @@ def tet_mesh(
         s = gmsh.model.addDiscreteEntity(2)
         gmsh.model.mesh.addNodes(2, s, list(range(1, len(V) + 1)), (V * 1e3).ravel().tolist())  # mm
         gmsh.model.mesh.addElementsByType(s, 2, [], (F.ravel() + 1).tolist())
-        gmsh.model.mesh.classifySurfaces(math.radians(angle_deg), True, True, math.pi)
-        gmsh.model.mesh.createGeometry()
+        if angle_deg is not None:
+            gmsh.model.mesh.classifySurfaces(math.radians(angle_deg), True, True, math.pi)
+            gmsh.model.mesh.createGeometry()
         surfs = [e[1] for e in gmsh.model.getEntities(2)]
         loop = gmsh.model.geo.addSurfaceLoop(surfs)
         gmsh.model.geo.addVolume([loop])
@@ -241,17 +244,18 @@ def tet_mesh_retried(
     size_m: float,
     min_size_m: float,
     curvature: int,
-    angles_deg: tuple[float, ...] = (40.0,),
+    angles_deg: tuple[float | None, ...] = (40.0,),
 ) -> tuple[np.ndarray, np.ndarray]:
-    """tet_mesh at the element sizes times each of SIZE_RETRIES, each at the feature angles angles_deg in turn, until
-    gmsh meshes the tooth; SimulationError (exit 3) naming what to change when every size is refused."""
+    """tet_mesh at the element sizes times each of SIZE_RETRIES, each at the feature angles angles_deg in turn (None:
+    the surface's own triangles, tet_mesh), until gmsh meshes the tooth; SimulationError (exit 3) naming what to
+    change when every size is refused."""
     errors = []
     for f in SIZE_RETRIES:
         for angle in angles_deg:
             try:
                 return tet_mesh(V, F, size_m * f, min_size_m * f, curvature, angle)
             except Exception as exc:  # gmsh raises plain Exception with its message
-                errors.append(f"x{f:g} at {angle:g} deg: {exc}")
+                errors.append(f"x{f:g} at {'no re-meshing' if angle is None else f'{angle:g} deg'}: {exc}")
     raise SimulationError(
         f"the FE root stress: gmsh refused the wheel tooth's mesh at every element size tried ({'; '.join(errors)}); "
         "change rating.fe_mesh_density (1 to 4) or gear.backlash_mm slightly, or rate without --fe "
@@ -447,7 +451,7 @@ def tooth_mesh(
     teeth: int = 1,
     min_size_m: float | None = None,
     curvature_elements: int = CURVATURE_ELEMENTS,
-    classify_angles_deg: tuple[float, ...] = (40.0,),
+    classify_angles_deg: tuple[float | None, ...] = (40.0,),
 ) -> ToothMesh:
     """The tetrahedral mesh of the sector of `teeth` teeth (section_outline; 1: the one-tooth sector), cached by
     geometry (meshgen.cache). `density` d sets the element sizes together (d = 1 is the default, d = 1 and 2 are an

@@ -318,6 +318,12 @@ def load_sweep(path: str | Path, max_errors: int = 5, on_parsed: Callable[[], No
         raise ScenarioError(f"{path.name}: not valid YAML{f' at line {mark.line + 1}' if mark else ''}") from None
     if not isinstance(raw, dict):
         raise ScenarioError(f"{path.name}: the top level must be a mapping (name, base, set, grid, zip, random)")
+    if {"gear", "model"} & raw.keys() and not {"base", "grid", "zip", "random"} & raw.keys():
+        raise ScenarioError(
+            f"{path.name}: a scenario, not a sweep file (it has {', '.join(sorted({'gear', 'model'} & raw.keys()))} "
+            f"and no base / grid / zip / random): run it with `wormsim run {path.name}`, or name it as a sweep file's "
+            "base (docs/sweeps.md)"
+        )
     raw = {k: (_yaml12_numbers(v) if k in ("set", "grid", "zip", "random") else v) for k, v in raw.items()}
     try:
         spec = SweepFile.model_validate(raw)

@@ -69,7 +69,13 @@ WORM_RADII = 7  # load heights of the worm model, root .. tip
 LOAD_RADIUS_MX = 0.25  # load patch radius in axial modules (as wormsim.rating.fe_root.LOAD_RADIUS_MX)
 MIN_SIZE_MX = 0.75  # smallest FE element (at density 1), axial modules: the fillet needs no stress resolution here
 CURVATURE_ELEMENTS = 2  # FE elements per full turn of a curved surface at density 1
-CLASSIFY_ANGLES_DEG = (60.0, 50.0, 40.0, 30.0)  # gmsh's feature angles, tried in turn (fe_root.tooth_mesh)
+CLASSIFY_ANGLES_DEG = (
+    60.0,
+    50.0,
+    40.0,
+    30.0,
+    None,
+)  # feature angles in turn, last the surface as is (fe_root.tet_mesh)
 DIRECT_DOFS_MAX = 120000  # SuperLU below this many dofs: one factorisation, GRID_FACE x GRID_PROFILE solves
 INSET_MX = 0.05  # centre line points this far inside the end faces and the tip, in axial modules
 H_NORMAL_MX = 0.02  # finite-difference step of the flank normal, in axial modules
