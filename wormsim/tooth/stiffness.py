@@ -26,6 +26,7 @@ from wormsim.tooth import compliance, ltca, mesh_stiffness
 from wormsim.tooth.mesh_stiffness import MeshStiffness
 
 STIFFNESS_SOURCES = ("teeth", "scenario", "hertz")
+LTCA_SAMPLES = 16  # loaded TCA samples per mesh cycle (line_stiffness_n_per_m2's, so one LTCA serves both)
 
 
 def hertz_per_length_n_per_m2(materials: Materials) -> float:
@@ -64,7 +65,7 @@ def pair_stiffness_n_per_m(contact: Contact, g: GearGeometry, materials: Materia
 
 
 def line_stiffness_n_per_m2(
-    g: GearGeometry, materials, torque_nm: float | None = None, samples: int = 16, density: int = 1
+    g: GearGeometry, materials, torque_nm: float | None = None, samples: int = LTCA_SAMPLES, density: int = 1
 ) -> float:
     """k'_eff (N/m per m of contact line): the per-length stiffness that makes wormsim.tooth.mesh_stiffness's mean
     k_mesh equal the LTCA's mean mesh stiffness (wormsim.tooth.ltca) at wheel torque torque_nm (default
@@ -73,6 +74,34 @@ def line_stiffness_n_per_m2(
     res = ltca.loaded_contact(g, materials, t, samples=samples, density=density)
     unit = mesh_stiffness.mesh_stiffness(g, 1.0, "unit", samples)
     return float(np.mean(res.mesh_stiffness_n_per_m) / np.mean(unit.k_mesh_fwd_n_per_m))
+
+
+def mesh_stiffness_table(contact: Contact, g: GearGeometry, materials: Materials, samples: int) -> MeshStiffness:
+    """torsional's k(theta1) tables over one mesh cycle: wormsim.tooth.mesh_stiffness's TCA with k' of
+    per_length_stiffness; where the source is the teeth's compliance, k(theta1) of each flank side is the loaded TCA's
+    (wormsim.tooth.ltca at reference_torque_nm, LTCA_SAMPLES per cycle, periodic linear interpolation onto the
+    table's samples): the teeth's bending couples the contact lines and smooths the variation (k ptp / mean 0.26 / 0.19
+    TCA / LTCA on the screw jack, 0.36 / 0.26 on involute_41, docs/tooth_compliance.md), with the same mean (k' is
+    chosen so, line_stiffness_n_per_m2); the contact-line lengths and teeth counts stay the TCA's."""
+    import dataclasses
+
+    kp, source = per_length_stiffness(contact, g, materials)
+    ms = mesh_stiffness.mesh_stiffness(g, kp, source, samples)
+    if source != "teeth":
+        return ms
+    t = compliance.reference_torque_nm(g)
+    k = {}
+    for side in (1, -1):
+        lt = ltca.loaded_contact(g, materials, t, samples=LTCA_SAMPLES, side=side)
+        k[side] = np.interp(ms.theta1_rad, lt.theta1_rad, lt.mesh_stiffness_n_per_m, period=ms.period_rad)
+    arm2 = ms.arm0_m**2
+    return dataclasses.replace(
+        ms,
+        k_mesh_fwd_n_per_m=k[1],
+        k_mesh_rev_n_per_m=k[-1],
+        k_theta_fwd_nm_per_rad=k[1] * arm2,
+        k_theta_rev_nm_per_rad=k[-1] * arm2,
+    )
 
 
 def stiffness_outputs(

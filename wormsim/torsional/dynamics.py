@@ -14,7 +14,8 @@ worm pushes in forward drive (side +1) touches for e > g and the opposite flank 
 in between, no force. (With assembly errors, `errors:`, the gaps are the kinematic TCA's g_side(theta1) and the
 elastic torque is the loaded TCA's table of the displaced flanks, wormsim.torsional.loaded_tca; docs/errors.md 5a.)
 The penetration along the line of action is delta = arm0 (|e| - g), arm0 = r2 cos(alpha_n)
-cos(gamma) (wormsim.tooth.mesh_stiffness: k(theta1) is computed there, once, from the generated flanks).
+cos(gamma) (wormsim.tooth.stiffness.mesh_stiffness_table: k(theta1) from the generated flanks, once; with the teeth's
+compliance, the stiffness's default, the loaded tooth contact analysis's).
 
 Mesh torque on the wheel (ADAMS IMPACT form with e = 1, damping blended in over the penetration depth d_max
 like IMPACT's STEP, never pulling):
@@ -87,8 +88,8 @@ from wormsim.locking import Held, backdrive_self_locks, held_keys, run_keys
 from wormsim.metrics import dominant_frequency, drive_summary, mean_speeds_rpm, mesh_line_keys, window_of
 from wormsim.result import Result
 from wormsim.scenario import Scenario
-from wormsim.tooth.mesh_stiffness import MeshStiffness, mesh_stiffness
-from wormsim.tooth.stiffness import per_length_stiffness, stiffness_outputs
+from wormsim.tooth.mesh_stiffness import MeshStiffness
+from wormsim.tooth.stiffness import mesh_stiffness_table, stiffness_outputs
 from wormsim.units import rad_s_to_rpm, step
 
 CHORD_ITER = 4  # backward Euler: Newton iterations that reuse the first Jacobian of a step
@@ -404,9 +405,9 @@ def simulate(scenario: Scenario, progress=None, method: str = "implicit") -> Res
     if scipy_method is None and method != "implicit":
         raise ValueError(f"torsional method {method!r}: allowed implicit, {', '.join(SCIPY_METHODS.values())}")
     g = derive(scenario.gear)
-    kp, src = per_length_stiffness(scenario.contact, g, scenario.materials)
     t_ms = time.perf_counter()
-    ms = mesh_stiffness(g, kp, src, scenario.simulation.mesh_stiffness_samples)
+    ms = mesh_stiffness_table(scenario.contact, g, scenario.materials, scenario.simulation.mesh_stiffness_samples)
+    kp = ms.stiffness_per_length_n_per_m2
     t_ms = time.perf_counter() - t_ms
     I1, I2 = inertias(scenario, g)
     pair = displaced_pair(scenario.errors, g)
