@@ -76,3 +76,30 @@ def test_the_timestep_follows_the_softer_contact():
     h_hertz, _ = choose_timestep(hz, derive(hz.gear), ph.law)
     h_teeth, _ = choose_timestep(th, derive(th.gear), pt.law)
     assert h_teeth > h_hertz
+
+
+def test_torsional_k_theta_is_the_loaded_tcas_with_the_teeth():
+    """mesh_stiffness_table: with the teeth's compliance k(theta1) of each side is the LTCA's at its samples (same mean
+    as the contact-line TCA's with k'_eff, a smaller variation: the bending couples the lines); with an explicit K or
+    Hertz it is the contact-line TCA's."""
+    import numpy as np
+
+    from wormsim.tooth import compliance, ltca, mesh_stiffness
+
+    sc = _sc(UNSET)
+    g = derive(sc.gear)
+    ms = ST.mesh_stiffness_table(sc.contact, g, sc.materials, 64)
+    tca = mesh_stiffness.mesh_stiffness(g, ms.stiffness_per_length_n_per_m2, "teeth", 64)
+    t = compliance.reference_torque_nm(g)
+    for side, k in ((1, ms.k_mesh_fwd_n_per_m), (-1, ms.k_mesh_rev_n_per_m)):
+        lt = ltca.loaded_contact(g, sc.materials, t, samples=ST.LTCA_SAMPLES, side=side)
+        np.testing.assert_allclose(k[:: 64 // ST.LTCA_SAMPLES], lt.mesh_stiffness_n_per_m, rtol=1e-12)
+    np.testing.assert_allclose(ms.k_theta_fwd_nm_per_rad, ms.k_mesh_fwd_n_per_m * ms.arm0_m**2, rtol=1e-12)
+    assert np.mean(ms.k_mesh_fwd_n_per_m) == pytest.approx(np.mean(tca.k_mesh_fwd_n_per_m), rel=0.01)
+    assert np.ptp(ms.k_mesh_fwd_n_per_m) < 0.8 * np.ptp(tca.k_mesh_fwd_n_per_m)  # 0.255 against 0.363 of the mean
+    seed = _sc()
+    kp, _ = ST.per_length_stiffness(seed.contact, g, seed.materials)
+    same = ST.mesh_stiffness_table(seed.contact, g, seed.materials, 64)
+    np.testing.assert_array_equal(
+        same.k_mesh_fwd_n_per_m, mesh_stiffness.mesh_stiffness(g, kp, "scenario", 64).k_mesh_fwd_n_per_m
+    )
