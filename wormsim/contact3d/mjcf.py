@@ -413,6 +413,8 @@ def build_model(
         p.inertias.worm_load_inertia_kg_m2, p.inertias.wheel_load_inertia_kg_m2
     )  # x mass_scaling
     _set_options(spec, scenario.simulation, law, h)
+    if sups is not None:
+        shafts.set_solver(spec, sups)  # CG where shaft joints move (wormsim.contact3d.shafts.SOLVER)
     _add_mesh_sensor(spec)
     model = spec.compile()
 
