@@ -65,7 +65,7 @@ def machine_info() -> dict:
     }
 
 
-def _run_case(case: BenchCase, repeats: int) -> tuple[dict, float, float, float | None, float | None]:
+def _run_case(case: BenchCase, repeats: int) -> tuple[dict, float, float, float | None, float | None, int]:
     sc = case.build()
     # warm-up: a run of a few steps builds the geometry / k(theta) caches, so the timed runs measure
     # simulation, not one-off generation (which `wormsim mesh` reports on its own)
@@ -83,7 +83,7 @@ def _run_case(case: BenchCase, repeats: int) -> tuple[dict, float, float, float 
         if res.summary.get("step_wall_us") is not None:
             loops.append(1e-6 * res.summary["step_wall_us"] * res.steps)
     loop = statistics.median(loops) if loops else None
-    return res.summary, statistics.median(walls), res.sim_time_s, loop, min(loops) if loops else None
+    return res.summary, statistics.median(walls), res.sim_time_s, loop, min(loops) if loops else None, res.steps
 
 
 def speedups(records: list[dict], key: str = "wall_s_per_sim_s", name: str = "speedup_vs_pieces") -> dict:
@@ -224,7 +224,7 @@ def run_bench(
     machine_start = machine_info()
     for case in bench_cases(quick, models, scenarios, geometries, resolutions, shafts):
         try:
-            summary, wall, sim_s, loop, loop_best = _run_case(case, repeats)
+            summary, wall, sim_s, loop, loop_best, steps = _run_case(case, repeats)
         except SimulationError as exc:
             notes.append(f"{case.scenario} {case.model} {case.resolution} dt={case.timestep_s}: failed: {exc}")
             records.append(
@@ -257,7 +257,7 @@ def run_bench(
             "loop_wall_s": loop,
             "loop_wall_s_per_sim_s": loop / sim_s if loop is not None and sim_s else None,
             "loop_wall_s_best": loop_best,
-            "steps": summary.get("steps"),
+            "steps": steps,
             "status": "ok",
             "reference": case.reference,
             "finer": case.finer,
