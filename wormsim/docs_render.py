@@ -144,6 +144,31 @@ def bench_flanks_vs_pieces_table(name: str = "bench_flanks_vs_pieces") -> str:
     return _table(head, rows) + "\n" + note + _source(name)
 
 
+def bench_shafts_table(names: tuple[str, ...] = ("bench_shafts_before", "bench_shafts")) -> str:
+    """A shafts: run's step against the rigid one's (`wormsim bench --shafts`, bench_meta.json
+    step_ratio_shafts_vs_rigid), one row per record: before the shafts' step changes and now."""
+    rows = []
+    for name in names:
+        d = load(name)
+        for seed, levels in sorted(d["meta"].get("step_ratio_shafts_vs_rigid", {}).items()):
+            for level, r in sorted(levels.items()):
+                rows.append(
+                    [
+                        f"{d['provenance']['commit']}",
+                        f"{seed} ({level}, {r['timestep_s']:.3g} s)",
+                        f"{r['rigid_step_wall_us']:.0f} us",
+                        f"{r['shafts_step_wall_us']:.0f} us",
+                        f"{r['loop']:.2f}x",
+                        f"{r['loop_best']:.2f}x",
+                        f"{r['whole']:.2f}x",
+                        f"{d['meta']['machine']['load_average_1min']:.1f}",
+                    ]
+                )
+    head = ["commit", "seed (level, step)", "rigid step", "shafts step", "step ratio (median)", "ratio (best)"]
+    head += ["whole simulate()", "load (2 CPUs)"]
+    return _table(head, rows) + "\n" + "".join(_source(n) for n in names)
+
+
 def flank_speed_table(name: str = "flank_speed") -> str:
     """Per step, exact flanks against medium convex pieces (sweeps/measure_flank_speed.py, best of the repeats)."""
     best = load(name)["best"]
@@ -1121,6 +1146,7 @@ TABLES: dict[str, Callable[[], str]] = {
     "bench_stability": bench_stability_table,
     "bench_flanks_vs_pieces": bench_flanks_vs_pieces_table,
     "flank_speed": flank_speed_table,
+    "bench_shafts": bench_shafts_table,
     "seat_motor_20s": seat_motor_20s_table,
     "sweep_speedup": sweep_speedup_table,
     "sweep_scaling": sweep_scaling_table,
