@@ -588,8 +588,8 @@ def run_sweep(
 
 
 class _PlotImport:
-    """matplotlib's import (wormsim.prewarm's) in a thread while the points run; a failure is dropped (the plot
-    imports for itself)."""
+    """matplotlib's import (pyplot on the Agg backend, what sweep.png needs; not the run writers' rerun) in a thread
+    while the points run; a failure is dropped (the plot imports for itself)."""
 
     def __init__(self):
         self._thread = None
@@ -597,11 +597,12 @@ class _PlotImport:
     def start(self) -> None:
         import threading
 
-        from wormsim import prewarm
-
         def work():
             try:
-                prewarm._import_writers()
+                import matplotlib
+
+                matplotlib.use("Agg")
+                import matplotlib.pyplot  # noqa: F401
             except Exception:
                 pass
 
