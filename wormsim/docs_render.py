@@ -242,6 +242,13 @@ def sweep_speedup_table(name: str = "sweep_speedup") -> str:
     return text + "\n" + _source(name)
 
 
+def _before_after(x: dict) -> str:
+    """A scaling run's fixed cost split: the command's start to the first point, the last point to its exit."""
+    if x.get("before_first_point_s") is None:
+        return "-"
+    return f"{x['before_first_point_s']:.1f} / {x['after_last_point_s']:.1f}"
+
+
 def sweep_scaling_table(name: str = "sweep_scaling") -> str:
     """A contact3d sweep as `wormsim sweep` commands on 1 and 2 workers, and the scaling model
     (sweeps/measure_sweep_scaling.py)."""
@@ -254,6 +261,7 @@ def sweep_scaling_table(name: str = "sweep_scaling") -> str:
                 f"{x['command_wall_s']:.1f}",
                 f"{x['span_s']:.1f}",
                 f"{x['fixed_s']:.1f}",
+                _before_after(x),
                 f"{x['cluster_start_s']:.1f}",
                 "-" if x.get("warm_s") is None else f"{x['warm_s']:.1f}",
                 f"{x['point_wall_median_s']:.2f}",
@@ -269,6 +277,7 @@ def sweep_scaling_table(name: str = "sweep_scaling") -> str:
         "command s",
         "points' span s",
         "fixed s",
+        "before first point / after last s",
         "cluster start s",
         "warm-up s",
         "point median s",
@@ -284,7 +293,18 @@ def sweep_scaling_table(name: str = "sweep_scaling") -> str:
         f"\n{r['what']}. Speed-up 1 -> 2 workers: {r['speedup_command']:.2f}x for the whole command, "
         f"{r['speedup_span']:.2f}x over the points' span; the step grows {r['step_growth_2']:.2f}x with 2 busy "
         f"workers. Load average after: {', '.join(f'{v:.1f}' for v in r['load_average_after'])} "
-        f"({r['cpu_count']} CPUs).\n\n"
+        f"({r['cpu_count']} CPUs)."
+        + (
+            " Commands (s), in turns: "
+            + "; ".join(
+                f"{n} worker{'s' if n != '1' else ''}: {', '.join(f'{v:.1f}' for v in w)}"
+                for n, w in sorted(r["command_walls_s"].items())
+            )
+            + "."
+            if r.get("command_walls_s")
+            else ""
+        )
+        + "\n\n"
         f"Model T(N) = fixed + ceil(P / N) t_point g(N), t_point = {m['t_point_s']:.1f} s the 1-worker span per "
         "point: "
         f"T(1) {m['T_1_s']:.1f} s, T(2) {m['T_2_s']:.1f} s (with the measured g(2)), "
