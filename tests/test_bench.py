@@ -221,3 +221,53 @@ def test_json_results_are_readable_by_others(tmp_path):
     umask = os.umask(0)
     os.umask(umask)
     assert mode == 0o666 & ~umask
+
+
+def test_shafts_twins_follow_their_rigid_case_and_their_ratio_pairs_them():
+    """bench --shafts: each flanks case at the default step is followed by its shafted twin (cases.SHAFTS_BLOCK in
+    its scenario, not the reference), and shaft_ratios divides each twin by its rigid run; the twins stay out of the
+    flanks-against-pieces speed-ups."""
+    from wormsim.bench.cases import SHAFTS_BLOCK, bench_cases
+    from wormsim.bench.run import shaft_ratios, speedups
+
+    cases = bench_cases(quick=True, models=("contact3d",), geometries=("flanks",), shafts=True)
+    twins = [i for i, c in enumerate(cases) if c.shafts]
+    assert len(twins) == 2  # coarse and medium at the default step
+    for i in twins:
+        rigid, twin = cases[i - 1], cases[i]
+        assert not rigid.shafts and rigid.timestep_factor == 1.0 and not twin.reference and not twin.finer
+        assert (rigid.resolution, rigid.timestep_s, rigid.overrides) == (
+            twin.resolution,
+            twin.timestep_s,
+            twin.overrides,
+        )
+        assert twin.build().shafts.worm.bending and rigid.build().shafts is None
+    assert SHAFTS_BLOCK["worm"]["radial_stiffness_n_per_um"] > 0
+
+    def rec(shafts: bool, geo: str, loop: float, best: float, wall: float) -> dict:
+        return {
+            "scenario": "screw_jack",
+            "model": "contact3d",
+            "resolution": {"level": "medium", "geometry": geo},
+            "timestep_s": 1e-5,
+            "timestep_factor": 1.0,
+            "status": "ok",
+            "shafts": shafts,
+            "loop_wall_s": loop,
+            "loop_wall_s_best": best,
+            "wall_s": wall,
+            "steps": 1000,
+            "wall_s_per_sim_s": wall,
+            "loop_wall_s_per_sim_s": loop,
+        }
+
+    records = [
+        rec(False, "flanks", 2.0, 1.5, 3.0),
+        rec(True, "flanks", 3.0, 1.8, 4.5),
+        rec(False, "pieces", 20.0, 20, 30),
+    ]
+    r = shaft_ratios(records)["screw_jack"]["medium"]
+    assert r["loop"] == 1.5 and r["loop_best"] == 1.2 and r["whole"] == 1.5
+    assert r["rigid_step_wall_us"] == 2000.0 and r["shafts_step_wall_us"] == 3000.0
+    assert speedups(records) == {"screw_jack": {"medium": 10.0}}  # the rigid flanks run's, not the twin's
+    assert "speedup_vs_pieces" not in records[1]

@@ -79,6 +79,12 @@ def build_parser() -> argparse.ArgumentParser:
         help="contact3d: only this contact.geometry (repeatable; default both, for the speed-up)",
     )
     p.add_argument(
+        "--shafts",
+        action="store_true",
+        help="contact3d flanks: each default-step case also with a shafts: block (compliant bearings, the worm "
+        "bending), its step against the rigid one's (bench_meta.json step_ratio_shafts_vs_rigid)",
+    )
+    p.add_argument(
         "--resolution",
         action="append",
         default=None,
@@ -203,6 +209,7 @@ def _cmd_bench(args) -> int:
             scenarios=tuple(args.scenarios) if args.scenarios else None,
             geometries=tuple(args.geometries) if args.geometries else None,
             resolutions=tuple(args.resolutions) if args.resolutions else None,
+            shafts=args.shafts,
         )
     return EXIT_OK
 

@@ -144,6 +144,31 @@ def bench_flanks_vs_pieces_table(name: str = "bench_flanks_vs_pieces") -> str:
     return _table(head, rows) + "\n" + note + _source(name)
 
 
+def bench_shafts_table(names: tuple[str, ...] = ("bench_shafts_before", "bench_shafts")) -> str:
+    """A shafts: run's step against the rigid one's (`wormsim bench --shafts`, bench_meta.json
+    step_ratio_shafts_vs_rigid), one row per record: before the shafts' step changes and now."""
+    rows = []
+    for name in names:
+        d = load(name)
+        for seed, levels in sorted(d["meta"].get("step_ratio_shafts_vs_rigid", {}).items()):
+            for level, r in sorted(levels.items()):
+                rows.append(
+                    [
+                        f"{d['provenance']['commit']}",
+                        f"{seed} ({level}, {r['timestep_s']:.3g} s)",
+                        f"{r['rigid_step_wall_us']:.0f} us",
+                        f"{r['shafts_step_wall_us']:.0f} us",
+                        f"{r['loop']:.2f}x",
+                        f"{r['loop_best']:.2f}x",
+                        f"{r['whole']:.2f}x",
+                        f"{d['meta']['machine']['load_average_1min']:.1f}",
+                    ]
+                )
+    head = ["commit", "seed (level, step)", "rigid step", "shafts step", "step ratio (median)", "ratio (best)"]
+    head += ["whole simulate()", "load (2 CPUs)"]
+    return _table(head, rows) + "\n" + "".join(_source(n) for n in names)
+
+
 def flank_speed_table(name: str = "flank_speed") -> str:
     """Per step, exact flanks against medium convex pieces (sweeps/measure_flank_speed.py, best of the repeats)."""
     best = load(name)["best"]
@@ -217,6 +242,13 @@ def sweep_speedup_table(name: str = "sweep_speedup") -> str:
     return text + "\n" + _source(name)
 
 
+def _before_after(x: dict) -> str:
+    """A scaling run's fixed cost split: the command's start to the first point, the last point to its exit."""
+    if x.get("before_first_point_s") is None:
+        return "-"
+    return f"{x['before_first_point_s']:.1f} / {x['after_last_point_s']:.1f}"
+
+
 def sweep_scaling_table(name: str = "sweep_scaling") -> str:
     """A contact3d sweep as `wormsim sweep` commands on 1 and 2 workers, and the scaling model
     (sweeps/measure_sweep_scaling.py)."""
@@ -229,6 +261,7 @@ def sweep_scaling_table(name: str = "sweep_scaling") -> str:
                 f"{x['command_wall_s']:.1f}",
                 f"{x['span_s']:.1f}",
                 f"{x['fixed_s']:.1f}",
+                _before_after(x),
                 f"{x['cluster_start_s']:.1f}",
                 "-" if x.get("warm_s") is None else f"{x['warm_s']:.1f}",
                 f"{x['point_wall_median_s']:.2f}",
@@ -244,6 +277,7 @@ def sweep_scaling_table(name: str = "sweep_scaling") -> str:
         "command s",
         "points' span s",
         "fixed s",
+        "before first point / after last s",
         "cluster start s",
         "warm-up s",
         "point median s",
@@ -259,7 +293,18 @@ def sweep_scaling_table(name: str = "sweep_scaling") -> str:
         f"\n{r['what']}. Speed-up 1 -> 2 workers: {r['speedup_command']:.2f}x for the whole command, "
         f"{r['speedup_span']:.2f}x over the points' span; the step grows {r['step_growth_2']:.2f}x with 2 busy "
         f"workers. Load average after: {', '.join(f'{v:.1f}' for v in r['load_average_after'])} "
-        f"({r['cpu_count']} CPUs).\n\n"
+        f"({r['cpu_count']} CPUs)."
+        + (
+            " Commands (s), in turns: "
+            + "; ".join(
+                f"{n} worker{'s' if n != '1' else ''}: {', '.join(f'{v:.1f}' for v in w)}"
+                for n, w in sorted(r["command_walls_s"].items())
+            )
+            + "."
+            if r.get("command_walls_s")
+            else ""
+        )
+        + "\n\n"
         f"Model T(N) = fixed + ceil(P / N) t_point g(N), t_point = {m['t_point_s']:.1f} s the 1-worker span per "
         "point: "
         f"T(1) {m['T_1_s']:.1f} s, T(2) {m['T_2_s']:.1f} s (with the measured g(2)), "
@@ -1121,6 +1166,7 @@ TABLES: dict[str, Callable[[], str]] = {
     "bench_stability": bench_stability_table,
     "bench_flanks_vs_pieces": bench_flanks_vs_pieces_table,
     "flank_speed": flank_speed_table,
+    "bench_shafts": bench_shafts_table,
     "seat_motor_20s": seat_motor_20s_table,
     "sweep_speedup": sweep_speedup_table,
     "sweep_scaling": sweep_scaling_table,

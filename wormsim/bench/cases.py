@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import importlib.util
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from importlib.resources import files
 
 import numpy as np
@@ -11,7 +11,7 @@ import numpy as np
 from wormsim.contact3d.mjcf import prepare
 from wormsim.contact3d.timestep import default_timestep
 from wormsim.run import LEVELS
-from wormsim.scenario import ScenarioError, load_scenario
+from wormsim.scenario import Scenario, ScenarioError, load_scenario
 
 SCENARIOS = files("wormsim.scenarios")  # the seed scenarios, shipped as package data
 ERROR_KEYS = ("ratio", "tangential_force_mean_n", "tangential_force_p2p_n", "mesh_frequency_hz", "efficiency")
@@ -27,6 +27,14 @@ class BenchCase:
     reference: bool = False  # the converged reference of its scenario
     finer: bool = False  # the finer run that checks the reference
     timestep_factor: float | None = None  # contact3d: timestep_s / the default timestep of its geometry
+    shafts: bool = False  # contact3d: the run with SHAFTS_BLOCK, twin of the rigid case with the same fields
+
+    def build(self) -> Scenario:
+        """The case's scenario: the seed with its overrides, and SHAFTS_BLOCK where `shafts`."""
+        sc = load_scenario(SCENARIOS / f"{self.scenario}.yaml", list(self.overrides))
+        if not self.shafts:
+            return sc
+        return Scenario.model_validate({**sc.model_dump(), "shafts": SHAFTS_BLOCK})
 
 
 def _level_available(model: str) -> bool:
@@ -44,6 +52,17 @@ VARIANTS = {
 DURATION_S = {"seat_motor": 0.25, "screw_jack": 0.3, "involute_41": 0.3}
 QUICK_DURATION_S = 0.15
 GEOMETRIES = ("flanks", "pieces")  # contact3d's contact.geometry, both benched so one run gives the speed-up
+# `bench --shafts`: the shafts: block of the shafted twins (both shafts on compliant bearings, the worm bending: every
+# joint and spring of wormsim.contact3d.shafts; tests/test_shafts.py's balance case), each run against its rigid twin
+SHAFTS_BLOCK = {
+    "worm": {
+        "bearings_mm": [-60, 60],
+        "radial_stiffness_n_per_um": 500,
+        "axial_stiffness_n_per_um": 200,
+        "bending": True,
+    },
+    "wheel": {"bearings_mm": [-30, 30], "radial_stiffness_n_per_um": 500, "axial_stiffness_n_per_um": 200},
+}
 
 
 def contact3d_default_timestep(name: str, overrides: tuple[str, ...] = ()) -> float:
@@ -59,6 +78,7 @@ def bench_cases(
     scenarios: tuple[str, ...] | None = None,
     geometries: tuple[str, ...] | None = None,
     resolutions: tuple[str, ...] | None = None,
+    shafts: bool = False,
 ) -> list[BenchCase]:
     """The grid. contact3d, for each contact.geometry (flanks, pieces): resolution levels x timesteps of 2, 1 and 1/2
     times its default (the default is 0.4 x the explicit stability limit, so 2x probes the edge); the reference is
@@ -66,7 +86,8 @@ def bench_cases(
     torsional: k(theta) samples per mesh cycle.
     quick: the seat motor only, 0.15 s, coarse/medium. models: only these levels. scenarios: only these seeds (names
     of VARIANTS). geometries: only these contact.geometry values for contact3d. resolutions: only these contact3d
-    resolution levels (the reference is then the finest of them)."""
+    resolution levels (the reference is then the finest of them). shafts: each contact3d flanks case at the default
+    step followed by its shafted twin (SHAFTS_BLOCK), for the shafts' cost per step (run.shaft_ratios)."""
     names = ("seat_motor",) if quick else tuple(VARIANTS)
     if scenarios is not None:
         unknown = sorted(set(scenarios) - set(VARIANTS))
@@ -113,6 +134,13 @@ def bench_cases(
                         common + ("model=torsional", f"simulation.mesh_stiffness_samples={n}"),
                     )
                 )
+    if shafts:
+        twins = []
+        for c in out:
+            twins.append(c)
+            if c.model == "contact3d" and c.resolution.get("geometry") == "flanks" and c.timestep_factor == 1.0:
+                twins.append(replace(c, shafts=True, reference=False, finer=False))
+        out = twins
     return out
 
 

@@ -31,7 +31,6 @@ import numpy as np
 
 from wormsim.bench.cases import (
     GEOMETRIES,
-    SCENARIOS,
     BenchCase,
     _level_available,
     bench_cases,
@@ -42,7 +41,7 @@ from wormsim.errors import SimulationError
 from wormsim.output import write_json_atomic
 from wormsim.provenance import provenance
 from wormsim.run import simulate
-from wormsim.scenario import ScenarioError, load_scenario
+from wormsim.scenario import ScenarioError
 
 
 def pareto_front(cost: np.ndarray, error: np.ndarray) -> np.ndarray:
@@ -66,8 +65,8 @@ def machine_info() -> dict:
     }
 
 
-def _run_case(case: BenchCase, repeats: int) -> tuple[dict, float, float, float | None]:
-    sc = load_scenario(SCENARIOS / f"{case.scenario}.yaml", list(case.overrides))
+def _run_case(case: BenchCase, repeats: int) -> tuple[dict, float, float, float | None, float | None, int]:
+    sc = case.build()
     # warm-up: a run of a few steps builds the geometry / k(theta) caches, so the timed runs measure
     # simulation, not one-off generation (which `wormsim mesh` reports on its own)
     warm = sc.model_copy(deep=True)
@@ -84,7 +83,7 @@ def _run_case(case: BenchCase, repeats: int) -> tuple[dict, float, float, float 
         if res.summary.get("step_wall_us") is not None:
             loops.append(1e-6 * res.summary["step_wall_us"] * res.steps)
     loop = statistics.median(loops) if loops else None
-    return res.summary, statistics.median(walls), res.sim_time_s, loop
+    return res.summary, statistics.median(walls), res.sim_time_s, loop, min(loops) if loops else None, res.steps
 
 
 def speedups(records: list[dict], key: str = "wall_s_per_sim_s", name: str = "speedup_vs_pieces") -> dict:
@@ -95,7 +94,7 @@ def speedups(records: list[dict], key: str = "wall_s_per_sim_s", name: str = "sp
     out: dict = {}
     for r in records:
         res = r.get("resolution") or {}
-        if r["model"] != "contact3d" or res.get("geometry") != "flanks" or r["status"] != "ok":
+        if r["model"] != "contact3d" or res.get("geometry") != "flanks" or r["status"] != "ok" or r.get("shafts"):
             continue
         p = next(
             (
@@ -105,6 +104,7 @@ def speedups(records: list[dict], key: str = "wall_s_per_sim_s", name: str = "sp
                 and q["scenario"] == r["scenario"]
                 and q["status"] == "ok"
                 and q.get("timestep_factor") == r.get("timestep_factor")
+                and not q.get("shafts")
                 and (q.get("resolution") or {}) == {**res, "geometry": "pieces"}
             ),
             None,
@@ -128,7 +128,8 @@ def speedups_equal_accuracy(records: list[dict], key: str = "wall_s_per_sim_s") 
 
     def ok(r: dict, geo: str) -> bool:
         res = r.get("resolution") or {}
-        return r["model"] == "contact3d" and res.get("geometry") == geo and r["status"] == "ok" and bool(r.get(key))
+        good = r["model"] == "contact3d" and res.get("geometry") == geo and r["status"] == "ok" and bool(r.get(key))
+        return good and not r.get("shafts")
 
     def as_accurate(f: dict, p: dict) -> bool:
         ef, ep = f.get("error") or {}, p.get("error") or {}
@@ -168,6 +169,42 @@ def speedups_equal_accuracy(records: list[dict], key: str = "wall_s_per_sim_s") 
     return out
 
 
+def shaft_ratios(records: list[dict]) -> dict:
+    """Each shafted run (`bench --shafts`, cases.SHAFTS_BLOCK) against its rigid twin (same scenario, resolution and
+    timestep, in the same bench run), per scenario and resolution level: `loop` the stepping loop's wall time per
+    simulated second over the rigid run's (medians of the repeats; `loop_best`: their fastest repeats, the reading
+    least disturbed by other processes), `whole` the same for the whole simulate() call, and both runs' step_wall_us
+    (median repeats)."""
+    out: dict = {}
+    for r in records:
+        if not r.get("shafts") or r["status"] != "ok":
+            continue
+        twin = next(
+            (
+                q
+                for q in records
+                if not q.get("shafts")
+                and q["status"] == "ok"
+                and q["scenario"] == r["scenario"]
+                and q["model"] == r["model"]
+                and q.get("resolution") == r.get("resolution")
+                and q.get("timestep_s") == r.get("timestep_s")
+            ),
+            None,
+        )
+        if twin is None or not twin.get("loop_wall_s") or not r.get("loop_wall_s"):
+            continue
+        out.setdefault(r["scenario"], {})[(r.get("resolution") or {}).get("level")] = {
+            "loop": r["loop_wall_s"] / twin["loop_wall_s"],
+            "loop_best": r["loop_wall_s_best"] / twin["loop_wall_s_best"],
+            "whole": r["wall_s"] / twin["wall_s"],
+            "rigid_step_wall_us": 1e6 * twin["loop_wall_s"] / twin["steps"],
+            "shafts_step_wall_us": 1e6 * r["loop_wall_s"] / r["steps"],
+            "timestep_s": r.get("timestep_s"),
+        }
+    return out
+
+
 def run_bench(
     quick: bool,
     out_dir: str | Path,
@@ -176,6 +213,7 @@ def run_bench(
     scenarios: tuple[str, ...] | None = None,
     geometries: tuple[str, ...] | None = None,
     resolutions: tuple[str, ...] | None = None,
+    shafts: bool = False,
 ) -> list[dict]:
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -184,9 +222,9 @@ def run_bench(
     repeats = repeats or (1 if quick else 3)
     records, summaries, notes = [], {}, []
     machine_start = machine_info()
-    for case in bench_cases(quick, models, scenarios, geometries, resolutions):
+    for case in bench_cases(quick, models, scenarios, geometries, resolutions, shafts):
         try:
-            summary, wall, sim_s, loop = _run_case(case, repeats)
+            summary, wall, sim_s, loop, loop_best, steps = _run_case(case, repeats)
         except SimulationError as exc:
             notes.append(f"{case.scenario} {case.model} {case.resolution} dt={case.timestep_s}: failed: {exc}")
             records.append(
@@ -207,6 +245,7 @@ def run_bench(
             continue
         rec = {
             "scenario": case.scenario,
+            "shafts": case.shafts,
             "model": case.model,
             "resolution": case.resolution,
             "timestep_s": summary.get("timestep_s", case.timestep_s),
@@ -217,6 +256,8 @@ def run_bench(
             "wall_s_per_sim_s": wall / sim_s if sim_s else None,
             "loop_wall_s": loop,
             "loop_wall_s_per_sim_s": loop / sim_s if loop is not None and sim_s else None,
+            "loop_wall_s_best": loop_best,
+            "steps": steps,
             "status": "ok",
             "reference": case.reference,
             "finer": case.finer,
@@ -236,6 +277,8 @@ def run_bench(
         "speedup_flanks_vs_pieces_loop": speedups(records, "loop_wall_s_per_sim_s", "loop_speedup_vs_pieces"),
         "notes": notes,
     }
+    if shafts:
+        meta["step_ratio_shafts_vs_rigid"] = shaft_ratios(records)
     for scen in {r["scenario"] for r in records}:
         ref = next((r for r in records if r["scenario"] == scen and r.get("reference") and r["status"] == "ok"), None)
         if ref is None:
@@ -296,7 +339,11 @@ def plot_bench(records: list[dict], path: Path, keys: tuple[str, ...] = PANEL_KE
     ok = [
         r
         for r in records
-        if r["status"] == "ok" and r.get("wall_s_per_sim_s") and not r.get("finer") and not r.get("reference")
+        if r["status"] == "ok"
+        and r.get("wall_s_per_sim_s")
+        and not r.get("finer")
+        and not r.get("reference")
+        and not r.get("shafts")
     ]
     fig, axes = plt.subplots(1, len(keys), figsize=(5.2 * len(keys), 5.0), constrained_layout=True, squeeze=False)
     labels = sorted({curve_label(r) for r in ok})

@@ -8,7 +8,8 @@ Built with mujoco.MjSpec from the template `models/worm_pair.xml` (see models/RE
   ACTIVE WINDOW of `window_teeth` tooth slots around the line of centres, which wormsim.contact3d.runner
   re-poses by whole pitches as the wheel turns (tooth k lives in slot k mod W), so the cost does not
   grow with z2. Contype/conaffinity let worm pieces meet wheel pieces only;
-- visual-only geoms: the smooth watertight meshes (whole worm, whole wheel);
+- visual-only geoms: the smooth watertight meshes (whole worm, whole wheel); with contact.geometry flanks a
+  cylinder of each part's tip radius and length stands in (the flank contacts' geoms; no run reads the mesh);
 - inertias: axial moments of the visual meshes times the materials' densities (trimesh mass
   properties; a solid cylinder r_f..r_a as a fallback if a mesh is not watertight);
 - drive: speed -> `velocity` actuator (kv chosen for a 0.1 % speed droop at the expected torque, integrated
@@ -413,6 +414,8 @@ def build_model(
         p.inertias.worm_load_inertia_kg_m2, p.inertias.wheel_load_inertia_kg_m2
     )  # x mass_scaling
     _set_options(spec, scenario.simulation, law, h)
+    if sups is not None:
+        shafts.set_solver(spec, sups)  # CG where shaft joints move (wormsim.contact3d.shafts.SOLVER)
     _add_mesh_sensor(spec)
     model = spec.compile()
 
@@ -555,16 +558,26 @@ def _add_geoms(
         g.friction = [mu0, 0.0, 0.0]
         g.margin = 0.0
 
-    _add_mesh(spec, "worm_visual", gs.worm_visual)
-    _add_mesh(spec, "wheel_visual", gs.wheel_visual)
+    if not flanks:
+        _add_mesh(spec, "worm_visual", gs.worm_visual)
+        _add_mesh(spec, "wheel_visual", gs.wheel_visual)
+    stand_in = {"worm_visual": (geo.r_a1, geo.worm_length / 2), "wheel_visual": (geo.r_a2, geo.face_width / 2)}
     for b, name, rgba in (
         (worm_b, "worm_visual", (0.55, 0.6, 0.7, 1)),
         (wheel_b, "wheel_visual", (0.85, 0.65, 0.3, 1)),
     ):
         g = b.add_geom(default=spec.find_default("visual"))
-        g.name, g.meshname, g.rgba = name, name, rgba
+        g.name, g.rgba = name, rgba
         if flanks:
-            set_contact(g)  # the flank contacts' geoms (wormsim.contact3d.flank_step): friction, solref
+            # the flank contacts' geoms (wormsim.contact3d.flank_step): friction, solref; a cylinder of the part's tip
+            # radius and length about its axis stands in for the smooth mesh, which no flank run reads (the contacts
+            # come from the kernel, the bodies' inertias are explicit, the recording draws the meshes itself) and
+            # whose compile (60k vertices for the screw jack) cost every run 0.7 s
+            g.type = mujoco.mjtGeom.mjGEOM_CYLINDER
+            g.size = [*stand_in[name], 0.0]
+            set_contact(g)
+        else:
+            g.meshname = name
     worm_names = []
     for i, piece in enumerate([] if flanks else gs.worm_pieces):
         _add_mesh(spec, f"worm_piece_{i}", piece)

@@ -53,6 +53,7 @@ DAMPING_RATIO = 0.05  # bearings' and bending's damping, share of critical again
 TINY_MASS_KG = 1e-9  # a carrier without a shaft mass of its own (the wheel's)
 STABLE_SHARE = 0.8  # the timestep may use at most this share of the stiffest shaft mode's explicit limit 2 / omega
 MARGIN_FACTOR = 3.0  # the candidate window covers this many times the static mesh displacement at the working load
+SOLVER = mujoco.mjtSolver.mjSOL_CG  # the constraint solver of a model whose shafts move (set_solver)
 
 
 def beam_stiffness_n_per_m(youngs_modulus_pa: float, second_moment_m4: float, l1_m: float, l2_m: float) -> float:
@@ -203,6 +204,15 @@ def add_part(
     j.name, j.type, j.axis = f"{name}_hinge", HINGE, [0, 0, 1]
     j.pos = hinge_pos
     return body
+
+
+def set_solver(spec: mujoco.MjSpec, sups: dict[str, Support | None]) -> None:
+    """MuJoCo's conjugate-gradient solver (SOLVER) for a model with shaft joints: Newton's Hessian of the elliptic
+    friction cones grows with nv^2 per contact, and the shafts take nv from 2 to up to 14; CG needs no Hessian and
+    converges within MuJoCo's tolerance in a few iterations here (decision 0035, measured there). The rigid model
+    (no shafts: block, or only rigid supports) keeps MuJoCo's default, Newton."""
+    if any(s is not None and s.moves for s in sups.values()):
+        spec.option.solver = SOLVER
 
 
 def mesh_margin_rad(supports: dict[str, Support | None], normal_force_n: float, geo: GearGeometry) -> float:

@@ -34,7 +34,7 @@ import numpy as np
 from wormsim.tooth.gap import _wrap, worm_gap_ext
 from wormsim.tooth.grid import FlankGrid
 from wormsim.tooth.merge import merge_flanks
-from wormsim.tooth.pose import N_WORM_PARAMS, static_dir_to_world, to_static, tooth_angle
+from wormsim.tooth.pose import N_WORM_PARAMS, WHEEL, WORM, static_dir_to_world, to_static, tooth_angle
 
 TAPER_SHARE = 0.5  # outer share of the candidate margin over which an edge contact's depth fades to zero
 MARGIN_PITCH = 0.10  # candidate points: conjugate angle within this fraction of a pitch (plus the backlash
@@ -42,6 +42,8 @@ MARGIN_PITCH = 0.10  # candidate points: conjugate angle within this fraction of
 MEMO_GAP_SHARE = 0.5  # a memorised open slice is skipped while its bound keeps this share of the gap it had
 MEMO_JITTER_MODULE = 1e-3  # allowance (x m_x) for the slice minimum's change at constant TE (measured <= 1.5e-5)
 MEMO_AGE_CYCLE = 1.0 / 8  # a memorised slice is evaluated again after this share of a mesh cycle of worm rotation
+MEMO_COLS = 4  # the memo table's columns: gline, TE, theta1, the pose's drift (_pose_drift) when it was evaluated
+MEMO_CONSTS = 4  # rho_max, jitter allowance, age, the largest distance of a grid point from the wheel's origin
 INSIDE_SHARE = 0.5 * (1.0 + 1e-3)  # line points deeper inside than this x the slice width: weight 1 without the face
 # slope (its |change| across a slice is at most the slice width; 1e-3 is far above the slope's round-off)
 
@@ -80,21 +82,23 @@ def find_contacts(
         taper_rad = TAPER_SHARE * margin
     work = (np.empty(6), np.empty(N), np.empty(N), np.empty((N, 3)), np.empty((N, 3)), np.empty(N, dtype=np.int64))
     if memo is None:
-        memo = (np.zeros((0, 2, 1, 3)), np.zeros(3))
+        memo = (np.zeros((0, 2, 1, MEMO_COLS)), np.zeros(MEMO_CONSTS))
     return _find_contacts(
         xy, c, c_range, span, zeta, ks, theta1, theta2, margin, taper_rad, P, (pos, nrm, depth, meta, line), work, memo
     )
 
 
 def flank_memo(grid: FlankGrid, z2: int) -> tuple[np.ndarray, np.ndarray]:
-    """Preallocated state of find_contacts' open-slice memo for one grid: table (z2, 2, S, 3) = per (tooth mod z2,
-    flank, slice) the line depth's gap gline (> 0; 0 = nothing memorised), TE and theta1 when it was evaluated, and
-    consts = (largest radius of a grid point, jitter allowance, largest worm-angle age) (`_find_contacts`)."""
+    """Preallocated state of find_contacts' open-slice memo for one grid: table (z2, 2, S, MEMO_COLS) = per (tooth
+    mod z2, flank, slice) the line depth's gap gline (> 0; 0 = nothing memorised), TE, theta1 and the poses' drift
+    when it was evaluated, and consts = (largest radius of a grid point, jitter allowance, largest worm-angle age,
+    largest distance of a grid point from the wheel's origin) (`_find_contacts`, `_pose_drift`)."""
     P = grid.params
     z1 = abs(P[12]) * 2 * math.pi / P[11]
     rho = float(np.nanmax(np.where(np.isfinite(grid.c), grid.rho[None], np.nan)))
-    consts = np.array([rho, MEMO_JITTER_MODULE * P[1] / math.pi, MEMO_AGE_CYCLE * 2 * math.pi / z1])
-    return np.zeros((z2, 2, grid.slices, 3)), consts
+    reach = math.hypot(rho, float(np.max(np.abs(grid.zeta))))
+    consts = np.array([rho, MEMO_JITTER_MODULE * P[1] / math.pi, MEMO_AGE_CYCLE * 2 * math.pi / z1, reach])
+    return np.zeros((z2, 2, grid.slices, MEMO_COLS)), consts
 
 
 @numba.njit(cache=True, _nrt=False)
@@ -105,20 +109,26 @@ def _find_contacts(xy, c, c_range, span, zeta, ks, theta1, theta2, margin, taper
     candidate window: the memo's check (`_memo_skips`), the start point (`_start_point`), the slice's contact
     (`_slice_contact`).
 
-    The open-slice memo (memo = flank_memo(...); an empty table turns it off, as do displaced poses): a slice whose
-    flanks were apart at its last evaluation, with the gap's minimum gline_e > 0 inside the profile (not at its ends,
-    the parabola through three points, the line's point inside the threaded region), is skipped while
-        gline_e - 2 rho_max |TE - TE_e| - J > MEMO_GAP_SHARE gline_e   and   |theta1 - theta1_e| <= age.
-    Along the conjugate motion the minimum of such a slice depends on the TE alone (the flanks are conjugate): over
-    recorded mesh cycles of the three seeds it moved by <= 1.5e-5 m_x at constant TE (J = 1e-3 m_x), and a point of the
-    wheel moves by rho |dTE| relative to the conjugate pose (factor 2 for the gap's gradient). A skipped slice gives no
-    contact, as its evaluation would: tests/test_flank_kernel_memo.py compares with and without over mesh cycles."""
+    The open-slice memo (memo = flank_memo(...); an empty table turns it off): a slice whose flanks were apart at its
+    last evaluation, with the gap's minimum gline_e > 0 inside the profile (not at its ends, the parabola through
+    three points, the line's point inside the threaded region), is skipped while
+        gline_e - 2 rho_max |TE - TE_e| - J - 2 (delta + delta_e) > MEMO_GAP_SHARE gline_e
+    and |theta1 - theta1_e| <= age. Along the conjugate motion the minimum of such a slice depends on the TE alone
+    (the flanks are conjugate): over recorded mesh cycles of the three seeds it moved by <= 1.5e-5 m_x at constant TE
+    (J = 1e-3 m_x), and a point of the wheel moves by rho |dTE| relative to the conjugate pose (factor 2 for the gap's
+    gradient). With displaced poses (wormsim.tooth.pose: errors:, shafts:) the flanks sit off the nominal assembly
+    by delta (`_pose_drift`, now) and delta_e (at the slice's evaluation), the largest distance a wheel grid point
+    lies from where the nominal assembly puts it: the gap then differs from the nominal assembly's by at most 2 delta
+    (the same factor 2), so the nominal bound holds with 2 (delta + delta_e) more; delta = 0 for the nominal poses. A
+    skipped slice gives no contact, as its evaluation would: tests/test_flank_kernel_memo.py compares with and without
+    over mesh cycles, nominal and with moving poses."""
     tmp, gaps, exc, pts, nrs, stamp = work
     mtab, mc = memo
-    use_memo = mtab.shape[0] > 0 and P.shape[0] <= N_WORM_PARAMS
+    use_memo = mtab.shape[0] > 0
     S = c.shape[1]
     pitch = P[11]
     te = _wrap(theta2 - P[12] * theta1, pitch)
+    drift = _pose_drift(P, theta2, mc[3]) if use_memo and P.shape[0] > N_WORM_PARAMS else 0.0
     taper_end = margin  # edge contacts fade to zero at this distance past the profile's conjugate range
     margin = margin + abs(te)
     stamp[:] = -1
@@ -144,13 +154,13 @@ def _find_contacts(xy, c, c_range, span, zeta, ks, theta1, theta2, margin, taper
                 # (a property of the slice's position, not of the wheel's lag; zero before the window cuts)
                 past = max(c_range[sg, j, 0] - target, target - c_range[sg, j, 1], 0.0)
                 taper = min(max((taper_end - past) / taper_rad, 0.0), 1.0)
-                if use_memo and _memo_skips(mtab, mc, k, sg, j, theta1, te):
+                if use_memo and _memo_skips(mtab, mc, k, sg, j, theta1, te, drift):
                     continue
                 if span[sg, j, 0] < 0:
                     continue
                 i_s = _start_point(c, span, sg, j, target)
                 sid += 1
-                memo_row = (use_memo, mtab, te)
+                memo_row = (use_memo, mtab, te, drift)
                 n, full = _slice_contact(ev, span, zeta, sg, j, k, i_s, sid, taper, memo_row, out, n)
                 if full:
                     return n
@@ -158,7 +168,7 @@ def _find_contacts(xy, c, c_range, span, zeta, ks, theta1, theta2, margin, taper
 
 
 @numba.njit(cache=True, inline="always")
-def _memo_skips(mtab, mc, k, sg, j, theta1, te):
+def _memo_skips(mtab, mc, k, sg, j, theta1, te, drift):
     """The open-slice memo's check of (tooth k, flank sg, slice j) (_find_contacts); a memorised slice that is not
     skipped is forgotten."""
     km = k % mtab.shape[0]
@@ -166,11 +176,45 @@ def _memo_skips(mtab, mc, k, sg, j, theta1, te):
     if ge > 0.0:
         if (
             abs(theta1 - mtab[km, sg, j, 2]) <= mc[2]
-            and ge - 2.0 * mc[0] * abs(te - mtab[km, sg, j, 1]) - mc[1] > MEMO_GAP_SHARE * ge
+            and ge - 2.0 * mc[0] * abs(te - mtab[km, sg, j, 1]) - mc[1] - 2.0 * (drift + mtab[km, sg, j, 3])
+            > MEMO_GAP_SHARE * ge
         ):
             return True
         mtab[km, sg, j, 0] = 0.0
     return False
+
+
+@numba.njit(cache=True, inline="always")
+def _pose_drift(P, theta2, reach):
+    """delta of `_find_contacts`' memo: how far the displaced poses in P (wormsim.tooth.pose) put a wheel grid point
+    from where the nominal assembly does, as a bound: with D = A^-1 X_g Rz(-theta2) the wheel's frame, its hinge
+    angle taken out, in the static worm frame, and D0 the nominal (x, y, z) -> (y + a, -z, -x),
+    |D q - D0 q| <= |t - t0| + ||R - R0||_F |q|, |q| <= reach (the grid's largest distance from the wheel's origin)."""
+    cs, sn = math.cos(theta2), math.sin(theta2)
+    d_t = 0.0
+    d_r = 0.0
+    for i in range(3):
+        # column i of A's rotation, A's translation taken from the wheel's
+        t = 0.0
+        m0 = m1 = m2 = 0.0
+        for r in range(3):
+            a = P[WORM + 4 * r + i]
+            g0, g1 = P[WHEEL + 4 * r], P[WHEEL + 4 * r + 1]
+            m0 += a * (g0 * cs - g1 * sn)
+            m1 += a * (g0 * sn + g1 * cs)
+            m2 += a * P[WHEEL + 4 * r + 2]
+            t += a * (P[WHEEL + 4 * r + 3] - P[WORM + 4 * r + 3])
+        # the nominal rows: (0, 1, 0) + a e_x, (0, 0, -1), (-1, 0, 0)
+        if i == 0:
+            d_t += (t - P[10]) ** 2
+            d_r += m0 * m0 + (m1 - 1.0) ** 2 + m2 * m2
+        elif i == 1:
+            d_t += t * t
+            d_r += m0 * m0 + m1 * m1 + (m2 + 1.0) ** 2
+        else:
+            d_t += t * t
+            d_r += (m0 + 1.0) ** 2 + m1 * m1 + m2 * m2
+    return math.sqrt(d_t) + math.sqrt(d_r) * reach
 
 
 @numba.njit(cache=True, inline="always")
@@ -252,10 +296,11 @@ def _slice_contact(ev, span, zeta, sg, j, k, i_s, sid, taper, memo_row, out, n):
     gmin, x = _edge_minimum(ev, sg, j, zj, ib, nb, best, qa, qb, x, e_x, par, gm, gp, sid)
     gline = best + qa * x_l + qb * x_l * x_l
     if gmin >= 0.0 and gline >= 0.0:
-        use_memo, mtab, te = memo_row
+        use_memo, mtab, te, drift = memo_row
         if use_memo and par and e_x <= 0.0 and gline > 0.0 and span[sg, j, 0] < ib < span[sg, j, 1]:
             km = k % mtab.shape[0]
             mtab[km, sg, j, 0], mtab[km, sg, j, 1], mtab[km, sg, j, 2] = gline, te, ev[3]
+            mtab[km, sg, j, 3] = drift
         return n, False
     if gmin == np.inf:
         x = x_l  # no edge inside reach: the line's point (only its weight can make it carry)
@@ -537,7 +582,7 @@ def _layout(S, N, cap, nP, W, z2):
     """The packed buffers' layout, declared once: the shapes of the float buffer's fields (_F_FIELDS order) and of
     the int buffer's after its header (_I_FIELDS order). PackedKernel sizes the buffers by it; `_views` cuts them."""
     f = ((2, S, N, 2), (2, S, N), (2, S, 2), (S,), (nP,), (cap, 3), (cap, 3), (cap,), (cap, 4), (cap, 2), (cap,))
-    f2 = ((cap, 9), (z2, 2, S, 3), (3,), (6,), (N,), (N,), (N, 3), (N, 3))
+    f2 = ((cap, 9), (z2, 2, S, MEMO_COLS), (MEMO_CONSTS,), (6,), (N,), (N,), (N, 3), (N, 3))
     f3 = ((cap, 3), (cap, 3), (cap,), (cap,), (cap, 9), (cap,), (cap,), (cap,), (cap,), (13,))
     return f + f2 + f3, ((2, S, 2), (W,), (N,))
 
