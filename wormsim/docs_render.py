@@ -1102,9 +1102,55 @@ def stiffness_seeds_table(name: str = "stiffness_seeds") -> str:
     return _table(head, rows) + "\n" + _source(name)
 
 
+def slice_convergence_table(name: str = "slice_convergence_medium") -> str:
+    """The default slice count S against 2 S (sweeps/slice_convergence_default.py): F_t p2p (whole and below the
+    meshing band's limit), p_H max (hertz (4)) and one contact's largest p_H (hertz (3)), each S -> 2 S and its
+    change; 'yes' where F_t p2p and p_H max are both within 10 %."""
+    rec = load(name)
+    rows = []
+
+    def pair(runs: list, ch: dict, key: str, fmt: str) -> str:
+        a, b = runs[0].get(key), runs[1].get(key)
+        if a is None or b is None:
+            return "-"
+        c = ch.get(key)
+        return f"{fmt.format(a)} / {fmt.format(b)} ({'-' if c is None else f'{100 * c:+.1f} %'})"
+
+    for case, c in rec["cases"].items():
+        runs, ch = c["runs"], c["change_default_vs_double"]
+        src = runs[0].get("contact_stiffness_source") or "-"
+        if c.get("hertz_fallback"):
+            src += " (teeth's failed)"
+        ok = all(ch.get(k) is not None and abs(ch[k]) <= 0.10 for k in ("ft_p2p_n", "ph_max_mpa"))
+        rows.append(
+            [
+                case,
+                src,
+                f"{runs[0]['slices']} / {runs[1]['slices']}",
+                pair(runs, ch, "ft_p2p_n", "{:.3g}"),
+                pair(runs, ch, "ft_p2p_band_n", "{:.3g}"),
+                pair(runs, ch, "ph_max_mpa", "{:.0f}"),
+                pair(runs, ch, "ph_max_cell_mpa", "{:.0f}"),
+                "yes" if ok else "no",
+            ]
+        )
+    head = [
+        "case",
+        "contact stiffness",
+        "slices S / 2 S",
+        "F_t p2p [N]",
+        f"F_t p2p below {rec['band_hz']:.0f} Hz [N]",
+        "p_H max [MPa] (averaged, (4))",
+        "one contact's p_H [MPa] ((3))",
+        "both within 10 %",
+    ]
+    return _table(head, rows) + "\n" + _source(name)
+
+
 TABLES: dict[str, Callable[[], str]] = {
     "calculix_check": calculix_check_table,
     "stiffness_seeds": stiffness_seeds_table,
+    "slice_convergence": slice_convergence_table,
     "torsional_seeds": torsional_seeds_table,
     "rexs_stages": rexs_stages_table,
     "rexs_rating": rexs_rating_table,
