@@ -1144,7 +1144,8 @@ def slice_convergence_table(name: str = "slice_convergence_medium") -> str:
         "one contact's p_H [MPa] ((3))",
         "both within 10 %",
     ]
-    return _table(head, rows) + "\n" + _source(name)
+    # the run's --save folder (pattern tables kept aside, not a record) shown as DIR
+    return _table(head, rows) + "\n" + re.sub(r"--save \S+", "--save DIR", _source(name))
 
 
 TABLES: dict[str, Callable[[], str]] = {
