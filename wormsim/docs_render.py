@@ -1102,11 +1102,17 @@ def stiffness_seeds_table(name: str = "stiffness_seeds") -> str:
     return _table(head, rows) + "\n" + _source(name)
 
 
-def slice_convergence_table(name: str = "slice_convergence_medium") -> str:
+# sweeps/slice_convergence_default.py's records at medium: the cases, and the seat motor's (run beside them)
+SLICE_CONVERGENCE_RECORDS = ("slice_convergence_medium", "slice_convergence_seat_motor")
+
+
+def slice_convergence_table(*names: str) -> str:
     """The default slice count S against 2 S (sweeps/slice_convergence_default.py): F_t p2p (whole and below the
     meshing band's limit), p_H max (hertz (4)) and one contact's largest p_H (hertz (3)), each S -> 2 S and its
-    change; 'yes' where F_t p2p and p_H max are both within 10 %."""
-    rec = load(name)
+    change; 'yes' where F_t p2p and p_H max are both within 10 %. The rows of each record in `names` (default:
+    SLICE_CONVERGENCE_RECORDS) that exists."""
+    names = tuple(n for n in (names or SLICE_CONVERGENCE_RECORDS) if (DATA / f"{n}.json").exists())
+    recs = [load(n) for n in names]
     rows = []
 
     def pair(runs: list, ch: dict, key: str, fmt: str) -> str:
@@ -1116,7 +1122,8 @@ def slice_convergence_table(name: str = "slice_convergence_medium") -> str:
         c = ch.get(key)
         return f"{fmt.format(a)} / {fmt.format(b)} ({'-' if c is None else f'{100 * c:+.1f} %'})"
 
-    for case, c in rec["cases"].items():
+    cases = {k: v for rec in recs for k, v in rec["cases"].items()}  # a case in a later record replaces its row
+    for case, c in cases.items():
         runs, ch = c["runs"], c["change_default_vs_double"]
         src = runs[0].get("contact_stiffness_source") or "-"
         if c.get("hertz_fallback"):
@@ -1139,13 +1146,13 @@ def slice_convergence_table(name: str = "slice_convergence_medium") -> str:
         "contact stiffness",
         "slices S / 2 S",
         "F_t p2p [N]",
-        f"F_t p2p below {rec['band_hz']:.0f} Hz [N]",
+        f"F_t p2p below {recs[0]['band_hz']:.0f} Hz [N]",
         "p_H max [MPa] (averaged, (4))",
         "one contact's p_H [MPa] ((3))",
         "both within 10 %",
     ]
     # the run's --save folder (pattern tables kept aside, not a record) shown as DIR
-    return _table(head, rows) + "\n" + re.sub(r"--save \S+", "--save DIR", _source(name))
+    return _table(head, rows) + "\n" + "".join(re.sub(r"--save \S+", "--save DIR", _source(n)) for n in names)
 
 
 TABLES: dict[str, Callable[[], str]] = {
