@@ -45,8 +45,8 @@ s L the contacts' own line lengths (2). A contact entering or leaving the line h
 divides a vanishing force by a vanishing length, and MuJoCo's constraint force keeps a part that does not scale with s
 (the impedance term D J qacc, D from solimp and A_hat); in (4) a window whose line is shorter than l_H counts its load
 over l_H. Measured with (3) per contact (the maximum over contacts above 1 % of the mean F_n), S against 2 S slices:
-4-start-z41 151 / 303 MPa, random gear 0 153 / 1967 MPa (a contact of 0.08 N at the profile's end); with (4)
-132 / 131 and 127 / 131 MPa (sweeps/slice_convergence_default.py, docs/contact3d.md "Default slice count").
+4-start-z41 187 / 2841 MPa, random gear 0 153 / 1967 MPa (a contact of 0.08 N at the profile's end); with (4)
+131 / 131 and 127 / 131 MPa (sweeps/slice_convergence_default.py, docs/contact3d.md "Default slice count").
 """
 
 from __future__ import annotations
