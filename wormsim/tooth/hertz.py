@@ -318,8 +318,8 @@ class PatternLog:
                 "contact_pattern_extent_face_mm": float(self.extent_face_m(sel) * 1e3),
                 "contact_pressure_max_mpa": float(pavg[imax] * 1e-6) if finite.any() else nan,
                 "contact_pressure_mean_mpa": float((fn[ok] * p[ok]).sum() / fn[ok].sum() * 1e-6),
-                "contact_pressure_max_face_mm": float(z[imax] * 1e3),
-                "contact_pressure_max_radius_mm": float(r[imax] * 1e3),
+                "contact_pressure_max_face_mm": float(z[imax] * 1e3) if finite.any() else nan,
+                "contact_pressure_max_radius_mm": float(r[imax] * 1e3) if finite.any() else nan,
             }
         )
         return keys
