@@ -13,7 +13,8 @@ each case (a long sweep can be cut).
         [--record NAME] [--save DIR]
 
 --medium runs the variety and random gears at simulation.resolution medium (the default resolution; their test
-configurations are coarse, 8 slices). --save writes each run's contact pattern table and F_t (npz).
+configurations are coarse, 8 slices). --save writes each run's contact pattern table and F_t (npz). --factor F
+compares F x the default count against 2 F x it (the record's default_slices is then F x the default).
 """
 
 from __future__ import annotations
@@ -113,10 +114,11 @@ def main() -> None:
     ap.add_argument("--medium", action="store_true")
     ap.add_argument("--record", default="slice_convergence_default")
     ap.add_argument("--save", type=Path, help="folder: each run's contact pattern table and F_t (npz)")
+    ap.add_argument("--factor", type=int, default=1, help="compare factor x the default against twice that")
     a = ap.parse_args()
-    out: dict = {"band_hz": BAND_HZ, "medium": a.medium, "cases": {}}
+    out: dict = {"band_hz": BAND_HZ, "medium": a.medium, "factor": a.factor, "cases": {}}
     for name in a.cases:
-        s0 = flank_slices(scenario(name, None, a.medium))
+        s0 = a.factor * flank_slices(scenario(name, None, a.medium))
         try:
             hertz = False
             runs = [measure(scenario(name, s, a.medium), a.save, name) for s in (s0, 2 * s0)]
