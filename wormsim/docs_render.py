@@ -1159,6 +1159,7 @@ TABLES: dict[str, Callable[[], str]] = {
     "calculix_check": calculix_check_table,
     "stiffness_seeds": stiffness_seeds_table,
     "slice_convergence": slice_convergence_table,
+    "slice_convergence_double": lambda: slice_convergence_table("slice_convergence_double"),
     "torsional_seeds": torsional_seeds_table,
     "rexs_stages": rexs_stages_table,
     "rexs_rating": rexs_rating_table,
