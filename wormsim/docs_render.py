@@ -1144,7 +1144,7 @@ def slice_convergence_table(*names: str) -> str:
     head = [
         "case",
         "contact stiffness",
-        "slices S / 2 S",
+        "slices n / 2 n",
         "F_t p2p [N]",
         f"F_t p2p below {recs[0]['band_hz']:.0f} Hz [N]",
         "p_H max [MPa] (averaged, (4))",
