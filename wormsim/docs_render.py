@@ -1102,8 +1102,8 @@ def stiffness_seeds_table(name: str = "stiffness_seeds") -> str:
     return _table(head, rows) + "\n" + _source(name)
 
 
-# sweeps/slice_convergence_default.py's records at medium: the cases, and the seat motor's (run beside them)
-SLICE_CONVERGENCE_RECORDS = ("slice_convergence_medium", "slice_convergence_seat_motor")
+# sweeps/slice_convergence_default.py's records at medium: the cases, more variety gears, the seat motor (run apart)
+SLICE_CONVERGENCE_RECORDS = ("slice_convergence_medium", "slice_convergence_variety", "slice_convergence_seat_motor")
 
 
 def slice_convergence_table(*names: str) -> str:
