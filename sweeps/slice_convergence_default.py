@@ -65,6 +65,12 @@ def scenario(name: str, slices: int | None, medium: bool = False, hertz: bool = 
     return load_scenario(GEAR, [*FAST, *FLANK_GEARS[name], *res, *extra, stiffness])
 
 
+def _table(res) -> np.ndarray:
+    """The run's contact pattern rows (wormsim.tooth.hertz.PatternLog.table)."""
+    log = res.extra.get("flank_pattern_log")
+    return log.table() if log is not None else np.zeros((0, 8))
+
+
 def cell_peak_mpa(T, t: np.ndarray, window) -> float | None:
     """The largest p_H of one contact, (3) of wormsim.tooth.hertz, over the contacts in the steady window carrying at
     least 1 % of their mean normal force (the maximum before the averaged (4); for comparison)."""
@@ -87,7 +93,7 @@ def measure(sc: Scenario, save: Path | None = None, tag: str = "") -> dict:
         pat = res.extra["flank_pattern"]
         np.savez(
             save / f"{tag}_S{r['flank_slices']}.npz",
-            table=res.extra.get("pattern_table", np.zeros((0, 8))),
+            table=_table(res),
             t_s=t,
             window=np.array(r["steady_window_s"]),
             f_t=S["tangential_force_n"],
@@ -99,7 +105,7 @@ def measure(sc: Scenario, save: Path | None = None, tag: str = "") -> dict:
         "ft_p2p_n": r["tangential_force_p2p_n"],
         "ft_p2p_band_n": float(p2p_below(t[m], S["tangential_force_n"][m], BAND_HZ)),
         "ph_max_mpa": r.get("contact_pressure_max_mpa"),
-        "ph_max_cell_mpa": cell_peak_mpa(res.extra.get("pattern_table"), t, r["steady_window_s"]),
+        "ph_max_cell_mpa": cell_peak_mpa(_table(res), t, r["steady_window_s"]),
         "ft_mean_n": r["tangential_force_mean_n"],
         "timestep_s": r["timestep_s"],
         "contact_pair_stiffness_n_per_m": r.get("contact_pair_stiffness_n_per_m"),
