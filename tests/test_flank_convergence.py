@@ -17,6 +17,8 @@ from wormsim.metrics import p2p_below
 from wormsim.scenario import load_scenario
 
 KEYS = ("tangential_force_p2p_n", "transmission_error_p2p_urad")
+# issue 31: F_t p2p and p_H max (wormsim.tooth.hertz (4)) within 10 % of twice the slices; the TE p2p as well
+SLICE_KEYS = (*KEYS, "contact_pressure_max_mpa")
 MESH_BAND_HZ = 1000.0  # F_t's meshing band: below the lowest contact mode measured (involute_41, 1.3-1.8 kHz)
 _CACHE: dict[tuple, dict] = {}
 _BAND: dict[tuple, float] = {}
@@ -59,13 +61,14 @@ DEFAULT_SLICES = {
     "screw_jack": 16,
     "seat_motor": 32,
     "involute_41": 24,
-}  # wormsim.tooth.grid.default_slices at medium
+}  # wormsim.tooth.grid.default_slices at medium (the CI runs' resolution)
 
 
 SLICES_XFAIL = {
-    ("involute_41", "tangential_force_p2p_n"): "whole-band F_t p2p 147.7 N at 24 slices against 230.5 N at 48 (+56 %): "
-    "the 41-tooth wheel's contact mode (mass_scaling_mesh_mode_hz 1672 Hz) rings above the meshing band; its meshing "
-    "band below 1 kHz converges (test_flank_mesh_band_converged_in_slices), and so does the TE p2p",
+    ("involute_41", "tangential_force_p2p_n"): "whole-band F_t p2p 437.3 N at 24 slices against 293.1 N at 48 "
+    "(+49.2 %; below 1 kHz 373.5 against 289.3 N, +29.1 %): with the teeth's compliance (1.01e9 N/m per tooth pair) "
+    "the contact mode falls to about 770 Hz, where the slices' switching rings it (docs/data/"
+    "slice_convergence_medium.json); its p_H max converges (250.4 -> 253.0 MPa), and so does the TE p2p",
 }
 
 
@@ -76,11 +79,14 @@ SLICES_XFAIL = {
         if (n, k) in SLICES_XFAIL
         else (n, k)
         for n in DEFAULT_SLICES
-        for k in KEYS
+        for k in SLICE_KEYS
     ],
 )
 def test_flank_fluctuation_converged_in_slices(name, key):
-    """The default slice count (the CI run, medium: flanks.default_slices) against twice it: within 10 %. Seat motor
+    """The default slice count (the CI run, medium: flanks.default_slices) against twice it: within 10 % (issue 31:
+    F_t p2p and p_H max, wormsim.tooth.hertz (4); and the TE p2p). p_H max: screw jack 318.3 -> 322.2 MPa, involute_41
+    250.4 -> 253.0 MPa, seat motor 661.9 -> 628.9 MPa (+5.2 %; one contact's p_H, the maximum before: 341.9 -> 338.8,
+    300.7 -> 294.4 and 844.7 -> 856.8 MPa; docs/data/slice_convergence_medium.json, _seat_motor.json). Seat motor
     (32; F_t p2p 0.07 % of its mean): F_t p2p 0.869 -> 0.851 N (-2.1 %), TE p2p 219.9 -> 203.4 urad (-7.5 %); at 16
     slices (the default before) F_t p2p was 1.043 N, -16.7 % to 32: the slices' switching rang the contact mode
     (F_t above 1 kHz p2p 0.313 / 0.189 N at 16 / 32). Screw jack (16): F_t p2p 1.636 -> 1.639 N, TE p2p 8.580 ->

@@ -206,30 +206,47 @@ def test_extent_is_the_face_span_holding_95_percent_of_the_load():
     assert log.extent_face_m(rows([0, 15], [1.0, 1.0])) == pytest.approx(g.face_width - 0.1 * w, rel=1e-12)
 
 
-def test_pressure_maximum_skips_contacts_entering_or_leaving_the_line():
-    """A contact carrying a vanishing share of its slice divides a vanishing force by a vanishing line length (the
-    screw jack CI run: 2069 MPa from < 0.005 N): the maximum counts contacts with at least
-    PRESSURE_MIN_FORCE_SHARE of the mean contact F_n; the F_n-weighted mean counts every contact."""
+def test_pressure_maximum_is_the_line_load_averaged_over_one_module_of_line():
+    """hertz (4): the peak p_H of the line load averaged over l_H = m_x of contact line centred on each contact (its
+    contacts' own line lengths s L, at least l_H per window), not one contact's (3). A contact entering the line with
+    a vanishing share s of its slice divides a vanishing force by a vanishing length in (3) (here 1e-4 N on
+    s = 1e-7: p_H 1.7 GPa; the screw jack CI run had 2069 MPa from < 0.005 N); in (4) its window counts over l_H.
+    Screw jack, 16 slices: m_x 2.5 mm over 1.41 mm slices, windows of 2 slices (the contact's and the next)."""
     g = derive(load_scenario(SCENARIOS / "screw_jack.yaml").gear)
     log = FO.PatternLog.__new__(FO.PatternLog)
-    log.cv = FO.flank_curvature(g, 16)
-    # (i, sigma, j, f, F_n, p_H, zeta, rho)
-    T = np.array(
-        [
-            [0, 0, 7, 10.4, 10.0, 300e6, -0.7e-3, 28.3e-3],
-            [0, 0, 11, 2.5, 1e-4, 2.0e9, 4.9e-3, 28.5e-3],
-            [1, 0, 8, 10.0, 12.0, 320e6, 0.7e-3, 28.9e-3],
-        ]
-    )
+    log.geo, log.e_star, log.cv = g, 1.3e11, FO.flank_curvature(g, 16)
+    cv = log.cv
+    n = math.ceil(FO.PRESSURE_LENGTH_MX * g.m_x / cv.slice_width - 1e-9)
+    assert n == 2
+    f = {j: int(np.flatnonzero(np.isfinite(cv.inv_rho[0, j]) & np.isfinite(cv.line_len[0, j]))[20]) for j in range(16)}
+    k = {j: cv.inv_rho[0, j, f[j]] for j in range(16)}
+    # sample 0: a line over slices 4..9, slice 4 entering (1e-4 N on s = 1e-7), slice 9 half covered; sample 1: one
+    # contact covering a fifth of slice 12 (line shorter than l_H)
+    line = {(0, 4): (1e-4, 1e-7), (0, 5): (10.0, 1.0), (0, 6): (12.0, 1.0), (0, 7): (14.0, 1.0), (0, 8): (12.0, 1.0)}
+    line |= {(0, 9): (8.0, 0.5), (1, 12): (6.0, 0.2)}
+    sL = {key: s_ * cv.line_len[0, key[1], f[key[1]]] for key, (F, s_) in line.items()}
+    rows = []
+    for (i, j), (F, _) in line.items():
+        p3 = FO.hertz_line_pressure_pa(F / sL[i, j], log.e_star, k[j])  # the contact's own (3), as _rows makes it
+        rows.append([i, 0, j, f[j], F, p3, cv.zeta[j], 28e-3])
+    T = np.array(rows)
     log.table = lambda: T
+    assert T[0, 5] > 1.5e9  # the entering contact's (3)
+
+    def by_hand(keys):
+        F = np.array([line[key][0] for key in keys])
+        K = np.array([k[key[1]] for key in keys])
+        w = F.sum() / max(sum(sL[key] for key in keys), g.m_x)
+        return math.sqrt(w * log.e_star * (F * K).sum() / F.sum() / math.pi)
+
+    # each contact's window within its line: slices j and j + 1, clipped to the line
+    expect = {key: by_hand([x for x in ((key[0], key[1]), (key[0], key[1] + 1)) if x in line]) for key in line}
+    p = log.averaged_pressure_pa(T)
+    assert p == pytest.approx(list(expect.values()), rel=1e-6)
     s = log.summary(np.array([0.0, 1.0]), (0.0, 1.0))
-    # row 2 of T (320 MPa at zeta 0.7 mm, rho 28.9 mm): row 1's 1e-4 N is below PRESSURE_MIN_FORCE_SHARE (by hand)
-    assert s["contact_pressure_max_mpa"] == pytest.approx(320.0)
-    assert s["contact_pressure_max_face_mm"] == pytest.approx(0.7) and s[
-        "contact_pressure_max_radius_mm"
-    ] == pytest.approx(28.9)
-    fn, p = T[:, 4], T[:, 5]
-    assert s["contact_pressure_mean_mpa"] == pytest.approx((fn * p).sum() / fn.sum() * 1e-6, rel=1e-12)
-    T[1, 4] = 0.5  # 2.3 % of the mean: counted
-    # row 1's 2.0e9 Pa once its F_n counts (by hand from T)
-    assert log.summary(np.array([0.0, 1.0]), (0.0, 1.0))["contact_pressure_max_mpa"] == pytest.approx(2000.0)
+    kmax = max(expect, key=expect.get)
+    assert s["contact_pressure_max_mpa"] == pytest.approx(expect[kmax] * 1e-6, rel=1e-6)
+    assert s["contact_pressure_max_mpa"] < 1000.0  # not the entering contact's 1.7 GPa
+    assert s["contact_pressure_max_face_mm"] == pytest.approx(cv.zeta[kmax[1]] * 1e3)
+    fn, p3 = T[:, 4], T[:, 5]
+    assert s["contact_pressure_mean_mpa"] == pytest.approx((fn * p3).sum() / fn.sum() * 1e-6, rel=1e-12)

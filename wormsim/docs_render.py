@@ -1147,9 +1147,64 @@ def stiffness_seeds_table(name: str = "stiffness_seeds") -> str:
     return _table(head, rows) + "\n" + _source(name)
 
 
+# sweeps/slice_convergence_default.py's records at medium: the cases, more variety gears, the seat motor (run apart)
+SLICE_CONVERGENCE_RECORDS = ("slice_convergence_medium", "slice_convergence_variety", "slice_convergence_seat_motor")
+
+
+def slice_convergence_table(*names: str) -> str:
+    """The default slice count S against 2 S (sweeps/slice_convergence_default.py): F_t p2p (whole and below the
+    meshing band's limit), p_H max (hertz (4)) and one contact's largest p_H (hertz (3)), each S -> 2 S and its
+    change; 'yes' where F_t p2p and p_H max are both within 10 %. The rows of each record in `names` (default:
+    SLICE_CONVERGENCE_RECORDS) that exists."""
+    names = tuple(n for n in (names or SLICE_CONVERGENCE_RECORDS) if (DATA / f"{n}.json").exists())
+    recs = [load(n) for n in names]
+    rows = []
+
+    def pair(runs: list, ch: dict, key: str, fmt: str) -> str:
+        a, b = runs[0].get(key), runs[1].get(key)
+        if a is None or b is None:
+            return "-"
+        c = ch.get(key)
+        return f"{fmt.format(a)} / {fmt.format(b)} ({'-' if c is None else f'{100 * c:+.1f} %'})"
+
+    cases = {k: v for rec in recs for k, v in rec["cases"].items()}  # a case in a later record replaces its row
+    for case, c in cases.items():
+        runs, ch = c["runs"], c["change_default_vs_double"]
+        src = runs[0].get("contact_stiffness_source") or "-"
+        if c.get("hertz_fallback"):
+            src += " (teeth's failed)"
+        ok = all(ch.get(k) is not None and abs(ch[k]) <= 0.10 for k in ("ft_p2p_n", "ph_max_mpa"))
+        rows.append(
+            [
+                case,
+                src,
+                f"{runs[0]['slices']} / {runs[1]['slices']}",
+                pair(runs, ch, "ft_p2p_n", "{:.3g}"),
+                pair(runs, ch, "ft_p2p_band_n", "{:.3g}"),
+                pair(runs, ch, "ph_max_mpa", "{:.0f}"),
+                pair(runs, ch, "ph_max_cell_mpa", "{:.0f}"),
+                "yes" if ok else "no",
+            ]
+        )
+    head = [
+        "case",
+        "contact stiffness",
+        "slices n / 2 n",
+        "F_t p2p [N]",
+        f"F_t p2p below {recs[0]['band_hz']:.0f} Hz [N]",
+        "p_H max [MPa] (averaged, (4))",
+        "one contact's p_H [MPa] ((3))",
+        "both within 10 %",
+    ]
+    # the run's --save folder (pattern tables kept aside, not a record) shown as DIR
+    return _table(head, rows) + "\n" + "".join(re.sub(r"--save \S+", "--save DIR", _source(n)) for n in names)
+
+
 TABLES: dict[str, Callable[[], str]] = {
     "calculix_check": calculix_check_table,
     "stiffness_seeds": stiffness_seeds_table,
+    "slice_convergence": slice_convergence_table,
+    "slice_convergence_double": lambda: slice_convergence_table("slice_convergence_double"),
     "torsional_seeds": torsional_seeds_table,
     "rexs_stages": rexs_stages_table,
     "rexs_rating": rexs_rating_table,

@@ -344,9 +344,18 @@ KEYS: dict[str, Key] = {
     "contact_pattern_centroid_radius_mm": Key("mm", GEAR, "centroid of the contact pattern, radius on the wheel"),
     "contact_pattern_extent_face_mm": Key("mm", GEAR, "width of the contact pattern across the face"),
     "contact_pattern_source": Key("text", GEAR, "loaded (contact3d flanks) or kinematic (marking film) pattern"),
-    "contact_pressure_max_mpa": Key("MPa", C, "largest Hertz line-contact pressure over the steady window (flanks)"),
+    "contact_pressure_max_mpa": Key(
+        "MPa",
+        C,
+        "largest Hertz line-contact pressure over the steady window (flanks): the peak of the line load averaged over "
+        "one axial module of contact line, not one slice's contact (wormsim.tooth.hertz (4); docs/contact3d.md)",
+    ),
     "contact_pressure_mean_mpa": Key("MPa", C, "mean Hertz pressure of the loaded contact lines (flanks)"),
-    "contact_pressure_max_face_mm": Key("mm", C, "face position of the largest pressure (0 at the mid-plane)"),
+    "contact_pressure_max_face_mm": Key(
+        "mm",
+        C,
+        "face position of the largest pressure (0 at the mid-plane; the slice at the averaging window's centre)",
+    ),
     "contact_pressure_max_radius_mm": Key("mm", C, "wheel radius of the largest pressure"),
     # ------------------------------------------------------------------ contact3d: what the run used
     "timestep_s": Key("s", GEAR, "integrator step used (torsional: the output/solver step)"),

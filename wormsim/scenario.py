@@ -201,9 +201,10 @@ class Contact(_Strict):
         ge=2,
         le=256,
         description=(
-            "flanks: slices across the face width (default: coarse 8, a quick look; medium and fine from the gear, a "
-            "slice's stiffness at most 1/5 of the mesh stiffness's fluctuation, a multiple of 8: seat motor 32, screw "
-            "jack 16, involute_41 24; at most 16 with simulation.mass_scaling, which keeps means only; docs/contact3d.md)"
+            "flanks: slices across the face width (default: coarse 8, a quick look; medium from the gear, a slice's "
+            "stiffness at most 1/5 of the mesh stiffness's fluctuation, a multiple of 8: seat motor 32, screw jack 16, "
+            "involute_41 24; fine twice medium's; at most 16 with simulation.mass_scaling, which keeps means only; "
+            "docs/contact3d.md)"
         ),
     )
 
@@ -275,7 +276,11 @@ class Simulation(_Strict):
         None, gt=0, le=0.01, description="default documented; the summary states the one used"
     )
     resolution: Literal["coarse", "medium", "fine"] = Field(
-        "medium", description="collision decomposition level (contact3d)"
+        "medium",
+        description=(
+            "contact3d's level of detail: flanks' slices across the face (coarse 8, medium the convergence rule, fine "
+            "twice medium's; docs/contact3d.md) and the pieces' facets"
+        ),
     )
     integrator: Literal["implicitfast", "rk4", "euler", "implicit", "discrete"] = "implicitfast"
     record_every: int = Field(

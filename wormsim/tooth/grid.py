@@ -31,7 +31,8 @@ from wormsim.tooth.window import window_size
 
 N_PROFILE = 64  # points along the profile per slice (the parabola refines between them)
 SLICES_COARSE = 8  # simulation.resolution coarse: a quick look (not converged; docs/contact3d.md)
-SLICE_SHARE = 0.2  # medium and fine: a slice's stiffness K / S at most this share of the mesh stiffness's p2p
+SLICES_FINE_FACTOR = 2  # fine: this many times medium's count (the count medium's convergence is measured against)
+SLICE_SHARE = 0.2  # medium: a slice's stiffness K / S at most this share of the mesh stiffness's p2p
 SLICES_STEP = 8  # the count rounded up to a multiple of this
 SLICES_TCA_SAMPLES = 128  # worm angles per mesh cycle of the TCA that gives the fluctuation
 # Default slices of a mass-scaled run, at most: mass scaling keeps the means and loses the fluctuation
@@ -50,12 +51,14 @@ def default_slices(g: GearGeometry, resolution: str) -> int:
 
     k_p2p / k_mean the fluctuation of the zero-load TCA's k(theta) (wormsim.tooth.mesh_stiffness, both flank
     sides, the smaller). Measured (docs/contact3d.md, "Default slice count"): seat motor 0.177 -> 32 slices (16 were
-    not converged), screw jack 0.376 -> 16, involute_41 0.267 -> 24. Coarse: SLICES_COARSE."""
+    not converged), screw jack 0.376 -> 16, involute_41 0.267 -> 24. That is medium's count; fine takes
+    SLICES_FINE_FACTOR times it (the count medium's convergence is measured against), coarse SLICES_COARSE."""
     if resolution == "coarse":
         return SLICES_COARSE
     ms = mesh_stiffness(g, 1.0, "slices", SLICES_TCA_SAMPLES)
     share = min(float(np.ptp(k) / np.mean(k)) for k in (ms.k_mesh_fwd_n_per_m, ms.k_mesh_rev_n_per_m))
-    return int(SLICES_STEP * math.ceil(1.0 / (SLICE_SHARE * max(share, 1e-3)) / SLICES_STEP))
+    medium = int(SLICES_STEP * math.ceil(1.0 / (SLICE_SHARE * max(share, 1e-3)) / SLICES_STEP))
+    return medium * SLICES_FINE_FACTOR if resolution == "fine" else medium
 
 
 @dataclass(frozen=True)

@@ -30,13 +30,23 @@ summary over the steady window, each sample weighted equally (samples are equall
 time integral): contact_pattern_centroid_face_mm / _radius_mm = the F_n-weighted mean slice centre zeta / flank radius
 rho; contact_pattern_extent_face_mm = the face span holding the central 95 % of the load (2.5 % and 97.5 % quantiles
 of F_n along zeta, the load of a slice spread evenly over its width); contact_pressure_max_mpa and where
-(contact_pressure_max_face_mm, _radius_mm); contact_pressure_mean_mpa = the F_n-weighted mean of p_H. The per-cell
-grid (flank, slice, profile point: load F_n dt and the largest p_H) is what report.png and the recording draw.
-The maximum (summary and grid) is taken over the contacts carrying at least PRESSURE_MIN_FORCE_SHARE of the mean
-contact F_n: a contact entering or leaving the line has a share s -> 0 of its slice, so (3) divides a vanishing force
-by a vanishing length, and MuJoCo's constraint force keeps a part that does not scale with s (the impedance term
-D J qacc, D from solimp and A_hat): screw jack CI run, 2069 MPa from a contact carrying < 0.005 N against 342 MPa
-from the loaded line; the same 342 MPa for any threshold from 1e-4 to 0.1 of the mean (docs/contact3d.md).
+(contact_pressure_max_face_mm, _radius_mm); contact_pressure_mean_mpa = the F_n-weighted mean of p_H (3). The per-cell
+grid (flank, slice, profile point: load F_n dt and the largest averaged p_H (4)) is what report.png and the recording
+draw.
+
+The maximum (summary and grid) is a peak of the line load averaged over a length of the contact line, not one
+contact's (3) (docs/decisions/0035-contact-pressure-peak.md): per sample and contact line (the contacts of one tooth
+flank on consecutive slices), over the window of the n = ceil(l_H / (b2 / S)) slices centred on each contact,
+
+    w_avg = sum F_n / max(sum s L, l_H),   1/rho'_avg = sum F_n / rho' / sum F_n,
+    p_H,avg = sqrt(w_avg E* / (pi rho'_avg)),   l_H = PRESSURE_LENGTH_MX m_x                                    (4)
+
+s L the contacts' own line lengths (2). A contact entering or leaving the line has a share s -> 0 of its slice, so (3)
+divides a vanishing force by a vanishing length, and MuJoCo's constraint force keeps a part that does not scale with s
+(the impedance term D J qacc, D from solimp and A_hat); in (4) a window whose line is shorter than l_H counts its load
+over l_H. Measured with (3) per contact (the maximum over contacts above 1 % of the mean F_n), S against 2 S slices:
+4-start-z41 187 / 2841 MPa, random gear 0 153 / 1967 MPa (a contact of 0.08 N at the profile's end); with (4)
+131 / 131 and 127 / 131 MPa (sweeps/slice_convergence_default.py, docs/contact3d.md "Default slice count").
 """
 
 from __future__ import annotations
@@ -54,7 +64,7 @@ from wormsim.tooth.grid import N_PROFILE, flank_grid
 
 H_STEP_MX = 0.02  # finite-difference step of (1), in axial modules
 EXTENT_LOAD_SHARE = 0.95  # contact_pattern_extent_face_mm: the face span holding this share of the load
-PRESSURE_MIN_FORCE_SHARE = 0.01  # p_H maximum: over contacts carrying at least this share of the mean contact F_n
+PRESSURE_LENGTH_MX = 1.0  # l_H of (4), in axial modules: the line length the pressure peak is averaged over
 
 
 @dataclass(frozen=True)
@@ -243,13 +253,45 @@ class PatternLog:
         rho = _lerp_rows(self.rho3, T[:, 1].astype(np.int64), j, T[:, 3])
         return np.column_stack([T, self.cv.zeta[j], rho])
 
+    def averaged_pressure_pa(self, T: np.ndarray) -> np.ndarray:
+        """(4) per row of table() rows T (in the log's order: per sample, the kernel's contacts, those of one tooth
+        flank on consecutive slices): the line load and curvature averaged over the window of slices centred on the
+        row, within its contact line; nan for a row without a p_H of its own (no load, no line length)."""
+        n_rows = len(T)
+        if not n_rows:
+            return np.zeros(0)
+        cv, g = self.cv, self.geo
+        sg, j = T[:, 1].astype(np.int64), T[:, 2].astype(np.int64)
+        k = _lerp_rows(cv.inv_rho, sg, j, T[:, 3])
+        ok = np.isfinite(k) & (k > 0) & np.isfinite(T[:, 5]) & (T[:, 5] > 0) & (T[:, 4] > 0)
+        F = np.where(ok, T[:, 4], 0.0)
+        with np.errstate(divide="ignore", invalid="ignore"):  # the contact's own line length s L, from its (3)
+            L = np.where(ok, F * self.e_star * k / (math.pi * T[:, 5] ** 2), 0.0)
+        length = PRESSURE_LENGTH_MX * g.m_x
+        n = max(1, math.ceil(length / cv.slice_width - 1e-9))
+        # a new contact line where the sample, the flank or the slice run changes
+        new = np.ones(n_rows, dtype=bool)
+        new[1:] = (T[1:, 0] != T[:-1, 0]) | (sg[1:] != sg[:-1]) | (j[1:] != j[:-1] + 1)
+        start = np.flatnonzero(new)
+        gid = np.cumsum(new) - 1
+        end = np.append(start[1:], n_rows)  # one past each line's last row
+        r = np.arange(n_rows)
+        lo = np.maximum(start[gid], r - (n - 1) // 2)
+        hi = np.minimum(end[gid], r + n // 2 + 1)
+        cF, cL, cK = (np.concatenate([[0.0], np.cumsum(x)]) for x in (F, L, np.where(ok, F * k, 0.0)))
+        sF, sL, sK = cF[hi] - cF[lo], cL[hi] - cL[lo], cK[hi] - cK[lo]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            p = hertz_line_pressure_pa(sF / np.maximum(sL, length), self.e_star, sK / sF)
+        return np.where(ok & (sF > 0), p, np.nan)
+
     def summary(self, t_s: np.ndarray, window_s) -> dict:
         """The summary keys of the module docstring over the samples with t in window_s."""
         T = self.table()
         w0, w1 = window_s
         inwin = (t_s >= w0) & (t_s <= w1)
-        sel = T[inwin[T[:, 0].astype(int)]] if len(T) else T
-        sel = sel[sel[:, 4] > 0] if len(sel) else sel
+        pavg = self.averaged_pressure_pa(T)
+        keep = inwin[T[:, 0].astype(int)] & (T[:, 4] > 0) if len(T) else np.zeros(0, dtype=bool)
+        sel, pavg = T[keep], pavg[keep]
         nan = float("nan")
         keys = {
             "contact_pattern_centroid_face_mm": nan,
@@ -266,17 +308,18 @@ class PatternLog:
             return keys
         fn, p, z, r = sel[:, 4], sel[:, 5], sel[:, 6], sel[:, 7]
         W = fn.sum()
-        imax = int(np.nanargmax(np.where(fn >= PRESSURE_MIN_FORCE_SHARE * fn.mean(), p, -np.inf)))
+        finite = np.isfinite(pavg)
+        imax = int(np.argmax(np.where(finite, pavg, -np.inf)))
         ok = np.isfinite(p)  # (_rows: no line length, no p_H)
         keys.update(
             {
                 "contact_pattern_centroid_face_mm": float((fn * z).sum() / W * 1e3),
                 "contact_pattern_centroid_radius_mm": float((fn * r).sum() / W * 1e3),
                 "contact_pattern_extent_face_mm": float(self.extent_face_m(sel) * 1e3),
-                "contact_pressure_max_mpa": float(p[imax] * 1e-6),
+                "contact_pressure_max_mpa": float(pavg[imax] * 1e-6) if finite.any() else nan,
                 "contact_pressure_mean_mpa": float((fn[ok] * p[ok]).sum() / fn[ok].sum() * 1e-6),
-                "contact_pressure_max_face_mm": float(z[imax] * 1e3),
-                "contact_pressure_max_radius_mm": float(r[imax] * 1e3),
+                "contact_pressure_max_face_mm": float(z[imax] * 1e3) if finite.any() else nan,
+                "contact_pressure_max_radius_mm": float(r[imax] * 1e3) if finite.any() else nan,
             }
         )
         return keys
@@ -300,14 +343,14 @@ class PatternLog:
         pmax = np.zeros((2, S, N))
         if len(T):
             inwin = (t_s >= window_s[0]) & (t_s <= window_s[1])
-            T = T[inwin[T[:, 0].astype(int)]]
-            T = T[T[:, 4] > 0]
+            pavg = self.averaged_pressure_pa(T)
+            keep = inwin[T[:, 0].astype(int)] & (T[:, 4] > 0)
+            T, pavg = T[keep], pavg[keep]
             sg, j = T[:, 1].astype(int), T[:, 2].astype(int)
             i = np.clip(np.rint(T[:, 3]).astype(int), 0, N - 1)
             np.add.at(load, (sg, j, i), T[:, 4])
-            if len(T):  # the pressure of the contacts the summary's maximum counts (module docstring)
-                k = (T[:, 4] >= PRESSURE_MIN_FORCE_SHARE * T[:, 4].mean()) & np.isfinite(T[:, 5])
-                np.maximum.at(pmax, (sg[k], j[k], i[k]), T[k, 5])
+            k = np.isfinite(pavg)  # the averaged pressure (4) the summary's maximum takes
+            np.maximum.at(pmax, (sg[k], j[k], i[k]), pavg[k])
         return {
             "load": load,
             "pressure_max_pa": pmax,
