@@ -35,7 +35,7 @@ grid (flank, slice, profile point: load F_n dt and the largest averaged p_H (4))
 draw.
 
 The maximum (summary and grid) is a peak of the line load averaged over a length of the contact line, not one
-contact's (3) (docs/decisions/0035-contact-pressure-peak.md): per sample and contact line (the contacts of one tooth
+contact's (3) (docs/decisions/0037-contact-pressure-peak.md): per sample and contact line (the contacts of one tooth
 flank on consecutive slices), over the window of the n = ceil(l_H / (b2 / S)) slices centred on each contact,
 
     w_avg = sum F_n / max(sum s L, l_H),   1/rho'_avg = sum F_n / rho' / sum F_n,
