@@ -189,43 +189,49 @@ def tooth_surface(g: GearGeometry, density: int = 1, teeth: int = 1) -> tuple[np
     return V, F
 
 
-def tet_mesh(
-    V: np.ndarray, F: np.ndarray, size_m: float, min_size_m: float, curvature: int, angle_deg: float | None = 40.0
-) -> tuple[np.ndarray, np.ndarray]:
-    """Tetrahedra (gmsh) inside the closed surface (V, F): the surface is classified into patches at sharp edges
-    (angle_deg), re-parametrised and re-meshed at `size_m` (refined on curvature, `curvature` elements per 2 pi of a
-    curve's turn, down to min_size_m: the root fillet), then the volume is meshed: (points (n, 3), tets (m, 4)).
-    angle_deg None: no re-meshing, the triangles (V, F) are the boundary and only the volume is meshed (interior
-    elements up to size_m): nothing to refuse for a closed surface, at the surface's own resolution."""
-    import gmsh
+MESH_TIMEOUT_S = 60.0  # one gmsh attempt's time limit (measured 3-15 s per attempt at load 10; some surfaces hang)
 
-    gmsh.initialize(["-noenv"], readConfigFiles=False)
-    try:
-        gmsh.option.setNumber("General.Terminal", 1 if _VERBOSE else 0)
-        gmsh.option.setNumber("General.NumThreads", 1)
-        gmsh.model.add("tooth")
-        s = gmsh.model.addDiscreteEntity(2)
-        gmsh.model.mesh.addNodes(2, s, list(range(1, len(V) + 1)), (V * 1e3).ravel().tolist())  # mm
-        gmsh.model.mesh.addElementsByType(s, 2, [], (F.ravel() + 1).tolist())
-        if angle_deg is not None:
-            gmsh.model.mesh.classifySurfaces(math.radians(angle_deg), True, True, math.pi)
-            gmsh.model.mesh.createGeometry()
-        surfs = [e[1] for e in gmsh.model.getEntities(2)]
-        loop = gmsh.model.geo.addSurfaceLoop(surfs)
-        gmsh.model.geo.addVolume([loop])
-        gmsh.model.geo.synchronize()
-        gmsh.option.setNumber("Mesh.MeshSizeMax", size_m * 1e3)
-        gmsh.option.setNumber("Mesh.MeshSizeMin", min_size_m * 1e3)
-        gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", curvature)
-        gmsh.model.mesh.generate(3)
-        tags, xyz, _ = gmsh.model.mesh.getNodes()
-        _, _, conn = gmsh.model.mesh.getElements(3)
-        P = np.asarray(xyz).reshape(-1, 3) / 1e3
-        order = np.empty(int(tags.max()) + 1, dtype=np.int64)
-        order[np.asarray(tags, dtype=np.int64)] = np.arange(len(tags))
-        T = order[np.asarray(conn[0], dtype=np.int64).reshape(-1, 4)]
-    finally:
-        gmsh.finalize()
+
+def tet_mesh(
+    V: np.ndarray,
+    F: np.ndarray,
+    size_m: float,
+    min_size_m: float,
+    curvature: int,
+    angle_deg: float | None = 40.0,
+    timeout_s: float = MESH_TIMEOUT_S,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Tetrahedra (gmsh) inside the closed surface (V, F): (points (n, 3), tets (m, 4)). The surface is classified
+    into patches at sharp edges (angle_deg), re-parametrised and re-meshed at `size_m` (refined on curvature,
+    `curvature` elements per 2 pi of a curve's turn, down to min_size_m: the root fillet), then the volume is meshed;
+    angle_deg None: no re-meshing, the triangles (V, F) are the boundary and only the volume is meshed (nothing to
+    refuse for a closed surface, at the surface's own resolution). gmsh runs in a child process
+    (wormsim.rating.gmsh_job): an attempt not done within timeout_s is refused (RuntimeError) like a gmsh error."""
+    import subprocess
+    import sys
+    import tempfile
+    from pathlib import Path
+
+    job = Path(__file__).with_name("gmsh_job.py")
+    with tempfile.TemporaryDirectory(prefix="wormsim-gmsh-") as d:
+        inp, out = Path(d) / "in.npz", Path(d) / "out.npz"
+        np.savez(
+            inp, V=V, F=F, size_m=size_m, min_size_m=min_size_m, curvature=curvature,
+            angle_deg=math.nan if angle_deg is None else angle_deg, verbose=_VERBOSE,
+        )  # fmt: skip
+        try:
+            r = subprocess.run(
+                [sys.executable, str(job), str(inp), str(out)], capture_output=True, text=True, timeout=timeout_s
+            )
+        except subprocess.TimeoutExpired:
+            raise RuntimeError(f"gmsh did not finish within {timeout_s:g} s") from None
+        if r.returncode != 0:
+            raise RuntimeError((r.stderr.strip().splitlines() or [f"gmsh exited {r.returncode}"])[-1])
+        res = np.load(out)
+        tags, P, conn = res["tags"], res["xyz"], res["tets"]
+    order = np.empty(int(tags.max()) + 1, dtype=np.int64)
+    order[tags] = np.arange(len(tags))
+    T = order[conn]
     used = np.unique(T)
     remap = -np.ones(len(P), dtype=np.int64)
     remap[used] = np.arange(len(used))
