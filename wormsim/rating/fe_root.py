@@ -41,8 +41,9 @@ from meshgen.cache import cached
 from meshgen.geometry import GearGeometry
 from wormsim.errors import SimulationError
 
-CODE_VERSION = "fe-root-3"
+CODE_VERSION = "fe-root-4"
 FILLET_COEF = 0.38  # rho_fP / m: ISO 53 profile A root radius of the basic rack
+FILLET_ROOM = 0.9  # a fillet's tangent points: at most this share of the way to the space middle / flank middle
 RIM_DEPTH_MX = 2.5  # rim below the throat root circle, in axial modules (model extent, clamped there)
 ROOT_BAND_MX = 0.35  # root band: element centroids within this many m_x above the root torus radius
 FLANK_DENSE = 48  # flank points per section before resampling
@@ -71,12 +72,18 @@ def _arc(r: float, a0: float, a1: float, n: int) -> np.ndarray:
     return np.stack([r * np.cos(t), r * np.sin(t)], axis=-1)
 
 
-def _fillet(corner: np.ndarray, toward_root: np.ndarray, toward_flank: np.ndarray, radius: float, n: int):
+def _fillet(
+    corner: np.ndarray, toward_root: np.ndarray, toward_flank: np.ndarray, radius: float, n: int, t_max: float = np.inf
+):
     """n points of the circular arc of `radius` tangent to the two rays from `corner` (unit directions), from the
-    root-side tangent point to the flank-side one; and the distance of the tangent points from the corner."""
+    root-side tangent point to the flank-side one; and the distance of the tangent points from the corner. Where
+    that distance would pass t_max (a tooth space narrower at its root than two fillets), the radius is the one whose
+    tangent points lie t_max from the corner."""
     u1, u2 = toward_root / np.linalg.norm(toward_root), toward_flank / np.linalg.norm(toward_flank)
     theta = math.acos(float(np.clip(u1 @ u2, -1.0, 1.0)))
     t = radius / math.tan(theta / 2)
+    if t > t_max:
+        t, radius = t_max, t_max * math.tan(theta / 2)
     bis = (u1 + u2) / np.linalg.norm(u1 + u2)
     centre = corner + bis * radius / math.sin(theta / 2)
     p1, p2 = corner + t * u1, corner + t * u2
@@ -125,13 +132,19 @@ def _tooth_top(g: GearGeometry, zeta: float, c: Counts) -> np.ndarray:
     B = np.stack([rho * np.cos(pb), rho * np.sin(pb)], -1)  # flank b, root -> tip
     r_f = FILLET_COEF * g.m_x
     s0, s1 = space_middles(g, zeta)
-    tan_a = np.array([math.sin(pa[0]), -math.cos(pa[0])])  # root circle tangent at A's root, towards space 0
-    fa, ta = _fillet(A[0], tan_a, A[1] - A[0], r_f, c.fillet)
-    tan_b = np.array([-math.sin(pb[0]), math.cos(pb[0])])  # towards space 1
-    fb, tb = _fillet(B[0], tan_b, B[1] - B[0], r_f, c.fillet)
-    # flanks from their fillet tangent point to the tip
+    # flanks' arc lengths from the root
     sa = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(A, axis=0), axis=1))])
     sb = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(B, axis=0), axis=1))])
+    # a fillet ends before the space middle and below the flank's middle (FILLET_ROOM of each): where a space is
+    # narrower at its root than two fillets (near the end faces of a throated wheel), the radius is smaller there and
+    # the outline stays simple (overlapping fillets are facets that gmsh refuses)
+    tan_a = np.array([math.sin(pa[0]), -math.cos(pa[0])])  # root circle tangent at A's root, towards space 0
+    room_a = FILLET_ROOM * min(lo * (pa[0] - float(s0)), 0.5 * sa[-1])
+    fa, ta = _fillet(A[0], tan_a, A[1] - A[0], r_f, c.fillet, room_a)
+    tan_b = np.array([-math.sin(pb[0]), math.cos(pb[0])])  # towards space 1
+    room_b = FILLET_ROOM * min(lo * (float(s1) - pb[0]), 0.5 * sb[-1])
+    fb, tb = _fillet(B[0], tan_b, B[1] - B[0], r_f, c.fillet, room_b)
+    # flanks from their fillet tangent point to the tip
     flank_a = _resample(np.concatenate([fa[-1:], A[sa > ta]]), c.flank)
     flank_b = _resample(np.concatenate([fb[-1:], B[sb > tb]]), c.flank)
     root_a = _arc(lo, s0, math.atan2(fa[0, 1], fa[0, 0]), c.root)
