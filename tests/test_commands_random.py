@@ -247,3 +247,31 @@ def test_random_gears_mostly_run_long():
         pytest.skip("runs after test_random_gear_every_command_exits_0_2_or_3_long")
     ok = [i for i, c in LONG_OUTCOMES.items() if all(c.get(k) == 0 for k in ("check", "torsional", "contact3d"))]
     assert len(ok) >= LONG_GEARS // 2, (len(ok), MESSAGES)
+
+
+def test_the_steep_4x38_za_gear_runs_at_contact3d(tmp_path, capfd):
+    """The issue's exit 1: a 4/38 ZA gear, q 6, alpha_n 10 deg (gamma 33.7 deg) at contact3d. A contact with no
+    contact-line length left in its slice (L = 0) divided by zero in hertz's p_H (ZeroDivisionError in the compiled
+    rows, with either stiffness model); it has no p_H now. The user's commands: init, then run with --set."""
+    user = User(tmp_path, capfd, "4x38 ZA")
+    g = str(tmp_path / "g.yaml")
+    assert user("init", "init", g) == 0
+    sets = {
+        "model": "contact3d",
+        "gear.profile": "ZA",
+        "gear.worm_starts": 4,
+        "gear.wheel_teeth": 38,
+        "gear.axial_module_mm": 1,
+        "gear.diameter_quotient": 6,
+        "gear.normal_pressure_angle_deg": 10,
+        "gear.face_width_mm": "null",
+        "simulation.resolution": "coarse",
+        "drive.speed_rpm": 3000,
+        "simulation.duration_s": 0.05,
+        "load.torque_nm": 5,
+        "contact.stiffness_model": "hertz",  # the FE compliance's cost apart; the teeth's stiffness failed alike
+    }
+    argv = [a for k, v in sets.items() for a in ("--set", f"{k}={v}")]
+    assert user("run", "run", g, "--out", str(tmp_path / "o"), "--no-progress", *argv) == 0
+    s = json.loads((tmp_path / "o" / "summary.json").read_text())
+    assert s["status"] == "ok" and math.isfinite(s["contact_pressure_max_mpa"]), s["contact_pressure_max_mpa"]
