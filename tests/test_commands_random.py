@@ -113,6 +113,7 @@ class User:
         self.dir, self.capfd, self.label = folder, capfd, label
         self.codes: dict[str, int] = {}
         self.wall_s: dict[str, float] = {}
+        self.messages: dict[str, str] = {}  # the last stderr line of each command that exits 2 or 3
 
     def __call__(self, name: str, *argv: str, limit_s: int = 300) -> int:
         self.capfd.readouterr()
@@ -135,6 +136,8 @@ class User:
             assert lines and lines[-1].startswith("simulation failed: "), where
             MESSAGES.append(f"{self.label} {name}: {lines[-1]}")
         self.codes[name] = code
+        if code:
+            self.messages[name] = lines[-1][:2000] if lines else ""
         return code
 
 
@@ -207,7 +210,12 @@ def use_every_command(index: int, folder: Path, capfd, commands=ALL, stiffness: 
                 assert "internal error" not in text, (user.label, name, text[-3000:])
     if os.environ.get("WORMSIM_COMMANDS_LOG"):  # one JSON line per gear: exit codes, wall times, exit-3 messages
         with open(os.environ["WORMSIM_COMMANDS_LOG"], "a") as f:
-            f.write(json.dumps({"index": index, "codes": user.codes, "wall_s": user.wall_s, "data": d}) + "\n")
+            f.write(
+                json.dumps(
+                    {"index": index, "codes": user.codes, "wall_s": user.wall_s, "messages": user.messages, "data": d}
+                )
+                + "\n"
+            )
     return user.codes
 
 

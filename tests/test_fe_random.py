@@ -144,3 +144,29 @@ def test_section_outlines_stay_simple_where_the_root_space_is_narrow(teeth):
     zetas = np.linspace(-g.face_width / 2, g.face_width / 2, c.zeta)
     crossings = [_crossings(fe_root.section_outline(g, z, c, teeth)) for z in zetas]
     assert crossings == [0] * len(zetas)
+
+
+# a random gear of tests/test_commands_random.py (index 114): gmsh cannot parametrise one of the patches it classifies
+# at 40 deg ("Wrong topology of boundary mesh for parametrization" at every size); it meshes at 60 deg, which the
+# mesher tries next (fe_root.FALLBACK_ANGLES_DEG)
+TOPOLOGY_GEAR = {
+    "profile": "ZI",
+    "hand": "left",
+    "worm_starts": 1,
+    "wheel_teeth": 24,
+    "axial_module_mm": 0.933,
+    "diameter_quotient": 12.77,
+    "normal_pressure_angle_deg": 17.7,
+    "backlash_mm": 0.0467,
+    "profile_shift_coefficient": -0.13,
+}
+
+
+def test_a_tooth_refused_at_every_size_meshes_at_another_feature_angle():
+    g = derive(Gear(**TOPOLOGY_GEAR))
+    V, F = fe_root.tooth_surface(g, fe_root.SURFACE_DENSITY)
+    size, min_size, curv = _sizes(g)
+    with pytest.raises(Exception, match="Wrong topology"):
+        fe_root.tet_mesh(V, F, size, min_size, curv)
+    tm = fe_root.tooth_mesh(g, use_cache=False)
+    assert len(tm.tets) > 1000

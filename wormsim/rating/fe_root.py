@@ -246,6 +246,10 @@ def tet_mesh(
 # facets)": two re-meshed patches meet in the same triangle at some sizes; measured on a 1-start ZI gear, z2 40, m_x 4,
 # q 10: refused at 1.0, meshed at 0.9). The largest and the smallest size scale together.
 SIZE_RETRIES = (1.0, 0.9, 1.1, 0.8, 1.25, 0.7)
+# gmsh's feature angles tried after every size at the caller's angles failed ("Wrong topology of boundary mesh for
+# parametrization" at 40 deg and every size on a 1-start ZI gear, z2 24, m_x 0.93, q 12.8, x2 -0.13: meshed at 60 deg);
+# a tooth that meshes at the caller's angles keeps its mesh
+FALLBACK_ANGLES_DEG = (60.0, 50.0, 30.0)
 
 
 def tet_mesh_retried(
@@ -255,16 +259,19 @@ def tet_mesh_retried(
     min_size_m: float,
     curvature: int,
     angles_deg: tuple[float, ...] = (40.0,),
+    fallback_angles_deg: tuple[float, ...] = (),
 ) -> tuple[np.ndarray, np.ndarray]:
     """tet_mesh at the element sizes times each of SIZE_RETRIES, each at the feature angles angles_deg in turn, until
-    gmsh meshes the tooth; SimulationError (exit 3) naming what to change when every size is refused."""
+    gmsh meshes the tooth; then the same at fallback_angles_deg; SimulationError (exit 3) naming what to change when
+    every size and angle is refused."""
     errors = []
-    for f in SIZE_RETRIES:
-        for angle in angles_deg:
-            try:
-                return tet_mesh(V, F, size_m * f, min_size_m * f, curvature, angle)
-            except Exception as exc:  # gmsh raises plain Exception with its message
-                errors.append(f"x{f:g} at {angle:g} deg: {exc}")
+    for angles in (angles_deg, tuple(a for a in fallback_angles_deg if a not in angles_deg)):
+        for f in SIZE_RETRIES if angles else ():
+            for angle in angles:
+                try:
+                    return tet_mesh(V, F, size_m * f, min_size_m * f, curvature, angle)
+                except Exception as exc:  # gmsh raises plain Exception with its message
+                    errors.append(f"x{f:g} at {angle:g} deg: {exc}")
     raise SimulationError(
         f"the FE root stress: gmsh refused the wheel tooth's mesh at every element size tried ({'; '.join(errors)}); "
         "change rating.fe_mesh_density (1 to 4) or gear.backlash_mm slightly, or rate without --fe "
@@ -466,8 +473,8 @@ def tooth_mesh(
     geometry (meshgen.cache). `density` d sets the element sizes together (d = 1 is the default, d = 1 and 2 are an
     h / (h/2) pair): largest 1.5 m_x / d (or size_m), smallest FILLET_COEF m_x / d (the fillet radius over d; or
     min_size_m / d), curvature_elements d per full turn of a curved surface (default CURVATURE_ELEMENTS). gmsh's
-    surface classification at each of classify_angles_deg in turn (tet_mesh_retried; its re-meshing of the classified
-    patches fails on some sectors at some angles)."""
+    surface classification at each of classify_angles_deg in turn, then at FALLBACK_ANGLES_DEG (tet_mesh_retried; its
+    re-meshing of the classified patches fails on some sectors at some angles)."""
     from dataclasses import asdict
 
     size = size_m if size_m is not None else 1.5 * g.m_x / density
@@ -476,7 +483,7 @@ def tooth_mesh(
 
     def build() -> ToothMesh:
         V, F = tooth_surface(g, SURFACE_DENSITY, teeth)
-        P, T = tet_mesh_retried(V, F, size, min_size, curvature, classify_angles_deg)
+        P, T = tet_mesh_retried(V, F, size, min_size, curvature, classify_angles_deg, FALLBACK_ANGLES_DEG)
         return ToothMesh(P, T, g.r_f2 - RIM_DEPTH_MX * g.m_x)
 
     parts = {"geometry": asdict(g), "density": density, "size_m": size, "code": CODE_VERSION}
