@@ -223,7 +223,7 @@ def use_every_command(index: int, folder: Path, capfd, commands=ALL, stiffness: 
 CI_GEARS = {
     0: ("check", "wedge", "torsional", "import", "rate", "rate_fe"),
     1: ("check", "torsional", "contact3d", "rate"),
-    2: ("check", "torsional", "mesh", "model", "sweep"),
+    21: ("check", "torsional", "mesh", "model", "sweep"),  # a 4x26 ZA gear: mesh and model cost less on a small wheel
 }
 
 
