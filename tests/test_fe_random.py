@@ -170,3 +170,28 @@ def test_a_tooth_refused_at_every_size_meshes_at_another_feature_angle():
         fe_root.tet_mesh(V, F, size, min_size, curv)
     tm = fe_root.tooth_mesh(g, use_cache=False)
     assert len(tm.tets) > 1000
+
+
+def test_rate_fe_refuses_teeth_that_cannot_be_made_naming_the_field(tmp_path, capsys):
+    """An 8-start ZI worm at alpha_n 27.9 deg (tests/test_commands_random.py, index 106) has a pointed thread, which
+    `wormsim check` refuses (exit 2); `rate --fe` refused it the same way, not with gmsh's overlapping facets (exit 3)."""
+    import yaml
+
+    gear = {
+        "profile": "ZI",
+        "worm_starts": 8,
+        "wheel_teeth": 37,
+        "axial_module_mm": 9.25,
+        "diameter_quotient": 10.09,
+        "normal_pressure_angle_deg": 27.9,
+        "backlash_mm": 0.4625,
+        "profile_shift_coefficient": -0.25,
+    }
+    path = tmp_path / "g.yaml"
+    path.write_text(
+        yaml.safe_dump({"name": "g", "gear": gear, "drive": {"speed_rpm": 350}, "load": {"torque_nm": 600}})
+    )
+    for argv in (["check", str(path)], ["rate", str(path), "--out", str(tmp_path / "o"), "--fe"]):
+        assert cli.main(argv) == 2, argv
+        err = capsys.readouterr().err
+        assert err.startswith("error: gear: the worm thread is pointed") and "normal_pressure_angle_deg" in err, err
