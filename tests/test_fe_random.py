@@ -172,9 +172,10 @@ def test_a_tooth_refused_at_every_size_meshes_at_another_feature_angle():
     assert len(tm.tets) > 1000
 
 
-def test_rate_fe_refuses_teeth_that_cannot_be_made_naming_the_field(tmp_path, capsys):
+def test_rate_refuses_teeth_that_cannot_be_made_naming_the_field(tmp_path, capsys):
     """An 8-start ZI worm at alpha_n 27.9 deg (tests/test_commands_random.py, index 106) has a pointed thread, which
-    `wormsim check` refuses (exit 2); `rate --fe` refused it the same way, not with gmsh's overlapping facets (exit 3)."""
+    `wormsim check` refuses (exit 2); `rate` refuses it the same way (it rated the gear that cannot be made, exit 0),
+    and `rate --fe` too (gmsh's overlapping facets, exit 3, before)."""
     import yaml
 
     gear = {
@@ -191,7 +192,8 @@ def test_rate_fe_refuses_teeth_that_cannot_be_made_naming_the_field(tmp_path, ca
     path.write_text(
         yaml.safe_dump({"name": "g", "gear": gear, "drive": {"speed_rpm": 350}, "load": {"torque_nm": 600}})
     )
-    for argv in (["check", str(path)], ["rate", str(path), "--out", str(tmp_path / "o"), "--fe"]):
+    rate = ["rate", str(path), "--out", str(tmp_path / "o")]
+    for argv in (["check", str(path)], rate, [*rate, "--fe"]):
         assert cli.main(argv) == 2, argv
         err = capsys.readouterr().err
         assert err.startswith("error: gear: the worm thread is pointed") and "normal_pressure_angle_deg" in err, err

@@ -12,9 +12,10 @@ def rate_command(scenario_path: str, out_dir: str, overrides: list[str], fe: boo
     sc = load_scenario(scenario_path, overrides)
     check_writable_dir(out_dir)  # refused before any work (exit 2)
     fe = fe or (sc.rating is not None and sc.rating.root_stress == "fe")
-    if fe and sc.gear is not None:
-        # the FE model is the tooth's solid: teeth that cannot be made (a pointed or undercut thread, no tooth at the
-        # face edges) are refused naming the field (exit 2), as `wormsim check` and `run` refuse them, not by gmsh
+    if sc.gear is not None:
+        # teeth that cannot be made (a pointed or undercut thread, no tooth at the face edges) are refused naming the
+        # field (exit 2), as `wormsim check` and `run` refuse them: no rating of a gear that does not exist, and no
+        # FE solid that gmsh refuses
         from wormsim.validate import validate_geometry
 
         validate_geometry(sc.model_copy(update={"model": "torsional"}))
