@@ -5,18 +5,19 @@ runs it -- `wormsim init`, the template edited, then check, run at wedge / torsi
 
 Each command exits 0, 2 (bad input: the last line of stderr is `error: ...` naming the field) or 3 (a refusal:
 `simulation failed: ...`), never 1 (an internal error) and never with a traceback. A sweep's failed point carries
-its message in sweep.json, and none is an internal error.
+its message in sweep.csv / sweep.json, and none is an internal error.
 
 The gears: numpy's default_rng([SEED, index]) over the schema's ranges (docs/scenario.md), in the region a drive
 engineer uses: every profile (ZA, ZN, ZI, ZK, ZC), either hand, z1 1-8, z2 10-200 (mostly 20-80), m_x 0.3-16 mm
 (log-uniform), q 6-18, alpha_n 8-28 deg, x2 -0.6 to 0.6 or none, face width none or 0.4-1.15 worm tip diameters,
 the wheel of bronze, aluminium bronze, nodular or grey cast iron or POM, 100-3000 rpm, and a load around
-0.04 m_x^3 z2 N m (a tenth of it for POM) times 0.2-2. contact3d runs with contact.stiffness_model=hertz (the FE
-compliance of each new gear costs 10-30 s), except every tenth gear of the long test, which runs with the default
-(the teeth's FE compliance: a mesh gmsh refuses is retried, else exit 3).
+0.04 m_x^3 z2 N m (a tenth of it for POM) times 0.2-2. The scenario file sets contact.stiffness_model=hertz (the
+teeth's FE compliance of each new gear costs 10-30 s at torsional and contact3d), except for every tenth gear of the
+long test, which keeps the default (the teeth's FE compliance: a mesh gmsh refuses is retried, else exit 3).
 
-`make test` runs CI_GEARS (a handful, each command on at least one of them); the long test (tests/conftest.py
-LONG_TESTS) runs LONG_GEARS gears with every command."""
+`make test` runs CI_GEARS (three gears, each command on at least one of them; about 35 s of CPU); the long test
+(tests/conftest.py LONG_TESTS) runs LONG_GEARS gears with every command (about 70 min on 2 busy cores with
+`-n 2`). WORMSIM_COMMANDS_LOG=FILE appends one JSON line per gear (exit codes, wall times, refusal messages)."""
 
 from __future__ import annotations
 
@@ -233,11 +234,11 @@ def test_random_gear_every_command_exits_0_2_or_3(index, tmp_path, capfd):
 
 
 def test_random_gears_mostly_run():
-    """Not vacuous: most gears pass check and run at torsional (exit 0)."""
+    """Not vacuous: the CI gears pass check and run at torsional (exit 0; measured: all three)."""
     if len(OUTCOMES) < len(CI_GEARS):
         pytest.skip("runs after test_random_gear_every_command_exits_0_2_or_3")
     ok = [i for i, c in OUTCOMES.items() if c.get("check") == 0 and c.get("torsional") == 0]
-    assert len(ok) >= 2, (OUTCOMES, MESSAGES)
+    assert len(ok) == len(CI_GEARS), (OUTCOMES, MESSAGES)
 
 
 LONG_OUTCOMES: dict[int, dict[str, int]] = {}
@@ -250,11 +251,13 @@ def test_random_gear_every_command_exits_0_2_or_3_long(index, tmp_path, capfd):
 
 
 def test_random_gears_mostly_run_long():
-    """Not vacuous: most long-test gears run every command (exit 0 from check, torsional and contact3d)."""
+    """Not vacuous: many long-test gears run (exit 0 from check, torsional and contact3d): measured 59 of 98; the
+    rest are refused by the geometry checks (exit 2), mostly a face width past the root torus's limit, a ZK tool that
+    undercuts the thread, pointed or undercut teeth."""
     if len(LONG_OUTCOMES) < LONG_GEARS:
         pytest.skip("runs after test_random_gear_every_command_exits_0_2_or_3_long")
     ok = [i for i, c in LONG_OUTCOMES.items() if all(c.get(k) == 0 for k in ("check", "torsional", "contact3d"))]
-    assert len(ok) >= LONG_GEARS // 2, (len(ok), MESSAGES)
+    assert len(ok) >= 40, (len(ok), MESSAGES)
 
 
 def test_the_steep_4x38_za_gear_runs_at_contact3d(tmp_path, capfd):
