@@ -293,7 +293,7 @@ def derive(gear: GearData) -> GearGeometry:
     b2_max = 2 * math.sqrt(max(R_root**2 - edge**2, 0.0))
     if gear.face_width_mm is None:
         b2 = min(b2, b2_max)  # the DIN guide default, clipped where the root torus would eat the edges
-    if b2 > b2_max:
+    if b2 > b2_max * (1 + 1e-9):  # (the clipped default given back, e.g. through REXS, is b2_max within rounding)
         raise GeometryError(
             f"gear.face_width_mm = {b2 / MM:.3f}: the wheel root torus leaves no tooth at the face edges; "
             f"allowed up to {b2_max / MM:.3f} mm"

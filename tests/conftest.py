@@ -44,6 +44,11 @@ LONG_TESTS: dict[str, set[str] | None] = {
     "test_rexs.py": {"contact3d_fva", "contact3d_other"},
     # the FE mesher's every retry on a 120-tooth wheel (a strict xfail, minutes)
     "test_contact3d_model.py": {"test_tooth_compliance_on_a_120_tooth_wheel"},
+    # 100 random gears through every command (~1 min each); a handful stay in `make test`
+    "test_commands_random.py": {
+        "test_random_gear_every_command_exits_0_2_or_3_long",
+        "test_random_gears_mostly_run_long",
+    },
 }
 
 

@@ -97,6 +97,20 @@ def test_write_model_is_standalone(tmp_path, name):
     assert len(slots) == z2
 
 
+def test_write_model_writes_a_mesh_beyond_mujocos_stl_limit_as_obj(tmp_path, monkeypatch):
+    """MuJoCo reads at most 200 000 faces from an STL file; a 77-tooth wheel's visual mesh has more (`wormsim model`
+    exited 1 on it, tests/test_commands_random.py): such a mesh is written as OBJ. Here the limit is lowered so that
+    the screw jack's visual meshes pass it."""
+    from wormsim.contact3d import mjcf
+
+    monkeypatch.setattr(mjcf, "STL_FACES_MAX", 5000)
+    path = write_model(load_scenario(SCEN / "screw_jack.yaml", COARSE), tmp_path / "m")
+    objs = sorted(p.name for p in (tmp_path / "m" / "meshes").glob("*.obj"))
+    assert "wheel_visual.obj" in objs and "worm_visual.obj" in objs, objs
+    m = mujoco.MjModel.from_xml_path(str(path))
+    assert m.nmesh == len(list((tmp_path / "m" / "meshes").iterdir()))
+
+
 def test_too_large_timestep_stops_with_a_diagnosis():
     sc = load_scenario(
         SCEN / "seat_motor.yaml",

@@ -46,3 +46,24 @@ def test_impossible_gear_data_is_an_input_error():
         derive(Gear(wheel_teeth=30, axial_module_mm=2, diameter_quotient=2))
     with pytest.raises(GeometryError, match="face_width_mm"):
         derive(Gear(wheel_teeth=30, axial_module_mm=2, diameter_quotient=10, face_width_mm=200))
+
+
+def test_the_clipped_default_face_width_given_back_is_accepted():
+    """A wheel whose DIN-guide face width would reach past the root torus gets b2_max as its default; that width
+    given back in mm (REXS export and import, tests/test_commands_random.py gear 123) was refused by one ulp."""
+    gear = dict(
+        profile="ZK",
+        worm_starts=2,
+        wheel_teeth=30,
+        axial_module_mm=0.838,
+        diameter_quotient=15.45,
+        normal_pressure_angle_deg=20.9,
+        profile_shift_coefficient=0.57,
+        backlash_mm=0.0419,
+    )
+    g = derive(Gear(**gear))
+    assert g.face_width < 0.75 * 2 * g.r_a1  # clipped
+    again = derive(Gear(**gear, face_width_mm=g.face_width * 1e3))
+    assert again.face_width == pytest.approx(g.face_width, rel=1e-12)
+    with pytest.raises(GeometryError, match="leaves no tooth at the face edges"):
+        derive(Gear(**gear, face_width_mm=g.face_width * 1e3 * 1.001))

@@ -669,8 +669,12 @@ RPM_PER_RAD_S = 30.0 / math.pi  # the standalone model's drive control is a spee
 CTRL_RANGE_FACTOR = 2.0  # the controls' range: +- this times the scenario's value (the viewer's sliders)
 
 
+STL_FACES_MAX = 200_000  # MuJoCo's STL decoder: "number of faces should be between 1 and 200000"
+
+
 def write_model(scenario: Scenario, out_dir: str | Path) -> Path:
-    """DIR/model.xml + DIR/meshes/*.stl: opens with `python -m mujoco.viewer --mjcf DIR/model.xml`.
+    """DIR/model.xml + DIR/meshes/*.stl (*.obj for a mesh of more than STL_FACES_MAX faces): opens with
+    `python -m mujoco.viewer --mjcf DIR/model.xml`.
 
     The standalone file gives every wheel tooth its collision pieces (the viewer does not re-pose a window,
     so the wheel can turn any number of turns), and MuJoCo recomputes body_invweight0 on load, so its
@@ -714,10 +718,12 @@ def write_model(scenario: Scenario, out_dir: str | Path) -> Path:
     for me in spec.meshes:
         v = np.asarray(me.uservert, dtype=float).reshape(-1, 3)
         f = np.asarray(me.userface, dtype=int).reshape(-1, 3)
-        trimesh.Trimesh(v, f, process=False).export(out / "meshes" / f"{me.name}.stl")
+        # MuJoCo reads at most STL_FACES_MAX faces from an STL file (a large wheel's visual mesh has more): OBJ then
+        name = f"{me.name}.stl" if len(f) <= STL_FACES_MAX else f"{me.name}.obj"
+        trimesh.Trimesh(v, f, process=False).export(out / "meshes" / name)
         me.uservert = []
         me.userface = []
-        me.file = f"{me.name}.stl"
+        me.file = name
     spec.meshdir = "meshes"
     spec.modelfiledir = str(out.resolve())
     path = out / "model.xml"

@@ -11,8 +11,16 @@ from wormsim.scenario import load_scenario
 def rate_command(scenario_path: str, out_dir: str, overrides: list[str], fe: bool = False) -> int:
     sc = load_scenario(scenario_path, overrides)
     check_writable_dir(out_dir)  # refused before any work (exit 2)
+    fe = fe or (sc.rating is not None and sc.rating.root_stress == "fe")
+    if sc.gear is not None:
+        # teeth that cannot be made (a pointed or undercut thread, no tooth at the face edges) are refused naming the
+        # field (exit 2), as `wormsim check` and `run` refuse them: no rating of a gear that does not exist, and no
+        # FE solid that gmsh refuses
+        from wormsim.validate import validate_geometry
+
+        validate_geometry(sc.model_copy(update={"model": "torsional"}))
     result = rate(sc)
-    if fe or (sc.rating is not None and sc.rating.root_stress == "fe"):
+    if fe:
         from wormsim.rating.fe_root import add_fe_root_stress
 
         add_fe_root_stress(sc, result)

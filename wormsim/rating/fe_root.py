@@ -41,8 +41,9 @@ from meshgen.cache import cached
 from meshgen.geometry import GearGeometry
 from wormsim.errors import SimulationError
 
-CODE_VERSION = "fe-root-3"
+CODE_VERSION = "fe-root-4"
 FILLET_COEF = 0.38  # rho_fP / m: ISO 53 profile A root radius of the basic rack
+FILLET_ROOM = 0.9  # a fillet's tangent points: at most this share of the way to the space middle / flank middle
 RIM_DEPTH_MX = 2.5  # rim below the throat root circle, in axial modules (model extent, clamped there)
 ROOT_BAND_MX = 0.35  # root band: element centroids within this many m_x above the root torus radius
 FLANK_DENSE = 48  # flank points per section before resampling
@@ -71,12 +72,18 @@ def _arc(r: float, a0: float, a1: float, n: int) -> np.ndarray:
     return np.stack([r * np.cos(t), r * np.sin(t)], axis=-1)
 
 
-def _fillet(corner: np.ndarray, toward_root: np.ndarray, toward_flank: np.ndarray, radius: float, n: int):
+def _fillet(
+    corner: np.ndarray, toward_root: np.ndarray, toward_flank: np.ndarray, radius: float, n: int, t_max: float = np.inf
+):
     """n points of the circular arc of `radius` tangent to the two rays from `corner` (unit directions), from the
-    root-side tangent point to the flank-side one; and the distance of the tangent points from the corner."""
+    root-side tangent point to the flank-side one; and the distance of the tangent points from the corner. Where
+    that distance would pass t_max (a tooth space narrower at its root than two fillets), the radius is the one whose
+    tangent points lie t_max from the corner."""
     u1, u2 = toward_root / np.linalg.norm(toward_root), toward_flank / np.linalg.norm(toward_flank)
     theta = math.acos(float(np.clip(u1 @ u2, -1.0, 1.0)))
     t = radius / math.tan(theta / 2)
+    if t > t_max:
+        t, radius = t_max, t_max * math.tan(theta / 2)
     bis = (u1 + u2) / np.linalg.norm(u1 + u2)
     centre = corner + bis * radius / math.sin(theta / 2)
     p1, p2 = corner + t * u1, corner + t * u2
@@ -125,13 +132,19 @@ def _tooth_top(g: GearGeometry, zeta: float, c: Counts) -> np.ndarray:
     B = np.stack([rho * np.cos(pb), rho * np.sin(pb)], -1)  # flank b, root -> tip
     r_f = FILLET_COEF * g.m_x
     s0, s1 = space_middles(g, zeta)
-    tan_a = np.array([math.sin(pa[0]), -math.cos(pa[0])])  # root circle tangent at A's root, towards space 0
-    fa, ta = _fillet(A[0], tan_a, A[1] - A[0], r_f, c.fillet)
-    tan_b = np.array([-math.sin(pb[0]), math.cos(pb[0])])  # towards space 1
-    fb, tb = _fillet(B[0], tan_b, B[1] - B[0], r_f, c.fillet)
-    # flanks from their fillet tangent point to the tip
+    # flanks' arc lengths from the root
     sa = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(A, axis=0), axis=1))])
     sb = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(B, axis=0), axis=1))])
+    # a fillet ends before the space middle and below the flank's middle (FILLET_ROOM of each): where a space is
+    # narrower at its root than two fillets (near the end faces of a throated wheel), the radius is smaller there and
+    # the outline stays simple (overlapping fillets are facets that gmsh refuses)
+    tan_a = np.array([math.sin(pa[0]), -math.cos(pa[0])])  # root circle tangent at A's root, towards space 0
+    room_a = FILLET_ROOM * min(lo * (pa[0] - float(s0)), 0.5 * sa[-1])
+    fa, ta = _fillet(A[0], tan_a, A[1] - A[0], r_f, c.fillet, room_a)
+    tan_b = np.array([-math.sin(pb[0]), math.cos(pb[0])])  # towards space 1
+    room_b = FILLET_ROOM * min(lo * (float(s1) - pb[0]), 0.5 * sb[-1])
+    fb, tb = _fillet(B[0], tan_b, B[1] - B[0], r_f, c.fillet, room_b)
+    # flanks from their fillet tangent point to the tip
     flank_a = _resample(np.concatenate([fa[-1:], A[sa > ta]]), c.flank)
     flank_b = _resample(np.concatenate([fb[-1:], B[sb > tb]]), c.flank)
     root_a = _arc(lo, s0, math.atan2(fa[0, 1], fa[0, 0]), c.root)
@@ -242,6 +255,10 @@ def tet_mesh(
 # facets)": two re-meshed patches meet in the same triangle at some sizes; measured on a 1-start ZI gear, z2 40, m_x 4,
 # q 10: refused at 1.0, meshed at 0.9). The largest and the smallest size scale together.
 SIZE_RETRIES = (1.0, 0.9, 1.1, 0.8, 1.25, 0.7)
+# gmsh's feature angles tried after every size at the caller's angles failed ("Wrong topology of boundary mesh for
+# parametrization" at 40 deg and every size on a 1-start ZI gear, z2 24, m_x 0.93, q 12.8, x2 -0.13: meshed at 60 deg);
+# a tooth that meshes at the caller's angles keeps its mesh
+FALLBACK_ANGLES_DEG = (60.0, 50.0, 30.0)
 
 
 def tet_mesh_retried(
@@ -251,17 +268,19 @@ def tet_mesh_retried(
     min_size_m: float,
     curvature: int,
     angles_deg: tuple[float | None, ...] = (40.0,),
+    fallback_angles_deg: tuple[float, ...] = (),
 ) -> tuple[np.ndarray, np.ndarray]:
     """tet_mesh at the element sizes times each of SIZE_RETRIES, each at the feature angles angles_deg in turn (None:
-    the surface's own triangles, tet_mesh), until gmsh meshes the tooth; SimulationError (exit 3) naming what to
-    change when every size is refused."""
+    the surface's own triangles, tet_mesh), until gmsh meshes the tooth; then the same at fallback_angles_deg;
+    SimulationError (exit 3) naming what to change when every size and angle is refused."""
     errors = []
-    for f in SIZE_RETRIES:
-        for angle in angles_deg:
-            try:
-                return tet_mesh(V, F, size_m * f, min_size_m * f, curvature, angle)
-            except Exception as exc:  # gmsh raises plain Exception with its message
-                errors.append(f"x{f:g} at {'no re-meshing' if angle is None else f'{angle:g} deg'}: {exc}")
+    for angles in (angles_deg, tuple(a for a in fallback_angles_deg if a not in angles_deg)):
+        for f in SIZE_RETRIES if angles else ():
+            for angle in angles:
+                try:
+                    return tet_mesh(V, F, size_m * f, min_size_m * f, curvature, angle)
+                except Exception as exc:  # gmsh raises plain Exception with its message
+                    errors.append(f"x{f:g} at {'no re-meshing' if angle is None else f'{angle:g} deg'}: {exc}")
     raise SimulationError(
         f"the FE root stress: gmsh refused the wheel tooth's mesh at every element size tried ({'; '.join(errors)}); "
         "change rating.fe_mesh_density (1 to 4) or gear.backlash_mm slightly, or rate without --fe "
@@ -463,8 +482,8 @@ def tooth_mesh(
     geometry (meshgen.cache). `density` d sets the element sizes together (d = 1 is the default, d = 1 and 2 are an
     h / (h/2) pair): largest 1.5 m_x / d (or size_m), smallest FILLET_COEF m_x / d (the fillet radius over d; or
     min_size_m / d), curvature_elements d per full turn of a curved surface (default CURVATURE_ELEMENTS). gmsh's
-    surface classification at each of classify_angles_deg in turn (tet_mesh_retried; its re-meshing of the classified
-    patches fails on some sectors at some angles)."""
+    surface classification at each of classify_angles_deg in turn, then at FALLBACK_ANGLES_DEG (tet_mesh_retried; its
+    re-meshing of the classified patches fails on some sectors at some angles)."""
     from dataclasses import asdict
 
     size = size_m if size_m is not None else 1.5 * g.m_x / density
@@ -473,7 +492,7 @@ def tooth_mesh(
 
     def build() -> ToothMesh:
         V, F = tooth_surface(g, SURFACE_DENSITY, teeth)
-        P, T = tet_mesh_retried(V, F, size, min_size, curvature, classify_angles_deg)
+        P, T = tet_mesh_retried(V, F, size, min_size, curvature, classify_angles_deg, FALLBACK_ANGLES_DEG)
         return ToothMesh(P, T, g.r_f2 - RIM_DEPTH_MX * g.m_x)
 
     parts = {"geometry": asdict(g), "density": density, "size_m": size, "code": CODE_VERSION}

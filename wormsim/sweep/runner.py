@@ -317,9 +317,12 @@ def open_client(scheduler: str | None, workers: int | None):
         import dask
 
         n = workers or default_workers()
+        # dask's own log lines stay off stderr up to ERROR: on a loaded machine a worker's heartbeat times out and
+        # distributed logs it with a traceback, though the worker reconnects and the sweep ends well (a point that
+        # fails, or a lost worker, is a row with its message in sweep.csv / sweep.json)
         with dask.config.set({"distributed.worker.multiprocessing-method": LOCAL_START_METHOD}):
             cluster = LocalCluster(
-                n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0", silence_logs=logging.ERROR
+                n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0", silence_logs=logging.CRITICAL
             )
         client = Client(cluster)
         kind = "LocalCluster (processes)"

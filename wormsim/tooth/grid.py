@@ -120,9 +120,9 @@ def _flank_grid(g: GearGeometry, slices: int, n_profile: int) -> FlankGrid:
         shift = dj if side > 0 else pitch - dj
         psi[i] = np.where(ok, sol.psi + shift, np.nan)
         c[i] = np.where(ok, sol.beta - sol.psi, np.nan)
-    with np.errstate(all="ignore"):
-        rng = np.stack([np.nanmin(c, axis=2), np.nanmax(c, axis=2)], axis=-1)
-    rng = np.where(np.isfinite(rng), rng, np.array([np.inf, -np.inf]))
+    # the conjugate angles' range per slice; a slice with no flank point has the empty range (inf, -inf)
+    fin = np.isfinite(c)
+    rng = np.stack([np.where(fin, c, np.inf).min(axis=2), np.where(fin, c, -np.inf).max(axis=2)], axis=-1)
     xy = np.stack([R * np.cos(psi), R * np.sin(psi)], axis=-1)
     act = np.isfinite(c)
     first = np.where(act.any(axis=2), np.argmax(act, axis=2), -1)
