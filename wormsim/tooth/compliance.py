@@ -386,6 +386,15 @@ def compute(g: GearGeometry, materials, density: int = 1, teeth: int = TEETH) ->
     )  # fmt: skip
 
 
+def cache_version() -> tuple:
+    """What a cached compliance (and a cached LTCA built on it) depends on besides its inputs: this module's
+    CODE_VERSION, the FE sector's geometry and mesher (wormsim.rating.fe_root.CODE_VERSION) and the mesher's feature
+    angles."""
+    from wormsim.rating import fe_root
+
+    return CODE_VERSION, fe_root.CODE_VERSION, CLASSIFY_ANGLES_DEG
+
+
 @functools.lru_cache(maxsize=16)
 def _tooth_compliance(g: GearGeometry, moduli: tuple, materials, density: int) -> ToothCompliance:
     parts = {
@@ -393,8 +402,8 @@ def _tooth_compliance(g: GearGeometry, moduli: tuple, materials, density: int) -
         "moduli": moduli,
         "density": density,
         "grid": (GRID_FACE, GRID_PROFILE, TEETH, WORM_THREADS, WORM_RADII, LOAD_RADIUS_MX),
-        "mesh": (MIN_SIZE_MX, CURVATURE_ELEMENTS, CLASSIFY_ANGLES_DEG, INSET_MX, H_NORMAL_MX),
-        "v": CODE_VERSION,
+        "mesh": (MIN_SIZE_MX, CURVATURE_ELEMENTS, INSET_MX, H_NORMAL_MX),
+        "v": cache_version(),
     }
     return cached("tooth-compliance", parts, lambda: compute(g, materials, density))
 

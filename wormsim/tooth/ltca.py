@@ -272,7 +272,7 @@ def _loaded_contact(g, moduli, materials, torque_nm, samples, side, density, dev
         "side": side,
         "density": density,
         "dev": None if dev is None else asdict(dev),
-        "v": (CODE_VERSION, compliance.CODE_VERSION, SEGMENTS_PER_WIDTH, FLATTENING_ITERATIONS),
+        "v": (CODE_VERSION, compliance.cache_version(), SEGMENTS_PER_WIDTH, FLATTENING_ITERATIONS),
     }
     return cached("ltca", parts, lambda: compute(g, materials, torque_nm, samples, side, density, dev=dev))
 
