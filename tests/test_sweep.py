@@ -181,6 +181,19 @@ def test_local_cluster_two_workers_with_a_failing_point(local_run):
     assert not (out / "runs").exists()  # per-point folders only with --keep-runs
 
 
+def test_a_sweep_whose_every_point_fails_exits_3_with_the_first_message(tmp_path, capsys):
+    f = _write(
+        tmp_path / "all_fail.yaml",
+        f"name: all_fail\nbase: {SCREW_JACK}\nset: {{model: torsional, simulation.duration_s: 0.12}}\n"
+        "grid: {load.torque_nm: [30000, 40000]}\n",
+    )
+    out = tmp_path / "out"
+    assert cli.main(["sweep", str(f), "--out", str(out), "--workers", "1", "--no-progress"]) == 3
+    err = capsys.readouterr().err
+    assert "every point of sweep all_fail failed" in err and "teeth would skip" in err
+    assert [r["status"] for r in _rows(out)] == ["failed", "failed"]  # the table is still written
+
+
 def _start(args: list[str], log: Path) -> subprocess.Popen:
     fh = log.open("w")
     return subprocess.Popen(args, stdout=fh, stderr=subprocess.STDOUT, start_new_session=True)

@@ -244,6 +244,16 @@ def _cmd_sweep(args) -> int:
         f"({c['resumed']} done earlier, {c['ran']} run now)"
     )
     print(f"wrote {out / 'sweep.csv'}, {out / 'sweep.json'}, {out / 'sweep.png'}")
+    if c["points"] and not c["ok"]:  # nothing to study: the table holds only failures
+        import csv
+
+        with (out / "sweep.csv").open(newline="") as fh:
+            first = next((r for r in csv.DictReader(fh) if r["status"] != "ok"), {})
+        print(
+            f"simulation failed: every point of sweep {sw.spec.name} failed (the first: {first.get('message', '?')})",
+            file=sys.stderr,
+        )
+        return EXIT_SIM
     return EXIT_OK
 
 
