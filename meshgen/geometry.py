@@ -1,7 +1,7 @@
 """Derived dimensions of a cylindrical worm gear pair (90 deg shaft angle), SI units.
 
-Sources: DIN 3975-1 / ISO 1122-1 for the names and the basic relations; seed 003
-(`../shared/seeds/003_a94382a6f782276d.txt`) for the involute helicoid parameters r_b and p.
+Sources: DIN 3975-1 / ISO 1122-1 for the names and the basic relations; seed 003 (the involute worm gear's
+document, README "Seeds") for the involute helicoid parameters r_b and p.
 
 Relations (m_x axial module, m_n normal module, z1 starts, z2 wheel teeth, gamma lead angle at d1):
 

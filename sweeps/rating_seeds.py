@@ -19,7 +19,7 @@ from wormsim.scenario import load_scenario
 
 ROOT = Path(__file__).resolve().parents[1]
 SEEDS = {"seat_motor": ("001", "POM"), "screw_jack": ("002", "GJL-250"), "involute_41": ("003", "CuAl10Fe5Ni5")}
-# what each seed document states about durability (shared/seeds/, paraphrased)
+# what each seed document states about durability (the seed documents, paraphrased)
 SEED_SAYS = {
     "seat_motor": "POM wheel (E 3.1 GPa); no stress or strength values",
     "screw_jack": "the meshing-force fluctuation drives fatigue (pitting, bending fatigue); no values",

@@ -1,6 +1,6 @@
 """The load-capacity rating (wormsim.rating): public benchmarks, the seeds, `wormsim rate` and its input errors.
 
-Benchmarks (/work/shared/references/worm-rating.md collects them with their sources):
+Benchmarks (docs/rating.md names them with their sources):
 * Niemann/Winter, Maschinenelemente vol. III, example 3, as recomputed by dsoftcon WormGear (dsoftcon.be/WormGear,
   forces and load-capacity output pages): z 1/40, d1 83.20 mm, d2 416.80 mm, mineral oil ISO VG 320, Ra1 0.8 um,
   L_h 25 000 h, K_A 1; v_g 6.59 m/s, mu_z 0.026 (rho_z 1.4954 deg), efficiency 0.82 worm driving / 0.79 wheel

@@ -1,6 +1,6 @@
 """Friction angle of the worm/wheel sliding contact, in SI (rad, m/s).
 
-Seed 000 (`../shared/seeds/000_30b2fd31dd44c873.txt`, table "Approximated formulae for the sliding
+Seed 000 (the two-sided wedge model's document, README "Seeds"; its table "Approximated formulae for the sliding
 friction angle"): for three steel-worm / bronze-wheel material groups the friction angle, in
 DEGREES, is a fit to experimental data over the sliding speed Vs in m/s:
 

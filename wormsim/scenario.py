@@ -1,4 +1,4 @@
-"""Scenario files: the pydantic schema of ../shared/INTERFACE.md, loading, `--set` overrides.
+"""Scenario files: the pydantic schema of the project's interface contract (docs/scenario.md), loading, `--set` overrides.
 
 Units are in the key names (`_mm`, `_deg`, `_rpm`, `_nm`, `_n`, `_s`, ...). This module is the
 one edge where user units meet the code: everything downstream reads the validated model and

@@ -77,5 +77,5 @@ PLASTIC_MODULUS_MAX_GPA = 10.0  # a wheel this soft is taken as a plastic when r
 # MITCalc Gear4 oil-type table (Tables!B26:E28), as reproduced in the same public web port
 Z_OIL = {"mineral": 0.89, "pao": 0.94, "peg": 1.0}
 # permissible oil sump temperature theta_Slim (C) per lubricant: docs of the BSI/MITCalc reproductions, collected in
-# /work/shared/references/worm-rating.md ("Temperature")
+# the public rating formulas of docs/rating.md ("Temperature")
 THETA_SLIM_C = {"mineral": 90.0, "pao": 100.0, "peg": 110.0}

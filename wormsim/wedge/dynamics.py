@@ -1,6 +1,6 @@
 """Two-sided wedge model (TSWM) of a worm drive: seed 000 with a third regime, standstill (locked).
 
-Source: `../shared/seeds/000_30b2fd31dd44c873.txt` ("seed 000"); docs/wedge.md derives every line.
+Source: seed 000, the two-sided wedge model's document (README, "Seeds"); docs/wedge.md derives every line.
 
 Bodies and forces (seed 000, fig. 1): body 1 (the worm, reduced to its pitch radius, mass m1 with
 the motor rotor) moves along x1 under the motor force F1; body 2 (the wheel, mass m2) moves along
