@@ -73,7 +73,7 @@ def _table(res) -> np.ndarray:
 
 def cell_peak_mpa(T, t: np.ndarray, window) -> float | None:
     """The largest p_H of one contact, (3) of wormsim.tooth.hertz, over the contacts in the steady window carrying at
-    least 1 % of their mean normal force (the maximum before the averaged (4); for comparison)."""
+    least 1 % of their mean normal force (the one-contact maximum, for comparison with the averaged (4))."""
     if T is None or not len(T):
         return None
     inwin = (t >= window[0]) & (t <= window[1])

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import signal
+from contextlib import contextmanager
 from pathlib import Path
 
 import pytest
@@ -60,3 +62,19 @@ def pytest_collection_modifyitems(config, items):
         callspec = getattr(item, "callspec", None)
         if rule is None or (callspec is not None and callspec.params.get("name") in rule) or item.originalname in rule:
             item.add_marker(pytest.mark.long)
+
+
+@contextmanager
+def time_limit(seconds: int):
+    """A hang becomes a failure (SIGALRM), not a stuck CI job."""
+
+    def expire(signum, frame):
+        raise TimeoutError(f"no result within {seconds} s")
+
+    old = signal.signal(signal.SIGALRM, expire)
+    signal.alarm(seconds)
+    try:
+        yield
+    finally:
+        signal.alarm(0)
+        signal.signal(signal.SIGALRM, old)

@@ -25,14 +25,13 @@ import json
 import math
 import os
 import re
-import signal
 import time
-from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
 import pytest
 import yaml
+from conftest import time_limit
 
 from wormsim import cli
 from wormsim.scenario import yaml_load
@@ -86,22 +85,6 @@ def draw(index: int) -> dict:
         "speed_rpm": round(float(np.exp(rng.uniform(math.log(100), math.log(3000)))), 1),
         "load_nm": round(load_nm, 4),
     }
-
-
-@contextmanager
-def time_limit(seconds: int):
-    """A hang becomes a failure (SIGALRM), not a stuck job."""
-
-    def expire(signum, frame):
-        raise TimeoutError(f"no result within {seconds} s")
-
-    old = signal.signal(signal.SIGALRM, expire)
-    signal.alarm(seconds)
-    try:
-        yield
-    finally:
-        signal.alarm(0)
-        signal.signal(signal.SIGALRM, old)
 
 
 FIELD = re.compile(r"\b[a-z_]+\.[a-z_0-9]+\b|\bgear\b|--[a-z]+")

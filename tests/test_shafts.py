@@ -90,16 +90,9 @@ def test_worm_bending_against_the_beam_formula_load_and_span():
 
 
 def test_bearing_forces_balance_the_mesh_forces():
-    block = {
-        "worm": {
-            "bearings_mm": [-60, 60],
-            "radial_stiffness_n_per_um": 500,
-            "axial_stiffness_n_per_um": 200,
-            "bending": True,
-        },
-        "wheel": {"bearings_mm": [-30, 30], "radial_stiffness_n_per_um": 500, "axial_stiffness_n_per_um": 200},
-    }
-    s, S = _run(json.dumps(block))
+    from wormsim.bench.cases import SHAFTS_BLOCK  # both shafts compliant, the worm bending (the bench's twin)
+
+    s, S = _run(json.dumps(SHAFTS_BLOCK))
     r, R = _run(RIGID)  # rigid bearings: their forces are the constraint's reaction split by the statics
     for summ, series in ((s, S), (r, R)):
         _balance(summ, series)

@@ -1,6 +1,7 @@
 """FE contact check of the tooth compliance with CalculiX (ccx): a worm thread segment and a wheel segment of the
 teeth in mesh as linear elastic bodies in frictionless surface-to-surface contact, meshed from meshgen's geometry.
-The open counterpart of seed 003's ANSYS contact analysis; the independent check of wormsim.tooth.ltca (issue 30).
+The open counterpart of seed 003's ANSYS contact analysis and the independent check of wormsim.tooth.ltca
+(docs/validation.md has the comparison).
 
 Model (assembly frame of meshgen.assembly, millimetres, N, MPa in the .inp):
 * Wheel segment: the teeth in contact at worm angle theta1 (meshgen.wheel's exact flanks, the sections of
