@@ -34,8 +34,9 @@ def record_states(name: str):
     import mujoco
 
     from wormsim import gear_theory as gt
-    from wormsim.contact3d.flank_step import FlankContacts, split_forward
+    from wormsim.contact3d.flank_step import FlankContacts
     from wormsim.contact3d.mjcf import build_model
+    from wormsim.contact3d.native import split_forward
     from wormsim.scenario import load_scenario
 
     sc = load_scenario(

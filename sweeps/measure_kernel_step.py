@@ -28,7 +28,7 @@ def _setup(name, extra, merge, mod, warm):
     import mujoco
 
     from wormsim import gear_theory as gt
-    from wormsim.contact3d import flank_step
+    from wormsim.contact3d import flank_step, native
     from wormsim.contact3d.mjcf import build_model
     from wormsim.scenario import load_scenario
 
@@ -47,7 +47,7 @@ def _setup(name, extra, merge, mod, warm):
     d = mujoco.MjData(m)
     flank_step.PackedKernel, flank_step.find_packed = mod.PackedKernel, mod.find_packed
     try:
-        flank_step.split_forward(m, d, fc.add)
+        native.split_forward(m, d, fc.add)
     finally:
         flank_step.PackedKernel, flank_step.find_packed = saved
     cmds = gt.commands(sc, bm.direction)
@@ -61,7 +61,8 @@ def _setup(name, extra, merge, mod, warm):
 
 def _time(s, steps):
     """(us per step, us per kernel call (FlankContacts.find inside the steps), contacts per step, final qpos)."""
-    from wormsim.contact3d import flank_step
+    from wormsim.contact3d import flank_step, native
+    from wormsim.contact3d.flank_handoff import fill_add
 
     m, d, fc, bm = s["m"], s["d"], s["fc"], s["bm"]
     acc = [0]
@@ -73,8 +74,8 @@ def _time(s, steps):
         acc[0] += clock() - a
         n = fc.n_handed()
         if n:
-            k = fc.kernel
-            fc.buffer.add(m, d, n, *fc.handed, fc.solref, fc.solreffriction, k.mfric, fc.mu, fc.merge)
+            fr = fc.solreffriction[1] != 0.0
+            fill_add(native.MJ_ADD_CONTACT, m._address, d._address, fc.hand, n, fc.handed, fc.mu, fr, fc.merge)
 
     j0 = s["j"]
     nc = 0
@@ -84,7 +85,7 @@ def _time(s, steps):
         t0 = clock()
         for j in range(j0, j0 + steps):
             d.ctrl[bm.drive_actuator], d.ctrl[bm.load_actuator] = s["drive"][j], s["load"][j]
-            flank_step.split_step(m, d, add)
+            native.split_step(m, d, add)
             nc += fc.n
         step_us = (clock() - t0) / steps / 1e3
     finally:

@@ -17,7 +17,8 @@ class Stepper:
         m = self.m
         self.qa_wheel = int(m.jnt_qposadr[m.dof_jntid[bm.wheel_dof]])
         if self.flanks:
-            from wormsim.contact3d.flank_step import FlankContacts, split_forward
+            from wormsim.contact3d.flank_step import FlankContacts
+            from wormsim.contact3d.native import split_forward
 
             self.fc = FlankContacts(bm, bm.law.contacts_per_pair)
             split_forward(m, d, self.fc.add)

@@ -121,7 +121,8 @@ def _settle(bm, d, torque_nm: float, steps: int, fc):
 @pytest.fixture(scope="module")
 def static_flanks():
     """Worm held at 0 rpm by its servo, frictionless, wheel torques 21 and 24 N m (tests/test_contact3d_law.py)."""
-    from wormsim.contact3d.flank_step import FlankContacts, split_forward
+    from wormsim.contact3d.flank_step import FlankContacts
+    from wormsim.contact3d.native import split_forward
 
     sc = load_scenario(
         SCEN / "seat_motor.yaml",

@@ -1,4 +1,4 @@
-"""The path contact3d's exact flanks use to reach MuJoCo's solver (wormsim.contact3d.flank_step.split_step): a 1 kg
+"""The path contact3d's exact flanks use to reach MuJoCo's solver (wormsim.contact3d.native.split_step): a 1 kg
 box on two slide joints (x, z) above a plane, MuJoCo's collision off for both, one contact added by hand each step
 between mj_collision and mj_makeConstraint with the contact law's direct solref (wormsim.contact3d.law (1))."""
 
@@ -10,7 +10,7 @@ import mujoco
 import numpy as np
 import pytest
 
-from wormsim.contact3d.flank_step import split_step
+from wormsim.contact3d.native import split_step
 
 XML = """<mujoco><option timestep="1e-3" integrator="implicitfast" cone="elliptic" gravity="0 0 -9.81"/>
 <worldbody><geom name="floor" type="plane" size="1 1 .1" contype="0" conaffinity="0"/>

@@ -7,8 +7,9 @@ import mujoco
 import numpy as np
 import pytest
 
-from wormsim.contact3d.flank_step import FlankContacts, split_forward
+from wormsim.contact3d.flank_step import FlankContacts
 from wormsim.contact3d.mjcf import build_model
+from wormsim.contact3d.native import split_forward
 from wormsim.scenario import load_scenario
 
 SCEN = Path(__file__).resolve().parents[1] / "scenarios"

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import wormsim.contact3d.flank_samples as FS
-from wormsim.contact3d import mjdata_layout
+from wormsim.contact3d import native as mjdata_layout
 from wormsim.contact3d.runner import simulate
 from wormsim.errors import SimulationError
 from wormsim.scenario import load_scenario

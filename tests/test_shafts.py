@@ -163,7 +163,8 @@ def test_shaft_log_series_equal_the_per_sample_formulas(block):
     import mujoco
 
     from wormsim import gear_theory as gt
-    from wormsim.contact3d.flank_step import FlankContacts, split_forward
+    from wormsim.contact3d.flank_step import FlankContacts
+    from wormsim.contact3d.native import split_forward
 
     sc = _scenario(json.loads(block))
     sc.drive.ramp_s, sc.load.ramp_s = 0.001, 0.001  # loaded within the samples

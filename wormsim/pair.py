@@ -23,7 +23,7 @@ user's model. They only set the working point the contact law's friction rows ar
 (3), (4)).
 
 What a step does: MuJoCo's own step, split so that the flank contacts are added between mj_collision and
-mj_makeConstraint (wormsim.contact3d.flank_step.split_step), so the user's contacts, actuators, tendons, equalities
+mj_makeConstraint (wormsim.contact3d.native.split_step), so the user's contacts, actuators, tendons, equalities
 and the model's timestep and integrator all stay MuJoCo's. The exact-flank kernel (wormsim.tooth.kernel) takes the
 bodies' poses from the data (d.xpos, d.xmat after the kinematics, wormsim.tooth.pose), so a moving or compliant
 housing meshes; the friction coefficient follows the sliding speed mu(Vs), Vs = |omega1| r1 / cos(gamma), omega1
@@ -56,8 +56,9 @@ from meshgen import assembly
 from meshgen import wheel as mwheel
 from meshgen.displaced import Deviations, wheel_mount, worm_mount
 from wormsim.contact3d import shafts
-from wormsim.contact3d.flank_step import FlankContacts, split_step
+from wormsim.contact3d.flank_step import FlankContacts
 from wormsim.contact3d.mjcf import Prepared, prepare
+from wormsim.contact3d.native import split_step
 from wormsim.contact3d.timestep import MAX_WORM_TURN_PER_STEP_RAD, OVERSPEED_GUARD, default_timestep
 from wormsim.friction import friction_coefficient, friction_coefficient_scalar
 from wormsim.geometry import displaced_pair
@@ -405,7 +406,7 @@ def _check_options(pair: WormPair, model: mujoco.MjModel) -> None:
 
 def step(model: mujoco.MjModel, data: mujoco.MjData, pairs: Sequence[WormPair]) -> None:
     """One MuJoCo step of `model` with the exact-flank contacts of every pair in `pairs` in one constraint solve
-    (wormsim.contact3d.flank_step.split_step: MuJoCo's step with the contacts added after its collision). The
+    (wormsim.contact3d.native.split_step: MuJoCo's step with the contacts added after its collision). The
     model's timestep and integrator are used as they are (module docstring for what is refused)."""
     bound = [p.bind(model) for p in pairs]
     h = float(model.opt.timestep)

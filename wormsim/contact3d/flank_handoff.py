@@ -3,12 +3,13 @@ written and added from compiled code, one Python call per step.
 
 Each contact is laid out in a buffer of mjContact records that this module owns: every record starts as a copy of
 the template contact (as MuJoCo's mj_addContact stores it, so geoms, dim, friction, solimp and the rest are MuJoCo's
-own bytes), the per-contact fields (dist, pos, frame, solref, solreffriction) are written into it by `_fill_add`, which
+own bytes), the per-contact fields (dist, pos, frame, solref, solreffriction) are written into it by `fill_add`, which
 then calls MuJoCo's C function mj_addContact (mujoco.h: "Add contact to d->contact list; return 0 if success;
 1 if buffer full") on each record: MuJoCo copies it into d.contact exactly as the Python binding would. Field
 offsets and the record size come from the binding's own views of d.contact (the struct is mjdata.h's mjContact, whose
-first field is dist), so no layout is written here. The C function is the one in the shared library the mujoco
-package loaded (libmujoco in its folder; dlopen returns the loaded copy).
+first field is dist), so no layout is written here. The C function is called by address (wormsim.contact3d.native).
+`fill_add`'s arguments are two records built once per model: `Handoff` (the buffer, its field offsets and the
+contact law's solref) and `Handed` (the kernel's arrays of what is handed over).
 
 Cost (docs/contact3d.md, "Exact flanks: cost"): the Python loop of mj_addContact and the per-field numpy writes
 cost about 3 us per contact; here the C call is about 0.2 us per contact.
@@ -17,84 +18,47 @@ cost about 3 us per contact; here the C call is about 0.2 us per contact.
 from __future__ import annotations
 
 import ctypes
-import glob
-import os
+from typing import NamedTuple
 
 import mujoco
 import numba
 import numpy as np
-from llvmlite import ir
-from numba import types
-from numba.extending import intrinsic
+
+from wormsim.contact3d.native import call_add
 
 FIELDS = ("pos", "frame", "solref", "solreffriction", "friction")  # per-contact fields written besides dist
 
 
-def _library() -> ctypes.CDLL:
-    folder = os.path.dirname(mujoco.__file__)
-    paths = sorted(
-        glob.glob(os.path.join(folder, "libmujoco.so*")) + glob.glob(os.path.join(folder, "libmujoco*.dylib"))
-    )
-    if not paths:
-        raise ImportError(f"no libmujoco shared library in {folder}")
-    return ctypes.CDLL(paths[0])
+class Handoff(NamedTuple):
+    """The record buffer of one model (ContactBuffer) and the contact law's solref (wormsim.contact3d.law)."""
+
+    records: np.ndarray  # the buffer as float64 rows
+    base: int  # its address
+    size: int  # bytes per record
+    offsets: np.ndarray  # of dist, pos, frame, solref, solreffriction, friction in float64 units
+    solref: np.ndarray
+    solreffriction: np.ndarray
 
 
-_MJ_ADD_CONTACT = ctypes.cast(_library().mj_addContact, ctypes.c_void_p).value  # int mj_addContact(m, d, con)
+class Handed(NamedTuple):
+    """The contacts handed over, the kernel's arrays (wormsim.contact3d.flank_step.FlankContacts.handed)."""
 
-
-@intrinsic
-def _call_add(typingctx, fn, m_addr, d_addr, c_addr):
-    """int fn(const mjModel*, mjData*, const mjContact*) called through its address (all four int64): the address is
-    an argument, so the caller can be cached, and no ctypes object is unboxed per call."""
-    sig = types.int32(types.int64, types.int64, types.int64, types.int64)
-
-    def codegen(context, builder, signature, args):
-        fnty = ir.FunctionType(ir.IntType(32), [ir.IntType(8).as_pointer()] * 3)
-        f = builder.inttoptr(args[0], fnty.as_pointer())
-        return builder.call(f, [builder.inttoptr(a, ir.IntType(8).as_pointer()) for a in args[1:]])
-
-    return sig, codegen
-
-
-@intrinsic
-def _f64_at(typingctx, addr):
-    """The float64 pointer at an address (int64)."""
-    sig = types.CPointer(types.float64)(types.int64)
-
-    def codegen(context, builder, signature, args):
-        return builder.inttoptr(args[0], context.get_value_type(types.CPointer(types.float64)))
-
-    return sig, codegen
+    depth: np.ndarray
+    pos: np.ndarray
+    frame: np.ndarray
+    weight: np.ndarray  # each contact's share of its slice
+    fscale: np.ndarray  # the merged contacts' friction scale (wormsim.tooth.merge: mfric)
 
 
 @numba.njit(cache=True)
-def _fill_add(
-    fn,
-    m_addr,
-    d_addr,
-    rec,
-    base,
-    size,
-    off,
-    n,
-    depth,
-    pos,
-    frame,
-    weight,
-    solref,
-    solreffriction,
-    friction_ref,
-    fscale,
-    mu,
-    scale_friction,
-):
-    """Writes the per-contact fields of records 0..n-1 (rec: the buffer as float64 rows, at address base, size bytes
-    each; off: the offsets of dist, pos, frame, solref, solreffriction, friction in float64 units): dist = -depth,
-    solref (and, where friction_ref, solreffriction) scaled by the contact's share of its slice (direct solref: -k,
-    -b); where scale_friction (one contact per tooth flank, wormsim.tooth.merge), the sliding friction
-    mu fscale[i] and solreffriction scaled by weight fscale; then mj_addContact (at address fn) on each. Returns how
-    many were added (it stops when the arena is full, where MuJoCo has warned with mjWARN_CONTACTFULL)."""
+def fill_add(fn, m_addr, d_addr, hand, n, out, mu, friction_rows, scale_friction):
+    """Writes the per-contact fields of records 0..n-1 of hand (Handoff) from out (Handed): dist = -depth, solref
+    (and, where friction_rows, solreffriction) scaled by the contact's share of its slice (direct solref: -k, -b);
+    where scale_friction (one contact per tooth flank, wormsim.tooth.merge), the sliding friction mu fscale[i] and
+    solreffriction scaled by weight fscale; then mj_addContact (at address fn) on each. Returns how many were added
+    (it stops when the arena is full, where MuJoCo has warned with mjWARN_CONTACTFULL)."""
+    rec, off, solref, solreffriction = hand.records, hand.offsets, hand.solref, hand.solreffriction
+    depth, pos, frame, weight, fscale = out.depth, out.pos, out.frame, out.weight, out.fscale
     o0, o1, o2, o3, o4, o5 = off[0], off[1], off[2], off[3], off[4], off[5]
     for i in range(n):
         r = rec[i]
@@ -106,12 +70,13 @@ def _fill_add(
         w = weight[i]
         r[o3], r[o3 + 1] = w * solref[0], w * solref[1]
         wf = w * fscale[i] if scale_friction else w
-        if friction_ref:
+        if friction_rows:
             r[o4], r[o4 + 1] = wf * solreffriction[0], wf * solreffriction[1]
         if scale_friction:
             r[o5] = r[o5 + 1] = mu * fscale[i]
+    base, size = hand.base, hand.size
     for i in range(n):
-        if _call_add(fn, m_addr, d_addr, base + i * size) != 0:
+        if call_add(fn, m_addr, d_addr, base + i * size) != 0:
             return i
     return n
 
@@ -150,28 +115,6 @@ class ContactBuffer:
         else:
             self.bytes[:] = raw
 
-    def add(self, m, d, n, depth, pos, frame, weight, solref, solreffriction, fscale, mu, scale_friction) -> int:
-        """Writes n contacts' fields and appends them to d.contact; returns how many MuJoCo took."""
-        n = min(n, self.cap)
-        fr = solreffriction[1] != 0.0
-        rec, off = self.rec, self.off
-        return _fill_add(
-            _MJ_ADD_CONTACT,
-            m._address,
-            d._address,
-            rec,
-            self.address,
-            self.size,
-            off,
-            n,
-            depth,
-            pos,
-            frame,
-            weight,
-            solref,
-            solreffriction,
-            fr,
-            fscale,
-            mu,
-            scale_friction,
-        )
+    def handoff(self, solref: np.ndarray, solreffriction: np.ndarray) -> Handoff:
+        """fill_add's record of this buffer with the contact law's solref."""
+        return Handoff(self.rec, int(self.address), int(self.size), self.off, solref, solreffriction)

@@ -1,67 +1,54 @@
 """The exact-flank step loop compiled: the steps of one record interval of wormsim.contact3d.runner in one
 numba call, MuJoCo's C stage functions called by address.
 
-Each step does what the runner's Python loop did with `FlankContacts.step` (wormsim.contact3d.flank_step), in the
-same order and with the same floating-point operations, so the results are bit-identical
-(tests/test_flank_loop.py): the drive and load commands into d.ctrl, the shaft speeds read, then `split_step`'s stages
-(mj_checkPos, mj_checkVel, mj_fwdKinematics, mj_makeM, mj_factorM, mj_collision; the flank contacts: the window
-update of FlankContacts.window, with assembly errors flank_pose.set_pose, kernel.find_packed (find_contacts with
-its memo, slice_weights, contact_frames), flank_handoff._fill_add; mj_makeConstraint, mj_island, mj_transmission,
-mj_projectConstraint, mj_sensorPos, mj_fwdVelocity, mj_sensorVel, mj_step2), then the runner's per-step sums
-(actuator torques, shaft powers T w, the contact sensor's count, force and moment, the peak |F_x|).
+`flank_step` is the one compiled step: MuJoCo's stage list (wormsim.contact3d.native.STEP) by address, with the
+flank contacts in its ADD_CONTACTS slot (`add_flanks`: the window update of FlankContacts.window, with assembly errors
+flank_pose.set_pose, kernel.find_packed (find_contacts with its memo, slice_weights, contact_frames),
+flank_handoff.fill_add). It does what `FlankContacts.step` (wormsim.contact3d.flank_step) does from Python, in the
+same order and with the same floating-point operations, so the results are bit-identical (tests/test_flank_loop.py).
+`run_table` steps an interval: per step the drive and load commands into d.ctrl, the shaft speeds read, flank_step,
+then the runner's per-step sums (actuator torques, shaft powers T w, the contact sensor's count, force and moment,
+the peak |F_x|).
 
-The stages are the functions of the shared library the mujoco package loaded (flank_handoff._library), called through
-their addresses as flank_handoff calls mj_addContact; all are `void f(const mjModel*, mjData*)`. What this skips of
+The stages are the functions of the shared library the mujoco package loaded (wormsim.contact3d.native), called
+through their addresses; all are `void f(const mjModel*, mjData*)`. What this skips of
 the Python binding is its error interception: an mju_error inside a stage (MuJoCo's fatal errors, e.g. its arena
 exhausted) is not turned into a Python exception here. MuJoCo's warnings (d.warning) are counted as before, and the
 runner's guards read them after each interval.
 
 `sample` is the runner's per-sample work on the flank contacts in one compiled call (`sample_flanks`, which
-flank_samples.run_samples calls too): flank_step._contact_forces (forces, points, teeth touching; with displaced
-poses the points via the displaced wheel body's frame), the largest penetration, hertz._rows (the contact pattern's
-rows), contact_sums.radial_and_radius, and the points stored into the run's arrays.
+flank_samples.run_samples calls too): flank_step.contact_forces (forces, points, teeth touching; with displaced
+poses the points via the displaced wheel body's frame), the largest penetration, hertz.pattern_rows (the contact
+pattern's rows), contact_sums.radial_and_radius, and the points stored into the run's arrays.
 
 Both take their per-run arrays as one table of addresses and shapes (`run_table`, `sample_table`: numba's unboxing of
-~30 arrays cost 10-20 us per call). Flank runs turn MuJoCo's islands off (`FlankLoop`: two dofs, one island; measured
-bit-identical). Cost and checks: docs/contact3d.md, "Exact flanks: the step loop compiled" (the Python loop spent
-about 1.3-3.5 us per stage call on the binding and 10-20 us per step on the runner's per-step reads and sums).
+~30 arrays cost 10-20 us per call), viewed as named records (StepViews, ContactRows). Flank runs turn MuJoCo's islands
+off (`FlankLoop`: two dofs, one island; measured bit-identical). Cost and checks: docs/contact3d.md, "Exact
+flanks: the step loop compiled" (the Python loop spent about 1.3-3.5 us per stage call on the binding and 10-20
+us per step on the runner's per-step reads and sums).
 """
 
 from __future__ import annotations
 
-import ctypes
 import enum
 import math
+from typing import NamedTuple
 
 import mujoco
 import numba
 import numpy as np
-from llvmlite import ir
-from numba import types
-from numba.extending import intrinsic
 
 from wormsim.contact3d.contact_sums import radial_and_radius, radius_mean
-from wormsim.contact3d.flank_handoff import _MJ_ADD_CONTACT, _f64_at, _fill_add, _library
-from wormsim.contact3d.flank_step import _contact_forces
+from wormsim.contact3d.flank_handoff import Handed, Handoff, fill_add
+from wormsim.contact3d.flank_step import contact_forces
+from wormsim.contact3d.native import N_BEFORE, call_stage, f1, f2, f3, f32x3, f64_at, i1, stage_addresses
 from wormsim.contact3d.series import N_SUMS, add_step
-from wormsim.tooth.hertz import _rows
+from wormsim.tooth.hertz import pattern_rows
 from wormsim.tooth.kernel import find_packed
 from wormsim.tooth.pose import set_pose
 
-STAGES_BEFORE = ("mj_checkPos", "mj_checkVel", "mj_fwdKinematics", "mj_makeM", "mj_factorM", "mj_collision")
-STAGES_AFTER = (
-    "mj_makeConstraint",
-    "mj_island",
-    "mj_transmission",
-    "mj_projectConstraint",
-    "mj_sensorPos",
-    "mj_fwdVelocity",
-    "mj_sensorVel",
-    "mj_step2",
-)
-N_BEFORE = len(STAGES_BEFORE)  # the stages before the flank contacts are added
 NO_WINDOW = np.iinfo(np.int64).min  # the window's first centre is not set yet
-# run_interval's integer and float parameters (FlankLoop.iv, FlankLoop.fv): the rows by name, the one declaration
+# the step's integer and float parameters (FlankLoop.iv, FlankLoop.fv): the rows by name, the one declaration
 IV = enum.IntEnum(
     "IV",
     (
@@ -86,133 +73,71 @@ IV = enum.IntEnum(
     start=0,
 )
 FV = enum.IntEnum("FV", ("tooth0", "pitch", "margin", "taper", "mu"), start=0)
+STAGE_ADDRESSES = stage_addresses()  # native.STEP by address, mj_addContact last
 
 
-def _addresses() -> np.ndarray:
-    lib = _library()
-    names = STAGES_BEFORE + STAGES_AFTER
-    return np.array([ctypes.cast(getattr(lib, s), ctypes.c_void_p).value for s in names], dtype=np.int64)
+class StepViews(NamedTuple):
+    """What flank_step reads and writes, viewed from the address table (`views`)."""
 
-
-STAGE_ADDRESSES = _addresses()
-
-
-@intrinsic
-def _call_stage(typingctx, fn, m_addr, d_addr):
-    """void fn(const mjModel*, mjData*) called through its address (all int64; as flank_handoff._call_add)."""
-    sig = types.void(types.int64, types.int64, types.int64)
-
-    def codegen(context, builder, signature, args):
-        fnty = ir.FunctionType(ir.VoidType(), [ir.IntType(8).as_pointer()] * 2)
-        f = builder.inttoptr(args[0], fnty.as_pointer())
-        builder.call(f, [builder.inttoptr(a, ir.IntType(8).as_pointer()) for a in args[1:]])
-        return context.get_dummy_value()
-
-    return sig, codegen
+    fns: np.ndarray  # STAGE_ADDRESSES
+    qpos: np.ndarray  # d.qpos
+    xpos: np.ndarray  # d.xpos
+    xmat: np.ndarray  # d.xmat
+    iv: np.ndarray  # the integer parameters (IV)
+    fv: np.ndarray  # the float parameters (FV: tooth 0's angle, the pitch angle, margin, taper, mu)
+    state: np.ndarray  # (the window's centre tooth, the last step's contact count)
+    fb: np.ndarray  # the kernel's buffers (flanks.PackedKernel: fb, ib) and ks (the window's teeth, a view of ib)
+    ib: np.ndarray
+    ks: np.ndarray
+    params: np.ndarray  # the kernel's P (a view of fb)
+    out: Handed  # FlankContacts.handed (the merged ones with one contact per tooth flank, wormsim.tooth.merge)
+    hand: Handoff  # the records (flank_handoff.ContactBuffer) and the law's solref
 
 
 @numba.njit(cache=True)
-def run_interval(fns, m_addr, d_addr, cmd, load, j0, j1, mjd, iv, fv, state, kern, params, out, hand, acc):
-    """Steps j0..j1-1 of the command arrays cmd (drive) and load (module docstring).
+def add_flanks(v, m_addr, d_addr):
+    """FlankContacts.add compiled (module docstring) on StepViews v; returns the number of contacts MuJoCo did not
+    take (arena full)."""
+    iv, fv, state, ks, qpos = v.iv, v.fv, v.state, v.ks, v.qpos
+    W, pitch = iv[IV.window_teeth], fv[FV.pitch]
+    th1, th2 = qpos[iv[IV.worm_qpos]], qpos[iv[IV.wheel_qpos]]
+    if iv[IV.displaced]:
+        set_pose(v.params, v.xpos, v.xmat, iv[IV.worm_body], iv[IV.wheel_body], th1)
+    cw = math.floor((-math.pi / 2 - fv[FV.tooth0] - th2) / pitch)
+    if cw != state[0]:
+        h = W // 2
+        for i in range(W):
+            ks[i] = cw - h + 1 + i
+        state[0] = cw
+    ib = v.ib
+    n = find_packed(v.fb, ib, th1, th2, fv[FV.margin], fv[FV.taper])
+    state[1] = n
+    nh = ib[7] if ib[6] != 0 else n  # one contact per tooth flank (wormsim.tooth.merge): out holds the merged ones
+    if nh == 0:
+        return 0
+    k = min(nh, v.hand.records.shape[0])
+    fns = v.fns
+    added = fill_add(
+        fns[fns.shape[0] - 1], m_addr, d_addr, v.hand, k, v.out, fv[FV.mu], iv[IV.friction_rows] != 0, ib[6] != 0
+    )
+    return k - added
 
-    mjd = (ctrl, qvel, qpos, actuator_force, sensordata, xpos, xmat): d's own arrays;
-    iv, fv: the integer and float parameters (rows IV, FV: the actuators, dofs, qpos addresses, bodies, window and
-    records; tooth 0's angle, the pitch angle, margin, taper, friction coefficient);
-    state = (the window's centre tooth, the last step's contact count);
-    kern = FlankContacts.kernel's buffers (fb, ib; flanks.PackedKernel) and ks (the window's teeth, a view of ib);
-    params = the kernel's P (a view of fb);
-    out = the kernel's (pos, depth, weight, frame, mfric), the merged ones with one contact per tooth flank
-    (FlankContacts.handed, wormsim.tooth.merge);
-    hand = (records, field offsets, solref, solreffriction).
-    acc (series.SUMS) receives the sums over the steps (series.add_step). Returns the number of contacts MuJoCo did
-    not take (arena full) summed over the steps."""
-    ctrl, qvel, qpos, act, sd, xpos, xmat = mjd
-    ia_drv, ia_load, dof1, dof2 = iv[IV.drive_actuator], iv[IV.load_actuator], iv[IV.worm_dof], iv[IV.wheel_dof]
-    a1, a2, s0 = iv[IV.worm_actuator], iv[IV.wheel_actuator], iv[IV.sensor]
-    qa1, qa2 = iv[IV.worm_qpos], iv[IV.wheel_qpos]
-    worm_body, wheel_body, displaced, W = iv[IV.worm_body], iv[IV.wheel_body], iv[IV.displaced], iv[IV.window_teeth]
-    size, base, fr = iv[IV.record_size], iv[IV.record_base], iv[IV.friction_rows]
-    tooth0, pitch, margin0, taper, mu = fv[FV.tooth0], fv[FV.pitch], fv[FV.margin], fv[FV.taper], fv[FV.mu]
-    fb, ib, ks = kern
-    pos, depth, weight, frame, fscale = out
-    rec, off, solref, solreffriction = hand
-    nb = N_BEFORE
-    sums = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
-    dropped = 0
-    for j in range(j0, j1):
-        ctrl[ia_drv] = cmd[j]
-        ctrl[ia_load] = load[j]
-        w1j, w2j = qvel[dof1], qvel[dof2]
-        for s in range(nb):
-            _call_stage(fns[s], m_addr, d_addr)
-        # FlankContacts.add: find, weights, frames, bulk hand-off
-        th1, th2 = qpos[qa1], qpos[qa2]
-        if displaced:
-            set_pose(params, xpos, xmat, worm_body, wheel_body, th1)
-        cw = math.floor((-math.pi / 2 - tooth0 - th2) / pitch)
-        if cw != state[0]:
-            h = W // 2
-            for i in range(W):
-                ks[i] = cw - h + 1 + i
-            state[0] = cw
-        n = find_packed(fb, ib, th1, th2, margin0, taper)
-        state[1] = n
-        nh = ib[7] if ib[6] != 0 else n  # one contact per tooth flank (wormsim.tooth.merge): out holds the merged ones
-        if nh:
-            k = min(nh, rec.shape[0])
-            added = _fill_add(
-                fns[fns.shape[0] - 1],
-                m_addr,
-                d_addr,
-                rec,
-                base,
-                size,
-                off,
-                k,
-                depth,
-                pos,
-                frame,
-                weight,
-                solref,
-                solreffriction,
-                fr != 0,
-                fscale,
-                mu,
-                ib[6] != 0,
-            )
-            dropped += k - added
-        for s in range(nb, fns.shape[0] - 1):
-            _call_stage(fns[s], m_addr, d_addr)
-        sums = add_step(sums, act, sd, a1, a2, s0, w1j, w2j)  # the per-step sums (wormsim.contact3d.series)
-    for k in range(N_SUMS):
-        acc[k] = sums[k]
+
+@numba.njit(cache=True)
+def flank_step(v, m_addr, d_addr):
+    """One step: native.STEP's stages by address, the flank contacts (add_flanks) in its ADD_CONTACTS slot; returns
+    the number of contacts MuJoCo did not take."""
+    fns = v.fns
+    for s in range(N_BEFORE):
+        call_stage(fns[s], m_addr, d_addr)
+    dropped = add_flanks(v, m_addr, d_addr)
+    for s in range(N_BEFORE, fns.shape[0] - 1):
+        call_stage(fns[s], m_addr, d_addr)
     return dropped
 
 
-@intrinsic
-def _f32_at(typingctx, addr):
-    """The float32 pointer at an address (int64)."""
-    sig = types.CPointer(types.float32)(types.int64)
-
-    def codegen(context, builder, signature, args):
-        return builder.inttoptr(args[0], context.get_value_type(types.CPointer(types.float32)))
-
-    return sig, codegen
-
-
-@intrinsic
-def _i64_at(typingctx, addr):
-    """The int64 pointer at an address (int64)."""
-    sig = types.CPointer(types.int64)(types.int64)
-
-    def codegen(context, builder, signature, args):
-        return builder.inttoptr(args[0], context.get_value_type(types.CPointer(types.int64)))
-
-    return sig, codegen
-
-
-# the arrays of run_interval in FlankLoop's address table: (name, dtype, ndim) per row, in row order; the one
-# declaration of the table's layout (Row: the rows by name, for run_table's unpacking and FlankLoop's arrays)
+# the arrays of the step in FlankLoop's address table: (name, dtype, ndim) per row, in row order; the one
+# declaration of the table's layout (Row: the rows by name, for `views` and FlankLoop's arrays)
 TABLE = (
     ("ctrl", "f8", 1),  # d.ctrl
     ("qvel", "f8", 1),  # d.qvel
@@ -229,7 +154,7 @@ TABLE = (
     ("depth", "f8", 1),
     ("weight", "f8", 1),
     ("frame", "f8", 2),
-    ("records", "i8", 2),  # the hand-off's records (as int64 rows; run_interval views them as float64)
+    ("records", "i8", 2),  # the hand-off's records (as int64 rows; viewed as float64)
     ("rec_off", "i8", 1),  # the records' field offsets
     ("solref", "f8", 1),
     ("solreffriction", "f8", 1),
@@ -244,78 +169,49 @@ Row = enum.IntEnum("Row", [name for name, _, _ in TABLE], start=0)  # T[Row.qpos
 
 
 @numba.njit(cache=True, inline="always")
-def _f1(T, k):
-    return numba.carray(_f64_at(T[k, 0]), (T[k, 1],))
+def records(T):
+    """The hand-off's records: int64 rows of the same bytes, viewed as float64."""
+    return numba.carray(f64_at(T[Row.records, 0]), (T[Row.records, 1], T[Row.records, 2]))
 
 
 @numba.njit(cache=True, inline="always")
-def _f2(T, k):
-    return numba.carray(_f64_at(T[k, 0]), (T[k, 1], T[k, 2]))
-
-
-@numba.njit(cache=True, inline="always")
-def _f3(T, k):
-    return numba.carray(_f64_at(T[k, 0]), (T[k, 1], T[k, 2], T[k, 3]))
-
-
-@numba.njit(cache=True, inline="always")
-def _f4(T, k):
-    return numba.carray(_f64_at(T[k, 0]), (T[k, 1], T[k, 2], T[k, 3], T[k, 4]))
-
-
-@numba.njit(cache=True, inline="always")
-def _f32x3(T, k):
-    return numba.carray(_f32_at(T[k, 0]), (T[k, 1], T[k, 2], T[k, 3]))
-
-
-@numba.njit(cache=True, inline="always")
-def _i1(T, k):
-    return numba.carray(_i64_at(T[k, 0]), (T[k, 1],))
-
-
-@numba.njit(cache=True, inline="always")
-def _i3(T, k):
-    return numba.carray(_i64_at(T[k, 0]), (T[k, 1], T[k, 2], T[k, 3]))
+def views(T):
+    """StepViews of the address table T (one row per TABLE entry, (address, shape))."""
+    R = Row
+    iv = i1(T, R.iv)
+    out = Handed(f1(T, R.depth), f2(T, R.pos), f2(T, R.frame), f1(T, R.weight), f1(T, R.mfric))
+    base, size = iv[IV.record_base], iv[IV.record_size]
+    hand = Handoff(records(T), base, size, i1(T, R.rec_off), f1(T, R.solref), f1(T, R.solreffriction))
+    return StepViews(
+        i1(T, R.stages), f1(T, R.qpos), f2(T, R.xpos), f2(T, R.xmat), iv, f1(T, R.fv), i1(T, R.state),
+        f1(T, R.fb), i1(T, R.ib), i1(T, R.ks), f1(T, R.params), out, hand,
+    )  # fmt: skip
 
 
 @numba.njit(cache=True, nogil=True)
 def run_table(T, m_addr, d_addr, cmd, load, j0, j1):
-    """run_interval with its arrays given by address and shape (T: one row per TABLE entry, (address, shape));
-    numba unboxes one array instead of 30 per call (about 10-20 us per call saved, docs/contact3d.md). Releases the
-    GIL, as MuJoCo's bindings do around mj_step: wormsim.run imports the report's libraries meanwhile."""
-    R = Row
-    mjd = (_f1(T, R.ctrl), _f1(T, R.qvel), _f1(T, R.qpos), _f1(T, R.act), _f1(T, R.sensordata))
-    mjd2 = (_f2(T, R.xpos), _f2(T, R.xmat))
-    kern = (_f1(T, R.fb), _i1(T, R.ib), _i1(T, R.ks))
-    out = (_f2(T, R.pos), _f1(T, R.depth), _f1(T, R.weight), _f2(T, R.frame), _f1(T, R.mfric))
-    rec = _records(T)
-    hand = (rec, _i1(T, R.rec_off), _f1(T, R.solref), _f1(T, R.solreffriction))
-    iv, fv = _i1(T, R.iv), _f1(T, R.fv)
-    state, acc = _i1(T, R.state), _f1(T, R.acc)
-    return run_interval(
-        _i1(T, R.stages),
-        m_addr,
-        d_addr,
-        cmd,
-        load,
-        j0,
-        j1,
-        mjd + mjd2,
-        iv,
-        fv,
-        state,
-        kern,
-        _f1(T, R.params),
-        out,
-        hand,
-        acc,
-    )
-
-
-@numba.njit(cache=True, inline="always")
-def _records(T):
-    """The hand-off's records: int64 rows of the same bytes, viewed as float64."""
-    return numba.carray(_f64_at(T[Row.records, 0]), (T[Row.records, 1], T[Row.records, 2]))
+    """Steps j0..j1-1 of the command arrays cmd (drive) and load (module docstring), their arrays given by address
+    and shape (T: one row per TABLE entry; numba unboxes one array instead of 30 per call, about 10-20 us per call
+    saved, docs/contact3d.md). T's acc (series.SUMS) receives the sums over the steps (series.add_step). Returns the
+    number of contacts MuJoCo did not take (arena full) summed over the steps. Releases the GIL, as MuJoCo's
+    bindings do around mj_step: wormsim.run imports the report's libraries meanwhile."""
+    v = views(T)
+    ctrl, qvel, act, sd = f1(T, Row.ctrl), f1(T, Row.qvel), f1(T, Row.act), f1(T, Row.sensordata)
+    iv = v.iv
+    ia_drv, ia_load, dof1, dof2 = iv[IV.drive_actuator], iv[IV.load_actuator], iv[IV.worm_dof], iv[IV.wheel_dof]
+    a1, a2, s0 = iv[IV.worm_actuator], iv[IV.wheel_actuator], iv[IV.sensor]
+    sums = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    dropped = 0
+    for j in range(j0, j1):
+        ctrl[ia_drv] = cmd[j]
+        ctrl[ia_load] = load[j]
+        w1j, w2j = qvel[dof1], qvel[dof2]
+        dropped += flank_step(v, m_addr, d_addr)
+        sums = add_step(sums, act, sd, a1, a2, s0, w1j, w2j)  # the per-step sums (wormsim.contact3d.series)
+    acc = f1(T, Row.acc)
+    for k in range(N_SUMS):
+        acc[k] = sums[k]
+    return dropped
 
 
 def address_table(arrays, table=TABLE) -> np.ndarray:
@@ -334,16 +230,30 @@ def address_table(arrays, table=TABLE) -> np.ndarray:
     return T
 
 
+class ContactRows(NamedTuple):
+    """A sample's contacts as sample_flanks reads them."""
+
+    adr: np.ndarray  # the contacts' efc_address
+    efc_force: np.ndarray
+    frame: np.ndarray  # the contacts' frames and points, or, where own, the kernel's (the same values:
+    pos: np.ndarray  # flank_handoff copies them into the contacts)
+    ncon: int
+    n_fc: int  # the kernel's contacts (the last n_fc of ncon)
+    own: bool
+    cone3: bool  # elliptic cone: three rows per contact
+
+
 @numba.njit(cache=True)
-def sample_flanks(
-    adr, frame, pos, own, efc_force, ncon, n_fc, cone3, meta, weight, depth, P, th2, z2, a, i, store, work, pat, rlog
-):
-    """FlankLoop.sample's compiled part (module docstring): adr the contacts' efc_address; frame, pos theirs or,
-    where own, the kernel's (the same values: flank_handoff copies them into the contacts); P the kernel's P (the
-    poses, with assembly errors: flank_step._contact_forces); store = (points in tooth
-    0's frame, forces, points; the run's float32 arrays, row i); work (3, cap, 3); pat = PatternLog's (inv_rho,
-    line_len, E*, buffer, rows used); rlog = contact_sums.RadiusLog's (buffer, rows used). Returns (teeth touching,
-    largest penetration, F_r,lc, sum w, sum w r, the pattern's rows used, the radius log's rows used)."""
+def sample_flanks(rows, kern, pose, i, store, work, pat, rlog):
+    """FlankLoop.sample's compiled part (module docstring): rows (ContactRows); kern = the kernel's (meta, weight,
+    depth, P) (P: the poses, with assembly errors: flank_step.contact_forces); pose = (th2, z2, centre distance a);
+    store = (points in tooth 0's frame, forces, points; the run's float32 arrays, row i); work (3, cap, 3); pat =
+    PatternLog's (inv_rho, line_len, E*, buffer, rows used); rlog = contact_sums.RadiusLog's (buffer, rows used).
+    Returns (teeth touching, largest penetration, F_r,lc, sum w, sum w r, the pattern's rows used, the radius log's
+    rows used)."""
+    adr, efc_force, frame, pos, ncon, n_fc, own, cone3 = rows
+    meta, weight, depth, P = kern
+    th2, z2, a = pose
     pts, forces, pts_world = store
     inv_rho, line_len, e_star, buf, pm = pat
     rbuf, rm = rlog
@@ -352,12 +262,12 @@ def sample_flanks(
         return 0, 0.0, -0.0, 0.0, 0.0, pm, rm
     k0 = ncon - n
     f0 = 0 if own else k0
-    m, nteeth = _contact_forces(adr[k0:], frame[f0:], pos[f0:], efc_force, cone3, meta, th2, z2, work, P)
+    m, nteeth = contact_forces(adr[k0:], frame[f0:], pos[f0:], efc_force, cone3, meta, th2, z2, work, P)
     pen = depth[0]
     for c in range(1, n):
         if depth[c] > pen:
             pen = depth[c]
-    pm = _rows(i, adr[k0:ncon], efc_force, meta, weight, inv_rho, line_len, e_star, buf, pm)
+    pm = pattern_rows(i, adr[k0:ncon], efc_force, meta, weight, inv_rho, line_len, e_star, buf, pm)
     fr, W, wr = radial_and_radius(work[1], work[2], m, a, i, rbuf, rm)
     for c in range(min(m, pts.shape[1])):
         for x in range(3):
@@ -384,35 +294,19 @@ SampleRow = enum.IntEnum("SampleRow", [name for name, _, _ in SAMPLE_TABLE], sta
 
 
 @numba.njit(cache=True)
-def sample_table(T, adr, frame, pos, own, efc_force, buf, rbuf, ncon, n_fc, cone3, th2, z2, a, i, e_star, pm, rm):
-    """sample_flanks with its per-run arrays given by address and shape (T: one row per SAMPLE_TABLE entry)."""
-    f32 = (_f32x3(T, SampleRow.pts), _f32x3(T, SampleRow.forces), _f32x3(T, SampleRow.pts_world))
-    return sample_flanks(
-        adr,
-        frame,
-        pos,
-        own,
-        efc_force,
-        ncon,
-        n_fc,
-        cone3,
-        _f2(T, SampleRow.meta),
-        _f1(T, SampleRow.weight),
-        _f1(T, SampleRow.depth),
-        _f1(T, SampleRow.params),
-        th2,
-        z2,
-        a,
-        i,
-        f32,
-        _f3(T, SampleRow.work),
-        (_f3(T, SampleRow.inv_rho), _f3(T, SampleRow.line_len), e_star, buf, pm),
-        (rbuf, rm),
-    )
+def sample_table(T, rows, pose, i, logs):
+    """sample_flanks with its per-run arrays given by address and shape (T: one row per SAMPLE_TABLE entry);
+    logs = (the pattern's buffer, E*, its rows used, the radius log's buffer, its rows used)."""
+    buf, e_star, pm, rbuf, rm = logs
+    R = SampleRow
+    f32 = (f32x3(T, R.pts), f32x3(T, R.forces), f32x3(T, R.pts_world))
+    kern = (f2(T, R.meta), f1(T, R.weight), f1(T, R.depth), f1(T, R.params))
+    pat = (f3(T, R.inv_rho), f3(T, R.line_len), e_star, buf, pm)
+    return sample_flanks(rows, kern, pose, i, f32, f3(T, R.work), pat, (rbuf, rm))
 
 
 class FlankLoop:
-    """run_interval's arguments for one FlankContacts and its MjData (module docstring); `run` steps an interval."""
+    """run_table's arguments for one FlankContacts and its MjData (module docstring); `run` steps an interval."""
 
     def __init__(self, fc, d, drive_actuator: int, load_actuator: int, a1: int, a2: int, sensor_adr: int):
         bm, m = fc.bm, fc.bm.model
@@ -445,7 +339,7 @@ class FlankLoop:
         self.iv = np.array([iv[k] for k in IV], dtype=np.int64)
         fv = {FV.tooth0: float(bm.tooth0_angle_rad), FV.pitch: fc.pitch, FV.margin: fc.margin0, FV.taper: fc.taper_rad}
         self.fv = np.array([fv.get(k, 0.0) for k in FV])  # mu: `prepare`
-        self.state = np.array([NO_WINDOW if fc._c is None else fc._c, fc.n], dtype=np.int64)
+        self.state = np.array([NO_WINDOW if fc.centre is None else fc.centre, fc.n], dtype=np.int64)
         self.acc = np.zeros(N_SUMS)
         self._tables(d, buf)
         self.dropped = 0
@@ -472,17 +366,17 @@ class FlankLoop:
             "ib": k.ib,
             "ks": fc.ks,
             "params": fc.params,
-            "pos": fc.handed[1],  # pos, depth, weight, frame: what is handed to MuJoCo (FlankContacts.handed)
-            "depth": fc.handed[0],
-            "weight": fc.handed[3],
-            "frame": fc.handed[2],
+            "pos": fc.handed.pos,  # pos, depth, weight, frame: what is handed to MuJoCo (FlankContacts.handed)
+            "depth": fc.handed.depth,
+            "weight": fc.handed.weight,
+            "frame": fc.handed.frame,
             "records": buf.bytes.view(np.int64),
             "rec_off": buf.off,
             "solref": fc.solref,
             "solreffriction": fc.solreffriction,
             "state": self.state,
             "acc": self.acc,
-            "stages": np.concatenate([STAGE_ADDRESSES, [_MJ_ADD_CONTACT]]).astype(np.int64),
+            "stages": STAGE_ADDRESSES,
             "iv": self.iv,
             "fv": self.fv,
             "mfric": k.mfric,
@@ -495,7 +389,7 @@ class FlankLoop:
         """run_table's address table with the contacts' current friction (before each call)."""
         fc = self.fc
         if fc.params is not fc.kernel.P:  # replaced: FlankContacts.find would repack (flank_step)
-            fc._pack()
+            fc.pack()
         if fc.kernel is not self._kernel:
             self._tables(self.d, fc.buffer)
         self.iv[IV.friction_rows] = fc.solreffriction[1] != 0.0
@@ -505,10 +399,10 @@ class FlankLoop:
     def sync(self) -> None:
         """fc.n and fc's window from the loop's state (after each call)."""
         self.fc.n = int(self.state[1])
-        self.fc._c = int(self.state[0])
+        self.fc.centre = int(self.state[0])
 
     def run(self, cmd: np.ndarray, load: np.ndarray, j0: int, j1: int) -> np.ndarray:
-        """Steps j0..j1-1 of the commands; returns the sums (run_interval's acc); fc.n and fc's window follow."""
+        """Steps j0..j1-1 of the commands; returns the sums (run_table's acc); fc.n and fc's window follow."""
         self.dropped += run_table(self.prepare(), self.m._address, self.d._address, cmd, load, j0, j1)
         self.sync()
         return self.acc
@@ -545,24 +439,9 @@ class FlankLoop:
             adr, efc, _, _, cone3 = fc.slice_rows(d)
             ncon = n = len(adr)
             own = True
-        nteeth, pen, fr, W, wr, pattern.m, rlog.m = sample_table(
-            T,
-            adr,
-            fc.frame if own else con.frame,
-            fc.pos if own else con.pos,
-            own,
-            efc,
-            pattern.buf,
-            rlog.buf,
-            ncon,
-            n,
-            cone3,
-            float(d.qpos[fc.qa2]),
-            self.z2,
-            self.a,
-            i,
-            pattern.e_star,
-            pattern.m,
-            rlog.m,
-        )
+        own_rows = (fc.frame, fc.pos) if own else (con.frame, con.pos)
+        rows = ContactRows(adr, efc, *own_rows, ncon, n, own, cone3)
+        pose = (float(d.qpos[fc.qa2]), self.z2, self.a)
+        logs = (pattern.buf, pattern.e_star, pattern.m, rlog.buf, rlog.m)
+        nteeth, pen, fr, W, wr, pattern.m, rlog.m = sample_table(T, rows, pose, i, logs)
         return nteeth, float(pen), fr, radius_mean(W, wr)

@@ -5,7 +5,7 @@ the per-sample Python (~45-60 us a sample: dispatch, guards, the series column) 
 Per sample, in the runner's order and with its floating-point operations (bit-identical series, pattern and radius
 logs, contact points: tests/test_flank_samples.py): the steps; the state read from d (shaft angles and speeds,
 d.time); the runner's Guards.state checks (non-finite state or MuJoCo's bad-qacc warning, overspeed, teeth jumped);
-mu from the friction law (wormsim.friction.friction_coefficient_scalar's three forms); flank_loop.sample_flanks (with
+mu from the friction law (wormsim.friction.mu_at); flank_loop.sample_flanks (with
 displaced poses, errors: or shafts:, the points go into tooth 0's frame through the displaced wheel body's frame);
 the penetration and lock checks of Guards.contact; the shafts' log (ShaftLog.record: mj_rnePostConstraint by address
 where a bearing is rigid, then its raw values, wormsim.contact3d.shafts.gather); the series column (series.SERIES
@@ -19,141 +19,139 @@ MuJoCo did not take.
 The runner then does that sample (runner._sample), so errors and their messages are the Python guards' own.
 
 d's scalar fields (time, ncon, nefc) and arena pointers (contact, efc_force) are read at their byte offsets in
-mjData, from MuJoCo's declared layout and checked once per process (wormsim.contact3d.mjdata_layout: an unknown
-layout raises, naming the MuJoCo version).
+mjData, from MuJoCo's declared layout and checked once per process (wormsim.contact3d.native.mjdata_offsets: an
+unknown layout raises, naming the MuJoCo version).
+
+run_samples' constants are one typed record per run (`SampleParams`); what changes between calls (the friction guard's
+next check, the contacts' mu, E*, the lock guard's state) and what comes back are the named slots of `io` (IO_*).
 """
 
 from __future__ import annotations
 
-import ctypes
-import enum
 import math
+from typing import NamedTuple
 
 import numba
 import numpy as np
-from numba import types
-from numba.extending import intrinsic
 
-from wormsim.contact3d.flank_handoff import _library
-from wormsim.contact3d.flank_loop import (
-    FV,
-    Row,
-    SampleRow,
-    _call_stage,
-    _f1,
-    _f64_at,
-    _i1,
-    _i64_at,
-    _records,
-    run_table,
-    sample_table,
-)
-from wormsim.contact3d.friction_law import mu_at
+from wormsim.contact3d.flank_loop import FV, ContactRows, Row, SampleRow, records, run_table, sample_table
 from wormsim.contact3d.guards import PENETRATED, RUNNING, STUCK, contact_event, state_event
-from wormsim.contact3d.mjdata_layout import mjdata_offsets
+from wormsim.contact3d.native import address, call_stage, f1, f64_at, i1, i32_at, i64_at, mjdata_offsets
 from wormsim.contact3d.series import column
 from wormsim.contact3d.shafts import gather
+from wormsim.friction import MuLaw, mu_at
 from wormsim.tooth.merge import split_forces
 
 ENABLED = True  # the runner's switch (tests compare against the per-sample path)
 ADR_CAP = 4096  # contacts per step the compiled sample reads (more: the sample goes to the Python path)
 
-# io: what run_samples hands back
-IO_NEXT, IO_PENDING, IO_TURN_MAX, IO_PM, IO_RM, IO_DROPPED, IO_EVENT = range(7)
+# io: what changes between calls (in) and what run_samples hands back (out), by slot
+IO_NEXT, IO_PENDING, IO_TURN_MAX, IO_PM, IO_RM, IO_DROPPED, IO_EVENT = range(
+    7
+)  # out (IO_TURN_MAX, IO_PM, IO_RM in too)
+IO_NEXT_CHECK, IO_MU, IO_E_STAR, IO_LOCKED = range(7, 11)  # in (IO_MU out too: the contacts' mu after the call)
+IO_LEN = 11
 # io[IO_EVENT]: why run_samples handed a sample back to the runner's Python path (0: it did not)
 EV_NONE, EV_GUARD, EV_FRICTION_CHECK, EV_CONE, EV_LOG_FULL, EV_DROPPED = range(6)
-# g (float parameters): their names in row order, the one declaration of g's layout
-G_NAMES = (
-    "dt",
-    "direction",
-    "ratio",
-    "overspeed_turn",
-    "jump_rad",
-    "pen_lim",
-    "lock_start",
-    "lock_fraction",
-    "next_check",
-    "r1",
-    "cos_gamma",
-    "mu_kind",  # 0 constant, 1 STEP(static, dynamic), 2 friction group
-    "mu_a",
-    "mu_b",
-    "mu_c",
-    "mu",  # the coefficient the contacts carry now (FlankContacts.mu)
-    "rpm",  # (rad/s) per rpm
-    "a",
-    "e_star",
-    "speed_driven",
-    "locked",  # the lock guard holds state (locked_since set)
-    "worm_is_drive",
-    "qa1",
-    "qa2",
-    "dof1",
-    "dof2",
-    "z2",
-    "deg",
-)
-G = enum.IntEnum("G", G_NAMES, start=0)  # g's rows by name: g[G.dt] (numba reads the members as constants)
 
 
-@intrinsic
-def _i32_at(typingctx, addr):
-    """The int32 pointer at an address (int64)."""
-    sig = types.CPointer(types.int32)(types.int64)
+class SampleParams(NamedTuple):
+    """run_samples' constants of one run (the guards' limits, the gear, the friction law, the model's addresses)."""
 
-    def codegen(context, builder, signature, args):
-        return builder.inttoptr(args[0], context.get_value_type(types.CPointer(types.int32)))
-
-    return sig, codegen
+    dt: float
+    direction: float
+    ratio: float
+    overspeed_turn: float
+    jump_rad: float
+    pen_lim: float
+    lock_start: float
+    lock_fraction: float
+    r1: float
+    cos_gamma: float
+    mu_law: MuLaw  # wormsim.friction.mu_at's law
+    rpm: float  # (rad/s) per rpm
+    a: float
+    speed_driven: bool
+    worm_is_drive: bool
+    qa1: int
+    qa2: int
+    dof1: int
+    dof2: int
+    z2: int
 
 
 @numba.njit(cache=True, inline="always")
-def _set_friction(T, mu):
+def set_friction(T, mu):
     """FlankContacts.set_friction where the cone's dimension stays: mu into the loop's fv and the hand-off's records
     (both friction entries), as set_template leaves them."""
-    _f1(T, Row.fv)[FV.mu] = mu
-    recs = _records(T)
-    o5 = _i1(T, Row.rec_off)[5]
+    f1(T, Row.fv)[FV.mu] = mu
+    recs = records(T)
+    o5 = i1(T, Row.rec_off)[5]
     for r in range(recs.shape[0]):
         recs[r, o5] = mu
         recs[r, o5 + 1] = mu
 
 
-@numba.njit(cache=True, nogil=True)
-def run_samples(
-    T, Ts, m_addr, d_addr, cmd, load, i0, i1, o0, rec, S, g, off, frame, pos, adr, pat_buf, r_buf, io, mrg, shaft
-):
-    """Samples i0..i1-1 (module docstring); sample i's steps are o0 + (i - i0) rec .. + rec of cmd and load.
-    T, Ts: flank_loop's run and sample tables; S the series (series.SERIES rows); g the parameters (G_NAMES); off
-    the checked mjData offsets (wormsim.contact3d.mjdata_layout); frame, pos the kernel's contacts; adr (ADR_CAP) work
-    room; pat_buf, r_buf the pattern's and the radius log's rows; io: IO_* (io[IO_PM], io[IO_RM] the logs' rows used
-    on entry); mrg: with one contact per tooth flank (merge) the kernel's (grp, share, mfric, mwrap) and the per-slice
-    rows' room (FlankContacts.slice_rows), else None; shaft = (mj_rnePostConstraint's address or 0, the shaft log's
-    raw addresses, its raw rows: wormsim.contact3d.shafts.ShaftLog), the addresses empty without `shafts:`."""
-    rne, sh_adr, sh_raw = shaft
-    acc = _f1(T, Row.acc)
-    state = _i1(T, Row.state)
-    qpos, qvel = _f1(T, Row.qpos), _f1(T, Row.qvel)
-    depth = _f1(Ts, SampleRow.depth)
-    ib = _i1(T, Row.ib)
-    qa1, qa2, dof1, dof2 = int(g[G.qa1]), int(g[G.qa2]), int(g[G.dof1]), int(g[G.dof2])
-    dt, direction, ratio = g[G.dt], g[G.direction], g[G.ratio]
-    turn_lim, jump_rad, pen_lim = g[G.overspeed_turn], g[G.jump_rad], g[G.pen_lim]
-    tptr = _f64_at(d_addr + off[0])
-    nptr = _i32_at(d_addr + off[1])
-    eptr = _i32_at(d_addr + off[2])
-    cptr = _i64_at(d_addr + off[3])
-    fptr = _i64_at(d_addr + off[4])
-    bptr = _i32_at(d_addr + off[5])
+@numba.njit(cache=True)
+def contact_guard(p, io, t, depth, n, w1, w2, cmd_i):
+    """Guards.contact's checks on the largest penetration of depth[:n] and the drive's speed: whether it raises or
+    the lock guard acts or keeps state (the sample then goes to the Python path)."""
+    pen = 0.0
+    if n > 0:
+        pen = depth[0]
+        for c in range(1, n):
+            if depth[c] > pen:
+                pen = depth[c]
+    w_drive = w1 if p.worm_is_drive else w2
+    event = contact_event(t, pen, p.pen_lim, w_drive, cmd_i, p.speed_driven, p.lock_start, p.lock_fraction)
+    return event == PENETRATED or event == STUCK or (event == RUNNING and io[IO_LOCKED] != 0.0)
+
+
+@numba.njit(cache=True)
+def contact_rows(d_addr, off, adr, ncon, n_fc, cone3, frame, pos, nh, mrg):
+    """The sample's contacts (ContactRows) read from d at the checked offsets off: d.contact's efc addresses into
+    adr, d.efc_force; with one contact per tooth flank (mrg not None) the merged contacts' forces split over their
+    slices (FlankContacts.slice_rows). Typed as FlankLoop.sample passes them (one compiled signature of
+    sample_table: int64 counts, a non-literal bool)."""
     size, o_adr = off[6], off[7]
-    mu_now = g[G.mu]
+    cbase = i64_at(d_addr + off[3])[0]
+    for k in range(ncon):
+        adr[k] = i32_at(cbase + k * size + o_adr)[0]
+    efc = numba.carray(f64_at(i64_at(d_addr + off[4])[0]), (max(i32_at(d_addr + off[2])[0], 0),))
+    if mrg is not None:
+        grp, share, mfric, mwrap, adr_m, efc_m = mrg
+        split_forces(adr[:ncon], efc, ncon - min(nh, ncon), cone3, grp, share, mfric, mwrap, n_fc, adr_m, efc_m)
+        return ContactRows(adr_m[:n_fc], efc_m, frame, pos, n_fc, n_fc, True, True)
+    return ContactRows(adr[:ncon], efc, frame, pos, np.int64(ncon), n_fc, True, cone3)
+
+
+@numba.njit(cache=True, nogil=True)
+def run_samples(tables, mj, cmds, span, S, p, room, io, mrg, shaft):
+    """Samples i0..i1-1 of span = (i0, i1, o0, rec) (module docstring); sample i's steps are o0 + (i - i0) rec ..
+    + rec of cmds = (drive, load). tables = flank_loop's run and sample tables (T, Ts); mj = (the model's and the
+    data's address); S the series (series.SERIES rows); p the run's SampleParams; room = (the checked mjData offsets
+    (native.mjdata_offsets), the kernel's contact frames and points, ADR_CAP work room, the pattern's and the radius
+    log's rows); io: IO_*; mrg: with one contact per tooth flank (merge) the kernel's (grp, share, mfric, mwrap) and
+    the per-slice rows' room (FlankContacts.slice_rows), else None; shaft = (mj_rnePostConstraint's address or 0, the
+    shaft log's raw addresses, its raw rows: wormsim.contact3d.shafts.ShaftLog), the addresses empty without
+    `shafts:`."""
+    T, Ts = tables
+    m_addr, d_addr = mj
+    cmd, load = cmds
+    i0, i1_, o0, rec = span
+    off, frame, pos, adr, pat_buf, r_buf = room
+    rne, sh_adr, sh_raw = shaft
+    acc, state, ib = f1(T, Row.acc), i1(T, Row.state), i1(T, Row.ib)
+    qpos, qvel = f1(T, Row.qpos), f1(T, Row.qvel)
+    depth = f1(Ts, SampleRow.depth)
+    tptr, nptr, bptr = f64_at(d_addr + off[0]), i32_at(d_addr + off[1]), i32_at(d_addr + off[5])
+    mu_now = io[IO_MU]
     cone3 = mu_now > 0.0
     turn_max = io[IO_TURN_MAX]
     pm, rm = int(io[IO_PM]), int(io[IO_RM])
-    z2 = int(g[G.z2])
     io[IO_PENDING] = 0.0
     io[IO_EVENT] = EV_NONE
-    for i in range(i0, i1):
+    for i in range(i0, i1_):
         o = o0 + (i - i0) * rec
         io[IO_NEXT] = i
         io[IO_TURN_MAX] = turn_max
@@ -165,72 +163,50 @@ def run_samples(
             io[IO_EVENT] = EV_DROPPED  # contacts MuJoCo did not take
             return
         cmd_i = cmd[o + rec - 1]
-        th1, th2 = qpos[qa1], qpos[qa2]
-        w1, w2 = qvel[dof1], qvel[dof2]
+        th1, th2 = qpos[p.qa1], qpos[p.qa2]
+        w1, w2 = qvel[p.dof1], qvel[p.dof2]
         t = tptr[0]
-        event, te, turn = state_event(th1, th2, w1, w2, bptr[0], dt, turn_lim, direction, ratio, jump_rad)
+        event, te, turn = state_event(
+            th1, th2, w1, w2, bptr[0], p.dt, p.overspeed_turn, p.direction, p.ratio, p.jump_rad
+        )
         if event != 0:  # Guards.state raises: the Python path
             io[IO_EVENT] = EV_GUARD
             return
-        if t > g[G.next_check]:  # the friction guard's next check
+        if t > io[IO_NEXT_CHECK]:  # the friction guard's next check
             io[IO_EVENT] = EV_FRICTION_CHECK
             return
-        vs = abs(w1) * g[G.r1] / g[G.cos_gamma]
-        mu = mu_at(vs, g[G.mu_kind], g[G.mu_a], g[G.mu_b], g[G.mu_c], g[G.deg])
+        law = p.mu_law
+        mu = mu_at(abs(w1) * p.r1 / p.cos_gamma, law.kind, law.a, law.b, law.c)  # at the sliding speed Vs
         if mu != mu_now:  # FlankContacts.set_friction: the records' friction, where the cone's dimension stays
             if (mu > 0.0) != (mu_now > 0.0):  # the cone's dimension changes (FlankContacts.set_friction)
                 io[IO_EVENT] = EV_CONE
                 return
-            _set_friction(T, mu)
+            set_friction(T, mu)
             mu_now = mu
-            g[G.mu] = mu
+            io[IO_MU] = mu
         # the sample's contacts: d.contact's efc addresses, the largest penetration (Guards.contact's first check)
         ncon = nptr[0]
         n_fc = state[1]
         if ncon > adr.shape[0] or pm + n_fc > pat_buf.shape[0] or rm + n_fc > r_buf.shape[0]:
             io[IO_EVENT] = EV_LOG_FULL
             return
-        n = n_fc if mrg is not None else min(n_fc, ncon)
-        pen = 0.0
-        if n > 0:
-            pen = depth[0]
-            for c in range(1, n):
-                if depth[c] > pen:
-                    pen = depth[c]
-        w_drive = w1 if g[G.worm_is_drive] != 0.0 else w2
-        event = contact_event(
-            t, pen, pen_lim, w_drive, cmd_i, g[G.speed_driven] != 0.0, g[G.lock_start], g[G.lock_fraction]
-        )
-        if event == PENETRATED or event == STUCK or (event == RUNNING and g[G.locked] != 0.0):
+        if contact_guard(p, io, t, depth, n_fc if mrg is not None else min(n_fc, ncon), w1, w2, cmd_i):
             io[IO_EVENT] = EV_GUARD  # Guards.contact raises, or the lock guard acts or keeps state
             return
-        cbase = cptr[0]
-        for k in range(ncon):
-            adr[k] = _i32_at(cbase + k * size + o_adr)[0]
-        efc = numba.carray(_f64_at(fptr[0]), (max(eptr[0], 0),))
-        # the contacts' rows (FlankContacts.slice_rows), typed as FlankLoop.sample passes them (one compiled
-        # signature of sample_table: int64 counts, a non-literal bool)
-        a_s, e_s, nc, c3 = adr[:ncon], efc, np.int64(ncon), cone3
-        if mrg is not None:  # one contact per tooth flank: the merged contacts' forces split over their slices
-            grp, share, mfric, mwrap, adr_m, efc_m = mrg
-            nh = min(ib[7], ncon)
-            split_forces(adr[:ncon], efc, ncon - nh, cone3, grp, share, mfric, mwrap, n_fc, adr_m, efc_m)
-            a_s, e_s, nc, c3 = adr_m[:n_fc], efc_m, n_fc, True
-        own = dropped == 0  # True here: d.contact's last entries are the kernel's contacts
-        nteeth, pen2, fr, W, wr, pm, rm = sample_table(
-            Ts, a_s, frame, pos, own, e_s, pat_buf, r_buf, nc, n_fc, c3, th2, z2, g[G.a], i, g[G.e_star], pm, rm
-        )
+        rows = contact_rows(d_addr, off, adr, ncon, n_fc, cone3, frame, pos, ib[7], mrg)
+        logs = (pat_buf, io[IO_E_STAR], pm, r_buf, rm)
+        nteeth, pen2, fr, W, wr, pm, rm = sample_table(Ts, rows, (th2, p.z2, p.a), i, logs)
         if rne != 0:  # ShaftLog.record: the reactions, then the raw values
-            _call_stage(rne, m_addr, d_addr)
+            call_stage(rne, m_addr, d_addr)
         gather(sh_adr, sh_raw, i)
         turn_max = max(turn_max, turn)
         r_c = wr / W if W > 0 else math.nan
         sums = (acc[0], acc[1], acc[2], acc[3], acc[4], acc[5], acc[6], acc[7], acc[8], acc[9])
-        col = column(t, th1, th2, w1, w2, cmd_i, sums, rec, nteeth, pen2, mu, te, fr, r_c, g[G.rpm])
+        col = column(t, th1, th2, w1, w2, cmd_i, sums, rec, nteeth, pen2, mu, te, fr, r_c, p.rpm)
         for k in range(len(col)):
             S[k, i] = col[k]
         io[IO_PENDING] = 0.0
-    io[IO_NEXT] = i1
+    io[IO_NEXT] = i1_
     io[IO_TURN_MAX] = turn_max
     io[IO_PM], io[IO_RM] = pm, rm
 
@@ -250,33 +226,32 @@ class FlankSamples:
         fc, geo = loop.fc, bm.geometry
         self.loop, self.fc, self.guards, self.rec, self.S = loop, fc, guards, rec, series
         self.off = mjdata_offsets()
-        g = np.zeros(len(G_NAMES))
-        g[G.dt] = guards.dt
-        g[G.direction] = bm.direction
-        g[G.ratio] = geo.ratio
-        g[G.overspeed_turn] = guards.turn_lim
-        g[G.jump_rad] = guards.jump_rad
-        g[G.pen_lim] = guards.pen_lim
-        g[G.lock_start] = guards.lock_start
-        g[G.lock_fraction] = gt.LOCK_SPEED_FRACTION
-        g[G.r1] = geo.r1
-        g[G.cos_gamma] = math.cos(geo.gamma)
-        kind, a, b, c_, deg = bm.plan.mu_params
-        g[G.mu_kind], g[G.mu_a], g[G.mu_b], g[G.mu_c] = kind, a, b, c_
-        g[G.deg] = deg
-        g[G.rpm] = RPM
-        g[G.a] = geo.a
-        g[G.speed_driven] = float(guards.speed_driven)
-        g[G.worm_is_drive] = float(bm.plan.drive_on == "worm")
-        g[G.qa1], g[G.qa2] = fc.qa1, fc.qa2
-        g[G.dof1], g[G.dof2] = bm.worm_dof, bm.wheel_dof
-        g[G.z2] = geo.z2
-        self.g = g
+        self.params = SampleParams(
+            dt=guards.dt,
+            direction=float(bm.direction),
+            ratio=float(geo.ratio),
+            overspeed_turn=guards.turn_lim,
+            jump_rad=guards.jump_rad,
+            pen_lim=guards.pen_lim,
+            lock_start=guards.lock_start,
+            lock_fraction=gt.LOCK_SPEED_FRACTION,
+            r1=float(geo.r1),
+            cos_gamma=math.cos(geo.gamma),
+            mu_law=bm.plan.mu_law,
+            rpm=RPM,
+            a=float(geo.a),
+            speed_driven=bool(guards.speed_driven),
+            worm_is_drive=bm.plan.drive_on == "worm",
+            qa1=int(fc.qa1),
+            qa2=int(fc.qa2),
+            dof1=int(bm.worm_dof),
+            dof2=int(bm.wheel_dof),
+            z2=int(geo.z2),
+        )
         self.adr = np.zeros(ADR_CAP, dtype=np.int64)
-        self.io = np.zeros(IO_EVENT + 1)
+        self.io = np.zeros(IO_LEN)
         self._store = store
-        rne = _library().mj_rnePostConstraint if slog is not None and slog.reactions else None
-        rne_fn = 0 if rne is None else ctypes.cast(rne, ctypes.c_void_p).value
+        rne_fn = address("mj_rnePostConstraint") if slog is not None and slog.reactions else 0
         if slog is None:
             self.shaft = (0, np.zeros(0, dtype=np.int64), np.zeros((1, 0)))
         else:
@@ -289,41 +264,19 @@ class FlankSamples:
     def run(self, cmd, load, i0: int, i1: int, o0: int, pattern, rlog) -> tuple[int, int]:
         """Samples i0..i1-1 (run_samples); returns (the next sample, the event: EV_NONE when the stretch is done,
         else why that sample, its steps done, is left to the runner's Python path)."""
-        loop, fc, g, io, guards = self.loop, self.fc, self.g, self.io, self.guards
-        T = loop.prepare()
+        loop, fc, io, guards = self.loop, self.fc, self.io, self.guards
+        tables = (loop.prepare(), loop.sample_table_for(pattern, self._store))
         k = fc.kernel
-        Ts = loop.sample_table_for(pattern, self._store)
-        g[G.next_check] = guards.friction.next_check
-        g[G.mu] = fc.mu
-        g[G.e_star] = pattern.e_star
-        g[G.locked] = float(guards.locked_since is not None)
+        io[IO_NEXT_CHECK], io[IO_MU], io[IO_E_STAR] = guards.friction.next_check, fc.mu, pattern.e_star
+        io[IO_LOCKED] = float(guards.locked_since is not None)
         io[IO_TURN_MAX], io[IO_PM], io[IO_RM] = guards.turn_max, pattern.m, rlog.m
-        run_samples(
-            T,
-            Ts,
-            loop.m._address,
-            loop.d._address,
-            cmd,
-            load,
-            i0,
-            i1,
-            o0,
-            self.rec,
-            self.S,
-            g,
-            self.off,
-            fc.frame,
-            fc.pos,
-            self.adr,
-            pattern.buf,
-            rlog.buf,
-            io,
-            (k.grp, k.share, k.mfric, k.mwrap, fc._adr, fc._efc) if fc.merge else None,
-            self.shaft,
-        )
+        room = (self.off, fc.frame, fc.pos, self.adr, pattern.buf, rlog.buf)
+        mrg = (k.grp, k.share, k.mfric, k.mwrap, fc.slice_adr, fc.slice_efc) if fc.merge else None
+        mj = (loop.m._address, loop.d._address)
+        run_samples(tables, mj, (cmd, load), (i0, i1, o0, self.rec), self.S, self.params, room, io, mrg, self.shaft)
         loop.sync()
-        if g[G.mu] != fc.mu:  # changed in the call (run_samples): as FlankContacts.set_friction leaves it
-            fc.mu = float(g[G.mu])
+        if io[IO_MU] != fc.mu:  # changed in the call (run_samples): as FlankContacts.set_friction leaves it
+            fc.mu = float(io[IO_MU])
             fc.template.friction = [fc.mu, fc.mu, 0.0, 0.0, 0.0]
         loop.dropped += int(io[IO_DROPPED])
         guards.turn_max = float(io[IO_TURN_MAX])

@@ -1,20 +1,12 @@
-"""MuJoCo's step split so that contacts found on the exact flanks (wormsim.tooth.kernel) enter its constraint
-solver.
-
-mj_step (MuJoCo 4.0.0, engine_forward.c) is mj_checkPos, mj_checkVel, mj_forward, mj_checkAcc, integrate, and
-mj_forward's position stage (mj_fwdPosition) is kinematics (mj_fwdKinematics), inertia (mj_makeM, mj_factorM),
-mj_collision, mj_makeConstraint, mj_island, mj_transmission, mj_projectConstraint. `split_step` runs the same stages
-one by one and adds the flank contacts with mj_addContact between mj_collision (which empties the contact list and
-its arena) and mj_makeConstraint (which turns the contacts into constraint rows), then mj_sensorPos, mj_fwdVelocity,
-mj_sensorVel and mj_step2 (actuation, acceleration, constraint solve, mj_sensorAcc, mj_checkAcc, and the implicit or
-Euler integrator: RK4 is not available this way, MuJoCo's mj_step2 falls back to Euler). Energy is not computed (the
-template disables it). Validated on a 1 kg box with collision off and the contact added by hand
+"""The exact-flank contacts of one model (wormsim.tooth.kernel) handed to MuJoCo's constraint solver: FlankContacts
+finds them and adds them to d.contact in the stage list's ADD_CONTACTS slot (wormsim.contact3d.native.split_step:
+between mj_collision and mj_makeConstraint). Validated on a 1 kg box with collision off and the contact added by hand
 (tests/test_flank_contact_path.py): static normal force = weight, penetration = the solref mapping, sliding
 deceleration = mu g.
 
 A contact is added by copying a template mjContact with its per-contact fields (dist, pos, frame, solref) written in
 (mj_addContact allocates it in the arena), all of a step's contacts from compiled code in one Python call
-(wormsim.contact3d.flank_handoff; docs/contact3d.md, "Exact flanks: cost").
+(wormsim.contact3d.flank_handoff.fill_add; docs/contact3d.md, "Exact flanks: cost").
 
 Every flank contact is between the worm's visual geom and the wheel's visual geom (contype/conaffinity 0, so MuJoCo
 never collides them itself): their bodies give the contact Jacobian, body_invweight0 the contact law's A_hat, and the
@@ -29,7 +21,8 @@ import mujoco
 import numba
 import numpy as np
 
-from wormsim.contact3d.flank_handoff import ContactBuffer
+from wormsim.contact3d.flank_handoff import ContactBuffer, Handed, fill_add
+from wormsim.contact3d.native import MJ_ADD_CONTACT, split_step
 from wormsim.tooth.grid import flank_grid
 from wormsim.tooth.kernel import MARGIN_PITCH, TAPER_SHARE, PackedKernel, find_packed
 from wormsim.tooth.merge import split_forces
@@ -64,7 +57,7 @@ class FlankContacts:
         self.n = 0
         self.qa1 = int(m.jnt_qposadr[m.dof_jntid[bm.worm_dof]])
         self.qa2 = int(m.jnt_qposadr[m.dof_jntid[bm.wheel_dof]])
-        self._c = None
+        self.centre = None
         self.ks = np.zeros(W, dtype=np.int64)
         worm_geom, wheel_geom = bm.meta.get("flank_geoms", ("worm_visual", "wheel_visual"))  # wormsim.pair: prefixed
         gw = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, worm_geom)
@@ -91,6 +84,7 @@ class FlankContacts:
         self.buffer = None
         self.set_friction(float(m.geom_friction[gw, 0]))
         self.buffer = ContactBuffer(m, t, cap)  # the bulk hand-off (wormsim.contact3d.flank_handoff)
+        self.hand = self.buffer.handoff(self.solref, self.solreffriction)
         # with errors: the kernel gets the displaced bodies' poses each step (wormsim.tooth.pose)
         self.params = self.grid.params
         dev = getattr(bm, "deviations", None)
@@ -104,9 +98,9 @@ class FlankContacts:
             self.margin0 += flank_pose.error_margin_rad(g, self.grid, dev) if dev is not None else 0.0
             self.margin0 += float(bm.meta.get("margin_rad", 0.0))
             self._set_pose = flank_pose.set_pose
-        self._pack()
+        self.pack()
 
-    def _pack(self) -> None:
+    def pack(self) -> None:
         """The kernel's arrays, memo included, in two buffers: one compiled call per step (kernel.find_packed);
         again when self.params was replaced."""
         k = self.kernel = PackedKernel(
@@ -118,9 +112,10 @@ class FlankContacts:
         self.memo = (k.memo, k.memo_consts)  # find_contacts' open-slice memo
         k.axes[:] = self._hinges()  # the merge's moment arms (wormsim.tooth.merge)
         # what is handed to MuJoCo: the slice contacts, or one per tooth flank (wormsim.tooth.merge)
-        self.handed = (k.mdepth, k.mpos, k.mframe, k.mweight) if self.merge else (k.depth, k.pos, k.frame, k.weight)
-        self._adr = np.zeros(len(k.depth), dtype=np.int64)  # slice_rows' per-slice rows (merge)
-        self._efc = np.zeros(3 * len(k.depth))
+        out = (k.mdepth, k.mpos, k.mframe, k.mweight) if self.merge else (k.depth, k.pos, k.frame, k.weight)
+        self.handed = Handed(*out, k.mfric)
+        self.slice_adr = np.zeros(len(k.depth), dtype=np.int64)  # slice_rows' per-slice rows (merge)
+        self.slice_efc = np.zeros(3 * len(k.depth))
 
     def _hinges(self) -> np.ndarray:
         """(point, direction) of the worm's and the wheel's hinge in the world at qpos0 and the wheel's speed per worm
@@ -151,9 +146,9 @@ class FlankContacts:
         k = self.kernel
         n = self.n
         nh = min(int(k.ib[7]), d.ncon)
-        adr, efc, k0 = self._adr, self._efc, d.ncon - nh
+        adr, efc, k0 = self.slice_adr, self.slice_efc, d.ncon - nh
         split_forces(d.contact.efc_address, d.efc_force, k0, dim3, k.grp, k.share, k.mfric, k.mwrap, n, adr, efc)
-        return self._adr[:n], self._efc, self.frame[:n], self.pos[:n], True
+        return self.slice_adr[:n], self.slice_efc, self.frame[:n], self.pos[:n], True
 
     def set_friction(self, mu: float) -> None:
         if mu != self.mu:
@@ -168,10 +163,10 @@ class FlankContacts:
         """Tooth indices of the mesh window (wormsim.contact3d.mjcf.window_teeth_at), updated by whole pitches."""
         bm = self.bm
         c = math.floor((-math.pi / 2 - bm.tooth0_angle_rad - theta2) / self.pitch)
-        if c != self._c:
+        if c != self.centre:
             h = bm.window_teeth // 2
             self.ks[:] = np.arange(c - h + 1, c - h + 1 + bm.window_teeth)
-            self._c = c
+            self.centre = c
         return self.ks
 
     def find(self, d: mujoco.MjData) -> int:
@@ -180,7 +175,7 @@ class FlankContacts:
         q = d.qpos  # one view (each d.qpos builds one: ~1 us)
         th1, th2 = q[self.qa1], q[self.qa2]
         if self.params is not self.kernel.P:
-            self._pack()
+            self.pack()
         if self.displaced:
             self._set_pose(self.params, d.xpos, d.xmat, self.bm.worm_body, self.bm.wheel_body, th1)
         self.window(th2)
@@ -194,8 +189,9 @@ class FlankContacts:
         self.find(d)
         n = self.n_handed()
         if n:
-            k = self.kernel
-            self.buffer.add(m, d, n, *self.handed, self.solref, self.solreffriction, k.mfric, self.mu, self.merge)
+            n = min(n, self.buffer.cap)
+            fr = self.solreffriction[1] != 0.0
+            fill_add(MJ_ADD_CONTACT, m._address, d._address, self.hand, n, self.handed, self.mu, fr, self.merge)
 
     def add_loop(self, m: mujoco.MjModel, d: mujoco.MjData) -> None:
         """`add` from Python: the template added once per contact, then its fields written through d.contact's views."""
@@ -203,7 +199,7 @@ class FlankContacts:
         n = self.n_handed()
         if n == 0:
             return
-        depth, pos, frame, weight = self.handed
+        depth, pos, frame, weight, _ = self.handed
         k0 = d.ncon
         t = self.template
         for _ in range(n):
@@ -228,45 +224,11 @@ class FlankContacts:
         split_step(m, d, self.add)
 
 
-def split_step(m: mujoco.MjModel, d: mujoco.MjData, add_contacts) -> None:
-    """mj_step with add_contacts(m, d) called between mj_collision and mj_makeConstraint (module docstring)."""
-    mujoco.mj_checkPos(m, d)
-    mujoco.mj_checkVel(m, d)
-    mujoco.mj_fwdKinematics(m, d)
-    mujoco.mj_makeM(m, d)
-    mujoco.mj_factorM(m, d)
-    mujoco.mj_collision(m, d)
-    add_contacts(m, d)
-    mujoco.mj_makeConstraint(m, d)
-    mujoco.mj_island(m, d)
-    mujoco.mj_transmission(m, d)
-    mujoco.mj_projectConstraint(m, d)
-    mujoco.mj_sensorPos(m, d)
-    mujoco.mj_fwdVelocity(m, d)
-    mujoco.mj_sensorVel(m, d)
-    mujoco.mj_step2(m, d)
-
-
-def split_forward(m: mujoco.MjModel, d: mujoco.MjData, add_contacts) -> None:
-    """mj_forward with the added contacts (for the initial state and for checks)."""
-    mujoco.mj_fwdKinematics(m, d)
-    mujoco.mj_makeM(m, d)
-    mujoco.mj_factorM(m, d)
-    mujoco.mj_collision(m, d)
-    add_contacts(m, d)
-    mujoco.mj_makeConstraint(m, d)
-    mujoco.mj_island(m, d)
-    mujoco.mj_transmission(m, d)
-    mujoco.mj_projectConstraint(m, d)
-    mujoco.mj_sensorPos(m, d)
-    mujoco.mj_forwardSkip(m, d, mujoco.mjtStage.mjSTAGE_POS, 0)
-
-
 def flank_contact_details(fc: FlankContacts, d: mujoco.MjData):
     """As wormsim.contact3d.sources.contact_details for flank contacts: (n teeth touching, max penetration, points in
     the frame of wheel tooth 0, forces on the wheel (world), points (world)). The kernel's contacts are d.contact's
     last fc.n entries; the force on the wheel (geom 2) is the elliptic-cone rows turned into the world frame
-    (`_contact_forces`, compiled: this runs at every sample)."""
+    (`contact_forces`, compiled: this runs at every sample)."""
     n = fc.n if fc.merge else min(fc.n, d.ncon)
     if n == 0:
         z = np.zeros((0, 3))
@@ -274,12 +236,12 @@ def flank_contact_details(fc: FlankContacts, d: mujoco.MjData):
     adr_all, efc, frame, pos, cone3 = fc.slice_rows(d)
     out = np.empty((3, n, 3))
     th2 = float(d.qpos[fc.qa2])
-    m, nteeth = _contact_forces(adr_all, frame, pos, efc, cone3, fc.meta, th2, fc.bm.geometry.z2, out, fc.params)
+    m, nteeth = contact_forces(adr_all, frame, pos, efc, cone3, fc.meta, th2, fc.bm.geometry.z2, out, fc.params)
     return nteeth, float(fc.depth[:n].max()), out[0, :m], out[1, :m], out[2, :m]
 
 
 @numba.njit(cache=True)
-def _contact_forces(adr, frame, pos, efc_force, cone3, meta, th2, z2, out, P):
+def contact_forces(adr, frame, pos, efc_force, cone3, meta, th2, z2, out, P):
     """flank_contact_details' loop over the contacts with a constraint row (adr >= 0), in order: out[0] the point
     in the frame of wheel tooth 0, out[1] the force on the wheel (the normal row and, with an elliptic cone (cone3),
     the two tangent rows, through the contact frame), out[2] the point; returns (their number, the number of distinct

@@ -43,7 +43,6 @@ from meshgen.pieces import GearSet
 from wormsim import gear_theory as gt
 from wormsim.contact3d import mass_scaling, shafts
 from wormsim.contact3d.backlash import check_backlash, check_conjugate_interference
-from wormsim.contact3d.friction_law import mu_params
 from wormsim.contact3d.law import (
     ContactLaw,
     contact_law,
@@ -53,7 +52,7 @@ from wormsim.contact3d.law import (
 )
 from wormsim.contact3d.mass_scaling import ScalingCheck
 from wormsim.contact3d.timestep import timestep_for
-from wormsim.friction import friction_coefficient
+from wormsim.friction import friction_coefficient, mu_law
 from wormsim.geometry import derive, displaced_pair, gear_set, solid_set
 from wormsim.locking import backdrive_self_locks, stall_torque_nm, wheel_start_rad
 from wormsim.scenario import Scenario, ScenarioError, Simulation
@@ -132,7 +131,7 @@ class Prepared:
     normal_force_n: float = 0.0  # nominal_normal_force_n: the whole mesh's normal force at the working load
     duty: gt.Duty | None = None  # the drive and load, their commands, ramps and working flank (gear_theory.duty)
     grid: FlankGrid | None = None  # contact.geometry flanks: the flank grid of law.contacts_per_pair slices
-    mu_params: tuple = ()  # the friction law mu(Vs) (wormsim.contact3d.friction_law.mu_params)
+    mu_law: tuple = ()  # the friction law mu(Vs) (wormsim.friction.MuLaw)
     transition_velocity_m_s: float = 0.0  # contact.transition_velocity_m_s
     e_star_pa: float = 0.0  # the pair's effective modulus (gear_theory.effective_modulus_pa)
     timestep_s: float = 0.0  # the model's timestep (build_model: timestep_for's or the one given)
@@ -356,7 +355,7 @@ def prepare(scenario: Scenario, gs: GearSet | None = None) -> Prepared:
         f_n,
         duty,
         grid,
-        mu_params=mu_params(scenario.contact),
+        mu_law=mu_law(scenario.contact),
         transition_velocity_m_s=scenario.contact.transition_velocity_m_s,
         e_star_pa=e_star,
         worm_speed_rad_s=w1,

@@ -6,7 +6,7 @@ behind one interface), the shafts' log (wormsim.contact3d.shafts, with `shafts:`
 (wormsim.contact3d.series), then `_loop` runs the record intervals: each interval's steps (the drive and load commands
 at each step's midpoint; the source sums the actuator torques, the shaft powers T w and the contact sensor's
 resultant on the wheel over the steps), then per sample (`_sample`) the state, the guards' checks, mu(Vs) at the
-sliding speed Vs = |omega1| r1 / cos(gamma) (wormsim.contact3d.friction_law), the source's contact outputs (teeth
+sliding speed Vs = |omega1| r1 / cos(gamma) (wormsim.friction), the source's contact outputs (teeth
 touching, largest penetration, contact points in tooth 0's frame, the radial force on the line of centres and the
 contact radius), the shafts' log and one series column: forces, moment, contact count, torques and powers are the
 MEANS over the interval (a box-car: the 10-80 kHz contact vibration does not alias into the meshing band), angles and
@@ -32,7 +32,6 @@ from wormsim import jit_cache, prewarm
 from wormsim.contact3d import jit_warmup, mass_scaling
 from wormsim.contact3d.contact_sums import RadiusLog
 from wormsim.contact3d.diagnosis import diverged_error
-from wormsim.contact3d.friction_law import mu_of
 from wormsim.contact3d.guards import Guards
 from wormsim.contact3d.metrics import contact3d_summary
 from wormsim.contact3d.mjcf import BuiltModel, build_model
@@ -40,7 +39,7 @@ from wormsim.contact3d.ringing_check import ringing
 from wormsim.contact3d.series import SERIES, column
 from wormsim.contact3d.shafts import ShaftLog
 from wormsim.contact3d.sources import FlankSource, PieceSource
-from wormsim.friction import friction_mode
+from wormsim.friction import friction_mode, mu_of
 from wormsim.locking import Held, held_keys, run_keys
 from wormsim.result import Result
 from wormsim.scenario import Scenario
@@ -161,7 +160,7 @@ def _sample(src, bm: BuiltModel, d, guards, S_all, rlog, store, rec: int, slog, 
     w1, w2 = float(qv[bm.worm_dof]), float(qv[bm.wheel_dof])
     t = float(d.time)
     te = guards.state(d, t, th1, th2, w1, w2)
-    mu = mu_of(abs(w1) * geo.r_m1 / math.cos(geo.gamma_m), bm.plan.mu_params)  # at the sliding speed Vs
+    mu = mu_of(abs(w1) * geo.r_m1 / math.cos(geo.gamma_m), bm.plan.mu_law)  # at the sliding speed Vs
     # each contact's force turned about the worm axis onto the line of centres: the radial force DIN 3975's
     # single pitch-point contact means; the force-weighted contact radius and efficiency there (contact_sums)
     nteeth, pen, fr_lc, r_c = src.sample(i, th2, mu, rlog, store)

@@ -45,7 +45,7 @@ import numba
 import numpy as np
 
 from meshgen.geometry import GearGeometry
-from wormsim.contact3d.flank_handoff import _f64_at
+from wormsim.contact3d.native import f64_at
 from wormsim.scenario import Scenario, ScenarioError, ShaftSupport
 
 DAMPING_RATIO = 0.05  # bearings' and bending's damping, share of critical against the shaft's mass (an assumption:
@@ -433,7 +433,7 @@ class ShaftLog:
 def gather(adr, raw, i):
     """Row i of raw: the float64 values at the addresses adr (ShaftLog.addresses)."""
     for k in range(adr.shape[0]):
-        raw[i, k] = _f64_at(adr[k])[0]
+        raw[i, k] = f64_at(adr[k])[0]
 
 
 def bearing_split(force: np.ndarray, moment: np.ndarray, bearings_m: tuple[float, float]) -> list[tuple]:

@@ -85,7 +85,8 @@ class FlankSource:
         `shafts:`), which the compiled samples write."""
         from wormsim.contact3d.flank_loop import FlankLoop
         from wormsim.contact3d.flank_samples import FlankSamples
-        from wormsim.contact3d.flank_step import FlankContacts, split_forward
+        from wormsim.contact3d.flank_step import FlankContacts
+        from wormsim.contact3d.native import split_forward
         from wormsim.tooth.hertz import PatternLog
 
         self.bm, self.d = bm, d

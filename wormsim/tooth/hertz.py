@@ -188,7 +188,7 @@ def _lerp_rows(a, sg, j, f):
 
 
 @numba.njit(cache=True)
-def _rows(i, adr, efc_force, meta, weight, inv_rho, line_len, e_star, out, m):
+def pattern_rows(i, adr, efc_force, meta, weight, inv_rho, line_len, e_star, out, m):
     """Appends (i, sigma, j, f, F_n, p_H (3)) per contact with a constraint row to out (float32) from row m. The
     contact carries the share weight[c] of its slice (kernel.slice_weights), so its line is weight[c] x L long."""
     for c in range(adr.shape[0]):
@@ -222,7 +222,7 @@ class PatternLog:
 
     def record(self, i: int, d) -> None:
         """The kernel's contacts (d.contact's last fc.n entries) at sample i: (i, sigma, j, f, F_n, p_H);
-        p_H by (3) (in `_rows`, compiled: the same formula as hertz_line_pressure_pa)."""
+        p_H by (3) (in `pattern_rows`, compiled: the same formula as hertz_line_pressure_pa)."""
         fc = self.fc
         n = fc.n if fc.merge else min(fc.n, d.ncon)
         if n == 0:
@@ -230,7 +230,7 @@ class PatternLog:
         self.reserve(n)
         adr, efc = fc.slice_rows(d)[:2]  # per slice contact (with one contact per tooth flank: its force split)
         cv = self.cv
-        self.m = _rows(i, adr, efc, fc.meta, fc.weight, cv.inv_rho, cv.line_len, self.e_star, self.buf, self.m)
+        self.m = pattern_rows(i, adr, efc, fc.meta, fc.weight, cv.inv_rho, cv.line_len, self.e_star, self.buf, self.m)
 
     def reserve(self, n: int) -> None:
         """Room for n more rows."""

@@ -2,7 +2,7 @@
 flank (same tooth, same side: meta[:, 0:2], contiguous in the kernel's order) handed to MuJoCo as one contact.
 
 The contact law is a linear spring per contact whose stiffness is scaled by the contact's share w_i of its slice
-(wormsim.contact3d.law (1); kernel.slice_weights; flank_handoff._fill_add scales solref by w). With a_i = w_i d_i:
+(wormsim.contact3d.law (1); kernel.slice_weights; flank_handoff.fill_add scales solref by w). With a_i = w_i d_i:
 
     depth = sum a_i / W,   W = sum w_i,   pos = sum a_i p_i / sum a_i  (the spring forces' centroid),
     normal = sum a_i n_i / |sum a_i n_i|,   c_w = |sum a_i n_i| / sum a_i,
