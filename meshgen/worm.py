@@ -34,39 +34,65 @@ normal pressure angle at radius r is sin(alpha_n) = |n . e_r| = |H'| / sqrt(H'^2
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
 
-from meshgen import worm_forms
+from meshgen import worm_forms, worm_forms_jit
 from meshgen.geometry import GearGeometry, GeometryError
 
 
-def _t_of_r(g: GearGeometry, r):
-    return np.sqrt(np.maximum(np.asarray(r, dtype=float) ** 2 / g.r_b**2 - 1.0, 0.0))
+@functools.lru_cache(maxsize=64)
+def worm_params(g: GearGeometry) -> np.ndarray:
+    """Scalars of the closed form (1), (2), in the order the compiled H(r) (meshgen.worm_forms_jit) and the contact
+    kernel (wormsim.tooth.gap) read them; read-only (cached per gear)."""
+    J = worm_forms_jit
+    form = J.ZI if g.profile == "ZI" else J.TABLE if g.profile in worm_forms.TABLE_FORMS else J.ZA
+    t1 = math.sqrt(max(g.r1**2 / g.r_b**2 - 1.0, 0.0)) if form == J.ZI else 0.0
+    table = worm_forms.form_table(g).params() if form == J.TABLE else np.zeros(J.TABLE_LEN)
+    head = np.array(
+        [
+            g.p,
+            g.p_x,
+            g.r_f1,
+            g.r_a1,
+            g.worm_length / 2,
+            form,
+            g.r_b,
+            math.tan(g.alpha_x),
+            t1 - math.atan(t1),
+            g.r1,
+            g.a,
+            2 * math.pi / g.z2,
+            g.hand * g.z1 / g.z2,
+        ],
+        dtype=float,
+    )
+    P = np.concatenate([head, table])  # ZN, ZK, ZC: H(r)'s table at P[TABLE_AT:]
+    P.flags.writeable = False
+    return P
+
+
+def half_thickness_and_dr(g: GearGeometry, r) -> tuple[np.ndarray, np.ndarray]:
+    """(H(r), dH/dr) (equations (1), (2) above; ZN, ZK, ZC: meshgen.worm_forms), m: the compiled evaluation
+    (meshgen.worm_forms_jit.thread_half_thickness) over r's shape."""
+    r = np.asarray(r, dtype=float)
+    H, dH = np.empty(r.shape), np.empty(r.shape)
+    worm_forms_jit.thread_half_thickness_many(
+        np.ascontiguousarray(r).reshape(-1), worm_params(g), H.reshape(-1), dH.reshape(-1)
+    )
+    return (H[()], dH[()]) if r.ndim == 0 else (H, dH)
 
 
 def half_thickness(g: GearGeometry, r):
-    """H(r): axial half-thickness of the thread at radius r (equations (1), (2) above; ZN, ZK, ZC:
-    meshgen.worm_forms), m."""
-    r = np.asarray(r, dtype=float)
-    if g.profile in worm_forms.TABLE_FORMS:
-        return worm_forms.form_table(g).half_thickness(r)
-    if g.profile == "ZA":
-        return g.p_x / 4 - (r - g.r1) * math.tan(g.alpha_x)
-    t, t1 = _t_of_r(g, r), float(_t_of_r(g, g.r1))
-    ap = abs(g.p)
-    return g.p_x / 4 - ap * ((t - np.arctan(t)) - (t1 - math.atan(t1)))
+    """H(r): axial half-thickness of the thread at radius r (half_thickness_and_dr), m."""
+    return half_thickness_and_dr(g, r)[0]
 
 
 def half_thickness_dr(g: GearGeometry, r):
-    """dH/dr: ZA -tan(alpha_x); ZI -|p| t / r (0 below r_b); ZN, ZK, ZC: meshgen.worm_forms."""
-    r = np.asarray(r, dtype=float)
-    if g.profile in worm_forms.TABLE_FORMS:
-        return worm_forms.form_table(g).half_thickness_dr(r)
-    if g.profile == "ZA":
-        return np.full_like(r, -math.tan(g.alpha_x))
-    return -abs(g.p) * _t_of_r(g, r) / r
+    """dH/dr: ZA -tan(alpha_x); ZI -|p| t / r (0 below r_b); ZN, ZK, ZC the table (half_thickness_and_dr)."""
+    return half_thickness_and_dr(g, r)[1]
 
 
 def wrap(u, period):

@@ -76,6 +76,7 @@ import numpy as np
 from numpy.polynomial import chebyshev as C
 
 from meshgen.errors import GeometryError
+from meshgen.worm_forms_jit import N_CHEB, table_many
 
 Gear = Any  # a meshgen.geometry.GearGeometry (not imported: meshgen.geometry imports this module)
 
@@ -83,7 +84,6 @@ DEFAULT_TOOL_DIAMETER_MM = 100.0  # ZK, ZC disc (docs/flank_forms.md)
 DEFAULT_PROFILE_RADIUS_MODULES = 5.5  # ZC tool arc radius / m_x (docs/flank_forms.md)
 DEFAULT_ZC_PROFILE_SHIFT = 0.5  # ZC wheel profile shift x2 (docs/flank_forms.md)
 
-N_CHEB = 40  # Chebyshev terms of the H(r) table
 TABLE_TOL_M = 1e-9  # the table's largest allowed deviation from the exact H(r) (form_table's check)
 FORMS = ("ZA", "ZN", "ZI", "ZK", "ZC")
 TABLE_FORMS = ("ZN", "ZK", "ZC")  # the forms evaluated by the table (ZA, ZI: closed forms in meshgen.worm)
@@ -270,18 +270,18 @@ class FormTable:
     r_hi: float
     coef: np.ndarray  # (N_CHEB,) Chebyshev coefficients of H in x = (2 r - r_lo - r_hi) / (r_hi - r_lo)
 
-    def _x(self, r):
-        return (2 * r - self.r_lo - self.r_hi) / (self.r_hi - self.r_lo)
+    def evaluate(self, r) -> tuple[np.ndarray, np.ndarray]:
+        """(H(r), dH/dr): the compiled series (meshgen.worm_forms_jit.half_thickness, the one evaluation)."""
+        r = np.asarray(r, float)
+        H, dH = np.empty(r.shape), np.empty(r.shape)
+        table_many(np.ascontiguousarray(r).reshape(-1), self.params(), H.reshape(-1), dH.reshape(-1))
+        return H, dH
 
     def half_thickness(self, r):
-        r = np.asarray(r, float)
-        rc = np.clip(r, self.r_lo, self.r_hi)
-        H = C.chebval(self._x(rc), self.coef)
-        return H + (r - rc) * self.half_thickness_dr(rc)
+        return self.evaluate(r)[0]
 
     def half_thickness_dr(self, r):
-        r = np.clip(np.asarray(r, float), self.r_lo, self.r_hi)
-        return C.chebval(self._x(r), C.chebder(self.coef)) * 2 / (self.r_hi - self.r_lo)
+        return self.evaluate(r)[1]
 
     def params(self) -> np.ndarray:
         """[r_lo, r_hi, coef...] for the compiled evaluator (meshgen.worm_forms_jit)."""

@@ -1,17 +1,25 @@
-"""Compiled H(r) of the ZN / ZK / ZC table (meshgen.worm_forms.FormTable) for the contact kernel.
+"""The worm's H(r) compiled, its one evaluation: the axial half-thickness of the thread and its derivative dH/dr at
+radius r (meshgen.worm's equations (1), (2): ZI the involute helicoid, ZA straight; ZN, ZK, ZC the Chebyshev table of
+meshgen.worm_forms.FormTable), on the worm's scalars P (meshgen.worm.worm_params). meshgen.worm.half_thickness,
+FormTable and the contact kernel's worm gap (wormsim.tooth.gap) all call `thread_half_thickness` / `half_thickness`.
 
-The kernel's scalars P carry the table at P[off:off + 2 + N_CHEB] = [r_lo, r_hi, Chebyshev coefficients]
+The kernel's scalars P carry the table at P[TABLE_AT:TABLE_AT + 2 + N_CHEB] = [r_lo, r_hi, Chebyshev coefficients]
 (FormTable.params); `half_thickness` evaluates the series by Clenshaw's recurrence with its derivative, continued
-linearly outside [r_lo, r_hi], as FormTable.half_thickness / half_thickness_dr do (tests/test_flank_forms_contact.py).
+linearly outside [r_lo, r_hi] (tests/test_flank_forms_contact.py).
 """
 
 from __future__ import annotations
 
+import math
+
 import numba
 
-from meshgen.worm_forms import N_CHEB
-
+N_CHEB = 40  # Chebyshev terms of the H(r) table
 TABLE_LEN = 2 + N_CHEB  # entries of FormTable.params()
+# the entries of P that H(r) reads (meshgen.worm.worm_params: the whole layout)
+P_P, P_PX, P_FORM, P_RB, P_TAN_ALPHA_X, P_T1, P_R1 = 0, 1, 5, 6, 7, 8, 9
+TABLE_AT = 13  # where the table starts in P
+ZA, ZI, TABLE = 0.0, 1.0, 2.0  # P[P_FORM]
 
 
 @numba.njit(cache=True, inline="always")
@@ -35,3 +43,32 @@ def half_thickness(r, P, off):
     H = x * b1 - b2 + P[off + 2]
     dH = (b1 + x * d1 - d2) * sc
     return H + (r - rc) * dH, dH
+
+
+@numba.njit(cache=True, inline="always")
+def thread_half_thickness(r, P):
+    """(H(r), dH/dr) of the worm (module docstring): ZI equation (2) with t = sqrt(r^2 / r_b^2 - 1) (0 below r_b),
+    ZA straight, ZN / ZK / ZC the table."""
+    if P[P_FORM] > 1.5:
+        return half_thickness(r, P, TABLE_AT)
+    if P[P_FORM] > 0.5:
+        r_b = P[P_RB]
+        x = r * r / (r_b * r_b) - 1.0
+        t = math.sqrt(x) if x > 0.0 else 0.0
+        ap = abs(P[P_P])
+        return P[P_PX] / 4 - ap * ((t - math.atan(t)) - P[P_T1]), -ap * t / r
+    return P[P_PX] / 4 - (r - P[P_R1]) * P[P_TAN_ALPHA_X], -P[P_TAN_ALPHA_X]
+
+
+@numba.njit(cache=True)
+def thread_half_thickness_many(r, P, H, dH):
+    """thread_half_thickness over the flat array r into H and dH."""
+    for i in range(r.shape[0]):
+        H[i], dH[i] = thread_half_thickness(r[i], P)
+
+
+@numba.njit(cache=True)
+def table_many(r, T, H, dH):
+    """half_thickness of the table T (FormTable.params) over the flat array r into H and dH."""
+    for i in range(r.shape[0]):
+        H[i], dH[i] = half_thickness(r[i], T, 0)

@@ -32,7 +32,7 @@ def test_kernel_distance_is_meshgen_thread_gap(name, profile):
     pts = np.stack([r * np.cos(phi), r * np.sin(phi), z], axis=1)
     th1 = 0.37
     ref = worm.thread_gap(g, pts, th1)
-    P = gap.worm_params(g)
+    P = worm.worm_params(g)
     out = np.zeros(6)
     got = np.array([gap.worm_gap(x, y, zz, th1, P, out) for x, y, zz in pts])
     assert np.allclose(got, ref, rtol=0, atol=1e-12 * g.m_x / 1e-3)

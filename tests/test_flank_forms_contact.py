@@ -13,7 +13,6 @@ from meshgen import worm, worm_forms
 from meshgen.geometry import derive
 from meshgen.worm_forms_jit import half_thickness
 from wormsim.scenario import load_scenario
-from wormsim.tooth import gap as F
 
 
 @pytest.mark.parametrize(
@@ -26,7 +25,7 @@ def test_kernel_distance_new_forms(name, profile):
 @pytest.mark.parametrize("profile", ["ZN", "ZK", "ZC"])
 def test_compiled_table_is_meshgen(profile):
     g = derive(load_scenario(SCENARIOS / "screw_jack.yaml", [f"gear.profile={profile}"]).gear)
-    P = F.worm_params(g)
+    P = worm.worm_params(g)
     lo, hi = worm_forms.table_range(g)
     r = np.linspace(lo - 0.5 * g.m_x, hi + 0.5 * g.m_x, 301)
     got = np.array([half_thickness(x, P, 13) for x in r])

@@ -33,6 +33,7 @@ mu 0.06 / 0.05 / 0.035 / 0.023 / 0.017 / 0.014 at 0.5 / 1 / 2 / 5 / 10 / 20 m/s)
 
 from __future__ import annotations
 
+import functools
 import math
 from typing import NamedTuple
 
@@ -92,8 +93,12 @@ def mu_of(vs, law):
     return mu_at(vs, law[0], law[1], law[2], law[3])
 
 
-_mu_ufunc = numba.vectorize(["float64(float64, float64, float64, float64, float64)"], cache=True)(mu_at.py_func)
-_rho_group_ufunc = numba.vectorize(["float64(float64, float64, float64, float64)"], cache=True)(rho_group_rad.py_func)
+@functools.cache
+def _ufuncs():
+    """(mu_at, rho_group_rad) as numpy ufuncs (numba.vectorize: the same definitions), built on first use."""
+    mu = numba.vectorize(["float64(float64, float64, float64, float64, float64)"], cache=True)(mu_at.py_func)
+    rho = numba.vectorize(["float64(float64, float64, float64, float64)"], cache=True)(rho_group_rad.py_func)
+    return mu, rho
 
 
 def mu_law(contact: Contact) -> MuLaw:
@@ -124,7 +129,7 @@ def rho_rad(vs_m_s, group: str | None = None, friction: float | None = None):
             a, b, c = GROUPS[group]
         except KeyError:
             raise ValueError(f"friction group {group!r}: allowed I, II, III") from None
-        out = _rho_group_ufunc(vs, a, b, c)
+        out = _ufuncs()[1](vs, a, b, c)
     return float(out) if np.ndim(out) == 0 else out
 
 
@@ -154,7 +159,7 @@ def friction_mode(contact: Contact) -> str:
 def friction_coefficient(contact: Contact, sliding_speed_m_s) -> float | np.ndarray:
     """mu(Vs): see the module docstring (mu_at). Vectorised over Vs."""
     vs = np.abs(np.asarray(sliding_speed_m_s, dtype=float))
-    out = _mu_ufunc(vs, *mu_law(contact))
+    out = _ufuncs()[0](vs, *mu_law(contact))
     return float(out) if np.ndim(out) == 0 else out
 
 

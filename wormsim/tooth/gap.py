@@ -8,8 +8,9 @@ closed form of meshgen.worm.thread_gap (equations (1), (2) there):
     grad G = sign(u) (e_z - (p / r) e_phi) - H'(r) e_r,                                              (1)
 
 negative inside the thread, valid for r_f1 <= r <= r_a1 and |z_s| <= b1 / 2; worm_gap_ext evaluates it past these
-bounds too (the flank extended) and returns the excess by which the point lies outside. The module repeats the
-worm's H(r) (meshgen.worm.half_thickness, ZI/ZA); tests/test_flank_contact.py pins it to meshgen.worm.thread_gap.
+bounds too (the flank extended) and returns the excess by which the point lies outside. H(r) is meshgen's compiled
+one (meshgen.worm_forms_jit.thread_half_thickness, on meshgen.worm.worm_params); tests/test_flank_contact.py pins the
+gap to meshgen.worm.thread_gap.
 """
 
 from __future__ import annotations
@@ -19,49 +20,9 @@ import math
 import numba
 import numpy as np
 
-from meshgen import worm, worm_forms, worm_forms_jit
+from meshgen import worm
 from meshgen.geometry import GearGeometry
-
-
-def worm_params(g: GearGeometry) -> np.ndarray:
-    """Scalars of meshgen.worm's closed form, in the order the kernel reads them."""
-    zi = 1.0 if g.profile == "ZI" else 2.0 if g.profile in worm_forms.TABLE_FORMS else 0.0
-    t1 = math.sqrt(max(g.r1**2 / g.r_b**2 - 1.0, 0.0)) if zi == 1.0 else 0.0
-    table = worm_forms.form_table(g).params() if zi == 2.0 else np.zeros(worm_forms_jit.TABLE_LEN)
-    head = np.array(
-        [
-            g.p,
-            g.p_x,
-            g.r_f1,
-            g.r_a1,
-            g.worm_length / 2,
-            zi,
-            g.r_b,
-            math.tan(g.alpha_x),
-            t1 - math.atan(t1),
-            g.r1,
-            g.a,
-            2 * math.pi / g.z2,
-            g.hand * g.z1 / g.z2,
-        ],
-        dtype=float,
-    )
-    return np.concatenate([head, table])  # ZN, ZK, ZC: H(r)'s table at P[13:] (meshgen.worm_forms_jit)
-
-
-@numba.njit(cache=True, inline="always")
-def _half_thickness(r, P):
-    """meshgen.worm.half_thickness and its derivative dH/dr (ZI equation (2), ZA straight; ZN, ZK, ZC the table)."""
-    p, p_x, r1 = P[0], P[1], P[9]
-    if P[5] > 1.5:
-        return worm_forms_jit.half_thickness(r, P, 13)
-    if P[5] > 0.5:
-        r_b = P[6]
-        x = r * r / (r_b * r_b) - 1.0
-        t = math.sqrt(x) if x > 0.0 else 0.0
-        ap = abs(p)
-        return p_x / 4 - ap * ((t - math.atan(t)) - P[8]), -ap * t / r
-    return p_x / 4 - (r - r1) * P[7], -P[7]
+from meshgen.worm_forms_jit import thread_half_thickness
 
 
 @numba.njit(cache=True, inline="always")
@@ -82,7 +43,7 @@ def worm_gap_ext(xs, ys, zs, theta1, P, out):
     p, p_x = P[0], P[1]
     phi = math.atan2(ys, xs)
     u = _wrap(zs - p * (phi - theta1), p_x)
-    H, dH = _half_thickness(r, P)
+    H, dH = thread_half_thickness(r, P)
     sg = 1.0 if u >= 0.0 else -1.0
     ir = 1.0 / r
     cp, sp = xs * ir, ys * ir

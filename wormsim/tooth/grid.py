@@ -24,7 +24,7 @@ import numpy as np
 from meshgen import wheel, worm
 from meshgen.cache import cached
 from meshgen.geometry import GearGeometry
-from wormsim.tooth.gap import worm_params
+from meshgen.worm import worm_params
 from wormsim.tooth.mesh_stiffness import mesh_stiffness
 from wormsim.tooth.trim import cut_points
 from wormsim.tooth.window import window_size

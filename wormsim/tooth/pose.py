@@ -35,7 +35,7 @@ import numpy as np
 
 from meshgen.worm_forms_jit import TABLE_LEN
 
-N_WORM_PARAMS = 13 + TABLE_LEN  # len(wormsim.tooth.kernel.worm_params(g)): the nominal kernel's P
+N_WORM_PARAMS = 13 + TABLE_LEN  # len(meshgen.worm.worm_params(g)): the nominal kernel's P
 WHEEL = N_WORM_PARAMS  # offsets into the displaced P (module docstring)
 WORM = WHEEL + 12
 SHIFT = WORM + 12
