@@ -5,6 +5,8 @@ in the ADD_CONTACTS slot enter the solver exactly as MuJoCo's own collision's co
 
 from __future__ import annotations
 
+import re
+
 import mujoco
 import numba
 import numpy as np
@@ -125,3 +127,28 @@ def test_stage_lists_are_one_table():
     assert native.STEP[native.N_BEFORE] == native.ADD_CONTACTS
     names = [s for s in native.STEP if s != native.ADD_CONTACTS]
     assert list(native.stage_addresses()) == [native.address(s) for s in names] + [native.MJ_ADD_CONTACT]
+
+
+def test_mjdata_layout_checks_on_this_mujoco():
+    """The offsets the compiled loop reads are MuJoCo's declared layout and read back the bindings' values."""
+    off = native.mjdata_offsets()
+    assert off.min() >= 0 and native.check(off) == [], off
+
+
+def test_mjdata_layout_that_does_not_check_raises_with_the_version(monkeypatch):
+    """A layout that does not match (here: mjData's time moved by 8 bytes, as a MuJoCo upgrade could) raises naming
+    the MuJoCo version and the fields; never a silent fallback."""
+    declared = native.declared_offsets()
+
+    def moved():
+        off = declared.copy()
+        off[0] += 8
+        return off
+
+    monkeypatch.setattr(native, "declared_offsets", moved)
+    native.mjdata_offsets.cache_clear()
+    try:
+        with pytest.raises(native.MjDataLayoutError, match=rf"MuJoCo {re.escape(mujoco.__version__)}.*'time'"):
+            native.mjdata_offsets()
+    finally:
+        native.mjdata_offsets.cache_clear()

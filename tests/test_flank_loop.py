@@ -12,7 +12,7 @@ from wormsim.contact3d.contact_sums import RadiusLog
 from wormsim.contact3d.flank_loop import FlankLoop
 from wormsim.contact3d.flank_step import FlankContacts
 from wormsim.contact3d.mjcf import build_model
-from wormsim.contact3d.native import split_forward
+from wormsim.contact3d.native import split_forward, split_step
 from wormsim.scenario import load_scenario
 
 SCEN = Path(__file__).resolve().parents[1] / "scenarios"
@@ -21,14 +21,15 @@ BASE = ["contact.geometry=flanks", "simulation.resolution=coarse", "drive.ramp_s
 
 
 def _python_sums(m, d, fc, bm, cmd, load, a1, a2, s0):
-    """The runner's former per-step loop (wormsim.contact3d.runner.run_model before flank_loop)."""
+    """The runner's former per-step loop (wormsim.contact3d.runner.run_model before flank_loop), the step from Python
+    (native.split_step with FlankContacts.add)."""
     sd, act, qv, ctrl = d.sensordata, d.actuator_force, d.qvel, d.ctrl
     t1 = t2 = p1 = p2 = nc = fx = fy = fz = mz = fpk = 0.0
     for j in range(len(cmd)):
         ctrl[bm.drive_actuator] = cmd[j]
         ctrl[bm.load_actuator] = load[j]
         w1j, w2j = qv[bm.worm_dof], qv[bm.wheel_dof]
-        fc.step(m, d)
+        split_step(m, d, fc.add)
         q1, q2 = act[a1], act[a2]
         t1 += q1
         t2 += q2

@@ -31,7 +31,6 @@ us per step on the runner's per-step reads and sums).
 from __future__ import annotations
 
 import enum
-import math
 from typing import NamedTuple
 
 import mujoco
@@ -46,6 +45,7 @@ from wormsim.contact3d.series import N_SUMS, add_step
 from wormsim.tooth.hertz import pattern_rows
 from wormsim.tooth.kernel import find_packed
 from wormsim.tooth.pose import set_pose
+from wormsim.tooth.window import window_centre
 
 NO_WINDOW = np.iinfo(np.int64).min  # the window's first centre is not set yet
 # the step's integer and float parameters (FlankLoop.iv, FlankLoop.fv): the rows by name, the one declaration
@@ -103,7 +103,7 @@ def add_flanks(v, m_addr, d_addr):
     th1, th2 = qpos[iv[IV.worm_qpos]], qpos[iv[IV.wheel_qpos]]
     if iv[IV.displaced]:
         set_pose(v.params, v.xpos, v.xmat, iv[IV.worm_body], iv[IV.wheel_body], th1)
-    cw = math.floor((-math.pi / 2 - fv[FV.tooth0] - th2) / pitch)
+    cw = window_centre(th2, fv[FV.tooth0], pitch)
     if cw != state[0]:
         h = W // 2
         for i in range(W):
@@ -134,6 +134,12 @@ def flank_step(v, m_addr, d_addr):
     for s in range(N_BEFORE, fns.shape[0] - 1):
         call_stage(fns[s], m_addr, d_addr)
     return dropped
+
+
+@numba.njit(cache=True, nogil=True)
+def step_table(T, m_addr, d_addr):
+    """One flank_step on the address table T (FlankContacts.step)."""
+    return flank_step(views(T), m_addr, d_addr)
 
 
 # the arrays of the step in FlankLoop's address table: (name, dtype, ndim) per row, in row order; the one
@@ -308,13 +314,14 @@ def sample_table(T, rows, pose, i, logs):
 class FlankLoop:
     """run_table's arguments for one FlankContacts and its MjData (module docstring); `run` steps an interval."""
 
-    def __init__(self, fc, d, drive_actuator: int, load_actuator: int, a1: int, a2: int, sensor_adr: int):
+    def __init__(self, fc, d, drive_actuator: int, load_actuator: int, a1: int, a2: int, sensor_adr: int, runner=True):
+        """runner: a run's loop (it turns MuJoCo's islands off); else FlankContacts.step's (the model as it is)."""
         bm, m = fc.bm, fc.bm.model
         self.fc, self.m, self.d = fc, m, d
         # one island: the worm and the wheel are the model's only dofs and the flank contacts couple them, so
         # MuJoCo's island decomposition (mj_island, ~3.5 us per step) only repartitions the same solve (measured
         # bit-identical: docs/contact3d.md, "Exact flanks: the step loop compiled")
-        if m.nv == 2:
+        if runner and m.nv == 2:
             m.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_ISLAND)
         buf = fc.buffer
         iv = {
@@ -395,6 +402,15 @@ class FlankLoop:
         self.iv[IV.friction_rows] = fc.solreffriction[1] != 0.0
         self.fv[FV.mu] = fc.mu
         return self.table
+
+    def step(self) -> None:
+        """One step (step_table) from fc's window and contact count; they follow."""
+        fc = self.fc
+        T = self.prepare()
+        self.state[0] = NO_WINDOW if fc.centre is None else fc.centre
+        self.state[1] = fc.n
+        self.dropped += step_table(T, self.m._address, self.d._address)
+        self.sync()
 
     def sync(self) -> None:
         """fc.n and fc's window from the loop's state (after each call)."""

@@ -22,11 +22,12 @@ import numba
 import numpy as np
 
 from wormsim.contact3d.flank_handoff import ContactBuffer, Handed, fill_add
-from wormsim.contact3d.native import MJ_ADD_CONTACT, split_step
+from wormsim.contact3d.native import MJ_ADD_CONTACT
 from wormsim.tooth.grid import flank_grid
 from wormsim.tooth.kernel import MARGIN_PITCH, TAPER_SHARE, PackedKernel, find_packed
 from wormsim.tooth.merge import split_forces
 from wormsim.tooth.pose import N_WORM_PARAMS, to_wheel_body, tooth_angle
+from wormsim.tooth.window import window_centre
 
 
 class FlankContacts:
@@ -58,6 +59,7 @@ class FlankContacts:
         self.qa1 = int(m.jnt_qposadr[m.dof_jntid[bm.worm_dof]])
         self.qa2 = int(m.jnt_qposadr[m.dof_jntid[bm.wheel_dof]])
         self.centre = None
+        self.stepper = None  # step's compiled loop (for one MjData)
         self.ks = np.zeros(W, dtype=np.int64)
         worm_geom, wheel_geom = bm.meta.get("flank_geoms", ("worm_visual", "wheel_visual"))  # wormsim.pair: prefixed
         gw = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, worm_geom)
@@ -162,7 +164,7 @@ class FlankContacts:
     def window(self, theta2: float) -> np.ndarray:
         """Tooth indices of the mesh window (wormsim.contact3d.mjcf.window_teeth_at), updated by whole pitches."""
         bm = self.bm
-        c = math.floor((-math.pi / 2 - bm.tooth0_angle_rad - theta2) / self.pitch)
+        c = window_centre(theta2, bm.tooth0_angle_rad, self.pitch)
         if c != self.centre:
             h = bm.window_teeth // 2
             self.ks[:] = np.arange(c - h + 1, c - h + 1 + bm.window_teeth)
@@ -221,7 +223,13 @@ class FlankContacts:
             c.solreffriction[k0:k1] = np.multiply.outer(wf, self.solreffriction)
 
     def step(self, m: mujoco.MjModel, d: mujoco.MjData) -> None:
-        split_step(m, d, self.add)
+        """One step of m (this model) on d: native.STEP with the flank contacts, the compiled step
+        (wormsim.contact3d.flank_loop.flank_step); `native.split_step(m, d, self.add)` is the same from Python."""
+        from wormsim.contact3d.flank_loop import FlankLoop  # flank_loop builds on this module
+
+        if self.stepper is None or self.stepper.d is not d:
+            self.stepper = FlankLoop(self, d, 0, 0, 0, 0, 0, runner=False)
+        self.stepper.step()
 
 
 def flank_contact_details(fc: FlankContacts, d: mujoco.MjData):

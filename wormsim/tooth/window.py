@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import math
 
+import numba
 import numpy as np
 
 from meshgen.geometry import GearGeometry
@@ -18,11 +19,17 @@ def window_size(geo: GearGeometry) -> int:
     return int(min(geo.z2, 2 * math.ceil(half) + 2))
 
 
+@numba.njit(cache=True)
+def window_centre(theta2, tooth0_angle, pitch):
+    """The tooth c whose window (window_teeth_at: c - W // 2 + 1 .. c - W // 2 + W) is nearest the line of centres
+    (angle -pi/2 in the assembly frame), tooth k at angle tooth0 + k pitch + theta2."""
+    return math.floor((-math.pi / 2 - tooth0_angle - theta2) / pitch)
+
+
 def window_teeth_at(theta2: float, z2: int, window: int, tooth0_angle: float) -> np.ndarray:
     """Unwrapped tooth indices k of the window at wheel angle theta2: the W teeth nearest the line of
-    centres (angle -pi/2 in the assembly frame), tooth k at angle tooth0 + 2 pi k / z2 + theta2."""
-    pitch = 2 * math.pi / z2
-    c = math.floor((-math.pi / 2 - tooth0_angle - theta2) / pitch)
+    centres (window_centre), tooth k at angle tooth0 + 2 pi k / z2 + theta2."""
+    c = window_centre(theta2, tooth0_angle, 2 * math.pi / z2)
     h = window // 2
     return np.arange(c - h + 1, c - h + 1 + window)
 
