@@ -74,25 +74,35 @@ def worm_params(g: GearGeometry) -> np.ndarray:
     return P
 
 
-def half_thickness_and_dr(g: GearGeometry, r) -> tuple[np.ndarray, np.ndarray]:
-    """(H(r), dH/dr) (equations (1), (2) above; ZN, ZK, ZC: meshgen.worm_forms), m: the compiled evaluation
-    (meshgen.worm_forms_jit.thread_half_thickness) over r's shape."""
-    r = np.asarray(r, dtype=float)
-    H, dH = np.empty(r.shape), np.empty(r.shape)
-    worm_forms_jit.thread_half_thickness_many(
-        np.ascontiguousarray(r).reshape(-1), worm_params(g), H.reshape(-1), dH.reshape(-1)
-    )
-    return (H[()], dH[()]) if r.ndim == 0 else (H, dH)
+def _t_of_r(g: GearGeometry, r):
+    return np.sqrt(np.maximum(np.asarray(r, dtype=float) ** 2 / g.r_b**2 - 1.0, 0.0))
 
 
 def half_thickness(g: GearGeometry, r):
-    """H(r): axial half-thickness of the thread at radius r (half_thickness_and_dr), m."""
-    return half_thickness_and_dr(g, r)[0]
+    """H(r): axial half-thickness of the thread at radius r (equations (1), (2) above; ZN, ZK, ZC: the table's
+    compiled evaluation, meshgen.worm_forms_jit), m. ZA and ZI stay in numpy here: the compiled closed form
+    (worm_forms_jit.thread_half_thickness, the contact kernel's) differs from it by an ulp at some radii (numpy's
+    arctan against the C library's atan), which moves the runs' results at the 1e-12 level."""
+    r = np.asarray(r, dtype=float)
+    if g.profile in worm_forms.TABLE_FORMS:
+        H = worm_forms.form_table(g).half_thickness(r)
+        return H[()] if r.ndim == 0 else H
+    if g.profile == "ZA":
+        return g.p_x / 4 - (r - g.r1) * math.tan(g.alpha_x)
+    t, t1 = _t_of_r(g, r), float(_t_of_r(g, g.r1))
+    ap = abs(g.p)
+    return g.p_x / 4 - ap * ((t - np.arctan(t)) - (t1 - math.atan(t1)))
 
 
 def half_thickness_dr(g: GearGeometry, r):
-    """dH/dr: ZA -tan(alpha_x); ZI -|p| t / r (0 below r_b); ZN, ZK, ZC the table (half_thickness_and_dr)."""
-    return half_thickness_and_dr(g, r)[1]
+    """dH/dr: ZA -tan(alpha_x); ZI -|p| t / r (0 below r_b); ZN, ZK, ZC: the table (as half_thickness)."""
+    r = np.asarray(r, dtype=float)
+    if g.profile in worm_forms.TABLE_FORMS:
+        dH = worm_forms.form_table(g).half_thickness_dr(r)
+        return dH[()] if r.ndim == 0 else dH
+    if g.profile == "ZA":
+        return np.full_like(r, -math.tan(g.alpha_x))
+    return -abs(g.p) * _t_of_r(g, r) / r
 
 
 def wrap(u, period):

@@ -1,7 +1,8 @@
 """The worm's H(r) compiled, its one evaluation: the axial half-thickness of the thread and its derivative dH/dr at
 radius r (meshgen.worm's equations (1), (2): ZI the involute helicoid, ZA straight; ZN, ZK, ZC the Chebyshev table of
-meshgen.worm_forms.FormTable), on the worm's scalars P (meshgen.worm.worm_params). meshgen.worm.half_thickness,
-FormTable and the contact kernel's worm gap (wormsim.tooth.gap) all call `thread_half_thickness` / `half_thickness`.
+meshgen.worm_forms.FormTable), on the worm's scalars P (meshgen.worm.worm_params). The contact kernel's worm gap
+(wormsim.tooth.gap) calls `thread_half_thickness`, FormTable (and so meshgen.worm.half_thickness for ZN, ZK, ZC) the
+table's `half_thickness`; meshgen.worm keeps ZA and ZI in numpy (its half_thickness says why).
 
 The kernel's scalars P carry the table at P[TABLE_AT:TABLE_AT + 2 + N_CHEB] = [r_lo, r_hi, Chebyshev coefficients]
 (FormTable.params); `half_thickness` evaluates the series by Clenshaw's recurrence with its derivative, continued
@@ -58,13 +59,6 @@ def thread_half_thickness(r, P):
         ap = abs(P[P_P])
         return P[P_PX] / 4 - ap * ((t - math.atan(t)) - P[P_T1]), -ap * t / r
     return P[P_PX] / 4 - (r - P[P_R1]) * P[P_TAN_ALPHA_X], -P[P_TAN_ALPHA_X]
-
-
-@numba.njit(cache=True)
-def thread_half_thickness_many(r, P, H, dH):
-    """thread_half_thickness over the flat array r into H and dH."""
-    for i in range(r.shape[0]):
-        H[i], dH[i] = thread_half_thickness(r[i], P)
 
 
 @numba.njit(cache=True)

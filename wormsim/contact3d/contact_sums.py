@@ -2,6 +2,8 @@
 on the line of centres and the force-weighted contact radius and efficiency. The sums are compiled (one call per
 sample); the efficiency is evaluated once for the whole run from a log of the contacts' radii and weights (the numpy
 version per sample cost about 65 us in small-array overhead; docs/contact3d.md, "Exact flanks: cost").
+`contact_forces` turns the exact-flank contacts' constraint rows into forces and points (wormsim.contact3d.flank_step,
+flank_loop).
 
 Each contact c (force F on the wheel, point p in the assembly frame, worm axis along x at y = -a):
 
@@ -22,6 +24,7 @@ import numba
 import numpy as np
 
 from wormsim import gear_theory as gt
+from wormsim.tooth.pose import N_WORM_PARAMS, to_wheel_body, tooth_angle
 
 
 @numba.njit(cache=True)
@@ -85,3 +88,49 @@ class RadiusLog:
 def radius_mean(W: float, wr: float) -> float:
     """sum w r / sum w; nan without contacts."""
     return wr / W if W > 0 else float("nan")
+
+
+@numba.njit(cache=True)
+def contact_forces(adr, frame, pos, efc_force, cone3, meta, th2, z2, out, P):
+    """flank_step.flank_contact_details' loop over the exact-flank contacts with a constraint row (adr >= 0), in
+    order: out[0] the point in the frame of wheel tooth 0, out[1] the force on the wheel (the normal row and, with an
+    elliptic cone (cone3), the two tangent rows, through the contact frame), out[2] the point; returns (their number,
+    the number of distinct teeth with a nonzero force). P is the kernel's P: with the rigid poses the point is turned
+    by -(th2 + 2 pi k / z2) about z; with displaced poses (P holds them, wormsim.tooth.pose) it goes into the
+    displaced wheel body's frame (pose.to_wheel_body) and is turned by -(2 pi k / z2 + f_k / r2)."""
+    m = 0
+    teeth = np.empty(adr.shape[0])
+    nt = 0
+    displaced = P.shape[0] > N_WORM_PARAMS
+    for c in range(adr.shape[0]):
+        a = adr[c]
+        if a < 0:
+            continue
+        f0 = efc_force[a]
+        f1 = efc_force[a + 1] if cone3 else 0.0
+        f2 = efc_force[a + 2] if cone3 else 0.0
+        fr = frame[c]
+        for i in range(3):
+            out[1, m, i] = f0 * fr[i] + f1 * fr[3 + i] + f2 * fr[6 + i]
+        x, y, z = pos[c, 0], pos[c, 1], pos[c, 2]
+        k = meta[c, 0]
+        if displaced:
+            bx, by, bz = to_wheel_body(x, y, z, P)
+            ang = -(2 * math.pi * k / z2 + tooth_angle(int(k), P)[1])
+        else:
+            bx, by, bz = x, y, z
+            ang = -(th2 + 2 * math.pi * k / z2)
+        ca, sa = math.cos(ang), math.sin(ang)
+        out[0, m, 0], out[0, m, 1], out[0, m, 2] = ca * bx - sa * by, sa * bx + ca * by, bz
+        out[2, m, 0], out[2, m, 1], out[2, m, 2] = x, y, z
+        if out[1, m, 0] != 0.0 or out[1, m, 1] != 0.0 or out[1, m, 2] != 0.0:
+            new = True
+            for t in range(nt):
+                if teeth[t] == k:
+                    new = False
+                    break
+            if new:
+                teeth[nt] = k
+                nt += 1
+        m += 1
+    return m, nt

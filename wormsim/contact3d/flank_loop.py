@@ -17,7 +17,7 @@ exhausted) is not turned into a Python exception here. MuJoCo's warnings (d.warn
 runner's guards read them after each interval.
 
 `sample` is the runner's per-sample work on the flank contacts in one compiled call (`sample_flanks`, which
-flank_samples.run_samples calls too): flank_step.contact_forces (forces, points, teeth touching; with displaced
+flank_samples.run_samples calls too): contact_sums.contact_forces (forces, points, teeth touching; with displaced
 poses the points via the displaced wheel body's frame), the largest penetration, hertz.pattern_rows (the contact
 pattern's rows), contact_sums.radial_and_radius, and the points stored into the run's arrays.
 
@@ -37,9 +37,8 @@ import mujoco
 import numba
 import numpy as np
 
-from wormsim.contact3d.contact_sums import radial_and_radius, radius_mean
+from wormsim.contact3d.contact_sums import contact_forces, radial_and_radius, radius_mean
 from wormsim.contact3d.flank_handoff import Handed, Handoff, fill_add
-from wormsim.contact3d.flank_step import contact_forces
 from wormsim.contact3d.native import N_BEFORE, call_stage, f1, f2, f3, f32x3, f64_at, i1, stage_addresses
 from wormsim.contact3d.series import N_SUMS, add_step
 from wormsim.tooth.hertz import pattern_rows
@@ -252,7 +251,7 @@ class ContactRows(NamedTuple):
 @numba.njit(cache=True)
 def sample_flanks(rows, kern, pose, i, store, work, pat, rlog):
     """FlankLoop.sample's compiled part (module docstring): rows (ContactRows); kern = the kernel's (meta, weight,
-    depth, P) (P: the poses, with assembly errors: flank_step.contact_forces); pose = (th2, z2, centre distance a);
+    depth, P) (P: the poses, with assembly errors: contact_sums.contact_forces); pose = (th2, z2, centre distance a);
     store = (points in tooth 0's frame, forces, points; the run's float32 arrays, row i); work (3, cap, 3); pat =
     PatternLog's (inv_rho, line_len, E*, buffer, rows used); rlog = contact_sums.RadiusLog's (buffer, rows used).
     Returns (teeth touching, largest penetration, F_r,lc, sum w, sum w r, the pattern's rows used, the radius log's

@@ -18,15 +18,14 @@ from __future__ import annotations
 import math
 
 import mujoco
-import numba
 import numpy as np
 
+from wormsim.contact3d.contact_sums import contact_forces
 from wormsim.contact3d.flank_handoff import ContactBuffer, Handed, fill_add
 from wormsim.contact3d.native import MJ_ADD_CONTACT
 from wormsim.tooth.grid import flank_grid
 from wormsim.tooth.kernel import MARGIN_PITCH, TAPER_SHARE, PackedKernel, find_packed
 from wormsim.tooth.merge import split_forces
-from wormsim.tooth.pose import N_WORM_PARAMS, to_wheel_body, tooth_angle
 from wormsim.tooth.window import window_centre
 
 
@@ -236,7 +235,7 @@ def flank_contact_details(fc: FlankContacts, d: mujoco.MjData):
     """As wormsim.contact3d.sources.contact_details for flank contacts: (n teeth touching, max penetration, points in
     the frame of wheel tooth 0, forces on the wheel (world), points (world)). The kernel's contacts are d.contact's
     last fc.n entries; the force on the wheel (geom 2) is the elliptic-cone rows turned into the world frame
-    (`contact_forces`, compiled: this runs at every sample)."""
+    (contact_sums.contact_forces, compiled: this runs at every sample)."""
     n = fc.n if fc.merge else min(fc.n, d.ncon)
     if n == 0:
         z = np.zeros((0, 3))
@@ -246,49 +245,3 @@ def flank_contact_details(fc: FlankContacts, d: mujoco.MjData):
     th2 = float(d.qpos[fc.qa2])
     m, nteeth = contact_forces(adr_all, frame, pos, efc, cone3, fc.meta, th2, fc.bm.geometry.z2, out, fc.params)
     return nteeth, float(fc.depth[:n].max()), out[0, :m], out[1, :m], out[2, :m]
-
-
-@numba.njit(cache=True)
-def contact_forces(adr, frame, pos, efc_force, cone3, meta, th2, z2, out, P):
-    """flank_contact_details' loop over the contacts with a constraint row (adr >= 0), in order: out[0] the point
-    in the frame of wheel tooth 0, out[1] the force on the wheel (the normal row and, with an elliptic cone (cone3),
-    the two tangent rows, through the contact frame), out[2] the point; returns (their number, the number of distinct
-    teeth with a nonzero force). P is the kernel's P: with the rigid poses the point is turned by
-    -(th2 + 2 pi k / z2) about z; with displaced poses (P holds them, wormsim.tooth.pose) it goes into the displaced
-    wheel body's frame (pose.to_wheel_body) and is turned by -(2 pi k / z2 + f_k / r2)."""
-    m = 0
-    teeth = np.empty(adr.shape[0])
-    nt = 0
-    displaced = P.shape[0] > N_WORM_PARAMS
-    for c in range(adr.shape[0]):
-        a = adr[c]
-        if a < 0:
-            continue
-        f0 = efc_force[a]
-        f1 = efc_force[a + 1] if cone3 else 0.0
-        f2 = efc_force[a + 2] if cone3 else 0.0
-        fr = frame[c]
-        for i in range(3):
-            out[1, m, i] = f0 * fr[i] + f1 * fr[3 + i] + f2 * fr[6 + i]
-        x, y, z = pos[c, 0], pos[c, 1], pos[c, 2]
-        k = meta[c, 0]
-        if displaced:
-            bx, by, bz = to_wheel_body(x, y, z, P)
-            ang = -(2 * math.pi * k / z2 + tooth_angle(int(k), P)[1])
-        else:
-            bx, by, bz = x, y, z
-            ang = -(th2 + 2 * math.pi * k / z2)
-        ca, sa = math.cos(ang), math.sin(ang)
-        out[0, m, 0], out[0, m, 1], out[0, m, 2] = ca * bx - sa * by, sa * bx + ca * by, bz
-        out[2, m, 0], out[2, m, 1], out[2, m, 2] = x, y, z
-        if out[1, m, 0] != 0.0 or out[1, m, 1] != 0.0 or out[1, m, 2] != 0.0:
-            new = True
-            for t in range(nt):
-                if teeth[t] == k:
-                    new = False
-                    break
-            if new:
-                teeth[nt] = k
-                nt += 1
-        m += 1
-    return m, nt
