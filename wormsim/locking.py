@@ -73,6 +73,21 @@ def stall_torque_nm(expected_drive_torque_nm: float) -> float:
     return expected_drive_torque_nm / gt.SPEED_DROOP
 
 
+def stick_velocity_m_s(scenario: Scenario, lead_angle_rad: float, alpha_n_rad: float) -> float:
+    """The friction law's stick state at contact3d (wormsim.contact3d.friction_law.stuck_after): v_t =
+    contact.transition_velocity_m_s where the wheel drives (the worm undriven) a pair that self-locks at rest,
+    rho'(mu(0)) >= gamma, else 0 (no stick state: mu follows mu(Vs) from the first sample, as on every other run).
+    Holding from rest needs it: the soft contact lets a freshly loaded pair slide a little (measured on the seat
+    motor demo gear, 2 N m in 2 ms, mu 0.0877 constant: the worm reaches Vs 0.90 mm/s at 1 ms, then creeps at
+    0.09 rpm), and with mu(Vs) blending towards the dynamic value over that slip the pair ran back."""
+    if scenario.drive.on != "wheel":
+        return 0.0
+    mu0 = float(friction_coefficient(scenario.contact, 0.0))
+    if not gt.self_locking(lead_angle_rad, gt.virtual_friction_angle_rad(mu0, alpha_n_rad)):
+        return 0.0
+    return float(scenario.contact.transition_velocity_m_s)
+
+
 def wheel_start_rad(scenario: Scenario, backlash_m: float, r2_m: float, perfect_pair: bool) -> float:
     """The wheel's starting angle at contact3d: a torque-driven wheel (a holding or back-driving run) starts on its
     loaded flank, turned by the half backlash j / (2 r2) (the flank grid's backlash, wormsim.tooth.grid) towards its
@@ -103,4 +118,13 @@ def held_keys(t_s: np.ndarray, worm_speed_rpm: np.ndarray, wheel_torque_nm: np.n
     }
 
 
-__all__ = ["Held", "NOT_LOCKED", "backdrive_self_locks", "held_keys", "run_keys", "stall_torque_nm", "wheel_start_rad"]
+__all__ = [
+    "Held",
+    "NOT_LOCKED",
+    "backdrive_self_locks",
+    "held_keys",
+    "run_keys",
+    "stall_torque_nm",
+    "stick_velocity_m_s",
+    "wheel_start_rad",
+]

@@ -48,7 +48,7 @@ from wormsim.contact3d.flank_loop import (
     run_table,
     sample_table,
 )
-from wormsim.contact3d.friction_law import mu_at
+from wormsim.contact3d.friction_law import mu_at, stuck_after
 from wormsim.contact3d.guards import PENETRATED, RUNNING, STUCK, contact_event, state_event
 from wormsim.contact3d.mjdata_layout import mjdata_offsets
 from wormsim.contact3d.series import column
@@ -92,6 +92,8 @@ G_NAMES = (
     "dof2",
     "z2",
     "deg",
+    "stick_v",  # the friction law's stick state: v_stick (Prepared.stick_velocity_m_s; 0: none)
+    "stuck",  # and the state (1.0 stuck)
 )
 G = enum.IntEnum("G", G_NAMES, start=0)  # g's rows by name: g[G.dt] (numba reads the members as constants)
 
@@ -176,7 +178,9 @@ def run_samples(
             io[IO_EVENT] = EV_FRICTION_CHECK
             return
         vs = abs(w1) * g[G.r1] / g[G.cos_gamma]
-        mu = mu_at(vs, g[G.mu_kind], g[G.mu_a], g[G.mu_b], g[G.mu_c], g[G.deg])
+        stuck = stuck_after(g[G.stuck] != 0.0, vs, g[G.stick_v])  # idempotent: a hand-back repeats it
+        g[G.stuck] = 1.0 if stuck else 0.0
+        mu = mu_at(0.0 if stuck else vs, g[G.mu_kind], g[G.mu_a], g[G.mu_b], g[G.mu_c], g[G.deg])
         if mu != mu_now:  # FlankContacts.set_friction: the records' friction, where the cone's dimension stays
             if (mu > 0.0) != (mu_now > 0.0):  # the cone's dimension changes (FlankContacts.set_friction)
                 io[IO_EVENT] = EV_CONE
@@ -264,6 +268,7 @@ class FlankSamples:
         kind, a, b, c_, deg = bm.plan.mu_params
         g[G.mu_kind], g[G.mu_a], g[G.mu_b], g[G.mu_c] = kind, a, b, c_
         g[G.deg] = deg
+        g[G.stick_v] = bm.plan.stick_velocity_m_s
         g[G.rpm] = RPM
         g[G.a] = geo.a
         g[G.speed_driven] = float(guards.speed_driven)
@@ -297,6 +302,7 @@ class FlankSamples:
         g[G.mu] = fc.mu
         g[G.e_star] = pattern.e_star
         g[G.locked] = float(guards.locked_since is not None)
+        g[G.stuck] = float(guards.stuck)
         io[IO_TURN_MAX], io[IO_PM], io[IO_RM] = guards.turn_max, pattern.m, rlog.m
         run_samples(
             T,
@@ -327,5 +333,6 @@ class FlankSamples:
             fc.template.friction = [fc.mu, fc.mu, 0.0, 0.0, 0.0]
         loop.dropped += int(io[IO_DROPPED])
         guards.turn_max = float(io[IO_TURN_MAX])
+        guards.stuck = bool(g[G.stuck] != 0.0)
         pattern.m, rlog.m = int(io[IO_PM]), int(io[IO_RM])
         return int(io[IO_NEXT]), int(io[IO_EVENT])

@@ -11,6 +11,7 @@ from wormsim.friction import GROUPS, friction_coefficient
 from wormsim.units import DEG
 
 CONSTANT, STEP, GROUP = 0.0, 1.0, 2.0  # mu_params' kind
+STICK_RELEASE = 0.1  # stuck_after: a sliding pair sticks again below this fraction of v_stick
 
 
 def mu_params(contact) -> tuple[float, float, float, float, float]:
@@ -45,6 +46,19 @@ def mu_at(vs, kind, a, b, c, deg):
         s = 0.0 if s < 0.0 else (1.0 if s > 1.0 else s)
         return h0 + (h1 - h0) * s * s * (3.0 - 2.0 * s)
     return math.tan(deg / (a * abs(vs) ** b + c))
+
+
+@numba.njit(cache=True, inline="always")
+def stuck_after(stuck, vs, v_stick):
+    """The stick state after a sample at the sliding speed vs (pre-sliding, as a static friction model's stick
+    phase: the static coefficient holds until the slip breaks away): a stuck pair stays stuck while vs < v_stick
+    and breaks away at vs >= v_stick; a sliding pair sticks again below STICK_RELEASE v_stick. While stuck, mu is
+    mu(0) (mu_at(0.0, ...)), else mu(vs). v_stick <= 0: never stuck (mu(vs) throughout). contact3d runs with
+    v_stick = contact.transition_velocity_m_s where the wheel drives a pair that self-locks at rest, starting stuck
+    (wormsim.locking.stick_velocity_m_s), and with 0 otherwise."""
+    if v_stick <= 0.0:
+        return False
+    return vs < (v_stick if stuck else STICK_RELEASE * v_stick)
 
 
 @numba.njit(cache=True)

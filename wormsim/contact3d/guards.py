@@ -83,6 +83,7 @@ class Guards:
         self.locked_since: float | None = None
         self.self_locking_backdrive = backdrive_self_locks(scenario, geo.gamma_m, geo.alpha_n)
         self.turn_max = 0.0
+        self.stuck = plan.stick_velocity_m_s > 0.0  # the friction law's stick state: a run starts at rest
         # sliding contacts' friction against their slip (wormsim.contact3d.friction_guard)
         self.friction = FrictionGuard(bm, rec * self.dt, scenario)
 

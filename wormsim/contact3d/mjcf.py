@@ -55,7 +55,7 @@ from wormsim.contact3d.mass_scaling import ScalingCheck
 from wormsim.contact3d.timestep import timestep_for
 from wormsim.friction import friction_coefficient
 from wormsim.geometry import derive, displaced_pair, gear_set, solid_set
-from wormsim.locking import backdrive_self_locks, stall_torque_nm, wheel_start_rad
+from wormsim.locking import backdrive_self_locks, stall_torque_nm, stick_velocity_m_s, wheel_start_rad
 from wormsim.scenario import Scenario, ScenarioError, Simulation
 from wormsim.tooth.grid import SLICES_MASS_SCALED, FlankGrid, default_slices, flank_grid
 from wormsim.tooth.window import slot_quat, window_size, window_teeth_at
@@ -134,6 +134,7 @@ class Prepared:
     grid: FlankGrid | None = None  # contact.geometry flanks: the flank grid of law.contacts_per_pair slices
     mu_params: tuple = ()  # the friction law mu(Vs) (wormsim.contact3d.friction_law.mu_params)
     transition_velocity_m_s: float = 0.0  # contact.transition_velocity_m_s
+    stick_velocity_m_s: float = 0.0  # the friction law's stick state (wormsim.locking.stick_velocity_m_s); 0: none
     e_star_pa: float = 0.0  # the pair's effective modulus (gear_theory.effective_modulus_pa)
     timestep_s: float = 0.0  # the model's timestep (build_model: timestep_for's or the one given)
     window_teeth: int = 0  # the wheel tooth slots with collision (build_model)
@@ -358,6 +359,7 @@ def prepare(scenario: Scenario, gs: GearSet | None = None) -> Prepared:
         grid,
         mu_params=mu_params(scenario.contact),
         transition_velocity_m_s=scenario.contact.transition_velocity_m_s,
+        stick_velocity_m_s=stick_velocity_m_s(scenario, geo.gamma_m, geo.alpha_n),
         e_star_pa=e_star,
         worm_speed_rad_s=w1,
         wheel_torque_nm=t2,

@@ -32,7 +32,7 @@ from wormsim import jit_cache, prewarm
 from wormsim.contact3d import jit_warmup, mass_scaling
 from wormsim.contact3d.contact_sums import RadiusLog
 from wormsim.contact3d.diagnosis import diverged_error
-from wormsim.contact3d.friction_law import mu_of
+from wormsim.contact3d.friction_law import mu_of, stuck_after
 from wormsim.contact3d.guards import Guards
 from wormsim.contact3d.metrics import contact3d_summary
 from wormsim.contact3d.mjcf import BuiltModel, build_model
@@ -161,7 +161,9 @@ def _sample(src, bm: BuiltModel, d, guards, S_all, rlog, store, rec: int, slog, 
     w1, w2 = float(qv[bm.worm_dof]), float(qv[bm.wheel_dof])
     t = float(d.time)
     te = guards.state(d, t, th1, th2, w1, w2)
-    mu = mu_of(abs(w1) * geo.r_m1 / math.cos(geo.gamma_m), bm.plan.mu_params)  # at the sliding speed Vs
+    vs = abs(w1) * geo.r_m1 / math.cos(geo.gamma_m)  # the sliding speed Vs
+    guards.stuck = stuck_after(guards.stuck, vs, bm.plan.stick_velocity_m_s)
+    mu = mu_of(0.0 if guards.stuck else vs, bm.plan.mu_params)  # static while stuck (friction_law.stuck_after)
     # each contact's force turned about the worm axis onto the line of centres: the radial force DIN 3975's
     # single pitch-point contact means; the force-weighted contact radius and efficiency there (contact_sums)
     nteeth, pen, fr_lc, r_c = src.sample(i, th2, mu, rlog, store)
