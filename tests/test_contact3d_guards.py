@@ -70,7 +70,10 @@ def _rho_deg(mu: float, alpha_n_deg: float) -> float:
                     "to 24 kN m (T_expected / SPEED_DROOP): the flank contacts slide in the held mesh where the "
                     "pieces hold (under 0.1 %); the seat motor demo gear's flanks hold (0.079 rpm at 1 N m, "
                     "tests/test_locking.py); the friction rows' damping at c_c (no sliding speed) and impratio "
-                    "1.2e6 did not change it. Not resolved (issue 31 item 4)"
+                    "1.2e6 did not change it, nor did 20 noslip iterations (opt.noslip_iterations; 9.68 rpm). The wheel "
+                    "still turns into the worm at up to 40 rpm (27 rpm at the end, penetration up to 1 mm) and the worm "
+                    "moves with it at 1-16 rpm: the stall torque overruns the contact; constant mu, so the friction "
+                    "law's stick state (decision 0039) does not apply. Not resolved (issue 31 item 4)"
                 ),
             ),
         ),
