@@ -14,7 +14,9 @@ each case (a long sweep can be cut).
 
 --medium runs the variety and random gears at simulation.resolution medium (the default resolution; their test
 configurations are coarse, 8 slices). --save writes each run's contact pattern table and F_t (npz). --factor F
-compares F x the default count against 2 F x it (the record's default_slices is then F x the default).
+compares F x the default count against 2 F x it (the record's default_slices is then F x the default). --impedance D
+runs with the contacts' impedance d = D (wormsim.contact3d.law.IMPEDANCE, the constraint's added mass d / (1 - d)
+of the mesh's effective mass per contact row) instead of the model's; the record says which (`impedance`).
 """
 
 from __future__ import annotations
@@ -121,8 +123,15 @@ def main() -> None:
     ap.add_argument("--record", default="slice_convergence_default")
     ap.add_argument("--save", type=Path, help="folder: each run's contact pattern table and F_t (npz)")
     ap.add_argument("--factor", type=int, default=1, help="compare factor x the default against twice that")
+    ap.add_argument("--impedance", type=float, help="the contacts' impedance d instead of law.IMPEDANCE")
     a = ap.parse_args()
-    out: dict = {"band_hz": BAND_HZ, "medium": a.medium, "factor": a.factor, "cases": {}}
+    if a.impedance is not None:  # an experiment on the law's constant (contact_law reads it at each build)
+        from wormsim.contact3d import law
+
+        law.IMPEDANCE = a.impedance
+    from wormsim.contact3d.law import IMPEDANCE
+
+    out: dict = {"band_hz": BAND_HZ, "medium": a.medium, "factor": a.factor, "impedance": IMPEDANCE, "cases": {}}
     for name in a.cases:
         s0 = a.factor * flank_slices(scenario(name, None, a.medium))
         try:
