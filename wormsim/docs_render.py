@@ -1205,6 +1205,10 @@ TABLES: dict[str, Callable[[], str]] = {
     "stiffness_seeds": stiffness_seeds_table,
     "slice_convergence": slice_convergence_table,
     "slice_convergence_double": lambda: slice_convergence_table("slice_convergence_double"),
+    "slice_convergence_impedance": lambda: slice_convergence_table(
+        "slice_convergence_impedance", "slice_convergence_impedance_rest"
+    ),
+    "slice_convergence_impedance_double": lambda: slice_convergence_table("slice_convergence_impedance_double"),
     "torsional_seeds": torsional_seeds_table,
     "rexs_stages": rexs_stages_table,
     "rexs_rating": rexs_rating_table,
