@@ -86,3 +86,29 @@ def test_local_workers_start_warm_from_the_fork_server(tmp_path):
     assert len(timing) == 2, timing
     warmed_by = {t["warmed_by_pid"] for t in timing}
     assert len(warmed_by) == 1 and None not in warmed_by and not warmed_by & {t["pid"] for t in timing}, timing
+
+
+def test_warm_worker_runs_once_per_process(monkeypatch):
+    """wormsim.sweep.warm.warm_worker: ensure_warm and the short run once; later calls (a worker forked from a warm
+    fork server, the plugin after the preload) skip; a failure is reported, not raised, and leaves it to retry."""
+    import os
+
+    from wormsim import jit_cache
+    from wormsim.contact3d import runner as c3d_runner
+    from wormsim.sweep import warm
+
+    calls = []
+    monkeypatch.setattr(warm, "_warm_pid", None)
+    monkeypatch.setattr(jit_cache, "ensure_warm", lambda runs: calls.append("ensure") or False)
+    monkeypatch.setattr(c3d_runner, "warm_runs", lambda runs: calls.append(("run", len(runs))))
+
+    def fails(runs):
+        raise RuntimeError("no cache")
+
+    monkeypatch.setattr(c3d_runner, "warm_runs", fails)
+    assert warm.warm_worker()["error"] == "RuntimeError: no cache" and warm.warm_pid() is None
+    monkeypatch.setattr(c3d_runner, "warm_runs", lambda runs: calls.append(("run", len(runs))))
+    assert warm.warm_worker() == {"compiled": False, "error": None, "skipped": False}
+    assert warm.warm_pid() == os.getpid()
+    assert warm.warm_worker()["skipped"] is True
+    assert calls == ["ensure", "ensure", ("run", 1)]
