@@ -222,8 +222,8 @@ def _cmd_sweep(args) -> int:
         raise ScenarioError(f"--workers {args.workers}: allowed an integer >= 1")
     started: list[ClusterStart] = []  # the cluster starts while the points are validated
 
-    def start() -> None:
-        started.append(ClusterStart(args.scheduler, args.workers))
+    def start(contact3d: bool) -> None:
+        started.append(ClusterStart(args.scheduler, args.workers, warm=contact3d))
 
     try:
         sw = load_sweep(args.sweep, on_parsed=start)

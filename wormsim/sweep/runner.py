@@ -49,6 +49,9 @@ def run_point(scenario: dict, keep_files: bool) -> dict:
     """One point, on a worker: simulate (and with keep_files write the result folder into a temporary directory
     and return its files). Never raises for a failed simulation: returns status "failed" and the message."""
     t_start = time.time()
+    from wormsim.sweep.warm import warm_pid
+
+    warmed_by = warm_pid()
     from wormsim.errors import SimulationError
     from wormsim.run import run_scenario, simulate
     from wormsim.scenario import Scenario
@@ -106,6 +109,9 @@ def run_point(scenario: dict, keep_files: bool) -> dict:
             "start": t_start,
             "end": time.time(),
             "setup_s": t_setup,
+            # the pid that loaded the kernels before this point: the fork server's for a worker forked warm
+            "warmed_by_pid": warmed_by,
+            "pid": os.getpid(),
             # this worker process's totals so far: seconds compiling, signatures compiled / loaded (wormsim.jit_cache)
             "compile_s": jit_cache.compile_seconds(),
             "jit_misses": jit["misses"],
@@ -287,6 +293,17 @@ def default_workers() -> int:
 LOCAL_START_METHOD = "forkserver"
 
 
+def start_fork_server(warm: bool) -> None:
+    """Start multiprocessing's fork server now, preloading the workers' imports (wormsim.sweep.preload) and with
+    `warm` the compiled contact3d kernels (wormsim.sweep.preload_warm), once for all workers, on another core while
+    this process validates the points. A server that runs already (an earlier sweep in this process) is kept."""
+    import multiprocessing
+    from multiprocessing import forkserver
+
+    multiprocessing.set_forkserver_preload(["wormsim.sweep.preload_warm" if warm else "wormsim.sweep.preload"])
+    forkserver.ensure_running()
+
+
 def open_client(scheduler: str | None, workers: int | None):
     """(client, cluster or None, info). scheduler None: a LocalCluster of `workers` single-threaded processes.
     Raises ScenarioError for a bad --workers or a scheduler that does not answer."""
@@ -357,12 +374,14 @@ class ClusterStart:
     """open_client in a thread, started before the sweep file is validated (the cluster's start overlaps it);
     `get()` waits for it (and re-raises its error), `close()` closes what it opened."""
 
-    def __init__(self, scheduler: str | None, workers: int | None):
+    def __init__(self, scheduler: str | None, workers: int | None, warm: bool = True):
         import threading
 
         self._result: tuple | None = None
         self._error: BaseException | None = None
         scheduler = scheduler or os.environ.get(SCHEDULER_ENV) or None
+        if scheduler is None:
+            start_fork_server(warm)
         self._thread = threading.Thread(
             target=self._run, args=(scheduler, workers), name="wormsim-cluster-start", daemon=True
         )
@@ -495,7 +514,7 @@ def run_sweep(
     try:
         if todo:
             if started is None:
-                started = ClusterStart(scheduler, workers)
+                started = ClusterStart(scheduler, workers, warm=any(p.scenario.model == "contact3d" for p in todo))
             client, cluster, cluster_info = started.get()
             started = None
             if any(p.scenario.model == "contact3d" for p in todo):

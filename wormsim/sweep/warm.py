@@ -11,12 +11,25 @@ A failure is dropped: the point compiles or loads for itself.
 from __future__ import annotations
 
 import asyncio
+import os
 
 from distributed.diagnostics.plugin import WorkerPlugin
 
+_warm_pid: int | None = None  # the process that ran the short run: this one, or the fork server it was forked from
+
+
+def warm_pid() -> int | None:
+    """The pid of the process that ran the short run in this process's memory (os.getpid(), or the fork server's
+    for a worker forked from a warm one); None before it."""
+    return _warm_pid
+
 
 def warm_worker() -> dict:
-    """ensure_warm and the short run in this process; returns {"compiled": bool, "error": str | None}."""
+    """ensure_warm and the short run in this process, unless done here already (a worker forked from the warm fork
+    server: wormsim.sweep.preload); returns {"compiled": bool, "error": str | None, "skipped": bool}."""
+    global _warm_pid
+    if _warm_pid is not None:
+        return {"compiled": False, "error": None, "skipped": True}
     from wormsim import jit_cache
     from wormsim.contact3d.runner import warm_runs
 
@@ -24,8 +37,9 @@ def warm_worker() -> dict:
         compiled = jit_cache.ensure_warm(warm_runs)
         warm_runs(jit_cache.WARM_RUNS[:1])
     except Exception as exc:  # (the points compile or load for themselves)
-        return {"compiled": False, "error": f"{exc.__class__.__name__}: {exc}"}
-    return {"compiled": compiled, "error": None}
+        return {"compiled": False, "error": f"{exc.__class__.__name__}: {exc}", "skipped": False}
+    _warm_pid = os.getpid()
+    return {"compiled": compiled, "error": None, "skipped": False}
 
 
 class WarmKernels(WorkerPlugin):
