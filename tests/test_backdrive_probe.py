@@ -7,7 +7,7 @@ import pytest
 from conftest import ROOT
 
 from meshgen.geometry import derive
-from wormsim.gear_theory import efficiency_at_radius
+from wormsim.physics.gear_theory import efficiency_at_radius
 from wormsim.run import simulate
 from wormsim.scenario import ScenarioError, load_scenario
 

@@ -1,4 +1,4 @@
-"""The compiled kernels' cache (wormsim.jit_cache): keyed by the code the compiled functions read, one folder per
+"""The compiled kernels' cache (wormsim.runtime.jit_cache): keyed by the code the compiled functions read, one folder per
 machine for every process, filled once under a lock, and the progress line's "compiling". The long test compiles on a
 fresh cache: two processes at once compile once, and a later process's contact3d runs compile nothing."""
 
@@ -17,7 +17,8 @@ from pathlib import Path
 
 import pytest
 
-from wormsim import jit_cache, progress
+from wormsim.runfolder import progress
+from wormsim.runtime import jit_cache
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -35,7 +36,7 @@ def test_key_follows_the_compiled_code_and_not_the_rest(tmp_path, monkeypatch):
     cli = tmp_path / "wormsim" / "cli.py"
     cli.write_text(cli.read_text() + "\n# a comment\n")
     assert jit_cache.cache_key() == k0  # the command line is not compiled code
-    for rel in ("wormsim/friction.py", "wormsim/tooth/gap.py", "meshgen/worm_forms_jit.py"):
+    for rel in ("wormsim/physics/friction.py", "wormsim/tooth/gap.py", "meshgen/worm_forms_jit.py"):
         f = tmp_path / rel
         text = f.read_text()
         f.write_text(text + "\n# changed\n")

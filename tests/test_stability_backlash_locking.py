@@ -27,9 +27,9 @@ from wormsim import cli
 from wormsim.contact3d.backlash import UM, flank_clearance_m, min_backlash_m, piece_bulge_m, piece_play
 from wormsim.contact3d.mjcf import build_model
 from wormsim.contact3d.runner import run_model, simulate
+from wormsim.physics.units import MM
 from wormsim.scenario import ScenarioError, load_scenario
 from wormsim.torsional import dynamics as torsional
-from wormsim.units import MM
 
 DEMO = SCEN / "seat_motor_demo.yaml"
 # the backlash check is the collision pieces' (their bulge beyond the exact flanks): its tests pin contact.geometry
@@ -263,7 +263,7 @@ def test_contact3d_lock_boundary_within_0p3_deg(demo_geometry, contact3d_free_rp
     reason=(
         "contact3d, static friction above and dynamic below the boundary (mu_s 0.0877 = gamma + 0.3 deg, mu_d 0.0773 = "
         "gamma - 0.3 deg), 2 N m on the seat motor demo wheel in 2 ms: the worm runs back at 1308 rpm (3.2 % of free) "
-        "though the wheel starts on its loaded flank (wormsim.locking.wheel_start_rad; centred: 1353 rpm, the impact "
+        "though the wheel starts on its loaded flank (wormsim.physics.locking.wheel_start_rad; centred: 1353 rpm, the impact "
         "after the backlash). The 2 ms ramp loads the contact so fast that the 4 g worm passes 5 rpm (Vs 2.2 mm/s > "
         "contact.transition_velocity_m_s 1 mm/s) within 0.5 ms, and mu(Vs) is dynamic from then on; impratio x100 and "
         "MuJoCo's noslip solver (20 iterations) gave the same 1308 rpm (the contacts are on the cone, where neither "
@@ -277,7 +277,7 @@ def test_contact3d_static_friction_governs_from_rest(demo_geometry, contact3d_fr
 
 def test_contact3d_static_friction_holds_from_rest_in_flank_contact(demo_geometry, contact3d_free_rpm):
     """Static self-locking from rest (issue 31): the same pair and friction (static above, dynamic below the
-    boundary), the wheel starting on its loaded flank (wormsim.locking.wheel_start_rad) and loaded over 20 ms, the
+    boundary), the wheel starting on its loaded flank (wormsim.physics.locking.wheel_start_rad) and loaded over 20 ms, the
     worm free, 0.03 s: the worm creeps at 0.09 rpm (measured), below 0.1 % of the free speed. The free speed here
     is the 2 ms ramp's at 0.01 s (41 000 rpm, the fixture), a lower bound of this run's (its torque-time integral
     is 20 ms x 2 N m against 9 ms x 2 N m). Started centred in the backlash, the same run ran back at 2690 rpm."""
@@ -294,7 +294,7 @@ def test_contact3d_static_friction_holds_from_rest_in_flank_contact(demo_geometr
     res = simulate(sc)
     held = abs(float(res.series["worm_speed_rpm"][-1]))
     assert held < 1e-3 * contact3d_free_rpm
-    s = res.summary  # the summary says so (wormsim.locking.run_keys): held at the wheel's 2 N m
+    s = res.summary  # the summary says so (wormsim.physics.locking.run_keys): held at the wheel's 2 N m
     assert s["locked"] is True and s["holding_torque_nm"] == 2.0 and s["creep_speed_rpm"] < 1e-3 * contact3d_free_rpm
 
 

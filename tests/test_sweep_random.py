@@ -1,5 +1,5 @@
 """The sweep file's random block with list draws (size: N, one value per wheel tooth) and the tolerance study's
-sweep files (sweeps/tolerance_grade.py, issue 12): reproducible draws within the limits, bad input exit 2."""
+sweep files (studies/tolerance_grade.py, issue 12): reproducible draws within the limits, bad input exit 2."""
 
 import importlib.util
 from pathlib import Path

@@ -1,5 +1,6 @@
 """The friction law mu(Vs) in compiled form, the one the runs use (Python sample loop and compiled samples alike):
-wormsim.friction.friction_coefficient_scalar's three forms with its operations, on five parameters (`mu_params`)."""
+wormsim.physics.friction.friction_coefficient_scalar's three forms with its operations, on five parameters
+(`mu_params`)."""
 
 from __future__ import annotations
 
@@ -7,15 +8,15 @@ import math
 
 import numba
 
-from wormsim.friction import GROUPS, friction_coefficient
-from wormsim.units import DEG
+from wormsim.physics.friction import GROUPS, friction_coefficient
+from wormsim.physics.units import DEG
 
 CONSTANT, STEP, GROUP = 0.0, 1.0, 2.0  # mu_params' kind
 
 
 def mu_params(contact) -> tuple[float, float, float, float, float]:
     """(kind, a, b, c, deg) of the scenario's contact block: constant mu = a; STEP(|Vs|, 0, a = static, b = v_t,
-    c = dynamic); friction group tan(deg / (a |Vs|^b + c)) (seed 000's rho(Vs), wormsim/friction.py)."""
+    c = dynamic); friction group tan(deg / (a |Vs|^b + c)) (seed 000's rho(Vs), wormsim/physics/friction.py)."""
     if contact.friction_group is not None:
         a, b, c = GROUPS[contact.friction_group]
         return GROUP, float(a), float(b), float(c), DEG
@@ -34,7 +35,7 @@ def mu_params(contact) -> tuple[float, float, float, float, float]:
 
 @numba.njit(cache=True, inline="always")
 def mu_at(vs, kind, a, b, c, deg):
-    """mu at the sliding speed vs (mu_params' forms; STEP is wormsim.units.step(|vs|, 0, a, b, c))."""
+    """mu at the sliding speed vs (mu_params' forms; STEP is wormsim.physics.units.step(|vs|, 0, a, b, c))."""
     if kind == CONSTANT:
         return a
     if kind == STEP:
