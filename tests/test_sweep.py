@@ -87,7 +87,7 @@ def test_points_are_validated_and_hashed():
     assert load_sweep(SWEEP).points[0].scenario_hash == sw.points[0].scenario_hash
 
 
-@pytest.mark.parametrize("path", sorted((ROOT / "sweeps").glob("*.yaml")), ids=lambda p: p.stem)
+@pytest.mark.parametrize("path", sorted((ROOT / "studies").glob("*.yaml")), ids=lambda p: p.stem)
 def test_shipped_sweeps_validate(path):
     """Every study in studies/ expands into valid points (they run for minutes, so CI only validates them)."""
     sw = load_sweep(path)
