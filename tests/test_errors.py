@@ -165,7 +165,7 @@ def test_cli_exit_2_names_the_limit(tmp_path):
         [
             sys.executable,
             "-m",
-            "wormsim.cli",
+            "wormsim",
             "run",
             str(SCEN / "seat_motor.yaml"),
             "--out",

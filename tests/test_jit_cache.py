@@ -33,7 +33,7 @@ def test_key_follows_the_compiled_code_and_not_the_rest(tmp_path, monkeypatch):
     monkeypatch.setattr(jit_cache, "_ROOT", _copy_tree(tmp_path))
     k0 = jit_cache.cache_key()
     assert k0 == jit_cache.cache_key() and len(k0) == 16
-    cli = tmp_path / "wormsim" / "cli.py"
+    cli = tmp_path / "wormsim" / "cli" / "entry.py"
     cli.write_text(cli.read_text() + "\n# a comment\n")
     assert jit_cache.cache_key() == k0  # the command line is not compiled code
     for rel in ("wormsim/physics/friction.py", "wormsim/tooth/gap.py", "meshgen/worm_forms_jit.py"):
@@ -51,7 +51,7 @@ def test_the_key_is_remembered_by_the_files_stamps(tmp_path, monkeypatch):
     root.mkdir()
     k0 = jit_cache._key_memo(root)
     assert k0 == jit_cache.cache_key() and json.loads((root / "keys.json").read_text()) == {jit_cache._stamp(): k0}
-    f = tmp_path / "src" / "wormsim" / "friction.py"
+    f = tmp_path / "src" / "wormsim" / "physics" / "friction.py"
     f.write_text(f.read_text() + "\n# changed\n")
     k1 = jit_cache._key_memo(root)
     assert k1 != k0 and k1 == jit_cache.cache_key() and len(json.loads((root / "keys.json").read_text())) == 2
