@@ -48,7 +48,7 @@ from meshgen.errors import GeometryError
 from meshgen.worm_forms import DEFAULT_PROFILE_RADIUS_MODULES, DEFAULT_TOOL_DIAMETER_MM
 
 # meshgen reads gear data in the units of its field names (mm, deg) and works in SI: these are its conversions
-# (the simulator's are in wormsim.units; meshgen imports nothing from wormsim)
+# (the simulator's are in wormsim.physics.units; meshgen imports nothing from wormsim)
 MM = 1e-3  # m per mm
 DEG = math.pi / 180.0  # rad per deg
 

@@ -7,7 +7,7 @@ import pytest
 from conftest import ROOT
 
 from meshgen.geometry import derive
-from wormsim.gear_theory import efficiency_at_radius
+from wormsim.physics.gear_theory import efficiency_at_radius
 from wormsim.run import simulate
 from wormsim.scenario import ScenarioError, load_scenario
 
@@ -53,7 +53,7 @@ def test_probe_scenario_swaps_drive_and_load_and_reads_the_held_worm():
     from types import SimpleNamespace
 
     from wormsim.contact3d import backdrive
-    from wormsim.errors import LockedError
+    from wormsim.exceptions import LockedError
 
     sc = load_scenario(MINIMAL, PROBE)
     fwd = {"wheel_speed_mean_rpm": 15.0, "efficiency_backdrive": 0.45, "ratio_theory": 40.0}

@@ -12,8 +12,8 @@ import math
 
 import pytest
 
-from wormsim import gear_theory
-from wormsim.geometry import derive
+from wormsim.physics import gear_theory
+from wormsim.physics.geometry import derive
 from wormsim.scenario import load_scenario
 from wormsim.tooth import calculix as cx
 from wormsim.tooth.compliance import iso6336_stiffness

@@ -20,8 +20,8 @@ from conftest import SCENARIOS as SCEN
 
 from wormsim.contact3d.law import friction_regularisation_velocity_m_s, friction_utilisation
 from wormsim.contact3d.mjcf import build_model
-from wormsim.friction import friction_coefficient
-from wormsim.gear_theory import commands, mesh_arms_m
+from wormsim.physics.friction import friction_coefficient
+from wormsim.physics.gear_theory import commands, mesh_arms_m
 from wormsim.scenario import ScenarioError, load_scenario
 
 DURATION_S = 0.05  # 10 000 steps of 5 us; contacts read over the last 40 % (after the 0.01 s ramps)
@@ -116,7 +116,7 @@ def test_impratio_follows_the_working_load():
 
 def test_load_inertia_is_the_loaded_hinge_armature_and_in_the_contact_mass():
     """load.inertia_kg_m2 (driven machine, rigid on the loaded shaft): the wheel hinge's armature, and the contact
-    law's A_hat = arm1^2 / I1 + arm2^2 / (I2 + J) (wormsim.gear_theory.mesh_arms_m) uses it; the bare gear is unchanged."""
+    law's A_hat = arm1^2 / I1 + arm2^2 / (I2 + J) (wormsim.physics.gear_theory.mesh_arms_m) uses it; the bare gear is unchanged."""
 
     over = ["simulation.resolution=coarse"]
     bare = build_model(load_scenario(SCEN / "seat_motor.yaml", over))

@@ -28,8 +28,8 @@ from wormsim.contact3d.friction_guard import friction_error
 from wormsim.contact3d.mjcf import build_model
 from wormsim.contact3d.runner import simulate
 from wormsim.contact3d.timestep import default_timestep
-from wormsim.errors import LockedError, SimulationError
-from wormsim.gear_theory import penetration_limit_m
+from wormsim.exceptions import LockedError, SimulationError
+from wormsim.physics.gear_theory import penetration_limit_m
 from wormsim.scenario import load_scenario
 
 DEMO = SCEN / "seat_motor_demo.yaml"
@@ -82,8 +82,8 @@ def _rho_deg(mu: float, alpha_n_deg: float) -> float:
 )
 def test_self_locking_pair_with_speed_driven_wheel_is_held_through_the_cli(tmp_path, capsys, geometry):
     """mu = 0.2: rho' = 12.0 deg > gamma = 5.71 deg, the wheel cannot turn the worm. That is the run's result
-    (wormsim.locking), not a failure: exit 0, status ok, `locked` true, the holding torque the stalled servo pushed
-    with (wormsim.locking.stall_torque_nm) and a creeping worm; no message about the contact. For each
+    (wormsim.physics.locking), not a failure: exit 0, status ok, `locked` true, the holding torque the stalled servo pushed
+    with (wormsim.physics.locking.stall_torque_nm) and a creeping worm; no message about the contact. For each
     contact.geometry. Before: exit 3, "the drive locked" (and with flanks the friction guard: at the worm load's
     normal force the flank contacts' friction rows were sized for 1e-4 of the held force)."""
     # gamma = atan(z1 / q) = atan(1 / 10) = 5.71 deg for the screw jack (scenarios/screw_jack.yaml)

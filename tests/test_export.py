@@ -10,7 +10,7 @@ from conftest import SCENARIOS
 
 from meshgen.export import assembly_data
 from meshgen.section import plot_section
-from wormsim.geometry import gear_set
+from wormsim.physics.geometry import gear_set
 from wormsim.scenario import load_scenario
 
 

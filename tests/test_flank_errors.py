@@ -170,7 +170,7 @@ def _kinematic_centroid_m(sc, res) -> float:
     here)."""
     from meshgen import displaced
     from meshgen import kinematic_tca as kt
-    from wormsim import gear_theory as gt
+    from wormsim.physics import gear_theory as gt
 
     bm = res.extra["built"]
     g = bm.geometry

@@ -54,7 +54,7 @@ def test_the_resolution_levels_differ_in_what_check_prints(name):
     """simulation.resolution makes a difference (issue 31): `wormsim check`'s derived values give each level its own
     slice count, coarse < medium < fine, for the seeds (seat motor 8 / 32 / 64, screw jack 8 / 16 / 32, involute_41
     8 / 24 / 48)."""
-    from wormsim.check_cmd import level_lines
+    from wormsim.cli.check import level_lines
 
     counts = []
     for level in ("coarse", "medium", "fine"):

@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from wormsim.friction import GROUPS, rho_rad, rho_static_rad
+from wormsim.physics.friction import GROUPS, rho_rad, rho_static_rad
 
 DEG = math.pi / 180
 

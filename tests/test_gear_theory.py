@@ -1,4 +1,4 @@
-"""wormsim.gear_theory: each shared formula pinned against values computed by hand from its source (DIN 3975-2,
+"""wormsim.physics.gear_theory: each shared formula pinned against values computed by hand from its source (DIN 3975-2,
 seed 000, ADAMS STEP), so that a level that calls it and a copy that drifts both show here."""
 
 from __future__ import annotations
@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from wormsim import gear_theory as gt
+from wormsim.physics import gear_theory as gt
 from wormsim.scenario import Material, Materials, load_scenario
 
 DEG = math.pi / 180
@@ -101,7 +101,7 @@ def test_commands_follow_adams_step_and_the_load_resists(scenario_dir):
     # STEP: s^2 (3 - 2 s) at s = 0.25 -> 0.15625; float and array paths agree exactly
     assert c.drive(t)[1] == pytest.approx(0.15625 * w)
     assert list(c.drive(t)) == [c.drive(float(x)) for x in t]
-    # ramp_s 0.3 of scenarios/seat_motor.yaml; + LOCK_SETTLE_S 0.02 of wormsim/gear_theory.py
+    # ramp_s 0.3 of scenarios/seat_motor.yaml; + LOCK_SETTLE_S 0.02 of wormsim/physics/gear_theory.py
     assert gt.ramps_end_s(sc) == 0.3 and gt.lock_check_start_s(sc) == pytest.approx(0.32)
 
 

@@ -16,13 +16,13 @@ import pytest
 from conftest import SCENARIOS
 
 from wormsim import cli
-from wormsim import gear_theory as gt
 from wormsim.contact3d import mass_scaling as msm
 from wormsim.contact3d.mjcf import prepare
 from wormsim.contact3d.runner import simulate
 from wormsim.contact3d.timestep import choose_timestep
-from wormsim.errors import RingingError
-from wormsim.gear_theory import round_down_125
+from wormsim.exceptions import RingingError
+from wormsim.physics import gear_theory as gt
+from wormsim.physics.gear_theory import round_down_125
 from wormsim.scenario import ScenarioError, load_scenario
 
 SEAT = SCENARIOS / "seat_motor.yaml"
@@ -46,10 +46,10 @@ def run(ms: str) -> dict:
 @pytest.mark.parametrize("ms", ["300", "auto"])
 def test_scaled_run_keeps_the_closed_forms(ms):
     """At a step >= 10 x the unscaled default: mean F_t within 1 % of T2 / r2 (DIN 3975-2, statics), the efficiency
-    within 1 % of tan(g_r) / tan(g_r + rho') at the contacts' radius (wormsim.gear_theory.efficiency_at_radius), the
+    within 1 % of tan(g_r) / tan(g_r + rho') at the contacts' radius (wormsim.physics.gear_theory.efficiency_at_radius), the
     ratio within 0.01 % of z2 / z1. Measured (S = 300 / 200): 1e-6 off the efficiency, 1e-4 off F_t."""
     from meshgen.geometry import derive
-    from wormsim.gear_theory import efficiency_at_radius
+    from wormsim.physics.gear_theory import efficiency_at_radius
 
     s = run(ms)
     sc1 = load_scenario(SEAT, CFG)

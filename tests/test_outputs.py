@@ -1,4 +1,4 @@
-"""The output-key reference (wormsim.outputs, docs/outputs.md): every key a level writes has an entry, the doc is
+"""The output-key reference (wormsim.results.summary_keys, docs/outputs.md): every key a level writes has an entry, the doc is
 current, and forces carry one sign convention in summary.json and the time series."""
 
 from __future__ import annotations
@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 from conftest import ROOT, SCENARIOS
 
-from wormsim import outputs
+from tools import outputs_doc
+from wormsim.results import summary_keys as outputs
 from wormsim.run import run_scenario
 from wormsim.scenario import load_scenario
 
@@ -41,7 +42,7 @@ def runs(tmp_path_factory):
 
 def test_docs_outputs_md_is_current():
     text = (ROOT / "docs" / "outputs.md").read_text()
-    assert text == outputs.markdown(), "docs/outputs.md is stale: python -m wormsim.outputs > docs/outputs.md"
+    assert text == outputs_doc.markdown(), "docs/outputs.md is stale: python -m tools.outputs_doc > docs/outputs.md"
 
 
 def test_every_table_entry_names_known_levels_and_a_unit():

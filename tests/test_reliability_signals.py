@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 from conftest import ROOT
 
-from wormsim.output import RESULT_FILES
+from wormsim.runfolder.writer import RESULT_FILES
 
 SEAT = ROOT / "scenarios" / "seat_motor.yaml"
 WORMSIM = Path(sys.executable).with_name("wormsim")
@@ -131,12 +131,12 @@ def test_second_run_into_the_same_folder_is_refused(good, tmp_path):
 
 
 def test_interrupt_is_sticky_and_restored():
-    """wormsim.interrupt: the handler raises Interrupted and records the signal, so a KeyboardInterrupt swallowed
+    """wormsim.runfolder.interrupt: the handler raises Interrupted and records the signal, so a KeyboardInterrupt swallowed
     somewhere (a lazy import's `except BaseException`) resurfaces at the next check(); restore() puts the old
     handlers back and clears it."""
     import pytest
 
-    from wormsim import interrupt
+    from wormsim.runfolder import interrupt
 
     old = interrupt.install()
     try:

@@ -28,10 +28,10 @@ from wormsim.contact3d.backlash import UM, flank_clearance_m, min_backlash_m, pi
 from wormsim.contact3d.friction_law import STICK_RELEASE, stuck_after
 from wormsim.contact3d.mjcf import build_model
 from wormsim.contact3d.runner import run_model, simulate
-from wormsim.locking import stick_velocity_m_s
+from wormsim.physics.locking import stick_velocity_m_s
+from wormsim.physics.units import MM
 from wormsim.scenario import ScenarioError, load_scenario
 from wormsim.torsional import dynamics as torsional
-from wormsim.units import MM
 
 DEMO = SCEN / "seat_motor_demo.yaml"
 # the backlash check is the collision pieces' (their bulge beyond the exact flanks): its tests pin contact.geometry
@@ -274,7 +274,7 @@ def test_contact3d_static_friction_governs_from_rest(demo_geometry, contact3d_fr
 
 
 def test_stick_state_only_where_the_wheel_drives_a_pair_self_locking_at_rest(demo_geometry):
-    """The stick state (wormsim.locking.stick_velocity_m_s) is v_t where the wheel drives a pair that self-locks at
+    """The stick state (wormsim.physics.locking.stick_velocity_m_s) is v_t where the wheel drives a pair that self-locks at
     rest and 0 elsewhere (forward runs, a pair that does not self-lock: their mu(Vs) is unchanged); stuck_after
     breaks away at v_t and sticks again below STICK_RELEASE v_t."""
     lock = _friction(_mu_at(demo_geometry, +0.3), _mu_at(demo_geometry, -0.3))
@@ -291,7 +291,7 @@ def test_stick_state_only_where_the_wheel_drives_a_pair_self_locking_at_rest(dem
 
 def test_contact3d_static_friction_holds_from_rest_in_flank_contact(demo_geometry, contact3d_free_rpm):
     """Static self-locking from rest (issue 31): the same pair and friction (static above, dynamic below the
-    boundary), the wheel starting on its loaded flank (wormsim.locking.wheel_start_rad) and loaded over 20 ms, the
+    boundary), the wheel starting on its loaded flank (wormsim.physics.locking.wheel_start_rad) and loaded over 20 ms, the
     worm free, 0.03 s: the worm creeps at 0.09 rpm (measured), below 0.1 % of the free speed. The free speed here
     is the 2 ms ramp's at 0.01 s (41 000 rpm, the fixture), a lower bound of this run's (its torque-time integral
     is 20 ms x 2 N m against 9 ms x 2 N m). Started centred in the backlash, the same run ran back at 2690 rpm
@@ -309,7 +309,7 @@ def test_contact3d_static_friction_holds_from_rest_in_flank_contact(demo_geometr
     res = simulate(sc)
     held = abs(float(res.series["worm_speed_rpm"][-1]))
     assert held < 1e-3 * contact3d_free_rpm
-    s = res.summary  # the summary says so (wormsim.locking.run_keys): held at the wheel's 2 N m
+    s = res.summary  # the summary says so (wormsim.physics.locking.run_keys): held at the wheel's 2 N m
     assert s["locked"] is True and s["holding_torque_nm"] == 2.0 and s["creep_speed_rpm"] < 1e-3 * contact3d_free_rpm
 
 

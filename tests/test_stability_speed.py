@@ -34,7 +34,7 @@ from wormsim.contact3d import guards as sim_mod
 from wormsim.contact3d.mjcf import build_model
 from wormsim.contact3d.runner import run_model, simulate
 from wormsim.contact3d.timestep import MAX_WORM_TURN_PER_STEP_RAD, OVERSPEED_GUARD, choose_timestep
-from wormsim.errors import ScenarioError, SimulationError
+from wormsim.exceptions import ScenarioError, SimulationError
 from wormsim.scenario import load_scenario
 
 JACK = SCENARIOS / "screw_jack.yaml"

@@ -93,8 +93,8 @@ def test_warm_worker_runs_once_per_process(monkeypatch):
     fork server, the plugin after the preload) skip; a failure is reported, not raised, and leaves it to retry."""
     import os
 
-    from wormsim import jit_cache
     from wormsim.contact3d import runner as c3d_runner
+    from wormsim.runtime import jit_cache
     from wormsim.sweep import warm
 
     calls = []

@@ -11,15 +11,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from wormsim import gear_theory as gt
-from wormsim.geometry import derive, displaced_pair
+from wormsim.physics import gear_theory as gt
+from wormsim.physics.geometry import derive, displaced_pair
 from wormsim.scenario import load_scenario
 from wormsim.tooth.mesh_stiffness import mesh_stiffness, stiffness_at
 from wormsim.tooth.stiffness import per_length_stiffness
 from wormsim.torsional import loaded_tca as lt
 
 SCEN = Path(__file__).resolve().parents[1] / "scenarios"
-# contact3d (exact flanks) on the same gear with the same shaft angles: the record of sweeps/errors_shaft_angle.py
+# contact3d (exact flanks) on the same gear with the same shaft angles: the record of studies/errors_shaft_angle.py
 # (docs/data/errors_shaft_angle.json, with its provenance): rows for 0, +0.1 and -0.1 deg
 CONTACT3D = {
     r["shaft_angle_deg"]: r

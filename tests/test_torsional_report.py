@@ -6,7 +6,7 @@ from __future__ import annotations
 import matplotlib.image as mpimg
 from conftest import SCENARIOS
 
-from wormsim.recording import recorded_entities
+from wormsim.results.recording import recorded_entities
 from wormsim.scenario import load_scenario
 from wormsim.torsional import report as torsional_report
 

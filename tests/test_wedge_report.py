@@ -6,7 +6,7 @@ from __future__ import annotations
 import matplotlib.image as mpimg
 from conftest import SCENARIOS
 
-from wormsim.recording import recorded_entities
+from wormsim.results.recording import recorded_entities
 from wormsim.scenario import load_scenario
 from wormsim.wedge import level as wedge_level
 from wormsim.wedge import report as wedge_report

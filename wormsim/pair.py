@@ -59,8 +59,8 @@ from wormsim.contact3d import shafts
 from wormsim.contact3d.flank_step import FlankContacts, split_step
 from wormsim.contact3d.mjcf import Prepared, prepare
 from wormsim.contact3d.timestep import MAX_WORM_TURN_PER_STEP_RAD, OVERSPEED_GUARD, default_timestep
-from wormsim.friction import friction_coefficient, friction_coefficient_scalar
-from wormsim.geometry import displaced_pair
+from wormsim.physics.friction import friction_coefficient, friction_coefficient_scalar
+from wormsim.physics.geometry import displaced_pair
 from wormsim.scenario import Scenario, load_scenario
 from wormsim.tooth.window import window_size
 
@@ -359,7 +359,8 @@ class WormPair:
         """(ft, fr, fa) [N]: the resultant of the pair's tooth forces on the wheel at the last step (the contact
         forces of the constraint solve: normal and two friction rows of each flank contact), resolved in the pair's
         assembly frame as it sits in the parent body now, in the sign convention of docs/outputs.md
-        (wormsim.outputs.FORCE_SIGNS, as contact3d's series tangential_force_n, radial_force_n, axial_force_n):
+        (wormsim.results.summary_keys.FORCE_SIGNS, as contact3d's series tangential_force_n, radial_force_n,
+        axial_force_n):
         tangential along +x (the wheel's positive sense at the pitch point on the line of centres), radial positive
         towards the wheel axis (+y, the separating force), axial along -hand z (F_a2 = F_t2 tan(gamma + rho') with
         its sign); contact3d's tangential_force_mean_n, radial_force_resultant_mean_n and axial_force_resultant_mean_n

@@ -1,14 +1,13 @@
 """The messages of the run's guards (wormsim.contact3d.guards): each builds its SimulationError subclass
-(wormsim.errors) with the diagnosis and what to change."""
+(wormsim.exceptions) with the diagnosis and what to change."""
 
 from __future__ import annotations
 
 import math
 
-from wormsim import gear_theory as gt
 from wormsim.contact3d.mjcf import BuiltModel
 from wormsim.contact3d.timestep import MAX_WORM_TURN_PER_STEP_RAD, default_timestep, speed_timestep_limit_s
-from wormsim.errors import (
+from wormsim.exceptions import (
     DivergedError,
     LockedError,
     OverspeedError,
@@ -16,9 +15,10 @@ from wormsim.errors import (
     SimulationError,
     TeethJumpedError,
 )
-from wormsim.friction import friction_coefficient
+from wormsim.physics import gear_theory as gt
+from wormsim.physics.friction import friction_coefficient
+from wormsim.physics.units import rad_s_to_rpm
 from wormsim.scenario import Scenario
-from wormsim.units import rad_s_to_rpm
 
 JUMP_PITCH = 0.5  # transmission error (in pitches) that counts as teeth jumping
 

@@ -5,7 +5,8 @@ the per-sample Python (~45-60 us a sample: dispatch, guards, the series column) 
 Per sample, in the runner's order and with its floating-point operations (bit-identical series, pattern and radius
 logs, contact points: tests/test_flank_samples.py): the steps; the state read from d (shaft angles and speeds,
 d.time); the runner's Guards.state checks (non-finite state or MuJoCo's bad-qacc warning, overspeed, teeth jumped);
-mu from the friction law (wormsim.friction.friction_coefficient_scalar's three forms); flank_loop.sample_flanks (with
+mu from the friction law (wormsim.physics.friction.friction_coefficient_scalar's three forms); flank_loop.sample_flanks
+(with
 displaced poses, errors: or shafts:, the points go into tooth 0's frame through the displaced wheel body's frame);
 the penetration and lock checks of Guards.contact; the shafts' log (ShaftLog.record: mj_rnePostConstraint by address
 where a bearing is rigid, then its raw values, wormsim.contact3d.shafts.gather); the series column (series.SERIES
@@ -248,8 +249,8 @@ class FlankSamples:
     def __init__(self, loop, guards, bm, rec: int, series: np.ndarray, store: tuple, slog=None):
         """The parameters from the guards and the run's plan (bm.plan: the friction law, the drive's kind); the run's
         series, point store (FlankLoop.sample's) and shaft log (wormsim.contact3d.shafts.ShaftLog, or None)."""
-        from wormsim import gear_theory as gt
-        from wormsim.units import RPM
+        from wormsim.physics import gear_theory as gt
+        from wormsim.physics.units import RPM
 
         fc, geo = loop.fc, bm.geometry
         self.loop, self.fc, self.guards, self.rec, self.S = loop, fc, guards, rec, series

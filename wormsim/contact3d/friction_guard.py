@@ -15,7 +15,7 @@ and the self-locking worm was back-driven at 700-900 rpm; with c_f = c_c (the pi
 The guard: after the ramps, the friction-weighted mean of cos(f_t, -v_t) over the contacts that slide (on the
 cone, slip faster than contact.transition_velocity_m_s, above which law (3) makes friction Coulomb's) must stay at or
 above ALIGN_MIN; below it for HOLD_S the run stops (SimulationError; where a speed-driven wheel drives a pair that
-is self-locking, the cause of the overload, the run ends held instead: wormsim.locking). Valid runs measured at
+is self-locking, the cause of the overload, the run ends held instead: wormsim.physics.locking). Valid runs measured at
 1.000 (screw jack, seat demo, involute_41 forward; the back-driven screw jack at mu 0.02).
 """
 
@@ -26,12 +26,12 @@ import math
 import mujoco
 import numba
 
-from wormsim import gear_theory as gt
 from wormsim.contact3d.diagnosis import locked_error
-from wormsim.errors import SimulationError
-from wormsim.friction import friction_coefficient
-from wormsim.locking import Held, backdrive_self_locks
-from wormsim.units import rad_s_to_rpm, rpm_to_rad_s
+from wormsim.exceptions import SimulationError
+from wormsim.physics import gear_theory as gt
+from wormsim.physics.friction import friction_coefficient
+from wormsim.physics.locking import Held, backdrive_self_locks
+from wormsim.physics.units import rad_s_to_rpm, rpm_to_rad_s
 
 ALIGN_MIN = 0.5  # friction-weighted cos(f_t, -v_t) of the sliding contacts below this ...
 HOLD_S = 0.02  # ... for this long (start-up transients measured: under 6 ms of misalignment, seat demo)
@@ -103,7 +103,7 @@ class FrictionGuard:
             geo = self.bm.geometry
             if backdrive_self_locks(
                 self.scenario, geo.gamma_m, geo.alpha_n
-            ):  # the held mesh's overload (wormsim.locking)
+            ):  # the held mesh's overload (wormsim.physics.locking)
                 raise Held(t, self.since)
             raise friction_error(t, cos, fn, w1, w2, self.f_nominal, self.bm, self.scenario, self.hold)
 

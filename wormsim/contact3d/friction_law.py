@@ -1,5 +1,6 @@
 """The friction law mu(Vs) in compiled form, the one the runs use (Python sample loop and compiled samples alike):
-wormsim.friction.friction_coefficient_scalar's three forms with its operations, on five parameters (`mu_params`)."""
+wormsim.physics.friction.friction_coefficient_scalar's three forms with its operations, on five parameters
+(`mu_params`)."""
 
 from __future__ import annotations
 
@@ -7,8 +8,8 @@ import math
 
 import numba
 
-from wormsim.friction import GROUPS, friction_coefficient
-from wormsim.units import DEG
+from wormsim.physics.friction import GROUPS, friction_coefficient
+from wormsim.physics.units import DEG
 
 CONSTANT, STEP, GROUP = 0.0, 1.0, 2.0  # mu_params' kind
 STICK_RELEASE = 0.1  # stuck_after: a sliding pair sticks again below this fraction of v_stick
@@ -16,7 +17,7 @@ STICK_RELEASE = 0.1  # stuck_after: a sliding pair sticks again below this fract
 
 def mu_params(contact) -> tuple[float, float, float, float, float]:
     """(kind, a, b, c, deg) of the scenario's contact block: constant mu = a; STEP(|Vs|, 0, a = static, b = v_t,
-    c = dynamic); friction group tan(deg / (a |Vs|^b + c)) (seed 000's rho(Vs), wormsim/friction.py)."""
+    c = dynamic); friction group tan(deg / (a |Vs|^b + c)) (seed 000's rho(Vs), wormsim/physics/friction.py)."""
     if contact.friction_group is not None:
         a, b, c = GROUPS[contact.friction_group]
         return GROUP, float(a), float(b), float(c), DEG
@@ -35,7 +36,7 @@ def mu_params(contact) -> tuple[float, float, float, float, float]:
 
 @numba.njit(cache=True, inline="always")
 def mu_at(vs, kind, a, b, c, deg):
-    """mu at the sliding speed vs (mu_params' forms; STEP is wormsim.units.step(|vs|, 0, a, b, c))."""
+    """mu at the sliding speed vs (mu_params' forms; STEP is wormsim.physics.units.step(|vs|, 0, a, b, c))."""
     if kind == CONSTANT:
         return a
     if kind == STEP:
@@ -55,7 +56,7 @@ def stuck_after(stuck, vs, v_stick):
     and breaks away at vs >= v_stick; a sliding pair sticks again below STICK_RELEASE v_stick. While stuck, mu is
     mu(0) (mu_at(0.0, ...)), else mu(vs). v_stick <= 0: never stuck (mu(vs) throughout). contact3d runs with
     v_stick = contact.transition_velocity_m_s where the wheel drives a pair that self-locks at rest, starting stuck
-    (wormsim.locking.stick_velocity_m_s), and with 0 otherwise."""
+    (wormsim.physics.locking.stick_velocity_m_s), and with 0 otherwise."""
     if v_stick <= 0.0:
         return False
     return vs < (v_stick if stuck else STICK_RELEASE * v_stick)

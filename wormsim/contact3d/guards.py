@@ -3,7 +3,7 @@ MuJoCo's bad-qacc warning (divergence), the worm turning more than OVERSPEED_GUA
 step (overspeed), the transmission error passing JUMP_PITCH of a pitch (teeth jumped), the sliding contacts'
 friction against their slip (wormsim.contact3d.friction_guard), penetration beyond gear_theory.penetration_limit_m,
 and a speed-driven drive stuck below half its command (locked). Each raises its SimulationError subclass
-(wormsim.errors) with what to change; the messages are built in wormsim.contact3d.diagnosis."""
+(wormsim.exceptions) with what to change; the messages are built in wormsim.contact3d.diagnosis."""
 
 from __future__ import annotations
 
@@ -12,7 +12,6 @@ import math
 import mujoco
 import numba
 
-from wormsim import gear_theory as gt
 from wormsim.contact3d.diagnosis import (
     JUMP_PITCH,
     diverged_error,
@@ -24,9 +23,10 @@ from wormsim.contact3d.diagnosis import (
 from wormsim.contact3d.friction_guard import FrictionGuard
 from wormsim.contact3d.mjcf import BuiltModel
 from wormsim.contact3d.timestep import MAX_WORM_TURN_PER_STEP_RAD, OVERSPEED_GUARD
-from wormsim.locking import Held, backdrive_self_locks
+from wormsim.physics import gear_theory as gt
+from wormsim.physics.locking import Held, backdrive_self_locks
+from wormsim.physics.units import rad_s_to_rpm
 from wormsim.scenario import Scenario
-from wormsim.units import rad_s_to_rpm
 
 DIVERGED, OVERSPEED, JUMPED = 1, 2, 3  # state_event's codes (0: none)
 PENETRATED, STUCK, RUNNING = 4, 5, 6  # contact_event's codes (0: none)
@@ -113,7 +113,8 @@ class Guards:
 
     def contact(self, t: float, pen: float, w_drive: float, cmd: float, w_worm: float = 0.0) -> None:
         """Penetration beyond the limit; a speed-driven drive stuck below half its command (locked) for lock_hold.
-        A wheel back-driving a self-locking pair ends the run as held (wormsim.locking.Held) when it stalls, or when
+        A wheel back-driving a self-locking pair ends the run as held (wormsim.physics.locking.Held) when it stalls, or
+        when
         its servo pushes the held mesh past the penetration limit while the worm (speed w_worm) creeps."""
         code = contact_event(
             t, pen, self.pen_lim, w_drive, cmd, self.speed_driven, self.lock_start, gt.LOCK_SPEED_FRACTION
@@ -125,7 +126,7 @@ class Guards:
         if code == STUCK:
             self.locked_since = t if self.locked_since is None else self.locked_since
             if t - self.locked_since > self.lock_hold:
-                if self.self_locking_backdrive:  # the answer, not a failure (wormsim.locking)
+                if self.self_locking_backdrive:  # the answer, not a failure (wormsim.physics.locking)
                     raise Held(t, self.locked_since)
                 raise locked_error(t, w_drive, cmd, self.bm, self.scenario)
         elif code == RUNNING:

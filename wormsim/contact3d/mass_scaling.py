@@ -41,10 +41,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from wormsim import gear_theory as gt
-from wormsim.errors import RingingError
+from wormsim.exceptions import RingingError
+from wormsim.physics import gear_theory as gt
+from wormsim.physics.units import rpm_to_rad_s
 from wormsim.scenario import ScenarioError
-from wormsim.units import rpm_to_rad_s
 
 KE_SHARE_TARGET = 0.01  # kinetic energy at most 1 % of the drive's work
 MODE_TO_MESH_MIN = 100.0  # scaled mesh mode at least 100 x the meshing frequency (seat motor, 36 rpm: at 50 x

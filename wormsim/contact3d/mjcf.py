@@ -28,7 +28,6 @@ from __future__ import annotations
 import functools
 import math
 from dataclasses import astuple, dataclass, field, replace
-from importlib.resources import files
 from pathlib import Path
 
 import mujoco
@@ -40,7 +39,6 @@ from meshgen.displaced import Deviations, wheel_mount, worm_mount
 from meshgen.geometry import GearGeometry
 from meshgen.kinematic_tca import KinematicTCA
 from meshgen.pieces import GearSet
-from wormsim import gear_theory as gt
 from wormsim.contact3d import mass_scaling, shafts
 from wormsim.contact3d.backlash import check_backlash, check_conjugate_interference
 from wormsim.contact3d.friction_law import mu_params
@@ -53,14 +51,16 @@ from wormsim.contact3d.law import (
 )
 from wormsim.contact3d.mass_scaling import ScalingCheck
 from wormsim.contact3d.timestep import timestep_for
-from wormsim.friction import friction_coefficient
-from wormsim.geometry import derive, displaced_pair, gear_set, solid_set
-from wormsim.locking import backdrive_self_locks, stall_torque_nm, stick_velocity_m_s, wheel_start_rad
+from wormsim.physics import gear_theory as gt
+from wormsim.physics.friction import friction_coefficient
+from wormsim.physics.geometry import derive, displaced_pair, gear_set, solid_set
+from wormsim.physics.locking import backdrive_self_locks, stall_torque_nm, stick_velocity_m_s, wheel_start_rad
+from wormsim.runtime.data import data_dir
 from wormsim.scenario import Scenario, ScenarioError, Simulation
 from wormsim.tooth.grid import SLICES_MASS_SCALED, FlankGrid, default_slices, flank_grid
 from wormsim.tooth.window import slot_quat, window_size, window_teeth_at
 
-TEMPLATE = files("wormsim.models") / "worm_pair.xml"  # models/, shipped as package data
+TEMPLATE = data_dir("models") / "worm_pair.xml"  # models/, shipped as package data
 MESH_SENSOR_DATA = 1 | 2 | 4 | 16  # contact sensor fields found, force, torque, pos (mjtConDataField bits)
 INTEGRATORS = {
     "implicitfast": mujoco.mjtIntegrator.mjINT_IMPLICITFAST,
@@ -134,7 +134,9 @@ class Prepared:
     grid: FlankGrid | None = None  # contact.geometry flanks: the flank grid of law.contacts_per_pair slices
     mu_params: tuple = ()  # the friction law mu(Vs) (wormsim.contact3d.friction_law.mu_params)
     transition_velocity_m_s: float = 0.0  # contact.transition_velocity_m_s
-    stick_velocity_m_s: float = 0.0  # the friction law's stick state (wormsim.locking.stick_velocity_m_s); 0: none
+    stick_velocity_m_s: float = (
+        0.0  # the friction law's stick state (wormsim.physics.locking.stick_velocity_m_s); 0: none
+    )
     e_star_pa: float = 0.0  # the pair's effective modulus (gear_theory.effective_modulus_pa)
     timestep_s: float = 0.0  # the model's timestep (build_model: timestep_for's or the one given)
     window_teeth: int = 0  # the wheel tooth slots with collision (build_model)
@@ -306,7 +308,8 @@ def prepare(scenario: Scenario, gs: GearSet | None = None) -> Prepared:
     t_drive = gt.expected_drive_torque_of(drv, load, geo.ratio, geo.gamma_m, geo.alpha_n, mu1)
     t2 = gt.working_wheel_torque_of(drv, load, geo.ratio)
     held = backdrive_self_locks(scenario, geo.gamma_m, geo.alpha_n)
-    if held:  # the mesh holds the stalled wheel servo's torque (wormsim.locking): the friction rows' hardness for it
+    # the mesh holds the stalled wheel servo's torque (wormsim.physics.locking): the friction rows' hardness for it
+    if held:
         t2 = max(t2, stall_torque_nm(t_drive))
     kv = gt.servo_gain_of(drv, t_drive) if duty.speed_driven else None
     arm1, arm2 = gt.mesh_arms_m(geo.r_m1, geo.r2, geo.alpha_n, geo.gamma_m)
@@ -437,7 +440,8 @@ def build_model(
     if kv is not None:
         meta["drive_kv_nm_s"] = kv
     meta["load_inertia_kg_m2"] = scenario.load.inertia_kg_m2
-    # a torque-driven wheel starts on its loaded flank (wormsim.locking.wheel_start_rad): the hinge's initial angle
+    # a torque-driven wheel starts on its loaded flank (wormsim.physics.locking.wheel_start_rad): the hinge's initial
+    # angle
     meta["wheel_start_rad"] = wheel_start_rad(scenario, geo.backlash, geo.r2, dev is None and sups is None)
     jw = model.jnt_qposadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, "wheel_hinge")]
     model.qpos0[jw] += meta["wheel_start_rad"]

@@ -5,7 +5,7 @@ speeds; the FFT amplitude spectrum of the tangential force over the steady windo
 meshing frequency marked; the contact pattern on a wheel tooth (contact points of the steady window,
 mapped into the frame of tooth 0: axial position across the face against radius, coloured by force).
 
-recording.rrd (wormsim.recording layout): /series/* time series on the sim_time timeline; the worm and
+recording.rrd (wormsim.results.recording layout): /series/* time series on the sim_time timeline; the worm and
 wheel meshes under /assembly/worm and /assembly/wheel moved by their 4x4 transforms; contact points
 (/assembly/contacts/points) and force arrows on the wheel (/assembly/contacts/forces, 1 mm per
 `ARROW_N_PER_MM` newtons) at up to MAX_FRAMES instants. With exact flanks: the steady-window contact
@@ -20,9 +20,9 @@ import numpy as np
 
 from meshgen import assembly
 from wormsim.contact3d.mjcf import visual_vertex_normals
-from wormsim.metrics import dominant_frequency
-from wormsim.recording import log_mesh, log_series, log_transforms, recording
-from wormsim.report_header import (
+from wormsim.results.metrics import dominant_frequency
+from wormsim.results.recording import log_mesh, log_series, log_transforms, recording
+from wormsim.results.report_header import (
     draw_header,
     gear_line,
     header_rows,
@@ -32,7 +32,7 @@ from wormsim.report_header import (
     steady_ylim,
     warning_text,
 )
-from wormsim.result import Result
+from wormsim.results.result import Result
 
 MAX_FRAMES = 1500
 ARROW_N_PER_MM = None  # chosen per run: the mean tooth force maps to 5 mm

@@ -28,7 +28,6 @@ import time
 import mujoco
 import numpy as np
 
-from wormsim import jit_cache, prewarm
 from wormsim.contact3d import jit_warmup, mass_scaling
 from wormsim.contact3d.contact_sums import RadiusLog
 from wormsim.contact3d.diagnosis import diverged_error
@@ -40,11 +39,12 @@ from wormsim.contact3d.ringing_check import ringing
 from wormsim.contact3d.series import SERIES, column
 from wormsim.contact3d.shafts import ShaftLog
 from wormsim.contact3d.sources import FlankSource, PieceSource
-from wormsim.friction import friction_mode
-from wormsim.locking import Held, held_keys, run_keys
-from wormsim.result import Result
+from wormsim.physics.friction import friction_mode
+from wormsim.physics.locking import Held, held_keys, run_keys
+from wormsim.physics.units import RPM
+from wormsim.results.result import Result
+from wormsim.runtime import jit_cache, prewarm
 from wormsim.scenario import Scenario
-from wormsim.units import RPM
 
 MAX_POINTS = 48  # contact points kept per sample (for the pattern and the recording)
 TARGET_SAMPLES = 20000  # automatic record_every aims at about this many samples per run (each the mean
@@ -80,11 +80,11 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
     slog = ShaftLog(m, bm.meta["shafts"], n_rec) if "shafts" in bm.meta else None  # wormsim.contact3d.shafts
     src = FlankSource(bm, d, io, guards, rec, S_all, store, slog) if flanks else PieceSource(bm, d, io, rec)
     t_wall = time.perf_counter()
-    prewarm.loop_started()  # the writers' warm-up thread goes now, beside the GIL-free loop (wormsim.prewarm)
+    prewarm.loop_started()  # the writers' warm-up thread goes now, beside the GIL-free loop (wormsim.runtime.prewarm)
     held = None
     try:
         _loop(src, bm, d, guards, S_all, rlog, store, rec, progress, slog)
-    except Held as h:  # a self-locking pair held the back-driving wheel: the run ends there (wormsim.locking)
+    except Held as h:  # a self-locking pair held the back-driving wheel: the run ends there (wormsim.physics.locking)
         held = h
         n_done = int(np.count_nonzero(S_all[0] > 0.0))  # samples written (t_s > 0); the held one is not
         S_all = S_all[:, :n_done]
@@ -175,7 +175,8 @@ def _sample(src, bm: BuiltModel, d, guards, S_all, rlog, store, rec: int, slog, 
 
 def force_signs(S: dict, hand: int) -> None:
     """The samples' forces (e_t = +x, e_r = -y outward, e_z) into the sign convention of docs/outputs.md
-    (wormsim.outputs.FORCE_SIGNS), in place: radial positive towards the wheel axis (separating), axial along
+    (wormsim.results.summary_keys.FORCE_SIGNS), in place: radial positive towards the wheel axis (separating), axial
+    along
     -hand e_z (F_a2 = F_t2 tan(gamma + rho') with its sign, as at torsional)."""
     S["radial_force_n"] *= -1.0
     S["radial_force_line_of_centres_n"] *= -1.0
@@ -186,8 +187,8 @@ def _stiffness_outputs(scenario: Scenario, bm: BuiltModel) -> tuple[dict, object
     """wormsim.tooth.stiffness.stiffness_outputs with the law's k' (K = k' b2): the same keys as torsional's, from
     the TCA table at the default sample count (simulation.mesh_stiffness_samples is torsional's); with the TCA and the
     LTCA (None unless the teeth's stiffness is used) for the report."""
-    from wormsim import gear_theory as gt
-    from wormsim.geometry import displaced_pair
+    from wormsim.physics import gear_theory as gt
+    from wormsim.physics.geometry import displaced_pair
     from wormsim.scenario import Simulation
     from wormsim.tooth.mesh_stiffness import mesh_stiffness
     from wormsim.tooth.stiffness import per_length_stiffness, stiffness_outputs
@@ -255,7 +256,7 @@ def simulate(scenario: Scenario, progress=None) -> Result:
     jit_cache.listen()  # the compile seconds counted (the progress line, a sweep's timing)
     jit_cache.ensure_warm(
         warm_runs, getattr(progress, "compiling", None)
-    )  # compiled once per machine (wormsim.jit_cache)
+    )  # compiled once per machine (wormsim.runtime.jit_cache)
     if progress is not None and time.perf_counter() - t0 > 0.5:  # the estimate's clock starts after the compile
         progress.restart_clock()
     jit_warmup.start()  # numba's start-up beside MuJoCo's model compilation (wormsim.contact3d.jit_warmup)
@@ -271,15 +272,14 @@ def simulate(scenario: Scenario, progress=None) -> Result:
 
 
 def warm_runs(runs: tuple[tuple[str, tuple[str, ...]], ...] = jit_cache.WARM_RUNS) -> None:
-    """The short contact3d runs of `runs` (default wormsim.jit_cache.WARM_RUNS, the machine's warm-up: every
+    """The short contact3d runs of `runs` (default wormsim.runtime.jit_cache.WARM_RUNS, the machine's warm-up: every
     compiled entry point with the signatures the runs use)."""
-    from importlib.resources import files
-
+    from wormsim.runtime.data import data_dir
     from wormsim.scenario import load_scenario
 
-    seeds = files("wormsim.scenarios")
+    seeds = data_dir("scenarios")
     if runs == jit_cache.WARM_RUNS:  # the flank grid's own compiled trim (a run whose grid is cached never calls it)
-        from wormsim.geometry import derive
+        from wormsim.physics.geometry import derive
         from wormsim.tooth import grid
 
         grid._flank_grid(derive(load_scenario(seeds / "screw_jack.yaml").gear), 2, 6)

@@ -345,7 +345,7 @@ class ShaftLog:
         gather(self.addresses(d), self.raw, i)
 
     def truncate(self, n: int) -> None:
-        """Keep the first n samples (a run that ended early: wormsim.locking)."""
+        """Keep the first n samples (a run that ended early: wormsim.physics.locking)."""
         self.raw = self.raw[:n]
         self.n = n
 

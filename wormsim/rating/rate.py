@@ -7,8 +7,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-from wormsim import gear_theory
-from wormsim.geometry import derive
+from wormsim.physics import gear_theory
+from wormsim.physics.geometry import derive
 from wormsim.rating import agma6034 as agma
 from wormsim.rating import iso14521 as iso
 from wormsim.rating import plastic

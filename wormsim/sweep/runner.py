@@ -27,7 +27,7 @@ from pathlib import Path
 
 from tqdm import tqdm
 
-from wormsim.output import ResultDir, write_json_atomic
+from wormsim.runfolder.writer import ResultDir, write_json_atomic
 from wormsim.scenario import ScenarioError
 from wormsim.sweep.spec import Point, Sweep
 
@@ -52,7 +52,7 @@ def run_point(scenario: dict, keep_files: bool) -> dict:
     from wormsim.sweep.warm import warm_pid
 
     warmed_by = warm_pid()
-    from wormsim.errors import SimulationError
+    from wormsim.exceptions import SimulationError
     from wormsim.run import run_scenario, simulate
     from wormsim.scenario import Scenario
 
@@ -98,7 +98,7 @@ def run_point(scenario: dict, keep_files: bool) -> dict:
             **base,
             "wall_time_s": time.perf_counter() - t0,
         }
-    from wormsim import jit_cache
+    from wormsim.runtime import jit_cache
 
     jit = jit_cache.dispatcher_stats()
     return {
@@ -112,7 +112,8 @@ def run_point(scenario: dict, keep_files: bool) -> dict:
             # the pid that loaded the kernels before this point: the fork server's for a worker forked warm
             "warmed_by_pid": warmed_by,
             "pid": os.getpid(),
-            # this worker process's totals so far: seconds compiling, signatures compiled / loaded (wormsim.jit_cache)
+            # this worker process's totals so far: seconds compiling, signatures compiled / loaded
+            # (wormsim.runtime.jit_cache)
             "compile_s": jit_cache.compile_seconds(),
             "jit_misses": jit["misses"],
             "jit_hits": jit["hits"],
@@ -158,7 +159,7 @@ def row_of(point: Point, summary: dict) -> dict:
         "message": summary.get("message", ""),
     }
     row.update({k: v for k, v in summary.items() if k not in _NOT_COLUMNS and _scalar(v)})
-    if summary.get("warnings"):  # the run's warnings (wormsim.run_warnings) as one cell
+    if summary.get("warnings"):  # the run's warnings (wormsim.results.run_warnings) as one cell
         row["warnings"] = "; ".join(summary["warnings"])
     row["wall_time_s"] = summary.get("wall_time_s")
     row["scenario_hash"] = point.scenario_hash
@@ -177,7 +178,8 @@ def columns(rows: list[dict], swept: list[str]) -> list[str]:
 
 
 def write_csv_atomic(path: Path, rows: list[dict], cols: list[str]) -> None:
-    """The whole table into a temporary file beside `path`, then os.replace (as wormsim.output.write_json_atomic)."""
+    """The whole table into a temporary file beside `path`, then os.replace (as
+    wormsim.runfolder.writer.write_json_atomic)."""
     buf = io.StringIO()
     w = csv.DictWriter(buf, fieldnames=cols, extrasaction="ignore", lineterminator="\n")
     w.writeheader()
@@ -209,7 +211,7 @@ def read_csv(path: Path) -> list[dict]:
 
 class SweepProgress:
     """Points done / total: a tqdm bar on a terminal; otherwise a log line per 10 % of the points (house style of
-    wormsim.progress; both off with WORMSIM_NO_PROGRESS)."""
+    wormsim.runfolder.progress; both off with WORMSIM_NO_PROGRESS)."""
 
     def __init__(self, name: str, total: int, done: int, enabled: bool | None = None, stream=None):
         self._stream = stream or sys.stderr

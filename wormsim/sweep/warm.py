@@ -2,7 +2,8 @@
 
 `WarmKernels.setup` runs on every worker that joins (distributed's WorkerPlugin, registered by the sweep when its
 points include contact3d runs) in a thread of the worker, so the worker's event loop keeps answering the scheduler:
-wormsim.jit_cache.ensure_warm (the machine's first worker compiles, holding the cache's lock; the others wait for it
+wormsim.runtime.jit_cache.ensure_warm (the machine's first worker compiles, holding the cache's lock; the others wait
+for it
 and load), then one short run (jit_cache.WARM_RUNS' first, WARM_STEPS steps) that loads every compiled function,
 numba's start-up and the imports into the worker process. A worker's first point then costs what its others cost.
 A failure is dropped: the point compiles or loads for itself.
@@ -30,8 +31,8 @@ def warm_worker() -> dict:
     global _warm_pid
     if _warm_pid is not None:
         return {"compiled": False, "error": None, "skipped": True}
-    from wormsim import jit_cache
     from wormsim.contact3d.runner import warm_runs
+    from wormsim.runtime import jit_cache
 
     try:
         compiled = jit_cache.ensure_warm(warm_runs)

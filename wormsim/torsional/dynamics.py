@@ -66,7 +66,7 @@ servo and the friction regularisation are many decades faster than the motion (s
 follows the motion and the quasi-static mesh force at steps of one k(theta) sample's worth of worm rotation
 (default_timestep) and damps the kHz modes. scipy solve_ivp (LSODA, BDF, Radau; `simulate(..., method=)`)
 resolves them and serves as the accuracy reference; it is 20-500x slower (docs/torsional.md).
-Summary keys and their computation: those of contact3d (wormsim.metrics: steady window, FFT peak), except
+Summary keys and their computation: those of contact3d (wormsim.results.metrics: steady window, FFT peak), except
 that mesh_frequency_hz is the meshing line of the transmission error, not of the tangential force (see
 torsional_summary; the force's peak is reported as force_peak_full_band_hz).
 """
@@ -80,17 +80,17 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from meshgen.geometry import GearGeometry
-from wormsim import gear_theory as gt
-from wormsim.errors import DivergedError, LockedError, PenetrationError, SimulationError
-from wormsim.friction import friction_coefficient, friction_coefficient_scalar, friction_mode
-from wormsim.geometry import derive, displaced_pair
-from wormsim.locking import Held, backdrive_self_locks, held_keys, run_keys
-from wormsim.metrics import dominant_frequency, drive_summary, mean_speeds_rpm, mesh_line_keys, window_of
-from wormsim.result import Result
+from wormsim.exceptions import DivergedError, LockedError, PenetrationError, SimulationError
+from wormsim.physics import gear_theory as gt
+from wormsim.physics.friction import friction_coefficient, friction_coefficient_scalar, friction_mode
+from wormsim.physics.geometry import derive, displaced_pair
+from wormsim.physics.locking import Held, backdrive_self_locks, held_keys, run_keys
+from wormsim.physics.units import rad_s_to_rpm, step
+from wormsim.results.metrics import dominant_frequency, drive_summary, mean_speeds_rpm, mesh_line_keys, window_of
+from wormsim.results.result import Result
 from wormsim.scenario import Scenario
 from wormsim.tooth.mesh_stiffness import MeshStiffness
 from wormsim.tooth.stiffness import mesh_stiffness_table, stiffness_outputs
-from wormsim.units import rad_s_to_rpm, step
 
 CHORD_ITER = 4  # backward Euler: Newton iterations that reuse the first Jacobian of a step
 MAX_SAMPLES = 20000
@@ -467,7 +467,8 @@ def simulate(scenario: Scenario, progress=None, method: str = "implicit") -> Res
     out = mesh.outputs(th1, w1, th2, w2)
     cmd = np.array([drive_f(x) for x in t])
     held = _guards(scenario, g, t, w1, w2, out, cmd)
-    if held is not None:  # a self-locking pair held the back-driving wheel: the run ends there (wormsim.locking)
+    # a self-locking pair held the back-driving wheel: the run ends there (wormsim.physics.locking)
+    if held is not None:
         n = int(np.searchsorted(t, held.t_s, side="right"))
         t, th1, w1, th2, w2, cmd = t[:n], th1[:n], w1[:n], th2[:n], w2[:n], cmd[:n]
         out = {k: v[:n] for k, v in out.items()}
@@ -547,7 +548,8 @@ def simulate(scenario: Scenario, progress=None, method: str = "implicit") -> Res
 def _guards(scenario, g, t, w1, w2, out, cmd) -> Held | None:
     """Teeth would skip (deflection past 0.4 m_x, gear_theory.penetration_limit_m, contact3d's penetration limit);
     a speed-driven drive stuck below half its command for 0.05 s after the ramps (locked: a jam, LockedError; or a
-    wheel back-driving a self-locking pair: returned as Held, the run's result, wormsim.locking). The deflection is
+    wheel back-driving a self-locking pair: returned as Held, the run's result, wormsim.physics.locking). The
+    deflection is
     checked up to the end of the run (the hold when held)."""
     drv = scenario.drive
     held = None
@@ -591,7 +593,8 @@ def _locked_guard(scenario, g, t, w1, w2, cmd) -> Held | None:
         run = np.nonzero(~bad[i0:])[0]
         i1 = i0 + (int(run[0]) if len(run) else len(bad) - i0) - 1
         if t[i1] - t[i0] >= gt.LOCK_HOLD_S or (not len(run) and t[-1] - t[i0] > 0):
-            if backdrive_self_locks(scenario, g.gamma_m, g.alpha_n):  # the answer, not a failure (wormsim.locking)
+            # the answer, not a failure (wormsim.physics.locking)
+            if backdrive_self_locks(scenario, g.gamma_m, g.alpha_n):
                 i_end = int(np.searchsorted(t, t[i0] + gt.LOCK_HOLD_S))
                 return Held(float(t[min(i_end, i1)]), float(t[i0]))
             raise LockedError(
@@ -603,8 +606,8 @@ def _locked_guard(scenario, g, t, w1, w2, cmd) -> Held | None:
 
 
 def torsional_summary(S: dict, scenario: Scenario, g: GearGeometry, ms: MeshStiffness) -> dict:
-    """contact3d's summary keys, computed by the same functions (wormsim.metrics), with one difference:
-    the meshing line is taken from the transmission error (wormsim.metrics.mesh_line). The mesh force element's
+    """contact3d's summary keys, computed by the same functions (wormsim.results.metrics), with one difference:
+    the meshing line is taken from the transmission error (wormsim.results.metrics.mesh_line). The mesh force element's
     tangential force is quasi-static: its fluctuation is the inertial part, the 2nd time derivative of the
     transmission error, which weights the harmonics of k(theta)'s tooth-entry kinks by n^2 and puts the
     force's peak on a harmonic (reported as force_peak_full_band_hz)."""

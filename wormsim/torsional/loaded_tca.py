@@ -38,7 +38,7 @@ import numpy as np
 from meshgen import assembly, displaced
 from meshgen.cache import cached
 from meshgen.geometry import GearGeometry
-from wormsim.errors import SimulationError
+from wormsim.exceptions import SimulationError
 from wormsim.tooth import gap as tooth_gap
 from wormsim.tooth import grid as tooth_grid
 from wormsim.tooth import kernel as tooth_kernel

@@ -6,7 +6,7 @@ From gear:, materials:, contact:, drive:, load: (docs/wedge.md, "Derived from ge
 - lead angle gamma, pitch radii r1, r2 and normal pressure angle alpha_n from the gear geometry (meshgen);
 - reduced masses m1 = I1 / r1^2 (worm at its pitch radius), m2 = I2 / r2^2 (wheel at its pitch radius), with the
   shaft inertias of the torsional level (gear_theory.shaft_inertias_kg_m2: solid cylinders, plus load.inertia_kg_m2);
-- friction: the contact's law mu(Vs) (wormsim.friction) with the gear levels' friction angle rho' = atan(mu /
+- friction: the contact's law mu(Vs) (wormsim.physics.friction) with the gear levels' friction angle rho' = atan(mu /
   cos alpha_n), so one friction input gives one friction angle at every level (seed 000's wedge: block takes rho =
   atan(mu));
 - load: F2 = -load.torque_nm / r2 on the wheel, with load.start_s / load.ramp_s (STEP);
@@ -28,11 +28,11 @@ import math
 
 import numpy as np
 
-from wormsim import gear_theory as gt
-from wormsim.friction import friction_coefficient, friction_mode
-from wormsim.geometry import derive
-from wormsim.result import Result
-from wormsim.units import DEG, rad_s_to_rpm, rpm_to_rad_s
+from wormsim.physics import gear_theory as gt
+from wormsim.physics.friction import friction_coefficient, friction_mode
+from wormsim.physics.geometry import derive
+from wormsim.physics.units import DEG, rad_s_to_rpm, rpm_to_rad_s
+from wormsim.results.result import Result
 from wormsim.wedge.dynamics import STEADY_FRACTION, WedgeParams, simulate_params
 
 KLOSS_PEAK_FACTOR = 3.0  # peak force / working force: a stiff curve, far from the motor's pull-out

@@ -27,7 +27,7 @@ Standstill (x1' = 0): the pair sticks (regime "locked", x1'' = 0) while the fric
     N0 = F1 sin g - F2 cos g,   T0 = -F1 cos g - F2 sin g,   |T0| <= tan(rho(0)) |N0|,
 
 is available, i.e. while F1/F2 lies between psi1 and psi2 at rho(0). Otherwise it slides in the
-direction s = -sign(T0). rho(Vs) is rho_rad of wormsim.friction (seed 000's fit; its value at
+direction s = -sign(T0). rho(Vs) is rho_rad of wormsim.physics.friction (seed 000's fit; its value at
 Vs = 0 is the static friction angle).
 
 Motor (seed 000, Kloss): F1 = 2 Fmax / (V + 1/V),  V = (V0 - x1') / (V0 - Vmax).
@@ -58,11 +58,11 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.integrate import solve_ivp, trapezoid
 
-from wormsim import gear_theory as gt
-from wormsim.errors import SimulationError
-from wormsim.friction import friction_coefficient, rho_rad
-from wormsim.result import Result
-from wormsim.units import DEG, step
+from wormsim.exceptions import SimulationError
+from wormsim.physics import gear_theory as gt
+from wormsim.physics.friction import friction_coefficient, rho_rad
+from wormsim.physics.units import DEG, step
+from wormsim.results.result import Result
 
 TRACTIVE, INVERSE, LOCKED, UNLOADED = "tractive", "inverse", "locked", "unloaded"
 REGIME_CODE = {LOCKED: 0, TRACTIVE: 1, INVERSE: 2, UNLOADED: 3}
