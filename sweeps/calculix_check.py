@@ -84,7 +84,7 @@ def fe_root_value(g, sc, side: int, torque_nm: float) -> dict:
 def one_gear(name: str, path: Path, angles: int, density: float, threads: int, workdir: Path, reread: bool) -> dict:
     sc = load_scenario(path)
     g = derive(sc.gear)
-    side = gear_theory.working_flank(sc, g.hand)
+    side = gear_theory.duty(sc, g.hand).working_flank
     m = sc.materials
     torque = abs(sc.load.torque_nm)
     arm0 = cx.arm0_m(g)
@@ -153,7 +153,7 @@ def convergence(a, gears: dict) -> dict:
     sc = load_scenario(GEARS["screw_jack"])
     g = derive(sc.gear)
     m = sc.materials
-    side = gear_theory.working_flank(sc, g.hand)
+    side = gear_theory.duty(sc, g.hand).working_flank
     lag = abs(sc.load.torque_nm) / (C_GUESS_N_PER_MM_UM * 1e9 * g.face_width * cx.arm0_m(g) ** 2)
     where = Path(a.workdir) / "screw_jack_fine"
     if a.reread:

@@ -134,7 +134,7 @@ def _forward(path, overrides, duration_s):
         path, [f"simulation.duration_s={duration_s}", "drive.ramp_s=0.01", "load.ramp_s=0.01", *overrides]
     )
     bm = build_model(sc, check_backlash_vs_pieces=False)
-    S = run_model(bm, sc).series
+    S = run_model(bm).series
     k = S["t_s"] > duration_s / 2
     return float(S["worm_torque_nm"][k].mean()), float(-S["wheel_power_w"][k].mean() / S["worm_power_w"][k].mean())
 

@@ -40,10 +40,9 @@ from wormsim.contact3d.ringing_check import ringing
 from wormsim.contact3d.series import SERIES, column
 from wormsim.contact3d.shafts import ShaftLog
 from wormsim.contact3d.sources import FlankSource, PieceSource
-from wormsim.friction import friction_mode
 from wormsim.locking import Held, held_keys, run_keys
 from wormsim.result import Result
-from wormsim.scenario import Scenario
+from wormsim.scenario import Scenario, Simulation
 from wormsim.units import RPM
 
 MAX_POINTS = 48  # contact points kept per sample (for the pattern and the recording)
@@ -51,22 +50,23 @@ TARGET_SAMPLES = 20000  # automatic record_every aims at about this many samples
 # over its interval, so decimation does not alias the contact vibration)
 
 
-def _record_every(scenario: Scenario, dt: float, n_steps: int, scaled: bool = False) -> int:
-    sim = scenario.simulation
+def _record_every(sim: Simulation, dt: float, n_steps: int, scaled: bool = False) -> int:
     if "record_every" in sim.model_fields_set:
         return sim.record_every
     return max(1, n_steps // (mass_scaling.SCALED_SAMPLES if scaled else TARGET_SAMPLES))
 
 
-def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
-    """Step the built model over simulation.duration_s at its timestep; sample, guard, summarise (module docstring)."""
+def run_model(bm: BuiltModel, progress=None) -> Result:
+    """Step the built model over simulation.duration_s at its timestep; sample, guard, summarise (module docstring).
+    Everything the run takes from its scenario comes with the model's plan (bm.plan)."""
     m = bm.model
     d = mujoco.MjData(m)
     dt = bm.timestep_s
-    n_steps = int(round(scenario.simulation.duration_s / dt))
-    rec = _record_every(scenario, dt, n_steps, bm.meta.get("mass_scaling", 1) > 1)
+    plan, sim = bm.plan, bm.plan.gear.simulation
+    n_steps = int(round(sim.duration_s / dt))
+    rec = _record_every(sim, dt, n_steps, plan.scaling.factor > 1)
     n_rec = n_steps // rec
-    guards = Guards(bm, rec, scenario)
+    guards = Guards(bm, rec)
     S_all = np.zeros((len(SERIES), n_rec))  # one column per sample, written at once
     S = dict(zip(SERIES, S_all))
     store = tuple(np.full((n_rec, MAX_POINTS, 3), np.nan, dtype=np.float32) for _ in range(3))  # p0, F, world p
@@ -76,7 +76,7 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
     ia_drv, ia_load = bm.drive_actuator, bm.load_actuator
     a1, a2 = (ia_drv, ia_load) if worm_is_drive else (ia_load, ia_drv)  # the worm's and the wheel's actuator
     io = (ia_drv, ia_load, a1, a2, s0)
-    flanks = bm.meta.get("contact_geometry") == "flanks"
+    flanks = plan.flanks
     slog = ShaftLog(m, bm.meta["shafts"], n_rec) if "shafts" in bm.meta else None  # wormsim.contact3d.shafts
     src = FlankSource(bm, d, io, guards, rec, S_all, store, slog) if flanks else PieceSource(bm, d, io, rec)
     t_wall = time.perf_counter()
@@ -98,15 +98,16 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
     force_signs(S, bm.geometry.hand)  # into docs/outputs.md's convention
     S["efficiency_theory_at_contact_radius"][:] = rlog.efficiency(S["friction_coefficient"], bm.geometry, worm_is_drive)
     wall = time.perf_counter() - t_wall
-    summary = _run_summary(
-        S, scenario, bm, rec, guards.turn_max, len(src.coll), 1e6 * wall / max(n_rec * rec, 1), flanks=flanks
-    )
+    summary = _run_summary(S, bm, rec, guards.turn_max, len(src.coll), 1e6 * wall / max(n_rec * rec, 1))
+    gp = plan.gear
     summary.update(
-        run_keys(scenario, bm.geometry, S["t_s"], S["worm_speed_rpm"])
+        run_keys(
+            gp.duty.drive, gp.rho_static_rad, gp.transition_velocity_m_s, bm.geometry, S["t_s"], S["worm_speed_rpm"]
+        )
         if held is None
         else held_keys(S["t_s"], S["worm_speed_rpm"], S["wheel_torque_nm"], held.stuck_since_s or held.t_s)
     )
-    st_keys, ms, lt = _stiffness_outputs(scenario, bm)  # the tooth pair's stiffness and load sharing (torsional's)
+    st_keys, ms, lt = _stiffness_outputs(bm)  # the tooth pair's stiffness and load sharing (torsional's)
     summary.update(st_keys)
     extra = {"points_tooth0": store[0], "points_world": store[2], "forces_world": store[1], "built": bm}
     extra.update({"mesh_stiffness": ms, "ltca": lt})
@@ -114,7 +115,12 @@ def run_model(bm: BuiltModel, scenario: Scenario, progress=None) -> Result:
     if slog is not None:  # the shafts' deflections and bearing forces
         S.update(slog.series())
         summary.update(slog.summary(S["t_s"], summary["steady_window_s"]))
-    summary.update(mass_scaling.run_summary(S, bm.plan.duty, scenario.simulation.mass_scaling, bm.meta, summary))
+    ine = plan.inertias  # the scaled shafts with the driven machine's inertia
+    ine_kg_m2 = (
+        ine.worm_inertia_kg_m2 + ine.worm_load_inertia_kg_m2,
+        ine.wheel_inertia_kg_m2 + ine.wheel_load_inertia_kg_m2,
+    )
+    summary.update(mass_scaling.run_summary(S, plan.duty, sim.mass_scaling, plan.scaling, ine_kg_m2, summary))
     rang = ringing(S, summary, dt, bm.law.stable_limit_s) if flanks else None  # flanks (ringing_check)
     if rang is not None:
         raise diverged_error(rang[0], dt, bm, rang[1])
@@ -180,53 +186,42 @@ def force_signs(S: dict, hand: int) -> None:
     S["axial_force_n"] *= -float(hand)
 
 
-def _stiffness_outputs(scenario: Scenario, bm: BuiltModel) -> tuple[dict, object, object | None]:
+def _stiffness_outputs(bm: BuiltModel) -> tuple[dict, object, object | None]:
     """wormsim.tooth.stiffness.stiffness_outputs with the law's k' (K = k' b2): the same keys as torsional's, from
     the TCA table at the default sample count (simulation.mesh_stiffness_samples is torsional's); with the TCA and the
     LTCA (None unless the teeth's stiffness is used) for the report."""
-    from wormsim import gear_theory as gt
-    from wormsim.geometry import displaced_pair
-    from wormsim.scenario import Simulation
     from wormsim.tooth.mesh_stiffness import mesh_stiffness
     from wormsim.tooth.stiffness import per_length_stiffness, stiffness_outputs
 
-    g = bm.geometry
-    kp, source = per_length_stiffness(scenario.contact, g, scenario.materials)
+    g, gp = bm.geometry, bm.plan.gear
+    kp, source = per_length_stiffness(gp.contact, g, gp.materials)
     ms = mesh_stiffness(g, kp, source, Simulation.model_fields["mesh_stiffness_samples"].default)
     keys, lt = stiffness_outputs(
         ms,
         g,
-        scenario.materials,
-        gt.working_wheel_torque_nm(scenario, g.ratio),
-        gt.working_flank(scenario, g.hand),
-        errors=displaced_pair(scenario.errors, g) is not None,
+        gp.materials,
+        gp.working_wheel_torque_nm,
+        gp.duty.working_flank,
+        errors=gp.displaced is not None,
     )
     return keys, ms, lt
 
 
-def _run_summary(
-    S: dict,
-    scenario: Scenario,
-    bm: BuiltModel,
-    rec: int,
-    turn_max: float,
-    collision_geoms: int,
-    step_wall_us: float,
-    flanks: bool = False,
-) -> dict:
+def _run_summary(S: dict, bm: BuiltModel, rec: int, turn_max: float, collision_geoms: int, step_wall_us: float) -> dict:
     """contact3d_summary plus what the run used: timestep, contact law, friction, window, contact geometry
     (contact.geometry; flank_slices: the flank contacts per tooth flank, None for pieces), cost."""
-    law = bm.law
+    law, gp, flanks = bm.law, bm.plan.gear, bm.plan.flanks
+    sim = gp.simulation
     return {
-        **contact3d_summary(S, scenario, bm),
-        "scenario": scenario.name,
+        **contact3d_summary(S, bm),
+        "scenario": gp.name,
         "timestep_s": bm.timestep_s,
         "timestep_stable_limit_s": law.stable_limit_s,
         "timestep_source": bm.timestep_source,
         "worm_turn_per_step_max_rad": turn_max,
-        "speculative": scenario.simulation.speculative,
-        "resolution": scenario.simulation.resolution,
-        "integrator": scenario.simulation.integrator,
+        "speculative": sim.speculative,
+        "resolution": sim.resolution,
+        "integrator": sim.integrator,
         "record_every": rec,
         "contact_pair_stiffness_n_per_m": law.pair_stiffness_n_per_m,
         "contact_stiffness_source": law.stiffness_source,
@@ -235,11 +230,11 @@ def _run_summary(
         "contact_damping_requested_n_s_per_m": law.contact_damping_requested_n_s_per_m * law.contacts_per_pair,
         "contact_damping_used_n_s_per_m": law.contact_damping_n_s_per_m * law.contacts_per_pair,
         "contact_damping_ratio": law.damping_ratio,
-        "friction": friction_mode(scenario.contact),
+        "friction": gp.friction_mode,
         "friction_impratio": law.impratio,
         "window_teeth": bm.window_teeth,
         "collision_geoms": collision_geoms,
-        "contact_geometry": bm.meta.get("contact_geometry", "pieces"),
+        "contact_geometry": gp.contact.geometry,
         "flank_slices": law.contacts_per_pair if flanks else None,
         "flank_contacts": bm.meta.get("flank_contacts") if flanks else None,
         "step_wall_us": step_wall_us,
@@ -258,9 +253,10 @@ def simulate(scenario: Scenario, progress=None) -> Result:
         progress.restart_clock()
     jit_warmup.start()  # numba's start-up beside MuJoCo's model compilation (wormsim.contact3d.jit_warmup)
     bm = build_model(scenario)
-    if progress is not None and scenario.simulation.mass_scaling != 1:
-        progress.note(mass_scaling.note(bm.meta["mass_scaling_check"], scenario.simulation.mass_scaling, bm.timestep_s))
-    res = run_model(bm, scenario, progress)
+    requested = bm.plan.gear.simulation.mass_scaling
+    if progress is not None and requested != 1:
+        progress.note(mass_scaling.note(bm.plan.scaling, requested, bm.timestep_s))
+    res = run_model(bm, progress)
     if scenario.simulation.backdrive_probe:  # a second run with the wheel driving (wormsim.contact3d.backdrive)
         from wormsim.contact3d.backdrive import probe
 

@@ -98,7 +98,7 @@ def rate(scenario: Scenario) -> dict:
     f = Factors()
     geo = derive(scenario.gear)
     ratio = geo.ratio
-    t2_nom = gear_theory.working_wheel_torque_nm(scenario, ratio)
+    t2_nom = gear_theory.working_wheel_torque_of(scenario.drive, scenario.load, ratio)
     if t2_nom <= 0:
         raise ScenarioError(
             "load.torque_nm = 0: a rating needs the nominal load; allowed: load.torque_nm != 0 (or a torque drive "

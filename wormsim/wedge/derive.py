@@ -43,7 +43,7 @@ RUNUP_S = 0.01  # the peak force also runs the reduced masses up to speed in abo
 def params_from_gear(scenario) -> tuple[WedgeParams, dict]:
     """(WedgeParams, what was derived: summary keys) of a gear scenario (module docstring)."""
     g = derive(scenario.gear)
-    I1, I2 = gt.shaft_inertias_kg_m2(scenario, g.r1, g.worm_length, g.r2, g.face_width)
+    I1, I2 = gt.shaft_inertias_kg_m2(scenario.materials, scenario.load, g.r1, g.worm_length, g.r2, g.face_width)
     # the worm meshes at its operating radius r_m1 and lead angle gamma_m (r1, gamma unshifted; DIN 3975-1)
     m1, m2 = I1 / g.r_m1**2, I2 / g.r2**2
     gamma, tg = g.gamma_m, math.tan(g.gamma_m)
