@@ -32,10 +32,7 @@ def small_case(tmp_path_factory, monkeypatch_module):
     side = gear_theory.duty(sc, g.hand).working_flank
     m = sc.materials
     lag = 12.0 / (15e9 * g.face_width * cx.arm0_m(g) ** 2)
-    r = cx.solve(
-        g, m.wheel.youngs_modulus_gpa * 1e9, m.wheel.poisson_ratio, m.worm.youngs_modulus_gpa * 1e9,
-        m.worm.poisson_ratio, side, 0.0, lag, workdir=tmp_path_factory.mktemp("ccx"),
-    )  # fmt: skip
+    r = cx.solve(g, m, side, 0.0, lag, workdir=tmp_path_factory.mktemp("ccx"))
     return g, m, r
 
 

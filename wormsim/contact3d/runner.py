@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import math
 import time
+from dataclasses import dataclass
 
 import mujoco
 import numpy as np
@@ -83,7 +84,7 @@ def run_model(bm: BuiltModel, progress=None) -> Result:
     prewarm.loop_started()  # the writers' warm-up thread goes now, beside the GIL-free loop (wormsim.prewarm)
     held = None
     try:
-        _loop(src, bm, d, guards, S_all, rlog, store, rec, progress, slog)
+        _loop(_Loop(src, bm, d, guards, S_all, rlog, store, rec, slog), progress)
     except Held as h:  # a self-locking pair held the back-driving wheel: the run ends there (wormsim.locking)
         held = h
         n_done = int(np.count_nonzero(S_all[0] > 0.0))  # samples written (t_s > 0); the held one is not
@@ -131,10 +132,28 @@ def run_model(bm: BuiltModel, progress=None) -> Result:
     return Result(model="contact3d", summary=summary, series=S, steps=steps, sim_time_s=float(d.time), extra=extra)
 
 
-def _loop(src, bm: BuiltModel, d, guards, S_all, rlog, store, rec: int, progress, slog) -> None:
+@dataclass
+class _Loop:
+    """What the stepping loop writes to and reads from: the contact source, the model and its data, the guards, the
+    series array, the radius log, the contact points' store, the samples' steps and the shafts' log (None without
+    `shafts:`)."""
+
+    src: object
+    bm: BuiltModel
+    d: mujoco.MjData
+    guards: Guards
+    S_all: np.ndarray
+    rlog: RadiusLog
+    store: tuple
+    rec: int
+    slog: ShaftLog | None
+
+
+def _loop(lp: _Loop, progress) -> None:
     """The samples in blocks of about 4096 steps' commands (each step's at its midpoint): the source advances
     (wormsim.contact3d.sources: a flank source runs whole stretches of samples compiled and hands back only the
     samples of its events) and `_sample` does the samples it hands back."""
+    bm, d, S_all, rec, src = lp.bm, lp.d, lp.S_all, lp.rec, lp.src
     dt, n_rec = bm.timestep_s, S_all.shape[1]
     cmds = bm.plan.commands
     block = max(1, 4096 // rec)
@@ -144,22 +163,22 @@ def _loop(src, bm: BuiltModel, d, guards, S_all, rlog, store, rec: int, progress
             t_blk = (i * rec + np.arange(min(block, n_rec - i) * rec) + 0.5) * dt
             cmd_arr, load_arr = cmds.drive(t_blk), cmds.load(t_blk)
         i_end = min(n_rec, i - i % block + block)
-        i, sums = src.advance(cmd_arr, load_arr, i, i_end, (i % block) * rec, rlog)
+        i, sums = src.advance(cmd_arr, load_arr, i, i_end, (i % block) * rec, lp.rlog)
         if sums is None:  # samples done up to i
             if progress is not None:
                 progress.update(float(S_all[0, i - 1]))
             continue
         cmd = float(cmd_arr[(i % block) * rec + rec - 1])
-        _sample(src, bm, d, guards, S_all, rlog, store, rec, slog, i, cmd, sums)
+        _sample(lp, i, cmd, sums)
         if progress is not None:
             progress.update(float(d.time))
         i += 1
 
 
-def _sample(src, bm: BuiltModel, d, guards, S_all, rlog, store, rec: int, slog, i: int, cmd: float, sums) -> None:
+def _sample(lp: _Loop, i: int, cmd: float, sums) -> None:
     """Sample i after its steps (cmd the drive command of its last step, sums its steps' sums): the state, the
-    guards, mu(Vs), the source's contact outputs, the shafts' log (slog, None without `shafts:`) and the series
-    column."""
+    guards, mu(Vs), the source's contact outputs, the shafts' log and the series column."""
+    bm, d, guards = lp.bm, lp.d, lp.guards
     m, geo = bm.model, bm.geometry
     qp, qv = d.qpos, d.qvel
     th1 = float(qp[m.jnt_qposadr[m.dof_jntid[bm.worm_dof]]])
@@ -170,11 +189,11 @@ def _sample(src, bm: BuiltModel, d, guards, S_all, rlog, store, rec: int, slog, 
     mu = mu_of(abs(w1) * geo.r_m1 / math.cos(geo.gamma_m), bm.plan.mu_params)  # at the sliding speed Vs
     # each contact's force turned about the worm axis onto the line of centres: the radial force DIN 3975's
     # single pitch-point contact means; the force-weighted contact radius and efficiency there (contact_sums)
-    nteeth, pen, fr_lc, r_c = src.sample(i, th2, mu, rlog, store)
+    nteeth, pen, fr_lc, r_c = lp.src.sample(i, th2, mu, lp.rlog, lp.store)
     guards.contact(t, pen, w1 if bm.plan.drive_on == "worm" else w2, cmd, w1)
-    if slog is not None:
-        slog.record(i, d)
-    S_all[:, i] = column(t, th1, th2, w1, w2, cmd, sums, rec, nteeth, pen, mu, te, fr_lc, r_c, RPM)
+    if lp.slog is not None:
+        lp.slog.record(i, d)
+    lp.S_all[:, i] = column(t, th1, th2, w1, w2, cmd, sums, lp.rec, nteeth, pen, mu, te, fr_lc, r_c, RPM)
 
 
 def force_signs(S: dict, hand: int) -> None:

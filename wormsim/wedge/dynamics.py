@@ -308,17 +308,7 @@ def simulate_params(p: WedgeParams, progress=None, name: str = "wedge") -> Resul
         t_end = next(b for b in stops if b > t * (1 + 1e-12) + 1e-15)
         F1, F2 = motor_force_n(v, p), load_force_n(t, p)
         if segs and segs[-1]["regime"] == UNLOADED and _unloaded_equilibrium(t, t_end, p):
-            ts = _segment_times(grid, t, t_end)  # still no load past a breakpoint: stay on the equilibrium
-            segs.append(
-                {
-                    "regime": UNLOADED,
-                    "t": ts,
-                    "x": x + v * (ts - t),
-                    "v": np.full_like(ts, v),
-                    "a": np.zeros_like(ts),
-                    "k": 0,
-                }
-            )
+            segs.append(_unloaded_segment(grid, t, t_end, x, v))  # still no load past a breakpoint: stay on it
             t, x = t_end, float(x + v * (t_end - t))
             continue
         if v == 0.0 and not seed_monitor:
@@ -326,16 +316,8 @@ def simulate_params(p: WedgeParams, progress=None, name: str = "wedge") -> Resul
                 t_break = _locked_until(t, t_end, F1, p, rho0)
                 t_stop = t_end if t_break is None else t_break
                 ts = _segment_times(grid, t, t_stop)
-                segs.append(
-                    {
-                        "regime": LOCKED,
-                        "t": ts,
-                        "x": np.full_like(ts, x),
-                        "v": np.zeros_like(ts),
-                        "a": np.zeros_like(ts),
-                        "k": 0,
-                    }
-                )
+                zero = np.zeros_like(ts)
+                segs.append({"regime": LOCKED, "t": ts, "x": np.full_like(ts, x), "v": zero, "a": zero.copy(), "k": 0})
                 t = t_stop
                 sigma_hint = None
                 if progress is not None:
@@ -393,17 +375,7 @@ def simulate_params(p: WedgeParams, progress=None, name: str = "wedge") -> Resul
         if hit_stop:
             v = 0.0
         elif hit_phi and _unloaded_equilibrium(t, t_end, p):
-            ts = _segment_times(grid, t, t_end)
-            segs.append(
-                {
-                    "regime": UNLOADED,
-                    "t": ts,
-                    "x": x + v * (ts - t),
-                    "v": np.full_like(ts, v),
-                    "a": np.zeros_like(ts),
-                    "k": 0,
-                }
-            )
+            segs.append(_unloaded_segment(grid, t, t_end, x, v))
             t, x = t_end, float(x + v * (t_end - t))
         elif hit_phi:
             sigma_hint = -sigma
@@ -411,6 +383,19 @@ def simulate_params(p: WedgeParams, progress=None, name: str = "wedge") -> Resul
             progress.update(t)
 
     return _assemble(segs, p, steps, name)
+
+
+def _unloaded_segment(grid: np.ndarray, t: float, t_end: float, x: float, v: float) -> dict:
+    """The segment from t to t_end on the unloaded equilibrium: constant speed v from x."""
+    ts = _segment_times(grid, t, t_end)
+    return {
+        "regime": UNLOADED,
+        "t": ts,
+        "x": x + v * (ts - t),
+        "v": np.full_like(ts, v),
+        "a": np.zeros_like(ts),
+        "k": 0,
+    }
 
 
 # ----------------------------------------------------------------------------- results
