@@ -2,7 +2,9 @@
 
 A profile hook (sys.setprofile) sees every Python call; a call whose frame holds a Scenario among its locals (its
 arguments at the call) is a step of the walk, named by its file (wormsim/ and meshgen/ only). A move is a step into
-another file than the previous step's; a move back up is a move into a file the walk has already left once.
+another file than the previous step's; a move back up is a move into a file the walk has already left once. The
+second count ("with returns") also steps back into the caller's file when such a call returns, as a reader who
+follows the scenario into a helper and back does.
 
     .venv/bin/python sweeps/scenario_walk.py [LEVEL ...]      # default: contact3d torsional wedge
 
@@ -20,8 +22,9 @@ ROOT = Path(__file__).resolve().parents[1]
 DURATION_S = {"contact3d": 0.01, "torsional": 0.05, "wedge": 0.05}
 
 
-def walk(level: str) -> list[str]:
-    """The files of the calls that hold a Scenario, in call order, for one simulate of the screw jack at `level`."""
+def walk(level: str) -> tuple[list[str], list[str]]:
+    """The files of the calls that hold a Scenario, in call order, for one simulate of the screw jack at `level`;
+    and the same walk with the returns of those calls (into the caller's file) as steps too."""
     from wormsim.run import simulate
     from wormsim.scenario import Scenario, load_scenario
 
@@ -29,8 +32,16 @@ def walk(level: str) -> list[str]:
     sc.simulation.duration_s = DURATION_S[level]
     roots = (str(ROOT / "wormsim"), str(ROOT / "meshgen"))
     files: list[str] = []
+    with_returns: list[str] = []
+    held: set[int] = set()  # the frames of the walk still running
 
     def hook(frame, event, arg):
+        if event == "return" and id(frame) in held:
+            held.discard(id(frame))
+            back = frame.f_back
+            if back is not None and back.f_code.co_filename.startswith(roots):
+                with_returns.append(str(Path(back.f_code.co_filename).relative_to(ROOT)))
+            return
         if event != "call":
             return
         fn = frame.f_code.co_filename
@@ -38,6 +49,8 @@ def walk(level: str) -> list[str]:
             return
         if any(isinstance(v, Scenario) for v in frame.f_locals.values()):
             files.append(str(Path(fn).relative_to(ROOT)))
+            with_returns.append(files[-1])
+            held.add(id(frame))
 
     simulate(sc.model_copy(deep=True))  # compiled and cached first: the walk is the run's, not the compiler's
     sys.setprofile(hook)
@@ -45,7 +58,7 @@ def walk(level: str) -> list[str]:
         simulate(sc)
     finally:
         sys.setprofile(None)
-    return files
+    return files, with_returns
 
 
 def moves(files: list[str]) -> tuple[int, int]:
@@ -62,9 +75,13 @@ def moves(files: list[str]) -> tuple[int, int]:
 
 def main(argv: list[str]) -> int:
     for level in argv or ["contact3d", "torsional", "wedge"]:
-        files = walk(level)
+        files, with_returns = walk(level)
         n, back = moves(files)
-        print(f"{level}: {len(files)} calls, {n} moves between files, {back} back up")
+        nr, backr = moves(with_returns)
+        print(
+            f"{level}: {len(files)} calls, {n} moves between files, {back} back up; "
+            f"with returns {nr} moves, {backr} back up"
+        )
         order = [f for i, f in enumerate(files) if i == 0 or f != files[i - 1]]
         print("  " + " > ".join(order))
     return 0

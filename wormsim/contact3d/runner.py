@@ -42,6 +42,7 @@ from wormsim.contact3d.series import SERIES, column
 from wormsim.contact3d.shafts import ShaftLog
 from wormsim.contact3d.sources import FlankSource, PieceSource
 from wormsim.locking import Held, held_keys, run_keys
+from wormsim.outputs import level_summary
 from wormsim.result import Result
 from wormsim.scenario import Scenario, Simulation
 from wormsim.units import RPM
@@ -99,9 +100,8 @@ def run_model(bm: BuiltModel, progress=None) -> Result:
     force_signs(S, bm.geometry.hand)  # into docs/outputs.md's convention
     S["efficiency_theory_at_contact_radius"][:] = rlog.efficiency(S["friction_coefficient"], bm.geometry, worm_is_drive)
     wall = time.perf_counter() - t_wall
-    summary = _run_summary(S, bm, rec, guards.turn_max, len(src.coll), 1e6 * wall / max(n_rec * rec, 1))
     gp = plan.gear
-    summary.update(
+    lock = (
         run_keys(
             gp.duty.drive, gp.rho_static_rad, gp.transition_velocity_m_s, bm.geometry, S["t_s"], S["worm_speed_rpm"]
         )
@@ -109,25 +109,22 @@ def run_model(bm: BuiltModel, progress=None) -> Result:
         else held_keys(S["t_s"], S["worm_speed_rpm"], S["wheel_torque_nm"], held.stuck_since_s or held.t_s)
     )
     st_keys, ms, lt = _stiffness_outputs(bm)  # the tooth pair's stiffness and load sharing (torsional's)
-    summary.update(st_keys)
+    step_wall_us = 1e6 * wall / max(n_rec * rec, 1)
+    summary = level_summary(
+        "contact3d", _run_summary(S, bm, rec, guards.turn_max, len(src.coll), step_wall_us), lock, st_keys
+    )
     extra = {"points_tooth0": store[0], "points_world": store[2], "forces_world": store[1], "built": bm}
     extra.update({"mesh_stiffness": ms, "ltca": lt})
-    src.finish(S, summary, extra)
-    if slog is not None:  # the shafts' deflections and bearing forces
-        S.update(slog.series())
-        summary.update(slog.summary(S["t_s"], summary["steady_window_s"]))
-    ine = plan.inertias  # the scaled shafts with the driven machine's inertia
-    ine_kg_m2 = (
-        ine.worm_inertia_kg_m2 + ine.worm_load_inertia_kg_m2,
-        ine.wheel_inertia_kg_m2 + ine.wheel_load_inertia_kg_m2,
-    )
-    summary.update(mass_scaling.run_summary(S, plan.duty, sim.mass_scaling, plan.scaling, ine_kg_m2, summary))
+    src.finish(S, summary, extra)  # the source's own keys (the flanks' contact pattern and pressure)
+    summary = level_summary("contact3d", summary, *_after_run_keys(S, bm, slog, summary))
     rang = ringing(S, summary, dt, bm.law.stable_limit_s) if flanks else None  # flanks (ringing_check)
     if rang is not None:
         raise diverged_error(rang[0], dt, bm, rang[1])
     if bm.kinematic_tca is not None:  # errors: the displaced exact flanks' kinematic TE and play
         kin = bm.kinematic_tca.summary(bm.geometry, bm.plan.duty.working_flank)
-        summary.update({k: v for k, v in kin.items() if not k.startswith("contact_pattern")})
+        summary = level_summary(
+            "contact3d", summary, {k: v for k, v in kin.items() if not k.startswith("contact_pattern")}
+        )
     steps = n_rec * rec if held is None else S_all.shape[1] * rec
     return Result(model="contact3d", summary=summary, series=S, steps=steps, sim_time_s=float(d.time), extra=extra)
 
@@ -203,6 +200,23 @@ def force_signs(S: dict, hand: int) -> None:
     S["radial_force_n"] *= -1.0
     S["radial_force_line_of_centres_n"] *= -1.0
     S["axial_force_n"] *= -float(hand)
+
+
+def _after_run_keys(S: dict, bm: BuiltModel, slog: ShaftLog | None, summary: dict) -> tuple[dict, dict]:
+    """(the shafts' keys, with their series added to S; the mass scaling's keys and ringing guard) after the run."""
+    shaft_keys: dict = {}
+    if slog is not None:  # the shafts' deflections and bearing forces
+        S.update(slog.series())
+        shaft_keys = slog.summary(S["t_s"], summary["steady_window_s"])
+    plan = bm.plan
+    ine = plan.inertias  # the scaled shafts with the driven machine's inertia
+    ine_kg_m2 = (
+        ine.worm_inertia_kg_m2 + ine.worm_load_inertia_kg_m2,
+        ine.wheel_inertia_kg_m2 + ine.wheel_load_inertia_kg_m2,
+    )
+    requested = plan.gear.simulation.mass_scaling
+    scaling = mass_scaling.run_summary(S, plan.duty, requested, plan.scaling, ine_kg_m2, {**summary, **shaft_keys})
+    return shaft_keys, scaling
 
 
 def _stiffness_outputs(bm: BuiltModel) -> tuple[dict, object, object | None]:

@@ -85,6 +85,7 @@ from wormsim.errors import DivergedError, LockedError, PenetrationError, Simulat
 from wormsim.friction import friction_coefficient_scalar
 from wormsim.locking import Held, held_keys, run_keys
 from wormsim.metrics import dominant_frequency, drive_summary, mean_speeds_rpm, mesh_line_keys, window_of
+from wormsim.outputs import level_summary
 from wormsim.plan import GearPlan, gear_plan
 from wormsim.result import Result
 from wormsim.scenario import Contact, Load, Materials, Scenario
@@ -525,46 +526,45 @@ def _summary(plan: GearPlan, su: _Setup, S: dict, held: Held | None, solver_keys
     """The torsional keys of the run (solver_keys: the integration's) and the teeth's LTCA for the report."""
     g, ms, mesh, kin = su.g, su.ms, su.mesh, su.kin
     t = S["t_s"]
-    summary = torsional_summary(S, plan, ms)
+    drive = torsional_summary(S, plan, ms)
     t2_work = plan.working_wheel_torque_nm
     st_keys, lt_teeth = stiffness_outputs(
         ms, g, plan.materials, t2_work, plan.duty.working_flank, errors=su.pair is not None
     )
-    summary.update(
+    lock = (
         run_keys(plan.duty.drive, plan.rho_static_rad, plan.transition_velocity_m_s, g, t, S["worm_speed_rpm"])
         if held is None
         else held_keys(t, S["worm_speed_rpm"], S["wheel_torque_nm"], held.stuck_since_s or held.t_s)
     )
-    summary.update(
-        {
-            "scenario": plan.name,
-            **solver_keys,
-            "mesh_stiffness_wall_s": su.t_ms,
-            "worm_inertia_kg_m2": su.I1,
-            "wheel_inertia_kg_m2": su.I2,
-            "inertia_source": "solid cylinders r1 x b1, r2 x b2 (+ load.inertia_kg_m2 on the loaded shaft)",
-            "mesh_natural_frequency_hz": mesh.omega_mesh / (2 * math.pi),
-            "contact_damping_requested_n_s_per_m": mesh.c_req,
-            "contact_damping_used_n_s_per_m": mesh.c_lin,
-            "contact_damping_ratio": mesh.c_lin / mesh.c_crit,
-            "drive_kv_nm_s": su.kv if su.speed_driven else None,
-            "backlash_angle_rad": 2 * mesh.gap,
-            "friction": plan.friction_mode,
-            **ms.summary(),
-            **st_keys,
-        }
-    )
+    used = {
+        "scenario": plan.name,
+        **solver_keys,
+        "mesh_stiffness_wall_s": su.t_ms,
+        "worm_inertia_kg_m2": su.I1,
+        "wheel_inertia_kg_m2": su.I2,
+        "inertia_source": "solid cylinders r1 x b1, r2 x b2 (+ load.inertia_kg_m2 on the loaded shaft)",
+        "mesh_natural_frequency_hz": mesh.omega_mesh / (2 * math.pi),
+        "contact_damping_requested_n_s_per_m": mesh.c_req,
+        "contact_damping_used_n_s_per_m": mesh.c_lin,
+        "contact_damping_ratio": mesh.c_lin / mesh.c_crit,
+        "drive_kv_nm_s": su.kv if su.speed_driven else None,
+        "backlash_angle_rad": 2 * mesh.gap,
+        "friction": plan.friction_mode,
+        **ms.summary(),
+        **st_keys,
+    }
+    errors: dict = {}
     if kin is not None:
         side = plan.duty.working_flank
-        summary.update(kin.summary(g, side))
+        errors.update(kin.summary(g, side))
         k_lt = su.ltca.secant_stiffness_nm_per_rad(side, t2_work) / ms.arm0_m**2
-        summary["mesh_stiffness_loaded_tca_mean_n_per_m"] = float(np.nanmean(k_lt)) if np.isfinite(k_lt).any() else None
-        summary["loaded_tca_wall_s"] = su.t_lt
+        errors["mesh_stiffness_loaded_tca_mean_n_per_m"] = float(np.nanmean(k_lt)) if np.isfinite(k_lt).any() else None
+        errors["loaded_tca_wall_s"] = su.t_lt
         te = kin.te_rad(side)
         S["transmission_error_kinematic_rad"] = np.interp(
             np.mod(S["worm_angle_rad"], kin.period_rad), np.append(kin.theta1_rad, kin.period_rad), np.append(te, te[0])
         )
-    return summary, lt_teeth
+    return level_summary("torsional", drive, lock, used, errors), lt_teeth
 
 
 def _guards(plan: GearPlan, t, w1, w2, out, cmd) -> Held | None:

@@ -31,6 +31,7 @@ import numpy as np
 from wormsim import gear_theory as gt
 from wormsim.friction import friction_coefficient, friction_mode
 from wormsim.geometry import derive
+from wormsim.outputs import level_summary
 from wormsim.result import Result
 from wormsim.units import DEG, rad_s_to_rpm, rpm_to_rad_s
 from wormsim.wedge.dynamics import STEADY_FRACTION, WedgeParams, simulate_params
@@ -120,7 +121,9 @@ def simulate_derived(scenario, progress=None) -> Result:
     p_in, p_out = mean(S["F1_n"] * S["v1_m_s"]), mean(-S["F2_n"] * S["v2_m_s"])
     mu = mean(S["friction_coefficient"])
     T_load = scenario.load.torque_nm
-    res.summary.update(
+    res.summary = level_summary(
+        "wedge",
+        res.summary,
         {
             "ratio": n1 / n2 if n2 > 0 else float("inf"),
             "ratio_theory": g.ratio,
@@ -139,6 +142,6 @@ def simulate_derived(scenario, progress=None) -> Result:
             "friction_coefficient_mean": mu,
             "friction": friction_mode(scenario.contact),
             **d,
-        }
+        },
     )
     return res

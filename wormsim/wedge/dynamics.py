@@ -61,6 +61,7 @@ from scipy.integrate import solve_ivp, trapezoid
 from wormsim import gear_theory as gt
 from wormsim.errors import SimulationError
 from wormsim.friction import friction_coefficient, rho_rad
+from wormsim.outputs import level_summary
 from wormsim.result import Result
 from wormsim.units import DEG, step
 
@@ -283,7 +284,8 @@ def simulate(scenario, progress=None) -> Result:
     summary; a scenario without one goes to wormsim.wedge.derive (wormsim.wedge.level picks)."""
     p = params_from_scenario(scenario)
     res = simulate_params(p, progress=progress, name=scenario.name)
-    res.summary["wedge_source"] = "wedge: block (seed 000: rho = atan(mu), forces reduced to the pitch radii)"
+    source = "wedge: block (seed 000: rho = atan(mu), forces reduced to the pitch radii)"
+    res.summary = level_summary("wedge", res.summary, {"wedge_source": source})
     return res
 
 
@@ -450,32 +452,35 @@ def _assemble(segs: list[dict], p: WedgeParams, steps: int, name: str) -> Result
     i1, i2 = int(np.argmax(np.abs(S1))), int(np.argmax(np.abs(S2)))
     Ft1, Ft2 = rated_forces_n(p)
     rho0 = rho_static(p)
-    summary = {
-        "speed_steady_m_s": v_ss,
-        "S1_peak_n": float(S1[i1]),
-        "S2_peak_n": float(S2[i2]),
-        "S1_peak_time_s": float(t[i1]),
-        "S2_peak_time_s": float(t[i2]),
-        "S1_steady_n": _time_mean(t, S1, t_ss),
-        "S2_steady_n": _time_mean(t, S2, t_ss),
-        "Kd1": abs(float(S1[i1])) / Ft1,
-        "Kd2": abs(float(S2[i2])) / Ft2,
-        "Ft1_n": Ft1,
-        "Ft2_n": Ft2,
-        **_summary_efficiencies(g, rho_ss, rho0),
-        "rho_steady_deg": rho_ss / DEG,
-        "rho_static_deg": rho0 / DEG,
-        **gt.backdrive_keys(g, rho0, rho_ss),
-        "stalled": bool(np.max(np.abs(x1)) == 0.0),
-        "locked_at_end": bool(code[-1] == 0),
-        "x1_end_m": float(x1[-1]),
-        "min_speed_m_s": float(np.min(v1)),
-        "max_speed_m_s": float(np.max(v1)),
-        "regimes": regimes,
-        "regime_timeline": [{"regime": r, "start_s": t0, "end_s": t1} for r, t0, t1 in timeline],
-        "monitor": p.monitor,
-        "steady_window_s": [t_ss, p.duration_s],
-    }
+    summary = level_summary(
+        "wedge",
+        {
+            "speed_steady_m_s": v_ss,
+            "S1_peak_n": float(S1[i1]),
+            "S2_peak_n": float(S2[i2]),
+            "S1_peak_time_s": float(t[i1]),
+            "S2_peak_time_s": float(t[i2]),
+            "S1_steady_n": _time_mean(t, S1, t_ss),
+            "S2_steady_n": _time_mean(t, S2, t_ss),
+            "Kd1": abs(float(S1[i1])) / Ft1,
+            "Kd2": abs(float(S2[i2])) / Ft2,
+            "Ft1_n": Ft1,
+            "Ft2_n": Ft2,
+            **_summary_efficiencies(g, rho_ss, rho0),
+            "rho_steady_deg": rho_ss / DEG,
+            "rho_static_deg": rho0 / DEG,
+            **gt.backdrive_keys(g, rho0, rho_ss),
+            "stalled": bool(np.max(np.abs(x1)) == 0.0),
+            "locked_at_end": bool(code[-1] == 0),
+            "x1_end_m": float(x1[-1]),
+            "min_speed_m_s": float(np.min(v1)),
+            "max_speed_m_s": float(np.max(v1)),
+            "regimes": regimes,
+            "regime_timeline": [{"regime": r, "start_s": t0, "end_s": t1} for r, t0, t1 in timeline],
+            "monitor": p.monitor,
+            "steady_window_s": [t_ss, p.duration_s],
+        },
+    )
     return Result(
         model="wedge",
         summary=summary,
