@@ -1,9 +1,8 @@
 """No function in wormsim/ or meshgen/ is longer than MAX_LINES lines (its docstring included) or takes more than
 MAX_PARAMS parameters (self / cls not counted, *args and **kwargs one each): the sources read with ast, nothing
 imported. PENDING names the functions still over a limit: those of the exact-flank path's files (the compiled path
-into MuJoCo is being rewritten there) and the compiled contact kernels whose scalar parameters are still to be
-grouped into records (each grouping needs the kernel's speed measured before and after); an entry that no longer
-exceeds a limit fails too, so the list only shrinks."""
+into MuJoCo is being rewritten there) and the compiled functions those files call; an entry that no longer exceeds a
+limit fails too, so the list only shrinks."""
 
 from __future__ import annotations
 
@@ -23,13 +22,6 @@ PENDING = {
     ("wormsim/contact3d/flank_samples.py", "run_samples"),
     ("wormsim/contact3d/series.py", "column"),  # called by flank_samples.run_samples
     ("wormsim/tooth/merge.py", "split_forces"),  # called by flank_step and flank_samples
-    ("wormsim/tooth/merge.py", "merge_flanks"),
-    ("wormsim/tooth/kernel.py", "find_contacts"),
-    ("wormsim/tooth/kernel.py", "_find_contacts"),
-    ("wormsim/tooth/kernel.py", "_slice_contact"),
-    ("wormsim/tooth/kernel.py", "_edge_minimum"),
-    ("wormsim/tooth/kernel.py", "_write_contact"),
-    ("wormsim/tooth/kernel.py", "_face_slope"),
 }
 
 
