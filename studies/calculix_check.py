@@ -84,7 +84,7 @@ def fe_root_value(g, sc, side: int, torque_nm: float) -> dict:
 def one_gear(name: str, path: Path, angles: int, density: float, threads: int, workdir: Path, reread: bool) -> dict:
     sc = load_scenario(path)
     g = derive(sc.gear)
-    side = gear_theory.working_flank(sc, g.hand)
+    side = gear_theory.duty(sc, g.hand).working_flank
     m = sc.materials
     torque = abs(sc.load.torque_nm)
     arm0 = cx.arm0_m(g)
@@ -96,10 +96,7 @@ def one_gear(name: str, path: Path, angles: int, density: float, threads: int, w
         if reread:
             r = cx.reread(workdir / name, th1)
         else:
-            r = cx.solve(
-                g, m.wheel.youngs_modulus_gpa * 1e9, m.wheel.poisson_ratio, m.worm.youngs_modulus_gpa * 1e9,
-                m.worm.poisson_ratio, side, th1, lag, density=density, workdir=workdir / name, threads=threads,
-            )  # fmt: skip
+            r = cx.solve(g, m, side, th1, lag, density=density, workdir=workdir / name, threads=threads)
         shown = ("theta1_deg", "torque_nm", "mesh_stiffness_n_per_m", "load_share", "torque_balance", "nodes")
         print(name, {k: r.get(k) for k in shown + ("root_stress_max_mpa", "ccx_wall_s")}, flush=True)
         cases.append(r)
@@ -153,16 +150,13 @@ def convergence(a, gears: dict) -> dict:
     sc = load_scenario(GEARS["screw_jack"])
     g = derive(sc.gear)
     m = sc.materials
-    side = gear_theory.working_flank(sc, g.hand)
+    side = gear_theory.duty(sc, g.hand).working_flank
     lag = abs(sc.load.torque_nm) / (C_GUESS_N_PER_MM_UM * 1e9 * g.face_width * cx.arm0_m(g) ** 2)
     where = Path(a.workdir) / "screw_jack_fine"
     if a.reread:
         fine = cx.reread(where, 0.0)
     else:
-        fine = cx.solve(
-            g, m.wheel.youngs_modulus_gpa * 1e9, m.wheel.poisson_ratio, m.worm.youngs_modulus_gpa * 1e9,
-            m.worm.poisson_ratio, side, 0.0, lag, density=a.fine, workdir=where, threads=a.threads,
-        )  # fmt: skip
+        fine = cx.solve(g, m, side, 0.0, lag, density=a.fine, workdir=where, threads=a.threads)
     coarse = gears["screw_jack"]["calculix"][0]
     keys = ("mesh_stiffness_n_per_m", "load_share", "root_stress_max_mpa", "torque_nm", "nodes", "h_fine_mm")
     return {

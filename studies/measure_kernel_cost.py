@@ -53,7 +53,7 @@ def record_states(name: str):
     fc = FlankContacts(bm, bm.law.contacts_per_pair)
     split_forward(m, d, fc.add)
     th0 = (float(d.qpos[fc.qa1]), float(d.qpos[fc.qa2]))
-    cmds = gt.commands(sc, bm.direction)
+    cmds = gt.duty(sc, bm.direction).commands
     dt = m.opt.timestep
     warm = int(round(0.012 / dt))
     pitch = 2 * math.pi / bm.geometry.z2

@@ -50,7 +50,7 @@ def _setup(name, extra, merge, mod, warm):
         flank_step.split_forward(m, d, fc.add)
     finally:
         flank_step.PackedKernel, flank_step.find_packed = saved
-    cmds = gt.commands(sc, bm.direction)
+    cmds = gt.duty(sc, bm.direction).commands
     dt = m.opt.timestep
     t = (np.arange(warm + 100000) + 0.5) * dt
     drive, load = cmds.drive(t), cmds.load(t)

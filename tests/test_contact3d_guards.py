@@ -110,7 +110,7 @@ def test_friction_guard_names_the_lock_only_where_the_wheel_drives_a_self_lockin
     for mu, locked in ((0.2, True), (0.02, False)):
         sc = load_scenario(JACK, WHEEL_DRIVEN + [f"contact.friction={mu}", LOCK_DURATION])
         bm = build_model(sc)
-        err = friction_error(0.03, 0.3, 2e5, 90.0, 5.0, 100.0, bm, sc)
+        err = friction_error(0.03, 0.3, 2e5, 90.0, 5.0, 100.0, bm)
         assert isinstance(err, LockedError) == locked, str(err)
         msg = str(err)
         assert "cos(f_t, -v_t) = 0.30" in msg and "2e+03 x the 100 N" in msg, msg

@@ -252,21 +252,13 @@ def test_flanks_no_grid_point_is_cut_by_the_worm():
         th2 = g.hand * th1 * g.z1 / g.z2
         ks = window_teeth_at(th2, g.z2, W, -math.pi / 2 + math.pi / g.z2).astype(np.int64)
         n = kernel.find_contacts(
-            fg.xy,
-            fg.c,
-            fg.c_range,
-            fg.span,
-            fg.zeta,
+            (fg.xy, fg.c, fg.c_range, fg.span, fg.zeta),
             ks,
             th1,
             th2 - g.hand * 2 * bl,
             kernel.MARGIN_PITCH * pitch + 3 * bl,
             fg.params,
-            pos,
-            nrm,
-            dep,
-            meta,
-            line,
+            (pos, nrm, dep, meta, line),
         )
         deepest.append(dep[:n].max())
     assert max(deepest) < 1.02 * expected and min(deepest) > 0.98 * expected, (min(deepest), max(deepest), expected)

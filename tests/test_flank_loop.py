@@ -55,7 +55,7 @@ def test_compiled_loop_equals_python_split_step(sets, mode):
     from wormsim.physics import gear_theory as gt
 
     dt = m.opt.timestep
-    cmds = gt.commands(sc, bm.direction)
+    cmds = gt.duty(sc, bm.direction).commands
     t = (np.arange(N_STEPS) + 0.5) * dt
     cmd, load = cmds.drive(t), cmds.load(t)
     a1, a2 = (bm.drive_actuator, bm.load_actuator)  # the screw jack's worm drives
@@ -125,7 +125,7 @@ def test_compiled_sample_equals_numpy_path(mode, sets):
     split_forward(m, d, fc.add)
     loop = FlankLoop(fc, d, bm.drive_actuator, bm.load_actuator, bm.drive_actuator, bm.load_actuator, 0)
     t = (np.arange(N_STEPS) + 0.5) * m.opt.timestep
-    cmds = gt.commands(sc, bm.direction)
+    cmds = gt.duty(sc, bm.direction).commands
     loop.run(cmds.drive(t), cmds.load(t), 0, N_STEPS)
     assert fc.n > 4
     mu = 0.05

@@ -43,7 +43,7 @@ def test_a_mass_scaled_run_takes_at_most_16_slices():
 
     seat = SCENARIOS / "seat_motor.yaml"
     scaled = build_model(load_scenario(seat, ["simulation.mass_scaling=1000"]))
-    assert scaled.meta["mass_scaling"] == 1000 and scaled.law.contacts_per_pair == grid.SLICES_MASS_SCALED == 16
+    assert scaled.plan.scaling.factor == 1000 and scaled.law.contacts_per_pair == grid.SLICES_MASS_SCALED == 16
     explicit = build_model(load_scenario(seat, ["simulation.mass_scaling=1000", "contact.slices=24"]))
     assert explicit.law.contacts_per_pair == 24
     assert build_model(load_scenario(seat)).law.contacts_per_pair == 32

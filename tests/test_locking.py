@@ -17,6 +17,7 @@ from meshgen.geometry import derive
 from wormsim import cli
 from wormsim.physics import gear_theory as gt
 from wormsim.physics.locking import backdrive_self_locks, stall_torque_nm
+from wormsim.physics.plan import gear_plan
 from wormsim.run import simulate
 from wormsim.scenario import load_scenario
 
@@ -56,10 +57,11 @@ def test_self_locking_condition_is_din_3975s():
     assert 0.082 < mu_star < 0.083
     for mu, locks in ((mu_star * 1.01, True), (mu_star * 0.99, False)):
         sc = load_scenario(DEMO, [*BACKDRIVE, f"contact.friction={mu}"])
-        assert backdrive_self_locks(sc, g.gamma, g.alpha_n) is locks
-    assert not backdrive_self_locks(
-        load_scenario(DEMO, ["contact.friction_static=0.2", "contact.friction_dynamic=0.2"]), g.gamma, g.alpha_n
-    )
+        assert gear_plan(sc).backdrive_self_locks is locks
+        assert backdrive_self_locks(sc.drive, g.gamma, gear_plan(sc).rho_static_rad) is locks
+    assert not gear_plan(
+        load_scenario(DEMO, ["contact.friction_static=0.2", "contact.friction_dynamic=0.2"])
+    ).backdrive_self_locks
 
 
 def test_torsional_backdrive_of_a_self_locking_pair_is_held_exit_0(tmp_path, capsys):

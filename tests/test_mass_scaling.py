@@ -191,13 +191,13 @@ def test_ringing_guard_on_efficiency_above_one():
     sc = load_scenario(SEAT, CFG + ["simulation.mass_scaling=300"])
     duty, req = gt.duty(sc, 1), sc.simulation.mass_scaling
     c = msm.ScalingCheck(300.0, 555.0, 3.0, 0.1, 0.008, {})
-    meta = {"mass_scaling_check": c, "shaft_inertias_kg_m2": (300 * 7.8e-8, 300 * 1.35e-6)}
+    ine = (300 * 7.8e-8, 300 * 1.35e-6)
     ok = {"efficiency": 0.613, "timestep_s": 1e-4, "timestep_stable_limit_s": 2.8e-4}
-    assert msm.run_summary(S, duty, req, meta, ok)["kinetic_energy_share"] < msm.KE_SHARE_TARGET
+    assert msm.run_summary(S, duty, req, c, ine, ok)["kinetic_energy_share"] < msm.KE_SHARE_TARGET
     with pytest.raises(RingingError, match="efficiency 1.83 > 1"):
-        msm.run_summary(S, duty, req, meta, {**ok, "efficiency": 1.83})
-    heavy = {**meta, "shaft_inertias_kg_m2": (1e5 * 7.8e-8, 1e5 * 1.35e-6)}
+        msm.run_summary(S, duty, req, c, ine, {**ok, "efficiency": 1.83})
+    heavy = (1e5 * 7.8e-8, 1e5 * 1.35e-6)
     with pytest.raises(RingingError, match="kinetic energy"):
-        msm.run_summary(S, duty, req, heavy, ok)
-    unscaled = {**meta, "mass_scaling_check": msm.ScalingCheck(1.0, 9620.0, 3.0, 0.1, 3e-5, {})}
-    assert msm.run_summary(S, duty, req, unscaled, {**ok, "efficiency": 1.83})["mass_scaling"] == 1
+        msm.run_summary(S, duty, req, c, heavy, ok)
+    unscaled = msm.ScalingCheck(1.0, 9620.0, 3.0, 0.1, 3e-5, {})
+    assert msm.run_summary(S, duty, req, unscaled, ine, {**ok, "efficiency": 1.83})["mass_scaling"] == 1

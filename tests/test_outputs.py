@@ -114,3 +114,16 @@ def test_a_left_hand_worm_gives_the_same_force_signs_at_torsional_and_contact3d(
         means[level] = [float(np.mean(r.series[f"{c}_force_n"][sl])) for c in ("tangential", "radial", "axial")]
     for level, (ft, fr, fa) in means.items():
         assert ft < 0 and fr > 0 and fa < 0, (level, ft, fr, fa)
+
+
+def test_level_summary_merges_in_order_and_refuses_a_key_without_the_levels_entry():
+    """wormsim.results.summary_keys.level_summary, every level's summary builder: later groups replace earlier keys; a key with
+    no entry, or whose entry does not name the level, raises KeyError naming it."""
+    s = outputs.level_summary("torsional", {"ratio": 1.0, "efficiency": 0.5}, {"efficiency": 0.6})
+    assert s == {"ratio": 1.0, "efficiency": 0.6}
+    with pytest.raises(KeyError, match="no_such_key"):
+        outputs.level_summary("contact3d", {"ratio": 1.0}, {"no_such_key": 1})
+    wedge_only = next(k for k, e in outputs.KEYS.items() if e.levels == ("wedge",))
+    with pytest.raises(KeyError, match=wedge_only):
+        outputs.level_summary("torsional", {wedge_only: 1.0})
+    assert outputs.level_summary("wedge", {wedge_only: 1.0}) == {wedge_only: 1.0}

@@ -172,7 +172,7 @@ def test_shaft_log_series_equal_the_per_sample_formulas(block):
     d = mujoco.MjData(m)
     fc = FlankContacts(bm, bm.law.contacts_per_pair)
     split_forward(m, d, fc.add)
-    cmds = gt.commands(sc, bm.direction)
+    cmds = gt.duty(sc, bm.direction).commands
     n, every = 12, 25
     log = shafts.ShaftLog(m, bm.meta["shafts"], n)
     ref: dict[str, list[float]] = {}

@@ -28,7 +28,7 @@ from wormsim.contact3d.backlash import UM, flank_clearance_m, min_backlash_m, pi
 from wormsim.contact3d.friction_law import STICK_RELEASE, stuck_after
 from wormsim.contact3d.mjcf import build_model
 from wormsim.contact3d.runner import run_model, simulate
-from wormsim.physics.locking import stick_velocity_m_s
+from wormsim.physics.plan import gear_plan
 from wormsim.physics.units import MM
 from wormsim.scenario import ScenarioError, load_scenario
 from wormsim.torsional import dynamics as torsional
@@ -136,7 +136,7 @@ def _forward(path, overrides, duration_s):
         path, [f"simulation.duration_s={duration_s}", "drive.ramp_s=0.01", "load.ramp_s=0.01", *overrides]
     )
     bm = build_model(sc, check_backlash_vs_pieces=False)
-    S = run_model(bm, sc).series
+    S = run_model(bm).series
     k = S["t_s"] > duration_s / 2
     return float(S["worm_torque_nm"][k].mean()), float(-S["wheel_power_w"][k].mean() / S["worm_power_w"][k].mean())
 
@@ -279,11 +279,14 @@ def test_stick_state_only_where_the_wheel_drives_a_pair_self_locking_at_rest(dem
     breaks away at v_t and sticks again below STICK_RELEASE v_t."""
     lock = _friction(_mu_at(demo_geometry, +0.3), _mu_at(demo_geometry, -0.3))
     free = _friction(_mu_at(demo_geometry, -0.3), _mu_at(demo_geometry, -0.5))
-    g, a = demo_geometry.gamma_m, demo_geometry.alpha_n
     v_t = load_scenario(DEMO).contact.transition_velocity_m_s
-    assert stick_velocity_m_s(load_scenario(DEMO, [*BACKDRIVE, *lock]), g, a) == v_t
-    assert stick_velocity_m_s(load_scenario(DEMO, [*BACKDRIVE, *free]), g, a) == 0.0
-    assert stick_velocity_m_s(load_scenario(DEMO, lock), g, a) == 0.0  # the worm drives
+
+    def stick(overrides):
+        return gear_plan(load_scenario(DEMO, overrides), demo_geometry).stick_velocity_m_s
+
+    assert stick([*BACKDRIVE, *lock]) == v_t
+    assert stick([*BACKDRIVE, *free]) == 0.0
+    assert stick(lock) == 0.0  # the worm drives
     assert stuck_after(True, 0.99 * v_t, v_t) and not stuck_after(True, v_t, v_t)
     assert not stuck_after(False, 0.5 * v_t, v_t) and stuck_after(False, 0.99 * STICK_RELEASE * v_t, v_t)
     assert not stuck_after(True, 0.0, 0.0)

@@ -293,14 +293,13 @@ def test_driven_machine_inertia_adds_to_the_loaded_shaft():
 
     base = load_scenario(ROOT / "scenarios" / "seat_motor.yaml")
     g = derive(base.gear)
-    i1, i2 = inertias(base, g)
-    j1, j2 = inertias(load_scenario(ROOT / "scenarios" / "seat_motor.yaml", ["load.inertia_kg_m2=2e-4"]), g)
+    i1, i2 = inertias(base.materials, base.load, g)
+    heavy = load_scenario(ROOT / "scenarios" / "seat_motor.yaml", ["load.inertia_kg_m2=2e-4"])
+    j1, j2 = inertias(heavy.materials, heavy.load, g)
     # the load.inertia_kg_m2=2e-4 input adds to the loaded shaft only
     assert j1 == i1 and abs(j2 - i2 - 2e-4) < 1e-15
-    k1, k2 = inertias(
-        load_scenario(
-            ROOT / "scenarios" / "seat_motor.yaml", ["load.inertia_kg_m2=2e-4", "load.on=worm", "drive.on=wheel"]
-        ),
-        g,
+    on_worm = load_scenario(
+        ROOT / "scenarios" / "seat_motor.yaml", ["load.inertia_kg_m2=2e-4", "load.on=worm", "drive.on=wheel"]
     )
+    k1, k2 = inertias(on_worm.materials, on_worm.load, g)
     assert k2 == i2 and abs(k1 - i1 - 2e-4) < 1e-15

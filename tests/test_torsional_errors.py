@@ -60,9 +60,9 @@ def test_shaft_angle_narrows_the_loaded_band_as_contact3d_shows():
     sc, g, kp, src = _pair("screw_jack", ["errors.shaft_angle_deg=0.1"])
     dev, kin = displaced_pair(sc.errors, g)
     ms = mesh_stiffness(g, kp, src, sc.simulation.mesh_stiffness_samples)
-    t2 = gt.working_wheel_torque_nm(sc, g.ratio)
+    t2 = gt.working_wheel_torque_of(sc.drive, sc.load, g.ratio)
     tab = lt.loaded_tca(g, dev, kin, kp * g.face_width, t2, float(np.mean(ms.k_theta_fwd_nm_per_rad)))
-    side = gt.working_flank(sc, g.hand)
+    side = gt.duty(sc, g.hand).working_flank
     T = tab.torque_fwd_nm if side > 0 else tab.torque_rev_nm
     ev = lt.Evaluator(g, dev, kp * g.face_width, tab.slices)
     hz = g.hand * g.z1 / g.z2

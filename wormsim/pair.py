@@ -59,7 +59,7 @@ from wormsim.contact3d import shafts
 from wormsim.contact3d.flank_step import FlankContacts, split_step
 from wormsim.contact3d.mjcf import Prepared, prepare
 from wormsim.contact3d.timestep import MAX_WORM_TURN_PER_STEP_RAD, OVERSPEED_GUARD, default_timestep
-from wormsim.physics.friction import friction_coefficient, friction_coefficient_scalar
+from wormsim.physics.friction import friction_coefficient_scalar
 from wormsim.physics.geometry import displaced_pair
 from wormsim.scenario import Scenario, load_scenario
 from wormsim.tooth.window import window_size
@@ -274,7 +274,7 @@ class WormPair:
         else:
             Tw = np.asarray(assembly.worm_to_assembly(0.0, geo), dtype=float)
             mounts = {"worm": (Tw, np.eye(4)), "wheel": (np.eye(4), np.eye(4))}
-        mu0 = float(friction_coefficient(self.scenario.contact, 0.0))
+        mu0 = p.gear.mu_static
         meshes = {"worm": p.pieces.worm_visual, "wheel": p.pieces.wheel_visual}
         props = {
             "worm": (ine.worm_mass_kg, ine.worm_inertia_kg_m2, geo.worm_length, (0.55, 0.6, 0.7, 1)),

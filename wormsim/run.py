@@ -57,6 +57,25 @@ def simulate(scenario: Scenario, progress: Progress | None = None) -> Result:
     return res
 
 
+def _failed(rd: ResultDir, warm: prewarm.Writers, exc: BaseException, message: str, base: dict, t0: float) -> None:
+    """A run that raised exc: the writers' warm-up cancelled; an interrupt that came back as another exception leaves
+    out_dir as it was (raised as interrupt.Interrupted), anything else writes a "failed" summary.json with message."""
+    warm.cancel()
+    if (sig := interrupt.pending()) is not None:
+        rd.abandon()
+        raise interrupt.Interrupted(sig) from exc
+    rd.fail(
+        {
+            "status": "failed",
+            "message": message,
+            **base,
+            "wall_time_s": time.perf_counter() - t0,
+            "sim_time_s": None,
+            "steps": None,
+        }
+    )
+
+
 def run_scenario(scenario: Scenario, out_dir: str | Path, progress: bool | None = None) -> dict:
     """Simulate `scenario` and write out_dir/{summary.json, timeseries.npz, report.png, recording.rrd}, as
     `wormsim run` does.
@@ -111,36 +130,10 @@ def run_scenario(scenario: Scenario, out_dir: str | Path, progress: bool | None 
         rd.abandon()
         raise
     except (SimulationError, ScenarioError) as exc:  # a diagnosis (exit 3) or input found invalid (exit 2)
-        warm.cancel()
-        if (sig := interrupt.pending()) is not None:
-            rd.abandon()
-            raise interrupt.Interrupted(sig) from exc
-        rd.fail(
-            {
-                "status": "failed",
-                "message": str(exc),
-                **base,
-                "wall_time_s": time.perf_counter() - t0,
-                "sim_time_s": None,
-                "steps": None,
-            }
-        )
+        _failed(rd, warm, exc, str(exc), base, t0)
         raise
     except BaseException as exc:  # never leave a result that looks complete
-        warm.cancel()
-        if (sig := interrupt.pending()) is not None:  # the interrupt came back as another exception
-            rd.abandon()
-            raise interrupt.Interrupted(sig) from exc
-        rd.fail(
-            {
-                "status": "failed",
-                "message": f"internal error: {exc.__class__.__name__}: {exc}",
-                **base,
-                "wall_time_s": time.perf_counter() - t0,
-                "sim_time_s": None,
-                "steps": None,
-            }
-        )
+        _failed(rd, warm, exc, f"internal error: {exc.__class__.__name__}: {exc}", base, t0)
         raise
     summary = {
         "status": "ok",

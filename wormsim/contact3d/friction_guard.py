@@ -28,9 +28,7 @@ import numba
 
 from wormsim.contact3d.diagnosis import locked_error
 from wormsim.exceptions import SimulationError
-from wormsim.physics import gear_theory as gt
-from wormsim.physics.friction import friction_coefficient
-from wormsim.physics.locking import Held, backdrive_self_locks
+from wormsim.physics.locking import Held
 from wormsim.physics.units import rad_s_to_rpm, rpm_to_rad_s
 
 ALIGN_MIN = 0.5  # friction-weighted cos(f_t, -v_t) of the sliding contacts below this ...
@@ -78,11 +76,11 @@ def _alignment(adr, dim, friction, f, v, v_min):
 class FrictionGuard:
     """The check of the module docstring, one call per sample."""
 
-    def __init__(self, bm, rec_interval_s: float, scenario):
-        """bm.plan: the ramps' end, the transition velocity, the working load's normal force; the scenario only for
-        the error's message (friction_error)."""
+    def __init__(self, bm, rec_interval_s: float):
+        """bm.plan: the ramps' end, the transition velocity, the working load's normal force, the self-locking
+        back-drive and what the error's message quotes (friction_error)."""
         plan = bm.plan
-        self.scenario, self.bm = scenario, bm
+        self.bm = bm
         self.start = plan.ramps_end_s
         self.hold = max(HOLD_S, 5 * rec_interval_s)
         self.v_min = plan.transition_velocity_m_s
@@ -100,16 +98,13 @@ class FrictionGuard:
             return
         self.since = t if self.since is None else self.since
         if t - self.since > self.hold:
-            geo = self.bm.geometry
-            if backdrive_self_locks(
-                self.scenario, geo.gamma_m, geo.alpha_n
-            ):  # the held mesh's overload (wormsim.physics.locking)
+            if self.bm.plan.gear.backdrive_self_locks:  # the held mesh's overload (wormsim.physics.locking)
                 raise Held(t, self.since)
-            raise friction_error(t, cos, fn, w1, w2, self.f_nominal, self.bm, self.scenario, self.hold)
+            raise friction_error(t, cos, fn, w1, w2, self.f_nominal, self.bm, self.hold)
 
 
 def friction_error(
-    t: float, cos: float, fn: float, w1: float, w2: float, f_nominal: float, bm, scenario, hold_s: float = HOLD_S
+    t: float, cos: float, fn: float, w1: float, w2: float, f_nominal: float, bm, hold_s: float = HOLD_S
 ) -> SimulationError:
     """Friction against the slip: where the wheel drives a pair that is self-locking at standstill, the drive is
     locked (wormsim.contact3d.diagnosis.locked_error's diagnosis, with what was measured); otherwise the load is
@@ -124,11 +119,10 @@ def friction_error(
         f"c_f = {law.friction_damping:.3g} N s/m was sized for (wormsim.contact3d.law (4)); the worm turns at "
         f"{rad_s_to_rpm(w1):.4g} rpm, the wheel at {rad_s_to_rpm(w2):.4g} rpm"
     )
-    drv = scenario.drive
+    drv = bm.plan.duty.drive
     if drv.on == "wheel" and drv.speed_rpm is not None:
-        mu0 = float(friction_coefficient(scenario.contact, 0.0))
-        if gt.virtual_friction_angle_rad(mu0, geo.alpha_n) >= geo.gamma_m:
-            err = locked_error(t, w2, rpm_to_rad_s(drv.speed_rpm), bm, scenario)
+        if bm.plan.gear.rho_static_rad >= geo.gamma_m:
+            err = locked_error(t, w2, rpm_to_rad_s(drv.speed_rpm), bm)
             return type(err)(f"{err} (caught by the friction guard: {what}; the back-driving is not physical)")
     pieces = " or run contact.geometry=pieces (friction rows with c_f = c_c)" if law.friction_damping_n_s_per_m else ""
     return SimulationError(

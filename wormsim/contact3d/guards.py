@@ -24,9 +24,8 @@ from wormsim.contact3d.friction_guard import FrictionGuard
 from wormsim.contact3d.mjcf import BuiltModel
 from wormsim.contact3d.timestep import MAX_WORM_TURN_PER_STEP_RAD, OVERSPEED_GUARD
 from wormsim.physics import gear_theory as gt
-from wormsim.physics.locking import Held, backdrive_self_locks
+from wormsim.physics.locking import Held
 from wormsim.physics.units import rad_s_to_rpm
-from wormsim.scenario import Scenario
 
 DIVERGED, OVERSPEED, JUMPED = 1, 2, 3  # state_event's codes (0: none)
 PENETRATED, STUCK, RUNNING = 4, 5, 6  # contact_event's codes (0: none)
@@ -67,11 +66,11 @@ def contact_event(t, pen, pen_lim, w_drive, cmd, speed_driven, lock_start, lock_
 class Guards:
     """The checks after every record interval (module docstring); each raises its SimulationError subclass. What they
     check against comes from the run's plan (bm.plan: the timestep, the drive's kind, the guards' times, the working
-    load); the scenario only completes the error messages (wormsim.contact3d.diagnosis quotes its inputs)."""
+    load, the values the error messages quote: wormsim.contact3d.diagnosis)."""
 
-    def __init__(self, bm: BuiltModel, rec: int, scenario: Scenario):
+    def __init__(self, bm: BuiltModel, rec: int):
         plan = bm.plan
-        self.bm, self.scenario, self.dt = bm, scenario, plan.timestep_s
+        self.bm, self.dt = bm, plan.timestep_s
         geo = bm.geometry
         self.pen_lim = gt.penetration_limit_m(geo.m_x)
         self.pitch_angle = 2 * math.pi / geo.z2
@@ -81,11 +80,11 @@ class Guards:
         self.lock_hold = max(gt.LOCK_HOLD_S, 20 * rec * self.dt)
         self.speed_driven = plan.speed_driven
         self.locked_since: float | None = None
-        self.self_locking_backdrive = backdrive_self_locks(scenario, geo.gamma_m, geo.alpha_n)
+        self.self_locking_backdrive = plan.gear.backdrive_self_locks
         self.turn_max = 0.0
         self.stuck = plan.stick_velocity_m_s > 0.0  # the friction law's stick state: a run starts at rest
         # sliding contacts' friction against their slip (wormsim.contact3d.friction_guard)
-        self.friction = FrictionGuard(bm, rec * self.dt, scenario)
+        self.friction = FrictionGuard(bm, rec * self.dt)
 
     def state(self, d: mujoco.MjData, t: float, th1: float, th2: float, w1: float, w2: float) -> float:
         """Divergence, overspeed, teeth jumped, friction against the slip; returns the transmission error (rad)."""
@@ -102,14 +101,14 @@ class Guards:
                 raise diverged_error(t, dt, bm, f"the worm ran away to {rad_s_to_rpm(abs(w1)):.0f} rpm")
             raise overspeed_error(t, w1, dt)
         if code == JUMPED:
-            raise jump_error(t, te / self.pitch_angle, dt, bm, self.scenario)
+            raise jump_error(t, te / self.pitch_angle, dt, bm)
         self.friction.check(d, t, w1, w2)
         return te
 
     def _creeping(self, w_worm: float) -> bool:
         """The worm's sliding speed below 10 transition velocities (the static friction's reach)."""
         geo = self.bm.geometry
-        return abs(w_worm) * geo.r_m1 / math.cos(geo.gamma_m) < 10 * self.scenario.contact.transition_velocity_m_s
+        return abs(w_worm) * geo.r_m1 / math.cos(geo.gamma_m) < 10 * self.bm.plan.transition_velocity_m_s
 
     def contact(self, t: float, pen: float, w_drive: float, cmd: float, w_worm: float = 0.0) -> None:
         """Penetration beyond the limit; a speed-driven drive stuck below half its command (locked) for lock_hold.
@@ -128,6 +127,6 @@ class Guards:
             if t - self.locked_since > self.lock_hold:
                 if self.self_locking_backdrive:  # the answer, not a failure (wormsim.physics.locking)
                     raise Held(t, self.locked_since)
-                raise locked_error(t, w_drive, cmd, self.bm, self.scenario)
+                raise locked_error(t, w_drive, cmd, self.bm)
         elif code == RUNNING:
             self.locked_since = None

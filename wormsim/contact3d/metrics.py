@@ -17,7 +17,7 @@ from wormsim.results.metrics import (
 )
 
 
-def contact3d_summary(S: dict, scenario, bm) -> dict:
+def contact3d_summary(S: dict, bm) -> dict:
     """drive_summary plus the meshing frequency from the tangential force and contact statistics; the steady window
     after the ramps of the run's plan (bm.plan.duty)."""
     geo, duty = bm.geometry, bm.plan.duty
@@ -28,7 +28,7 @@ def contact3d_summary(S: dict, scenario, bm) -> dict:
     f_theory = geo.z1 * n1 / 60.0
     f_full, _, _, _ = dominant_frequency(t[sl], S["tangential_force_n"][sl])
     # shaft powers: the interval means of T w over every step (the runner's worm_power_w, wheel_power_w)
-    drive = drive_summary(S, scenario, geo, i0, i1, n1, n2, shaft_powers_w=(S["worm_power_w"], S["wheel_power_w"]))
+    drive = drive_summary(S, bm.plan.gear, i0, i1, n1, n2, shaft_powers_w=(S["worm_power_w"], S["wheel_power_w"]))
     return {
         **drive,
         # the meshing line near z1 n1 / 60 (wormsim.results.metrics.mesh_line): the pieces' facets, the contact mode's

@@ -26,13 +26,6 @@ from wormsim.scenario import Drive, Load, Materials, Scenario, ScenarioError
 # ----------------------------------------------------------------------------- friction angle and efficiency
 
 
-def gear_drive(scenario: Scenario) -> Drive:
-    """The drive: block of a gear-level scenario (torsional, contact3d)."""
-    if scenario.drive is None:
-        raise ScenarioError(f"drive: model {scenario.model} needs a drive: block")
-    return scenario.drive
-
-
 def virtual_friction_angle_rad(mu, alpha_n_rad: float):
     """rho' = atan(mu / cos(alpha_n)): the friction angle in the flank normal seen in the worm's axial section
     (DIN 3975-2; Niemann / Winter III, eq. 24.31). Float or array mu."""
@@ -155,11 +148,6 @@ def mesh_arms_m(r1_m: float, r2_m: float, alpha_n_rad: float, lead_angle_rad: fl
     return r1_m * ca * math.sin(lead_angle_rad), r2_m * ca * math.cos(lead_angle_rad)
 
 
-def working_wheel_torque_nm(scenario: Scenario, ratio: float) -> float:
-    """working_wheel_torque_of the scenario's drive and load."""
-    return working_wheel_torque_of(gear_drive(scenario), scenario.load, ratio)
-
-
 def working_wheel_torque_of(drv: Drive, load: Load, ratio: float) -> float:
     """T2 (N m) through the mesh at the working load: the load, or the worm load times the ratio when the load is on
     the worm; a torque driving the WHEEL counts too, the larger of the two (it passes through the mesh whatever the
@@ -177,15 +165,17 @@ DEFAULT_DAMPING_RATIO = 0.1  # mesh damping when none is given, of one tooth pai
 MAX_DAMPING_RATIO = 0.1  # cap of the mesh damping (measured gear-mesh damping ratios: 0.03-0.17)
 
 
-def shaft_inertias_kg_m2(scenario: Scenario, r1_m: float, worm_length_m: float, r2_m: float, face_width_m: float):
+def shaft_inertias_kg_m2(
+    materials: Materials, load: Load, r1_m: float, worm_length_m: float, r2_m: float, face_width_m: float
+):
     """(I1, I2) in kg m^2: the worm a solid cylinder r1 x threaded length, the wheel a solid cylinder r2 x face width
     (I = m r^2 / 2, densities from materials:), plus the driven-machine inertia load.inertia_kg_m2 on the loaded
     shaft (rigid on it, as contact3d's joint armature). The torsional and the derived wedge level use it."""
-    mats = scenario.materials
+    mats = materials
     m1 = mats.worm.density_kg_m3 * math.pi * r1_m**2 * worm_length_m
     m2 = mats.wheel.density_kg_m3 * math.pi * r2_m**2 * face_width_m
-    j = scenario.load.inertia_kg_m2
-    j1, j2 = (j, 0.0) if scenario.load.on == "worm" else (0.0, j)
+    j = load.inertia_kg_m2
+    j1, j2 = (j, 0.0) if load.on == "worm" else (0.0, j)
     return 0.5 * m1 * r1_m**2 + j1, 0.5 * m2 * r2_m**2 + j2
 
 
@@ -217,11 +207,6 @@ def load_target_nm(drive: Drive, load: Load, direction: int) -> float:
     return -s * load.torque_nm
 
 
-def ramps_end_s(scenario: Scenario) -> float:
-    """ramps_end_of the scenario's drive and load."""
-    return ramps_end_of(gear_drive(scenario), scenario.load)
-
-
 def ramps_end_of(drive: Drive, load: Load) -> float:
     """When both commands have reached their full value (s)."""
     return max(drive.ramp_s, load.start_s + load.ramp_s)
@@ -245,21 +230,11 @@ class Commands:
         return step(t, self.load_start_s, 0.0, self.load_end_s, self.load_target_nm)
 
 
-def commands(scenario: Scenario, direction: int) -> Commands:
-    """commands_of the scenario's drive and load."""
-    return commands_of(gear_drive(scenario), scenario.load, direction)
-
-
 def commands_of(drv: Drive, load: Load, direction: int) -> Commands:
     """The drive's and the load's STEPs (Commands) for the expected direction (load_target_nm)."""
     return Commands(
         drive_target(drv), drv.ramp_s, load_target_nm(drv, load, direction), load.start_s, load.start_s + load.ramp_s
     )
-
-
-def working_flank(scenario: Scenario, hand: int) -> int:
-    """working_flank_of the scenario's drive."""
-    return working_flank_of(gear_drive(scenario), hand)
 
 
 def working_flank_of(drv: Drive, hand: int) -> int:
@@ -299,8 +274,12 @@ class Duty:
 
 
 def duty(scenario: Scenario, direction: int) -> Duty:
-    """The scenario's Duty for the expected direction (the pair's hand)."""
-    drv, load = gear_drive(scenario), scenario.load
+    """The scenario's Duty for the expected direction (the pair's hand): built once from the scenario's drive: and
+    load: blocks (a gear-level scenario, torsional or contact3d, has a drive: block); the levels and their helpers
+    take the Duty, not the scenario."""
+    if scenario.drive is None:
+        raise ScenarioError(f"drive: model {scenario.model} needs a drive: block")
+    drv, load = scenario.drive, scenario.load
     ramps = ramps_end_of(drv, load)
     return Duty(
         drv,
@@ -319,13 +298,6 @@ SPEED_DROOP = 1e-3  # speed servo: kv = T_expected / (SPEED_DROOP omega_cmd), a 
 MIN_EFFICIENCY = 0.05  # floor of the efficiency in the expected torque (a self-locking back-drive has 0)
 
 
-def expected_drive_torque_nm(
-    scenario: Scenario, ratio: float, lead_angle_rad: float, alpha_n_rad: float, mu: float
-) -> float:
-    """expected_drive_torque_of the scenario's drive and load."""
-    return expected_drive_torque_of(gear_drive(scenario), scenario.load, ratio, lead_angle_rad, alpha_n_rad, mu)
-
-
 def expected_drive_torque_of(
     drv: Drive, load: Load, ratio: float, lead_angle_rad: float, alpha_n_rad: float, mu: float
 ) -> float:
@@ -337,12 +309,6 @@ def expected_drive_torque_of(
     else:
         t_exp = abs(load.torque_nm) * ratio / max(eta, MIN_EFFICIENCY)
     return max(t_exp, 1e-3)
-
-
-def servo_gain_nm_s(scenario: Scenario, ratio: float, lead_angle_rad: float, alpha_n_rad: float, mu: float) -> float:
-    """servo_gain_of the scenario's drive at expected_drive_torque_nm."""
-    drv = gear_drive(scenario)
-    return servo_gain_of(drv, expected_drive_torque_of(drv, scenario.load, ratio, lead_angle_rad, alpha_n_rad, mu))
 
 
 def servo_gain_of(drv: Drive, expected_torque_nm: float) -> float:
@@ -366,11 +332,6 @@ LOCK_HOLD_S = 0.05  # ... and locked once stuck this long
 def penetration_limit_m(m_x: float) -> float:
     """Largest penetration (contact3d) or mesh deflection (torsional) a run allows: 0.4 m_x."""
     return PENETRATION_LIMIT_AXIAL_MODULES * m_x
-
-
-def lock_check_start_s(scenario: Scenario) -> float:
-    """lock_check_after the scenario's ramps (ramps_end_s)."""
-    return lock_check_after(ramps_end_s(scenario))
 
 
 def lock_check_after(ramps_end_s: float) -> float:

@@ -23,8 +23,7 @@ import math
 import numpy as np
 
 from wormsim.physics import gear_theory as gt
-from wormsim.physics.friction import friction_coefficient
-from wormsim.scenario import Scenario
+from wormsim.scenario import Drive
 
 
 class Held(Exception):
@@ -37,29 +36,35 @@ class Held(Exception):
         self.stuck_since_s = stuck_since_s
 
 
-def backdrive_self_locks(scenario: Scenario, lead_angle_rad: float, alpha_n_rad: float) -> bool:
-    """A speed-driven wheel against a pair that self-locks at standstill (module docstring)."""
-    if scenario.drive.on != "wheel" or scenario.drive.speed_rpm is None:
+def backdrive_self_locks(drive: Drive, lead_angle_rad: float, rho_static_rad: float) -> bool:
+    """A speed-driven wheel against a pair that self-locks at standstill, rho' at rest >= gamma (module
+    docstring)."""
+    if drive.on != "wheel" or drive.speed_rpm is None:
         return False
-    mu0 = float(friction_coefficient(scenario.contact, 0.0))
-    return gt.self_locking(lead_angle_rad, gt.virtual_friction_angle_rad(mu0, alpha_n_rad))
+    return gt.self_locking(lead_angle_rad, rho_static_rad)
 
 
-def run_keys(scenario: Scenario, geo, t_s: np.ndarray, worm_speed_rpm: np.ndarray) -> dict:
+def run_keys(
+    drive: Drive,
+    rho_static_rad: float,
+    transition_velocity_m_s: float,
+    geo,
+    t_s: np.ndarray,
+    worm_speed_rpm: np.ndarray,
+) -> dict:
     """`locked`, `holding_torque_nm`, `creep_speed_rpm` of a run that ended normally: a torque-driven wheel against a
     pair that self-locks at rest holds when the worm's mean |speed| over the run's last fifth slides slower than
     contact.transition_velocity_m_s (static friction's reach); the holding torque is then the wheel's torque
     command. Every other run: NOT_LOCKED."""
-    drv = scenario.drive
+    drv = drive
     if drv.on != "wheel" or drv.torque_nm is None or not len(t_s):
         return dict(NOT_LOCKED)
-    mu0 = float(friction_coefficient(scenario.contact, 0.0))
-    if not gt.self_locking(geo.gamma_m, gt.virtual_friction_angle_rad(mu0, geo.alpha_n)):
+    if not gt.self_locking(geo.gamma_m, rho_static_rad):
         return dict(NOT_LOCKED)
     k = t_s >= t_s[-1] - 0.2 * (t_s[-1] - t_s[0])
     creep = float(np.mean(np.abs(worm_speed_rpm[k])))
     vs = creep * 2 * math.pi / 60 * geo.r_m1 / math.cos(geo.gamma_m)
-    if vs >= scenario.contact.transition_velocity_m_s:
+    if vs >= transition_velocity_m_s:
         return dict(NOT_LOCKED)
     return {"locked": True, "holding_torque_nm": abs(float(drv.torque_nm)), "creep_speed_rpm": creep}
 
@@ -73,22 +78,21 @@ def stall_torque_nm(expected_drive_torque_nm: float) -> float:
     return expected_drive_torque_nm / gt.SPEED_DROOP
 
 
-def stick_velocity_m_s(scenario: Scenario, lead_angle_rad: float, alpha_n_rad: float) -> float:
+def stick_velocity_m_s(
+    drive: Drive, lead_angle_rad: float, rho_static_rad: float, transition_velocity_m_s: float
+) -> float:
     """The friction law's stick state at contact3d (wormsim.contact3d.friction_law.stuck_after): v_t =
     contact.transition_velocity_m_s where the wheel drives (the worm undriven) a pair that self-locks at rest,
     rho'(mu(0)) >= gamma, else 0 (no stick state: mu follows mu(Vs) from the first sample, as on every other run).
     Holding from rest needs it: the soft contact lets a freshly loaded pair slide a little (measured on the seat
     motor demo gear, 2 N m in 2 ms, mu 0.0877 constant: the worm reaches Vs 0.90 mm/s at 1 ms, then creeps at
     0.09 rpm), and with mu(Vs) blending towards the dynamic value over that slip the pair ran back."""
-    if scenario.drive.on != "wheel":
+    if drive.on != "wheel" or not gt.self_locking(lead_angle_rad, rho_static_rad):
         return 0.0
-    mu0 = float(friction_coefficient(scenario.contact, 0.0))
-    if not gt.self_locking(lead_angle_rad, gt.virtual_friction_angle_rad(mu0, alpha_n_rad)):
-        return 0.0
-    return float(scenario.contact.transition_velocity_m_s)
+    return float(transition_velocity_m_s)
 
 
-def wheel_start_rad(scenario: Scenario, backlash_m: float, r2_m: float, perfect_pair: bool) -> float:
+def wheel_start_rad(drive: Drive, flanks: bool, backlash_m: float, r2_m: float, perfect_pair: bool) -> float:
     """The wheel's starting angle at contact3d: a torque-driven wheel (a holding or back-driving run) starts on its
     loaded flank, turned by the half backlash j / (2 r2) (the flank grid's backlash, wormsim.tooth.grid) towards its
     torque; every other run starts centred in its backlash (0). Holding from rest needs the pair at rest in contact:
@@ -96,9 +100,9 @@ def wheel_start_rad(scenario: Scenario, backlash_m: float, r2_m: float, perfect_
     motor demo past contact.transition_velocity_m_s, so friction was the dynamic value from the first contact on
     (measured: the worm ran back at 3.2 % of its free speed; from flank contact with a 20 ms ramp it holds, 0.09 rpm,
     docs/stability_backlash_locking.md). Only the exact flanks (contact.geometry flanks) of a perfect pair: the
-    pieces' bulge and displaced flanks (errors:, shafts:) have their own play."""
-    drv = scenario.drive
-    if drv.on != "wheel" or drv.torque_nm is None or scenario.contact.geometry != "flanks" or not perfect_pair:
+    pieces' bulge and displaced flanks (errors:, shafts:) have their own play; flanks: contact.geometry is flanks."""
+    drv = drive
+    if drv.on != "wheel" or drv.torque_nm is None or not flanks or not perfect_pair:
         return 0.0
     return math.copysign(backlash_m / (2.0 * r2_m), drv.torque_nm) if drv.torque_nm else 0.0
 

@@ -686,7 +686,7 @@ def add_fe_root_stress(scenario, result: dict) -> dict:
 
     r = rating_inputs(scenario)
     g = derive(scenario.gear)
-    side = gear_theory.working_flank(scenario, g.hand)
+    side = gear_theory.duty(scenario, g.hand).working_flank
     t2 = result["inputs"]["wheel_torque_rated_nm"]
     t0 = time.perf_counter()
     fe = root_stress(

@@ -30,7 +30,6 @@ import math
 import numpy as np
 
 from wormsim.physics import gear_theory as gt
-from wormsim.physics.friction import friction_coefficient
 from wormsim.physics.units import RPM, rad_s_to_rpm
 
 
@@ -178,9 +177,9 @@ def _harmonic_amplitudes(t: np.ndarray, x: np.ndarray, f_hz: float) -> list[floa
     return [_hann_dtft_amplitude(tt, y, float(w.sum()), j * f_hz) for j in range(1, MESH_HARMONICS + 1)]
 
 
-def window_of(S: dict, scenario, geo) -> tuple[int, int, float]:
-    """window_after the scenario's ramps (gear_theory.ramps_end_s) with its drive."""
-    return window_after(S, scenario.drive.on, gt.ramps_end_s(scenario), geo)
+def window_of(S: dict, duty: gt.Duty, geo) -> tuple[int, int, float]:
+    """window_after the ramps of the run's drive and load (gear_theory.Duty)."""
+    return window_after(S, duty.drive.on, duty.ramps_end_s, geo)
 
 
 def window_after(S: dict, drive_on: str, ramp_end: float, geo) -> tuple[int, int, float]:
@@ -223,8 +222,7 @@ def mean_speeds_rpm(S: dict, i0: int, i1: int) -> tuple[float, float]:
 
 def drive_summary(
     S: dict,
-    scenario,
-    geo,
+    plan,
     i0: int,
     i1: int,
     n1: float,
@@ -235,9 +233,9 @@ def drive_summary(
     frequency, which each model takes from its own signal): ratio, forces, torques, speeds, efficiency
     (output / input power over the window) and its theory tan(g) / tan(g + rho') (or back-driving).
     shaft_powers_w: (worm, wheel) power series where the level has better ones than the samples' T w (contact3d:
-    interval means over every step)."""
+    interval means over every step). plan: the run's wormsim.physics.plan.GearPlan."""
     t = S["t_s"]
-    load = scenario.load
+    geo, load = plan.geometry, plan.duty.load
     sl = slice(i0, i1)
     ft = S["tangential_force_n"][sl]
     T1, T2 = S["worm_torque_nm"][sl], S["wheel_torque_nm"][sl]
@@ -274,7 +272,7 @@ def drive_summary(
         # static: mu at rest (the contact's friction law at Vs = 0); dynamic: the mean mu applied over the window
         **gt.backdrive_keys(
             geo.gamma_m,
-            gt.virtual_friction_angle_rad(float(friction_coefficient(scenario.contact, 0.0)), geo.alpha_n),
+            plan.rho_static_rad,
             gt.virtual_friction_angle_rad(mu, geo.alpha_n),
         ),
         "steady_window_s": [float(t[i0]), float(t[i1 - 1])],

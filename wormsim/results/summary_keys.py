@@ -533,6 +533,22 @@ SERIES: dict[str, tuple[tuple[str, ...], str]] = {
 }
 
 
+def level_summary(level: str, *parts: dict) -> dict:
+    """The one summary builder of every level (wedge, torsional, contact3d): the key groups the level measured from
+    its series and values, merged in order (a later group's key replaces an earlier one's), each key checked against
+    KEYS: a key without an entry, or whose entry does not name the level, raises KeyError (a level that writes a new
+    key adds its entry here first)."""
+    out: dict = {}
+    for part in parts:
+        out.update(part)
+    bad = [k for k in out if k not in KEYS or level not in KEYS[k].levels]
+    if bad:
+        raise KeyError(
+            f"{level} summary keys without an entry for {level} in wormsim.results.summary_keys.KEYS: {', '.join(bad)}"
+        )
+    return out
+
+
 def undocumented(summary: dict) -> list[str]:
     """The summary's keys without an entry in KEYS (wormsim.run names them on stderr; a test keeps this empty)."""
     return [k for k in summary if k not in KEYS]

@@ -476,16 +476,7 @@ def run_sweep(
     csv_path = out / CSV_NAME
     swept = sweep.swept_paths
     earlier = read_csv(csv_path)
-    ok_rows = {r.get("scenario_hash"): r for r in earlier if r.get("status") == "ok"}
-    rows: dict[int, dict] = {}
-    todo: list[Point] = []
-    for p in sweep.points:
-        old = ok_rows.get(p.scenario_hash)
-        if old is not None:
-            kept = {k: v for k, v in old.items() if "." not in k}  # dotted names: swept paths of that sweep
-            rows[p.index] = {**kept, "point": p.index, **p.values}
-        else:
-            todo.append(p)
+    rows, todo = _resume(sweep, earlier)
     resumed = len(rows)
     machine = machine_info()
     state = {
@@ -526,53 +517,8 @@ def run_sweep(
                 f"on {cluster_info['workers']} workers ({cluster_info['kind']} {cluster_info['scheduler']})"
             )
             write_json_atomic(out / JSON_NAME, _json_doc(sweep, rows, timing, machine, cluster_info, state))
-            from distributed import as_completed
 
-            # Only as many points in flight as the cluster has threads: a point waits on the scheduler, not in
-            # a worker's queue, so a worker that dies (segfault, OOM killer) fails the point it ran and no other.
-            futures = {}
-            queue = list(todo)
-
-            threads = _free_threads(client)
-            chunk = chunk_size(len(todo), threads)
-            cluster_info["points_per_task"] = chunk
-
-            def submit_next():
-                ps = queue[:chunk]
-                del queue[:chunk]
-                scs = [p.scenario.model_dump(mode="json") for p in ps]
-                key = f"wormsim-point-{ps[0].index}-{ps[0].scenario_hash}"
-                if chunk == 1:
-                    fut = client.submit(run_point, scs[0], keep_runs, pure=False, key=key)
-                else:
-                    fut = client.submit(run_points, scs, keep_runs, pure=False, key=f"{key}-{len(ps)}")
-                futures[fut] = (ps, time.time())
-                return fut
-
-            pending = as_completed([submit_next() for _ in range(min(-(-len(queue) // chunk), threads))])
-            png.start()  # matplotlib's import while the points run (this thread waits on them)
-            for fut in pending:
-                if queue:
-                    pending.add(submit_next())
-                ps, t_submit = futures[fut]
-                try:
-                    out_ = fut.result()
-                    results = [out_] if chunk == 1 else out_
-                except Exception as exc:  # (the worker died or the task could not run)
-                    results = [
-                        {
-                            "summary": {
-                                "status": "failed",
-                                "wall_time_s": None,
-                                "model": p.scenario.model,
-                                "message": f"worker lost: {exc.__class__.__name__}: {exc}",
-                            },
-                            "files": {},
-                            "timing": None,
-                        }
-                        for p in ps
-                    ]
-                received = time.time()
+            def on_results(ps: list[Point], results: list[dict], t_submit: float, received: float) -> None:
                 for p, res in zip(ps, results):
                     summary = res["summary"]
                     if keep_runs and res["files"]:
@@ -586,6 +532,8 @@ def run_sweep(
                     }
                     bar.point_done(summary.get("status") != "ok")
                 flush_csv()
+
+            _dispatch(client, todo, keep_runs, cluster_info, png, on_results)
     except KeyboardInterrupt:
         interrupted = True
     finally:
@@ -596,31 +544,96 @@ def run_sweep(
             finished=time.strftime("%Y-%m-%dT%H:%M:%S%z"), interrupted=interrupted, wall_s=time.perf_counter() - t_sweep
         )
         write_json_atomic(out / JSON_NAME, _json_doc(sweep, rows, timing, machine, cluster_info, state))
-        # the results are safe: the cluster closes in a thread while sweep.png is drawn
-        import threading
-
-        closing = threading.Thread(target=_close, args=(client, cluster), name="wormsim-cluster-close", daemon=True)
-        closing.start()
-        ordered = [rows[i] for i in sorted(rows)]
-        try:
-            png.join()
-            if not interrupted:
-                from wormsim.sweep.plot import write_sweep_png
-
-                write_sweep_png(ordered, swept, sweep.spec.plot, out / PNG_NAME, title=sweep.spec.name)
-        finally:
-            closing.join()
+        _close_and_plot(client, cluster, png, sweep, [rows[i] for i in sorted(rows)], None if interrupted else out)
     if interrupted:
         raise KeyboardInterrupt
     n_ok = sum(1 for r in rows.values() if r.get("status") == "ok")
-    return {
-        "points": len(sweep.points),
-        "ok": n_ok,
-        "failed": len(rows) - n_ok,
-        "resumed": resumed,
-        "ran": len(todo),
-        "cluster": cluster_info,
-    }
+    return {"points": len(sweep.points), "ok": n_ok, "failed": len(rows) - n_ok, "resumed": resumed,
+            "ran": len(todo), "cluster": cluster_info}  # fmt: skip
+
+
+def _close_and_plot(client, cluster, png: _PlotImport, sweep: Sweep, ordered: list[dict], out: Path | None) -> None:
+    """The results are safe: the cluster closes in a thread while sweep.png is drawn into out (None: not drawn, an
+    interrupted sweep)."""
+    import threading
+
+    closing = threading.Thread(target=_close, args=(client, cluster), name="wormsim-cluster-close", daemon=True)
+    closing.start()
+    try:
+        png.join()
+        if out is not None:
+            from wormsim.sweep.plot import write_sweep_png
+
+            write_sweep_png(ordered, sweep.swept_paths, sweep.spec.plot, out / PNG_NAME, title=sweep.spec.name)
+    finally:
+        closing.join()
+
+
+def _resume(sweep: Sweep, earlier: list[dict]) -> tuple[dict[int, dict], list[Point]]:
+    """(rows kept from an earlier sweep.csv, by point index; the points still to run): a point whose scenario hash
+    has an ok row there is not run again."""
+    ok_rows = {r.get("scenario_hash"): r for r in earlier if r.get("status") == "ok"}
+    rows: dict[int, dict] = {}
+    todo: list[Point] = []
+    for p in sweep.points:
+        old = ok_rows.get(p.scenario_hash)
+        if old is not None:
+            kept = {k: v for k, v in old.items() if "." not in k}  # dotted names: swept paths of that sweep
+            rows[p.index] = {**kept, "point": p.index, **p.values}
+        else:
+            todo.append(p)
+    return rows, todo
+
+
+def _dispatch(client, todo: list[Point], keep_runs: bool, cluster_info: dict, png: _PlotImport, on_results) -> None:
+    """Run the points of todo on the cluster in chunks (chunk_size; cluster_info gets points_per_task); each finished
+    chunk goes to on_results(points, results, submitted, received), a lost worker's chunk as failed results.
+    Only as many points in flight as the cluster has threads: a point waits on the scheduler, not in a worker's
+    queue, so a worker that dies (segfault, OOM killer) fails the point it ran and no other."""
+    from distributed import as_completed
+
+    futures = {}
+    queue = list(todo)
+    threads = _free_threads(client)
+    chunk = chunk_size(len(todo), threads)
+    cluster_info["points_per_task"] = chunk
+
+    def submit_next():
+        ps = queue[:chunk]
+        del queue[:chunk]
+        scs = [p.scenario.model_dump(mode="json") for p in ps]
+        key = f"wormsim-point-{ps[0].index}-{ps[0].scenario_hash}"
+        if chunk == 1:
+            fut = client.submit(run_point, scs[0], keep_runs, pure=False, key=key)
+        else:
+            fut = client.submit(run_points, scs, keep_runs, pure=False, key=f"{key}-{len(ps)}")
+        futures[fut] = (ps, time.time())
+        return fut
+
+    pending = as_completed([submit_next() for _ in range(min(-(-len(queue) // chunk), threads))])
+    png.start()  # matplotlib's import while the points run (this thread waits on them)
+    for fut in pending:
+        if queue:
+            pending.add(submit_next())
+        ps, t_submit = futures[fut]
+        try:
+            out_ = fut.result()
+            results = [out_] if chunk == 1 else out_
+        except Exception as exc:  # (the worker died or the task could not run)
+            results = [
+                {
+                    "summary": {
+                        "status": "failed",
+                        "wall_time_s": None,
+                        "model": p.scenario.model,
+                        "message": f"worker lost: {exc.__class__.__name__}: {exc}",
+                    },
+                    "files": {},
+                    "timing": None,
+                }
+                for p in ps
+            ]
+        on_results(ps, results, t_submit, time.time())
 
 
 class _PlotImport:
