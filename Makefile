@@ -1,5 +1,6 @@
 # Two commands do all set-up on a fresh machine: `make demo` and `make test`. The install compiles the contact3d
-# kernels once for this machine (wormsim.jit_cache.main with wormsim.contact3d.runner.warm_runs, ~1 min; every later process loads them).
+# kernels once for this machine (wormsim.runtime.jit_cache.main with wormsim.contact3d.runner.warm_runs, ~1 min;
+# every later process loads them).
 PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin
@@ -9,13 +10,14 @@ DEMO   ?= scenarios/seat_motor_demo.yaml
 .PHONY: demo test test-long lint install bench images docs clean
 
 # public modules whose types are checked (the API of wormsim/__init__.py and the shared theory)
-TYPED  := wormsim/__init__.py wormsim/scenario.py wormsim/run.py wormsim/result.py wormsim/errors.py \
-          wormsim/gear_theory.py wormsim/cli.py wormsim/geometry.py
+TYPED  := wormsim/__init__.py wormsim/exceptions.py wormsim/run.py wormsim/results/result.py \
+          wormsim/scenario/__init__.py wormsim/scenario/schema.py wormsim/scenario/loader.py wormsim/scenario/messages.py \
+          wormsim/physics/gear_theory.py wormsim/physics/geometry.py wormsim/cli/entry.py
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
 	$(BIN)/python -m pip install --quiet -e '.[test]'
-	$(BIN)/python -c 'import sys, wormsim.jit_cache as j, wormsim.contact3d.runner as r; sys.exit(j.main(r.warm_runs))'
+	$(BIN)/python -c 'import sys, wormsim.runtime.jit_cache as j, wormsim.contact3d.runner as r; sys.exit(j.main(r.warm_runs))'
 	@# CalculiX (the FE contact check, wormsim.tooth.calculix): Debian's calculix-ccx, installed when missing and root
 	command -v ccx >/dev/null 2>&1 || { [ "$$(id -u)" = 0 ] && apt-get update -qq && apt-get install -y -qq calculix-ccx; } \
 	  || echo "note: CalculiX (ccx) not installed (not root?): apt-get install calculix-ccx; its tests skip without it"
@@ -43,7 +45,7 @@ test-long: $(STAMP)
 bench: $(STAMP)
 	$(BIN)/wormsim bench --out out/bench
 
-export SECTION = import sys; from meshgen.section import plot_section; from wormsim.geometry import gear_set; \
+export SECTION = import sys; from meshgen.section import plot_section; from wormsim.physics.geometry import gear_set; \
 	from wormsim.scenario import load_scenario; sc = load_scenario(sys.argv[1]); plot_section(*gear_set(sc), sys.argv[2], sc.name)
 
 # docs/img from the current code: the demo's report, the mesh section (the records' figures: `make docs`)
@@ -52,9 +54,9 @@ images: $(STAMP)
 	cp out/demo/report.png docs/img/seat_motor_demo_report.png
 	$(BIN)/python -c "$$SECTION" scenarios/seat_motor.yaml docs/img/seat_motor_section.png
 
-# README/docs tables and docs/img figures rendered from the records docs/data/*.json (wormsim.docs_render); no simulation
+# README/docs tables and docs/img figures rendered from the records docs/data/*.json (tools.docs_render); no simulation
 docs: $(STAMP)
-	$(BIN)/python -m wormsim.docs_render
+	$(BIN)/python -m tools.docs_render
 
 clean:
 	rm -rf out .pytest_cache

@@ -28,7 +28,7 @@ with R0 of meshgen.assembly and
 Zero errors give exactly meshgen.assembly's transforms.
 
 Limits (each derived in docs/errors.md; `check_limits` raises meshgen's GeometryError naming the key and the limit;
-wormsim.geometry turns it into ScenarioError, exit 2).
+wormsim.physics.geometry turns it into ScenarioError, exit 2).
 j is the circumferential backlash at d2 (j / 2 per flank), alpha_x the axial pressure angle, c = h_f - h_a the tip
 clearance. In the worm's axial section through the pitch point the thread is a rack of flank angle alpha_x (ZA
 exactly; ZI: the slope of its axial profile at r1 is tan(alpha_x) as well), so a radial approach dr of the worm

@@ -3,7 +3,7 @@
 worm.stl in the worm frame, wheel.stl in the wheel frame (metres); assembly.json holds center_distance_m,
 the 4x4 transforms of both parts into the assembly frame at theta1 = theta2 = 0 (meshgen.assembly), the
 kinematic relation, the derived quantities (mm, deg) and the measured error of the convex collision pieces.
-Writing the files (atomically) and the recording are the simulator's (wormsim.mesh_cmd).
+Writing the files (atomically) and the recording are the simulator's (wormsim.cli.mesh).
 """
 
 from __future__ import annotations

@@ -48,7 +48,7 @@ from meshgen.errors import GeometryError
 from meshgen.worm_forms import DEFAULT_PROFILE_RADIUS_MODULES, DEFAULT_TOOL_DIAMETER_MM
 
 # meshgen reads gear data in the units of its field names (mm, deg) and works in SI: these are its conversions
-# (the simulator's are in wormsim.units; meshgen imports nothing from wormsim)
+# (the simulator's are in wormsim.physics.units; meshgen imports nothing from wormsim)
 MM = 1e-3  # m per mm
 DEG = math.pi / 180.0  # rad per deg
 
@@ -208,11 +208,9 @@ Q_MAX = 40.0  # largest diameter quotient (the schema's bound on gear.diameter_q
 WORM_LENGTH_MAX = 4.0  # threaded length at most 4 x the mesh zone (the default length)
 
 
-def derive(gear: GearData) -> GearGeometry:
-    """All derived quantities from gear data (a validated `gear:` block or a GearSpec). Raises GeometryError on
-    impossible data."""
-    z1, z2 = gear.worm_starts, gear.wheel_teeth
-    alpha_n = gear.normal_pressure_angle_deg * DEG
+def _quotient_and_lead_angle(gear: GearData) -> tuple[float, float]:
+    """(q, gamma) from gear.lead_angle_deg or gear.diameter_quotient, checked (Q_MAX; 0 < gamma < 45 deg)."""
+    z1 = gear.worm_starts
     if gear.lead_angle_deg is not None:
         gamma = gear.lead_angle_deg * DEG
         q = z1 / math.tan(gamma)
@@ -229,6 +227,79 @@ def derive(gear: GearData) -> GearGeometry:
             raise GeometryError(
                 f"gear.diameter_quotient = {q}: gives lead angle {gamma / DEG:.2f} deg; allowed (0, 45) deg"
             )
+    return q, gamma
+
+
+def _check_worm_root(gear: GearData, q: float, r1: float, r_f1: float) -> None:
+    """The worm's root radius r_f1 above 0.2 r1 (else GeometryError naming the input that sets q)."""
+    z1 = gear.worm_starts
+    if r_f1 <= 0.2 * r1:
+        q_min = 2.5 * gear.dedendum_coef
+        given = (
+            f"gear.diameter_quotient = {q:g}: allowed diameter_quotient >= {q_min:.1f}"
+            if gear.lead_angle_deg is None
+            else f"gear.lead_angle_deg = {gear.lead_angle_deg:g} (q = z1 / tan(gamma) = {q:.2f}): allowed "
+            f"lead_angle_deg <= {math.atan(z1 / q_min) / DEG:.3g} for {z1} start(s)"
+        )
+        raise GeometryError(
+            f"{given} (the worm root radius {r_f1 / MM:.3f} mm is too small for the reference radius {r1 / MM:.3f} mm "
+            f"with dedendum_coef {gear.dedendum_coef:g})"
+        )
+
+
+def _face_width(gear: GearData, a: float, worm_radii: tuple, wheel_radii: tuple, depth: float) -> float:
+    """The wheel's face width b2 (m): gear.face_width_mm, or the DIN 3975 guide's default (0.75 or 0.67 x the worm's
+    tip diameter) clipped where the root torus would eat the edges; checked against the worm and the root torus.
+    worm_radii = (r_a1, r_f1), wheel_radii = (r_f2, r_e2), depth = h_a + h_f."""
+    z1 = gear.worm_starts
+    (r_a1, r_f1), (r_f2, r_e2) = worm_radii, wheel_radii
+    b2 = gear.face_width_mm * MM if gear.face_width_mm is not None else (0.75 if z1 <= 3 else 0.67) * 2 * r_a1
+    if b2 >= 2 * (a - r_f1) * 0.999 or b2 > 2 * r_a1 * 1.2:
+        given = (
+            f"gear.face_width_mm = {b2 / MM:.3f}"
+            if gear.face_width_mm is not None
+            else f"gear.face_width_mm not given: its default {b2 / MM:.3f} mm ({0.75 if z1 <= 3 else 0.67:g} x worm "
+            "tip diameter, DIN 3975 guide)"
+        )
+        raise GeometryError(
+            f"{given}: too wide for this worm; allowed up to "
+            f"{min(1.2 * 2 * r_a1, 2 * (a - r_f1) * 0.999) / MM:.3f} mm (1.2 x worm tip diameter, and within the "
+            f"wheel's root)"
+        )
+    # the wheel root torus (tube radius a - r_f2) rises towards the face edges; the tooth must keep at least
+    # 0.1 of its full depth h_a + h_f under the rim radius r_e2 at zeta = +-b2/2
+    R_root, edge = a - r_f2, a - r_e2 + 0.1 * depth
+    b2_max = 2 * math.sqrt(max(R_root**2 - edge**2, 0.0))
+    if gear.face_width_mm is None:
+        b2 = min(b2, b2_max)  # the DIN guide default, clipped where the root torus would eat the edges
+    if b2 > b2_max * (1 + 1e-9):  # (the clipped default given back, e.g. through REXS, is b2_max within rounding)
+        raise GeometryError(
+            f"gear.face_width_mm = {b2 / MM:.3f}: the wheel root torus leaves no tooth at the face edges; "
+            f"allowed up to {b2_max / MM:.3f} mm"
+        )
+    return b2
+
+
+def _worm_length(gear: GearData, a: float, r_a1: float, r_e2: float, p_x: float) -> float:
+    """The threaded length b1 (m): gear.worm_length_mm, or what covers every point of the wheel rim that can reach
+    the worm tip cylinder plus one pitch (the mesh zone); checked from one pitch to WORM_LENGTH_MAX mesh zones."""
+    reach = r_e2**2 - (a - r_a1) ** 2
+    b1_mesh = 2 * math.sqrt(max(reach, 0.0)) + p_x
+    b1 = gear.worm_length_mm * MM if gear.worm_length_mm is not None else b1_mesh
+    if not p_x <= b1 <= WORM_LENGTH_MAX * b1_mesh:  # 1e6 mm ran for > 10 min at 5 GB (pieces along the thread)
+        raise GeometryError(
+            f"gear.worm_length_mm = {b1 / MM:.4g}: allowed {p_x / MM:.4g} (one axial pitch) to "
+            f"{WORM_LENGTH_MAX * b1_mesh / MM:.4g} mm ({WORM_LENGTH_MAX:g} x the mesh zone {b1_mesh / MM:.4g} mm)"
+        )
+    return b1
+
+
+def derive(gear: GearData) -> GearGeometry:
+    """All derived quantities from gear data (a validated `gear:` block or a GearSpec). Raises GeometryError on
+    impossible data."""
+    z1, z2 = gear.worm_starts, gear.wheel_teeth
+    alpha_n = gear.normal_pressure_angle_deg * DEG
+    q, gamma = _quotient_and_lead_angle(gear)
     if gear.axial_module_mm is not None:
         m_x = gear.axial_module_mm * MM
     else:
@@ -255,18 +326,7 @@ def derive(gear: GearData) -> GearGeometry:
             f"gear.profile_shift_coefficient = {x2:g}: gives a wheel root radius of {r_f2 / MM:.4g} mm; allowed: "
             f"-{X2_MAX:g} <= profile_shift_coefficient <= {X2_MAX:g} with the wheel root above half of r2"
         )
-    if r_f1 <= 0.2 * r1:
-        q_min = 2.5 * gear.dedendum_coef
-        given = (
-            f"gear.diameter_quotient = {q:g}: allowed diameter_quotient >= {q_min:.1f}"
-            if gear.lead_angle_deg is None
-            else f"gear.lead_angle_deg = {gear.lead_angle_deg:g} (q = z1 / tan(gamma) = {q:.2f}): allowed "
-            f"lead_angle_deg <= {math.atan(z1 / q_min) / DEG:.3g} for {z1} start(s)"
-        )
-        raise GeometryError(
-            f"{given} (the worm root radius {r_f1 / MM:.3f} mm is too small for the reference radius {r1 / MM:.3f} mm "
-            f"with dedendum_coef {gear.dedendum_coef:g})"
-        )
+    _check_worm_root(gear, q, r1, r_f1)
     d_e2 = getattr(gear, "wheel_outside_diameter_mm", None)
     r_e2 = r_a2 + 0.5 * m_x if d_e2 is None else d_e2 * MM / 2
     if not r_a2 <= r_e2 <= r_a2 + m_x * (1 + 1e-12):
@@ -274,39 +334,8 @@ def derive(gear: GearData) -> GearGeometry:
             f"gear.wheel_outside_diameter_mm = {d_e2:g}: allowed from the throat's tip diameter d_a2 = "
             f"{2 * r_a2 / MM:.4g} mm to d_a2 + 2 m_x = {2 * (r_a2 + m_x) / MM:.4g} mm"
         )
-    b2 = gear.face_width_mm * MM if gear.face_width_mm is not None else (0.75 if z1 <= 3 else 0.67) * 2 * r_a1
-    if b2 >= 2 * (a - r_f1) * 0.999 or b2 > 2 * r_a1 * 1.2:
-        given = (
-            f"gear.face_width_mm = {b2 / MM:.3f}"
-            if gear.face_width_mm is not None
-            else f"gear.face_width_mm not given: its default {b2 / MM:.3f} mm ({0.75 if z1 <= 3 else 0.67:g} x worm "
-            "tip diameter, DIN 3975 guide)"
-        )
-        raise GeometryError(
-            f"{given}: too wide for this worm; allowed up to "
-            f"{min(1.2 * 2 * r_a1, 2 * (a - r_f1) * 0.999) / MM:.3f} mm (1.2 x worm tip diameter, and within the "
-            f"wheel's root)"
-        )
-    # the wheel root torus (tube radius a - r_f2) rises towards the face edges; the tooth must keep at least
-    # 0.1 of its full depth h_a + h_f under the rim radius r_e2 at zeta = +-b2/2
-    R_root, edge = a - r_f2, a - r_e2 + 0.1 * (h_a + h_f)
-    b2_max = 2 * math.sqrt(max(R_root**2 - edge**2, 0.0))
-    if gear.face_width_mm is None:
-        b2 = min(b2, b2_max)  # the DIN guide default, clipped where the root torus would eat the edges
-    if b2 > b2_max * (1 + 1e-9):  # (the clipped default given back, e.g. through REXS, is b2_max within rounding)
-        raise GeometryError(
-            f"gear.face_width_mm = {b2 / MM:.3f}: the wheel root torus leaves no tooth at the face edges; "
-            f"allowed up to {b2_max / MM:.3f} mm"
-        )
-    # threaded length: cover every point of the wheel rim that can reach the worm tip cylinder, plus one pitch
-    reach = r_e2**2 - (a - r_a1) ** 2
-    b1_mesh = 2 * math.sqrt(max(reach, 0.0)) + p_x
-    b1 = gear.worm_length_mm * MM if gear.worm_length_mm is not None else b1_mesh
-    if not p_x <= b1 <= WORM_LENGTH_MAX * b1_mesh:  # 1e6 mm ran for > 10 min at 5 GB (pieces along the thread)
-        raise GeometryError(
-            f"gear.worm_length_mm = {b1 / MM:.4g}: allowed {p_x / MM:.4g} (one axial pitch) to "
-            f"{WORM_LENGTH_MAX * b1_mesh / MM:.4g} mm ({WORM_LENGTH_MAX:g} x the mesh zone {b1_mesh / MM:.4g} mm)"
-        )
+    b2 = _face_width(gear, a, (r_a1, r_f1), (r_f2, r_e2), h_a + h_f)
+    b1 = _worm_length(gear, a, r_a1, r_e2, p_x)
     s2 = p_x / 2 - gear.backlash_mm * MM
     if s2 <= 0.1 * p_x:
         raise GeometryError(

@@ -161,20 +161,7 @@ def analyse(
     Mg, Eg = displaced.wheel_mount(g, dev)
     tooth0 = wheel.tooth_angle(g, 0)
     h_probe = max(g.backlash, 0.2 * g.m_x * 0.05) / (2 * g.r2)
-    # every tooth's flank points in the wheel's body frame: tooth k = tooth 0 turned by k pitch + f_k / r2
-    rot = np.arange(g.z2) * pitch + dev.tooth_angle_shift(g, np.arange(g.z2))
-    cr, sr = np.cos(rot)[:, None, None], np.sin(rot)[:, None, None]
-    teeth = {
-        side: np.stack(
-            [
-                cr * P[None, ..., 0] - sr * P[None, ..., 1],
-                sr * P[None, ..., 0] + cr * P[None, ..., 1],
-                np.broadcast_to(P[..., 2], (g.z2,) + P.shape[:2]),
-            ],
-            axis=-1,
-        )
-        for side, P in fl.pts.items()
-    }
+    teeth = _teeth_points(g, dev, fl, pitch)
     gaps = {1: np.zeros(n), -1: np.zeros(n)}
     where = {1: np.zeros((n, 2)), -1: np.zeros((n, 2))}
     pats = {1: [], -1: []}
@@ -225,18 +212,6 @@ def analyse(
             _, ii, jj = np.nonzero(film.reshape(B.shape[:-1]))
             pats[side].append((fl.zeta[ii, jj], fl.rho[ii, jj], fl.area[ii, jj]))
 
-    def pattern(items) -> dict:
-        z = np.concatenate([a for a, _, _ in items])
-        r = np.concatenate([b for _, b, _ in items])
-        w = np.concatenate([c for _, _, c in items])
-        if not len(z):
-            return {"centroid_face_m": float("nan"), "centroid_radius_m": float("nan"), "extent_face_m": 0.0}
-        return {
-            "centroid_face_m": float(np.sum(w * z) / np.sum(w)),
-            "centroid_radius_m": float(np.sum(w * r) / np.sum(w)),
-            "extent_face_m": float(np.ptp(z)),
-        }
-
     return KinematicTCA(
         theta1_rad=th1s,
         period_rad=period,
@@ -244,9 +219,42 @@ def analyse(
         gap_rev_rad=gaps[-1],
         contact_fwd=where[1],
         contact_rev=where[-1],
-        pattern_fwd=pattern(pats[1]),
-        pattern_rev=pattern(pats[-1]),
+        pattern_fwd=_pattern(pats[1]),
+        pattern_rev=_pattern(pats[-1]),
     )
+
+
+def _teeth_points(g: GearGeometry, dev: displaced.Deviations, fl: _Flanks, pitch: float) -> dict:
+    """Every tooth's flank points in the wheel's body frame, per side: tooth k = tooth 0 turned by k pitch + f_k / r2
+    ((z2, nz, nr, 3))."""
+    rot = np.arange(g.z2) * pitch + dev.tooth_angle_shift(g, np.arange(g.z2))
+    cr, sr = np.cos(rot)[:, None, None], np.sin(rot)[:, None, None]
+    return {
+        side: np.stack(
+            [
+                cr * P[None, ..., 0] - sr * P[None, ..., 1],
+                sr * P[None, ..., 0] + cr * P[None, ..., 1],
+                np.broadcast_to(P[..., 2], (g.z2,) + P.shape[:2]),
+            ],
+            axis=-1,
+        )
+        for side, P in fl.pts.items()
+    }
+
+
+def _pattern(items) -> dict:
+    """The marking pattern's centroid (face, radius) and face extent from the (zeta, rho, area) of the film points of
+    every sample."""
+    z = np.concatenate([a for a, _, _ in items])
+    r = np.concatenate([b for _, b, _ in items])
+    w = np.concatenate([c for _, _, c in items])
+    if not len(z):
+        return {"centroid_face_m": float("nan"), "centroid_radius_m": float("nan"), "extent_face_m": 0.0}
+    return {
+        "centroid_face_m": float(np.sum(w * z) / np.sum(w)),
+        "centroid_radius_m": float(np.sum(w * r) / np.sum(w)),
+        "extent_face_m": float(np.ptp(z)),
+    }
 
 
 @functools.lru_cache(maxsize=16)

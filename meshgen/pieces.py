@@ -206,18 +206,18 @@ def wheel_slab_sections(
     g: GearGeometry,
     n_profile: int,
     zeta: np.ndarray,
-    lo_a,
-    hi_a,
-    lo_b,
-    hi_b,
+    flank_a: tuple,
+    flank_b: tuple,
     n_tip: int = 3,
     tip: bool = True,
     dpsi_a: float = 0.0,
     dpsi_b: float = 0.0,
 ):
     """Points of tooth-0 sections at the given zeta values: flank A (psi_a) from lo_a to hi_a, flank B from lo_b
-    to hi_b (radius arrays over zeta), plus n_tip points across the tip arc when tip: (len(zeta), m, 3).
-    dpsi_a, dpsi_b >= 0 move flank A / flank B into the tooth by that angle (conservative pieces)."""
+    to hi_b (flank_a = (lo_a, hi_a), flank_b = (lo_b, hi_b): radius arrays over zeta), plus n_tip points across the
+    tip arc when tip: (len(zeta), m, 3). dpsi_a, dpsi_b >= 0 move flank A / flank B into the tooth by that angle
+    (conservative pieces)."""
+    (lo_a, hi_a), (lo_b, hi_b) = flank_a, flank_b
     s = np.linspace(0.0, 1.0, n_profile)
     Z = np.broadcast_to(zeta[:, None], (len(zeta), n_profile))
     Ra = lo_a[:, None] + s[None, :] * (hi_a - lo_a)[:, None]
@@ -273,7 +273,7 @@ def build_wheel_tooth_pieces(g: GearGeometry, res: Resolution) -> list[trimesh.T
         out.append(
             _conservative_hull(
                 lambda da, db: wheel_slab_sections(
-                    g, res.profile_points, zeta[sl], ja[sl], tip[sl], jb[sl], tip[sl], dpsi_a=da, dpsi_b=db
+                    g, res.profile_points, zeta[sl], (ja[sl], tip[sl]), (jb[sl], tip[sl]), dpsi_a=da, dpsi_b=db
                 ),
                 checks,
                 g.m_x,

@@ -13,7 +13,7 @@ from wormsim.contact3d.slots import repose_window
 class Stepper:
     def __init__(self, bm, d: mujoco.MjData):
         self.bm, self.m, self.d = bm, bm.model, d
-        self.flanks = bm.meta.get("contact_geometry") == "flanks"
+        self.flanks = bm.plan.flanks
         m = self.m
         self.qa_wheel = int(m.jnt_qposadr[m.dof_jntid[bm.wheel_dof]])
         if self.flanks:

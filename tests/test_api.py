@@ -9,14 +9,14 @@ import pytest
 from conftest import ROOT
 
 import wormsim
+from tools.api_doc import ORDER, markdown
 from wormsim import cli
-from wormsim.api_doc import ORDER, markdown
-from wormsim.init_cmd import write_template
+from wormsim.cli.init import write_template
 from wormsim.scenario import ScenarioError, load_scenario
 
 
 def test_docs_api_md_is_current():
-    assert (ROOT / "docs" / "api.md").read_text() == markdown(), "regenerate: python -m wormsim.api_doc > docs/api.md"
+    assert (ROOT / "docs" / "api.md").read_text() == markdown(), "regenerate: python -m tools.api_doc > docs/api.md"
 
 
 @pytest.mark.parametrize("name", ORDER)

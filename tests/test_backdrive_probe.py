@@ -7,7 +7,7 @@ import pytest
 from conftest import ROOT
 
 from meshgen.geometry import derive
-from wormsim.gear_theory import efficiency_at_radius
+from wormsim.physics.gear_theory import efficiency_at_radius
 from wormsim.run import simulate
 from wormsim.scenario import ScenarioError, load_scenario
 
@@ -44,3 +44,34 @@ def test_probe_finds_a_self_locking_pair_held():
 def test_probe_is_refused_where_it_measures_nothing(sets):
     with pytest.raises(ScenarioError, match="backdrive_probe = true: .*allowed: model contact3d with drive.on worm"):
         load_scenario(MINIMAL, ["simulation.backdrive_probe=true", *sets])
+
+
+def test_probe_scenario_swaps_drive_and_load_and_reads_the_held_worm():
+    """wormsim.contact3d.backdrive: the probe drives the wheel at the forward run's wheel speed and loads the worm
+    with T2 eta' / i; a worm below HELD_BELOW of the wheel command times the ratio is a measured self-locking, a lock
+    error too, and otherwise the probe's efficiency is the measured back-driving efficiency."""
+    from types import SimpleNamespace
+
+    from wormsim.contact3d import backdrive
+    from wormsim.exceptions import LockedError
+
+    sc = load_scenario(MINIMAL, PROBE)
+    fwd = {"wheel_speed_mean_rpm": 15.0, "efficiency_backdrive": 0.45, "ratio_theory": 40.0}
+    p = backdrive.probe_scenario(sc, fwd)
+    assert p.drive.on == "wheel" and p.drive.speed_rpm == 15.0 and p.load.on == "worm"
+    assert p.load.torque_nm == pytest.approx(abs(sc.load.torque_nm) * 0.45 / 40.0)
+    assert p.simulation.backdrive_probe is False  # no probe of the probe
+
+    def runs_at(worm_rpm):
+        return lambda s: SimpleNamespace(summary={"worm_speed_mean_rpm": worm_rpm, "efficiency": 0.44})
+
+    free = backdrive.probe(sc, fwd, runs_at(15.0 * 40.0 * 0.98))
+    assert free["backdrive_measured_self_locking"] is False and free["backdrive_measured_efficiency"] == 0.44
+    held = backdrive.probe(sc, fwd, runs_at(15.0 * 40.0 * (backdrive.HELD_BELOW - 0.01)))
+    assert held["backdrive_measured_self_locking"] is True and held["backdrive_measured_efficiency"] == 0.0
+
+    def locks(s):
+        raise LockedError("drive locked")
+
+    locked = backdrive.probe(sc, fwd, locks)
+    assert locked["backdrive_measured_self_locking"] is True and "drive locked" in locked["backdrive_measured_message"]

@@ -214,7 +214,7 @@ def test_json_results_are_readable_by_others(tmp_path):
     import os
     import stat
 
-    from wormsim.output import write_json_atomic
+    from wormsim.runfolder.writer import write_json_atomic
 
     write_json_atomic(tmp_path / "x.json", {"a": 1})
     mode = stat.S_IMODE(os.stat(tmp_path / "x.json").st_mode)

@@ -12,8 +12,8 @@ import math
 
 import pytest
 
-from wormsim import gear_theory
-from wormsim.geometry import derive
+from wormsim.physics import gear_theory
+from wormsim.physics.geometry import derive
 from wormsim.scenario import load_scenario
 from wormsim.tooth import calculix as cx
 from wormsim.tooth.compliance import iso6336_stiffness
@@ -29,13 +29,10 @@ def small_case(tmp_path_factory, monkeypatch_module):
     g = derive(sc.gear)
     monkeypatch_module.setattr(cx, "H_FINE_MX", 0.4)
     monkeypatch_module.setattr(cx, "H_MAX_MX", 1.2)
-    side = gear_theory.working_flank(sc, g.hand)
+    side = gear_theory.duty(sc, g.hand).working_flank
     m = sc.materials
     lag = 12.0 / (15e9 * g.face_width * cx.arm0_m(g) ** 2)
-    r = cx.solve(
-        g, m.wheel.youngs_modulus_gpa * 1e9, m.wheel.poisson_ratio, m.worm.youngs_modulus_gpa * 1e9,
-        m.worm.poisson_ratio, side, 0.0, lag, workdir=tmp_path_factory.mktemp("ccx"),
-    )  # fmt: skip
+    r = cx.solve(g, m, side, 0.0, lag, workdir=tmp_path_factory.mktemp("ccx"))
     return g, m, r
 
 

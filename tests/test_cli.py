@@ -10,8 +10,8 @@ import numpy as np
 from conftest import ROOT
 
 from wormsim import cli, run
-from wormsim.errors import SimulationError
-from wormsim.result import Result
+from wormsim.exceptions import SimulationError
+from wormsim.results.result import Result
 from wormsim.scenario import load_scenario
 
 MINIMAL = ROOT / "tests" / "assets" / "minimal_contact3d.yaml"

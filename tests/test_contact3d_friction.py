@@ -20,8 +20,8 @@ from conftest import SCENARIOS as SCEN
 
 from wormsim.contact3d.law import friction_regularisation_velocity_m_s, friction_utilisation
 from wormsim.contact3d.mjcf import build_model
-from wormsim.friction import friction_coefficient
-from wormsim.gear_theory import commands, mesh_arms_m
+from wormsim.physics.friction import friction_coefficient
+from wormsim.physics.gear_theory import duty, mesh_arms_m
 from wormsim.scenario import ScenarioError, load_scenario
 
 DURATION_S = 0.05  # 10 000 steps of 5 us; contacts read over the last 40 % (after the 0.01 s ramps)
@@ -51,7 +51,7 @@ def sliding_contacts(rpm: float, impratio: float | None = None) -> tuple[np.ndar
     st = Stepper(bm, d)
     chunk, rows = 20, []
     f_floor = 1e-3 * sc.load.torque_nm / geo.r2
-    cmds = commands(sc, bm.direction)
+    cmds = duty(sc, bm.direction).commands
     for _ in range(int(round(DURATION_S / m.opt.timestep)) // chunk):
         d.ctrl[bm.drive_actuator], d.ctrl[bm.load_actuator] = cmds.drive(d.time), cmds.load(d.time)
         st.step(chunk)
@@ -116,7 +116,7 @@ def test_impratio_follows_the_working_load():
 
 def test_load_inertia_is_the_loaded_hinge_armature_and_in_the_contact_mass():
     """load.inertia_kg_m2 (driven machine, rigid on the loaded shaft): the wheel hinge's armature, and the contact
-    law's A_hat = arm1^2 / I1 + arm2^2 / (I2 + J) (wormsim.gear_theory.mesh_arms_m) uses it; the bare gear is unchanged."""
+    law's A_hat = arm1^2 / I1 + arm2^2 / (I2 + J) (wormsim.physics.gear_theory.mesh_arms_m) uses it; the bare gear is unchanged."""
 
     over = ["simulation.resolution=coarse"]
     bare = build_model(load_scenario(SCEN / "seat_motor.yaml", over))
@@ -127,7 +127,7 @@ def test_load_inertia_is_the_loaded_hinge_armature_and_in_the_contact_mass():
     assert heavy.model.dof_armature[heavy.worm_dof] == 0.0
     g = heavy.geometry
     a1, a2 = mesh_arms_m(g.r1, g.r2, g.alpha_n, g.gamma)
-    i1, i2 = heavy.meta["worm_inertia_kg_m2"], heavy.meta["wheel_inertia_kg_m2"]
+    i1, i2 = heavy.plan.inertias.worm_inertia_kg_m2, heavy.plan.inertias.wheel_inertia_kg_m2
     assert bare.law.inv_mass_hat == pytest.approx(a1**2 / i1 + a2**2 / i2, rel=1e-12)
     assert heavy.law.inv_mass_hat == pytest.approx(a1**2 / i1 + a2**2 / (i2 + 1e-4), rel=1e-12)
     with pytest.raises(ScenarioError, match="inertia_kg_m2"):

@@ -14,7 +14,7 @@ from conftest import SCENARIOS as SCEN
 
 from wormsim.contact3d.law import hertz_line_stiffness_n_per_m
 from wormsim.contact3d.mjcf import build_model
-from wormsim.friction import friction_coefficient
+from wormsim.physics.friction import friction_coefficient
 from wormsim.scenario import Contact, load_scenario
 
 

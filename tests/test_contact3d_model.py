@@ -12,8 +12,8 @@ from conftest import SCENARIOS as SCEN
 from wormsim.contact3d.mjcf import build_model, write_model
 from wormsim.contact3d.runner import simulate
 from wormsim.contact3d.slots import repose_window
-from wormsim.errors import SimulationError
-from wormsim.geometry import derive
+from wormsim.exceptions import SimulationError
+from wormsim.physics.geometry import derive
 from wormsim.scenario import load_scenario
 
 COARSE = ["simulation.resolution=coarse"]
@@ -157,7 +157,7 @@ def test_self_locking_worm_creeps_under_1_percent_of_frictionless():
 def test_run_writes_summary_series_report_and_3d_recording(tmp_path):
     """End to end through wormsim.run on a very short seat-motor demo: every INTERFACE.md contact3d key,
     a report and a recording holding the moving meshes, contact points and force arrows."""
-    from wormsim.recording import recorded_entities
+    from wormsim.results.recording import recorded_entities
     from wormsim.run import run_scenario
 
     sc = load_scenario(SCEN / "seat_motor_demo.yaml", ["simulation.duration_s=0.03"])

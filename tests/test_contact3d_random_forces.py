@@ -1,5 +1,5 @@
 """Random gears at contact3d checked beyond ratio and F_t (issue 31): the efficiency against the wedge formula at the
-contacts' own radius (DIN 3975-2 with the lead angle at r_c, wormsim.gear_theory.efficiency_at_radius) and the radial
+contacts' own radius (DIN 3975-2 with the lead angle at r_c, wormsim.physics.gear_theory.efficiency_at_radius) and the radial
 force on the line of centres against F_t2 tan(alpha_n) cos(rho') / cos(gamma + rho') (radial_force_theory_n), within
 3 % as the variant gears (tests/test_contact3d_variety.py). The gears: numpy's default_rng(31) drawn over the ranges
 of tests/test_robustness.py's property test (z1 1-4, z2 20-80, m_x 0.5-12 mm, q 6-16, alpha_n 10-25 deg, hand,
@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from meshgen.geometry import derive
-from wormsim import gear_theory as gt
+from wormsim.physics import gear_theory as gt
 from wormsim.run import simulate
 from wormsim.scenario import Scenario
 

@@ -9,7 +9,7 @@ from conftest import SCENARIOS
 
 from wormsim.contact3d.report import MAX_FRAMES, write_recording
 from wormsim.contact3d.runner import simulate
-from wormsim.recording import recorded_data
+from wormsim.results.recording import recorded_data
 from wormsim.scenario import load_scenario
 
 

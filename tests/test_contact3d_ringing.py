@@ -2,7 +2,7 @@
 steady per-step F_t peak exceeds 1.5 x its mean rang, and the run fails as diverged (exit 3) instead of finishing
 with a broken result.
 
-Measured (docs/contact3d.md, "Ringing above the stable limit"; sweeps/step_convergence.py's configurations, flanks):
+Measured (docs/contact3d.md, "Ringing above the stable limit"; studies/step_convergence.py's configurations, flanks):
 the seat motor CI run at 20 us (1.24 x the limit) rang to the end with ratio 52.82 and F_t peak 2.38 x its mean;
 narrow-b8 at 40 us (1.34 x) rang through its start into the steady window, peak 2.87 x. Stable runs above the limit
 stay at or below 1.18 x (4-start-z41 at 60 us, 1.85 x the limit); narrow-b8 at 30 us (1.01 x) at 1.07 x.
@@ -21,7 +21,7 @@ from test_contact3d_variety import FAST, FLANK_GEARS, GEAR
 from wormsim import cli
 from wormsim.contact3d.ringing_check import RING_PEAK_OVER_MEAN, ringing
 from wormsim.contact3d.runner import simulate
-from wormsim.errors import DivergedError
+from wormsim.exceptions import DivergedError
 from wormsim.scenario import load_scenario
 
 SEAT = [*CI["seat_motor"], "contact.geometry=flanks", "simulation.duration_s=0.08"]

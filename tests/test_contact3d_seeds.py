@@ -84,7 +84,7 @@ MESH_FREQUENCY_REL = 0.005
 
 def assert_mesh_frequency(s: dict, key: str, rel: float = MESH_FREQUENCY_REL) -> None:
     """s[key] within rel (0.5 %) of z1 n1 / 60 (seed 001: the meshing frequency), on a window of >= 5 mesh periods.
-    The peak is interpolated between FFT bins (wormsim.metrics.dominant_frequency), so the check is tighter than
+    The peak is interpolated between FFT bins (wormsim.results.metrics.dominant_frequency), so the check is tighter than
     one bin (17-20 % of f_mesh on these windows) and a wrong harmonic or a drifted peak fails."""
     w0, w1 = s["steady_window_s"]
     assert (w1 - w0) * s["mesh_frequency_theory_hz"] >= 5, ("steady window too short for the FFT", w0, w1)

@@ -24,7 +24,7 @@ def run(name: str) -> dict:
     return _CACHE[name]
 
 
-# mesh_frequency_hz is the meshing line near z1 n1 / 60 (wormsim.metrics.mesh_line): 29.97 / 22.14 / 24.14 Hz. The
+# mesh_frequency_hz is the meshing line near z1 n1 / 60 (wormsim.results.metrics.mesh_line): 29.97 / 22.14 / 24.14 Hz. The
 # largest F_t peak is not always there: involute_41 with the teeth's compliance (1.01e9 N/m per tooth pair against
 # Hertz's 5.41e9) has its contact mode near the 32nd meshing harmonic (772.56 Hz), which it amplifies (F_t p2p 437 N on
 # 13.8 kN; with Hertz 148 N; docs/data/stiffness_seeds.json)
@@ -49,7 +49,7 @@ def test_flanks_mesh_frequency(name):
 
 # the seat motor's radial force has a larger 2nd than 1st meshing harmonic (quasi-static at constant torque the
 # kernel's radial harmonics 1-4 are 0.998, 1.239, 0.688, 0.091 N; docs/contact3d.md, "Contacts leaving at zero load"):
-# the meshing line near z1 n1 / 60 is the 1st (wormsim.metrics.mesh_line)
+# the meshing line near z1 n1 / 60 is the 1st (wormsim.results.metrics.mesh_line)
 RADIAL_XFAIL: dict[str, str] = {}
 
 
@@ -102,10 +102,10 @@ def _geometry(name: str):
 @pytest.mark.parametrize("name", SEEDS)
 def test_flanks_worm_torque_is_t2_over_i_eta_at_the_contact_radius(name):
     """T1 = T2 / (i eta) (power balance, DIN 3975-2) with eta = tan(g_r) / tan(g_r + rho') at the contacts'
-    force-weighted worm radius r_c (tan g_r = tan g r1 / r_c, DIN 3975-1; wormsim.gear_theory.efficiency_at_radius),
+    force-weighted worm radius r_c (tan g_r = tan g r1 / r_c, DIN 3975-1; wormsim.physics.gear_theory.efficiency_at_radius),
     rho' = atan(mu / cos alpha_n): within 1 % (measured +0.07 / +0.12 / +0.13 %; at the pitch radius r1 the same
     formula is 1.2-1.8 % off, so the check tells the radii apart)."""
-    from wormsim import gear_theory as gt
+    from wormsim.physics import gear_theory as gt
 
     s, sc, g = run(name)["summary"], run(name)["scenario"], _geometry(name)
     eta = gt.efficiency_at_radius(
@@ -232,7 +232,7 @@ def test_flanks_mean_contact_pressure_is_the_line_contact_formula(name):
     is gamma, the worm's 90 deg - gamma): 1 / rho' = cos^2 g / (r2 sin a_n) + sin^2 g / (r1 sin a_n). Within 3 %."""
     import math
 
-    from wormsim import gear_theory as gt
+    from wormsim.physics import gear_theory as gt
 
     s, sc, g = run(name)["summary"], run(name)["scenario"], _geometry(name)
     length_m = torsional_run(name)["contact_line_length_mean_mm"] * 1e-3

@@ -95,13 +95,13 @@ FLANK_GEARS = {
     "narrow-b8": ["gear.face_width_mm=8", "simulation.duration_s=0.08"],  # 11.3
 }
 # The gears whose F_t has a meshing harmonic, not the 1st, as the largest line of its spectrum below 600 Hz: the
-# meshing line (wormsim.metrics.mesh_line) finds the 1st near z1 n1 / 60 on each (test_flanks_other_gears_mesh_frequency)
+# meshing line (wormsim.results.metrics.mesh_line) finds the 1st near z1 n1 / 60 on each (test_flanks_other_gears_mesh_frequency)
 HARMONIC = (
     "F_t's largest line below 599.4 Hz is a meshing harmonic, not the 1st, at 8, 16 and 32 slices: "
     "F_t's mesh lines are 0.02-1.6 N, rising towards the contact mode's band (2-7 kHz, lines 0.9-2.9 N); at constant "
     "load torque the mesh stiffness's fluctuation goes into the TE, and F_t's lines are the wheel's inertia times its "
     "acceleration, I2 (2 pi k f_m)^2 TE_k / r2 (test_flanks_harmonic_tangential_force_lines_...). Not a slicing artefact "
-    "(docs/contact3d.md, 'Variety with exact flanks'; sweeps/variant_harmonics.py): "
+    "(docs/contact3d.md, 'Variety with exact flanks'; studies/variant_harmonics.py): "
 )
 # left-ZA passes since contacts leave at zero load (docs/contact3d.md): 99.9 Hz, p2p 55.7 N on 833 N (before 499.5 Hz,
 # the 5th harmonic, p2p 77 N)
@@ -252,21 +252,13 @@ def test_flanks_no_grid_point_is_cut_by_the_worm():
         th2 = g.hand * th1 * g.z1 / g.z2
         ks = window_teeth_at(th2, g.z2, W, -math.pi / 2 + math.pi / g.z2).astype(np.int64)
         n = kernel.find_contacts(
-            fg.xy,
-            fg.c,
-            fg.c_range,
-            fg.span,
-            fg.zeta,
+            (fg.xy, fg.c, fg.c_range, fg.span, fg.zeta),
             ks,
             th1,
             th2 - g.hand * 2 * bl,
             kernel.MARGIN_PITCH * pitch + 3 * bl,
             fg.params,
-            pos,
-            nrm,
-            dep,
-            meta,
-            line,
+            (pos, nrm, dep, meta, line),
         )
         deepest.append(dep[:n].max())
     assert max(deepest) < 1.02 * expected and min(deepest) > 0.98 * expected, (min(deepest), max(deepest), expected)
@@ -320,7 +312,7 @@ def test_flanks_other_gears_forces_against_din_3975(name):
     torque T2 / (i eta) with the wedge formula at the contacts' radius r_c within 1 %, the radial force on the line of
     centres F_t2 tan(alpha_n) cos(rho') / cos(gamma + rho') within 3 %, the axial force T1 / r_c within 3 % (measured:
     0.0-0.2 %, -0.2-2.6 %, -2.6-1.7 %)."""
-    from wormsim import gear_theory as gt
+    from wormsim.physics import gear_theory as gt
 
     sc, g, s = flank_run(name)[:3]
     eta = gt.efficiency_at_radius(
@@ -356,7 +348,7 @@ def test_flanks_other_gears_mean_pressure_against_the_line_contact_formula(name)
     worms (large lead angles) carry their load away from the pitch point's curvature: strict xfails."""
     import math
 
-    from wormsim import gear_theory as gt
+    from wormsim.physics import gear_theory as gt
     from wormsim.torsional.dynamics import simulate as simulate_torsional
 
     sc, g, s = flank_run(name)[:3]

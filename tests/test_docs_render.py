@@ -1,4 +1,4 @@
-"""`make docs` (wormsim.docs_render): every rendered block of README.md and docs/*.md equals what the renderer makes
+"""`make docs` (tools.docs_render): every rendered block of README.md and docs/*.md equals what the renderer makes
 from its record, every record under docs/data/ carries its provenance, no measured record lies outside docs/data/, and
 the figures are byte-identical run to run."""
 
@@ -9,8 +9,8 @@ import json
 import pytest
 from conftest import ROOT
 
-from wormsim import docs_render as dr
-from wormsim.provenance import KEYS
+from tools import docs_render as dr
+from wormsim.results.provenance import KEYS
 
 RECORDS = sorted((ROOT / "docs" / "data").glob("*.json"))
 

@@ -17,7 +17,7 @@ import pytest
 from meshgen import displaced
 from meshgen import kinematic_tca as kt
 from meshgen.geometry import GeometryError, derive
-from wormsim.geometry import displaced_pair
+from wormsim.physics.geometry import displaced_pair
 from wormsim.scenario import ScenarioError, load_scenario
 from wormsim.tooth import mesh_stiffness as msk
 
@@ -165,7 +165,7 @@ def test_cli_exit_2_names_the_limit(tmp_path):
         [
             sys.executable,
             "-m",
-            "wormsim.cli",
+            "wormsim",
             "run",
             str(SCEN / "seat_motor.yaml"),
             "--out",
@@ -287,7 +287,7 @@ def test_wheel_axial_offset_moves_the_pattern_across_the_face_symmetrically():
 
 
 def test_torsional_reports_te_with_runout_and_its_sidebands():
-    from wormsim.metrics import dominant_frequency
+    from wormsim.results.metrics import dominant_frequency
     from wormsim.run import simulate
 
     sc = load_scenario(

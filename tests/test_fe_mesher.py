@@ -45,3 +45,28 @@ def test_a_refused_attempt_is_followed_by_the_next(box, monkeypatch):
     monkeypatch.setattr(fe_root, "tet_mesh", flaky)
     P, T = fe_root.tet_mesh_retried(*box, 0.004, 0.002, 2, (40.0, None))
     assert calls == [40.0, None] and len(T) > 0
+
+
+def test_the_job_writes_its_mesh_or_exits_3_with_gmsh_s_message(box, tmp_path):
+    """wormsim.rating.gmsh_job, the child's script (run as the parent runs it, in a process of its own): IN.npz ->
+    OUT.npz and exit 0; a surface gmsh refuses (an open one: a box without its last two faces) -> exit 3 and gmsh's
+    message on stderr, no OUT."""
+    import subprocess
+    import sys
+
+    from wormsim.rating import gmsh_job
+
+    V, F = box
+
+    def job(faces, name):
+        inp, out = tmp_path / f"{name}.in.npz", tmp_path / f"{name}.out.npz"
+        np.savez(inp, V=V, F=faces, size_m=0.004, min_size_m=0.002, curvature=2, angle_deg=np.nan, verbose=False)
+        cp = subprocess.run(
+            [sys.executable, gmsh_job.__file__, str(inp), str(out)], capture_output=True, text=True, timeout=120
+        )
+        return cp, out
+
+    cp, out = job(F, "closed")
+    assert cp.returncode == 0 and len(np.load(out)["tets"]) > 0
+    cp, out = job(F[:-2], "open")
+    assert cp.returncode == 3 and not out.exists() and cp.stderr.strip()

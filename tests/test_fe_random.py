@@ -12,8 +12,8 @@ from hypothesis import strategies as st
 from test_robustness import gear_data
 
 from wormsim import cli
-from wormsim.errors import ScenarioError, SimulationError
-from wormsim.geometry import derive
+from wormsim.exceptions import ScenarioError, SimulationError
+from wormsim.physics.geometry import derive
 from wormsim.rating import fe_root
 from wormsim.scenario import Gear
 

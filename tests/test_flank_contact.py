@@ -72,40 +72,24 @@ def test_conjugate_pose_touches_across_the_backlash(name):
         ks = window_teeth_at(th2c, g.z2, W, tooth0).astype(np.int64)
         for s in (-0.95, 0.95):
             n = kernel.find_contacts(
-                fg.xy,
-                fg.c,
-                fg.c_range,
-                fg.span,
-                fg.zeta,
+                (fg.xy, fg.c, fg.c_range, fg.span, fg.zeta),
                 ks,
                 th1,
                 th2c + s * bl,
                 kernel.MARGIN_PITCH * pitch + 3 * bl,
                 fg.params,
-                pos,
-                nrm,
-                dep,
-                meta,
-                np.zeros((len(dep), 2)),
+                (pos, nrm, dep, meta, np.zeros((len(dep), 2))),
             )
             assert n == 0, (th1, s, dep[:n].max())
         for s, flank in ((-2.0, 0), (2.0, 1)):
             n = kernel.find_contacts(
-                fg.xy,
-                fg.c,
-                fg.c_range,
-                fg.span,
-                fg.zeta,
+                (fg.xy, fg.c, fg.c_range, fg.span, fg.zeta),
                 ks,
                 th1,
                 th2c + g.hand * s * bl,
                 kernel.MARGIN_PITCH * pitch + 3 * bl,
                 fg.params,
-                pos,
-                nrm,
-                dep,
-                meta,
-                np.zeros((len(dep), 2)),
+                (pos, nrm, dep, meta, np.zeros((len(dep), 2))),
             )
             assert n >= 8 and np.all(meta[:n, 1] == flank)
             assert dep[:n].max() == pytest.approx(bl * arm0, rel=0.05)

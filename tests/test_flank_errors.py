@@ -170,12 +170,12 @@ def _kinematic_centroid_m(sc, res) -> float:
     here)."""
     from meshgen import displaced
     from meshgen import kinematic_tca as kt
-    from wormsim import gear_theory as gt
+    from wormsim.physics import gear_theory as gt
 
     bm = res.extra["built"]
     g = bm.geometry
     kin = bm.kinematic_tca if bm.kinematic_tca is not None else kt.analyse(g, displaced.Deviations())
-    pat = kin.pattern_fwd if gt.working_flank(sc, g.hand) > 0 else kin.pattern_rev
+    pat = kin.pattern_fwd if gt.duty(sc, g.hand).working_flank > 0 else kin.pattern_rev
     return float(pat["centroid_face_m"])
 
 

@@ -54,7 +54,7 @@ def test_torsional_validation_per_form(gear, form, tmp_path_factory):
 
 
 # involute_41's transmission error has a larger 2nd than 1st meshing harmonic (ZK, ZN1, ZN2 as ZI and ZA; ZC's largest
-# is the 1st): the meshing line (wormsim.metrics.mesh_line), not the spectrum's largest peak, is z1 n1 / 60
+# is the 1st): the meshing line (wormsim.results.metrics.mesh_line), not the spectrum's largest peak, is z1 n1 / 60
 @pytest.mark.parametrize("gear,form", CASES)
 def test_torsional_mesh_frequency_per_form(gear, form, tmp_path_factory):
     s, _ = torsional(gear, form, tmp_path_factory)

@@ -48,7 +48,7 @@ def test_memo_gives_the_same_contacts(name):
         wf = [np.zeros(cap), np.zeros((cap, 9))]
         for th1, th2 in _states(g, 600):
             ks = window_teeth_at(th2, g.z2, W, tooth0).astype(np.int64)
-            args = (fg.xy, fg.c, fg.c_range, fg.span, fg.zeta, ks, th1, th2, margin, fg.params, *bufs, 0.0)
+            args = ((fg.xy, fg.c, fg.c_range, fg.span, fg.zeta), ks, th1, th2, margin, fg.params, tuple(bufs), 0.0)
             n = kernel.find_contacts(*args, memo if use == "memo" else None)
             runs[use].append([b[:n].copy() for b in bufs])
             if use == "none":
@@ -145,7 +145,7 @@ def test_memo_with_displaced_poses_gives_the_same_contacts():
         for i, (th1, th2) in enumerate(_states(g, 600)):
             _set_displaced(P, g.a, th2, 0.05 * i)
             ks = window_teeth_at(th2, g.z2, W, tooth0).astype(np.int64)
-            args = (fg.xy, fg.c, fg.c_range, fg.span, fg.zeta, ks, th1, th2, margin, P, *bufs, 0.0)
+            args = ((fg.xy, fg.c, fg.c_range, fg.span, fg.zeta), ks, th1, th2, margin, P, tuple(bufs), 0.0)
             n = kernel.find_contacts(*args, memo if use == "memo" else None)
             runs[use].append([b[:n].copy() for b in bufs])
     assert sum(len(a[2]) > 0 for a in runs["none"]) > 250

@@ -54,10 +54,10 @@ def test_compiled_loop_equals_python_split_step(sets, mode):
     sc = load_scenario(SCEN / "screw_jack.yaml", BASE + sets + [f"contact.flank_contacts={mode}"])
     bm = build_model(sc)
     m = bm.model
-    from wormsim import gear_theory as gt
+    from wormsim.physics import gear_theory as gt
 
     dt = m.opt.timestep
-    cmds = gt.commands(sc, bm.direction)
+    cmds = gt.duty(sc, bm.direction).commands
     t = (np.arange(N_STEPS) + 0.5) * dt
     cmd, load = cmds.drive(t), cmds.load(t)
     a1, a2 = (bm.drive_actuator, bm.load_actuator)  # the screw jack's worm drives
@@ -115,8 +115,8 @@ def test_compiled_sample_equals_numpy_path(mode, sets):
     """FlankLoop.sample against flank_contact_details, PatternLog.record and the numpy sums the runner used; with
     assembly errors its points in tooth 0's frame against the displaced wheel body's frame in numpy (a few ulps:
     numpy's matrix product and cos may round differently)."""
-    from wormsim import gear_theory as gt
     from wormsim.contact3d.flank_step import flank_contact_details
+    from wormsim.physics import gear_theory as gt
     from wormsim.tooth.hertz import PatternLog
 
     sc = load_scenario(SCEN / "screw_jack.yaml", BASE + sets + [f"contact.flank_contacts={mode}"])
@@ -127,7 +127,7 @@ def test_compiled_sample_equals_numpy_path(mode, sets):
     split_forward(m, d, fc.add)
     loop = FlankLoop(fc, d, bm.drive_actuator, bm.load_actuator, bm.drive_actuator, bm.load_actuator, 0)
     t = (np.arange(N_STEPS) + 0.5) * m.opt.timestep
-    cmds = gt.commands(sc, bm.direction)
+    cmds = gt.duty(sc, bm.direction).commands
     loop.run(cmds.drive(t), cmds.load(t), 0, N_STEPS)
     assert fc.n > 4
     mu = 0.05

@@ -41,7 +41,7 @@ def test_merge_keeps_spring_resultant_and_both_moment_arms():
     out = [np.zeros((cap, 3)), np.zeros((cap, 3)), np.zeros(cap), np.zeros(cap), np.zeros(cap), np.zeros(cap)]
     grp, share = np.zeros(cap), np.zeros(cap)
     mpos, mnrm, mdepth, mweight, mfric, mwrap = out
-    nm = merge_flanks(meta, n, pos, nrm, depth, weight, grp, share, mpos, mnrm, mdepth, mweight, mfric, mwrap, axes)
+    nm = merge_flanks(meta, n, (pos, nrm, depth, weight), grp, share, (mpos, mnrm, mdepth, mweight, mfric, mwrap), axes)
     assert nm == len(sizes)
     a = weight * depth
     g = grp[:n].astype(int)
@@ -69,7 +69,7 @@ def test_split_gives_each_slice_its_spring_share():
     axes = np.array([0.0, -0.05, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 1 / 24])
     grp, share, mpos, mnrm = np.zeros(n), np.zeros(n), np.zeros((n, 3)), np.zeros((n, 3))
     mdepth, mweight, mfric, mwrap = np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n)
-    merge_flanks(meta, n, pos, nrm, depth, weight, grp, share, mpos, mnrm, mdepth, mweight, mfric, mwrap, axes)
+    merge_flanks(meta, n, (pos, nrm, depth, weight), grp, share, (mpos, mnrm, mdepth, mweight, mfric, mwrap), axes)
     efc = np.array([0.0, 0.0, 0.0, 50.0, 2.0, -1.0, 80.0, 3.0, 0.5])  # rows of contacts 1, 2 (contact 0: other)
     adr = np.array([-1, 3, 6])
     adr_out, efc_out = np.zeros(n, dtype=np.int64), np.zeros(3 * n)

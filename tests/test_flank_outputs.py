@@ -155,7 +155,7 @@ def test_report_and_recording_show_the_pattern(tmp_path):
 
     from wormsim.contact3d.report import write_recording, write_report
     from wormsim.contact3d.runner import simulate
-    from wormsim.recording import recorded_data, recorded_entities
+    from wormsim.results.recording import recorded_data, recorded_entities
 
     sc = load_scenario(
         SCENARIOS / "screw_jack.yaml",

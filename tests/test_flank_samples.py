@@ -10,7 +10,7 @@ import pytest
 
 import wormsim.contact3d.flank_samples as FS
 from wormsim.contact3d.runner import simulate
-from wormsim.errors import SimulationError
+from wormsim.exceptions import SimulationError
 from wormsim.scenario import load_scenario
 
 SCEN = Path(__file__).resolve().parents[1] / "scenarios"
@@ -104,7 +104,7 @@ HELD = (
         "contact.friction=0.2",
         "simulation.duration_s=0.085",
     ],
-)  # a wheel back-driving a self-locking pair: the run ends held (wormsim.locking)
+)  # a wheel back-driving a self-locking pair: the run ends held (wormsim.physics.locking)
 
 GUARDS = {
     "penetration": (

@@ -43,7 +43,7 @@ def test_a_mass_scaled_run_takes_at_most_16_slices():
 
     seat = SCENARIOS / "seat_motor.yaml"
     scaled = build_model(load_scenario(seat, ["simulation.mass_scaling=1000"]))
-    assert scaled.meta["mass_scaling"] == 1000 and scaled.law.contacts_per_pair == grid.SLICES_MASS_SCALED == 16
+    assert scaled.plan.scaling.factor == 1000 and scaled.law.contacts_per_pair == grid.SLICES_MASS_SCALED == 16
     explicit = build_model(load_scenario(seat, ["simulation.mass_scaling=1000", "contact.slices=24"]))
     assert explicit.law.contacts_per_pair == 24
     assert build_model(load_scenario(seat)).law.contacts_per_pair == 32
@@ -54,7 +54,7 @@ def test_the_resolution_levels_differ_in_what_check_prints(name):
     """simulation.resolution makes a difference (issue 31): `wormsim check`'s derived values give each level its own
     slice count, coarse < medium < fine, for the seeds (seat motor 8 / 32 / 64, screw jack 8 / 16 / 32, involute_41
     8 / 24 / 48)."""
-    from wormsim.check_cmd import level_lines
+    from wormsim.cli.check import level_lines
 
     counts = []
     for level in ("coarse", "medium", "fine"):

@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from wormsim.friction import GROUPS, rho_rad, rho_static_rad
+from wormsim.physics.friction import GROUPS, rho_rad, rho_static_rad
 
 DEG = math.pi / 180
 
@@ -52,7 +52,7 @@ def test_bad_arguments():
         rho_rad(1.0, group="IV")
 
 
-# mu(Vs) written once (wormsim.friction.mu_at): each caller against the formula it wrote before, and the law against
+# mu(Vs) written once (wormsim.physics.friction.mu_at): each caller against the formula it wrote before, and the law against
 # a handbook curve
 HANDBOOK = ((0.5, 0.06), (1.0, 0.05), (2.0, 0.035), (5.0, 0.023), (10.0, 0.017), (20.0, 0.014))  # m/s, mu
 
@@ -71,7 +71,7 @@ def _contacts():
 
 def _written_before(contact, vs: float) -> float:
     """The scalar forms the callers wrote themselves (friction_coefficient_scalar, contact3d's friction law)."""
-    from wormsim.units import step
+    from wormsim.physics.units import step
 
     vs = abs(vs)
     if contact.friction_group is not None:
@@ -87,7 +87,7 @@ SPEEDS = (0.0, 1e-4, 0.01, 0.02, 0.5, 1.0, 3.7, 15.0, -2.0)
 
 @pytest.mark.parametrize("name", list(_contacts()))
 def test_every_caller_goes_through_mu_at_with_the_old_results(name):
-    from wormsim.friction import friction_coefficient, friction_coefficient_scalar, mu_at, mu_law, mu_of
+    from wormsim.physics.friction import friction_coefficient, friction_coefficient_scalar, mu_at, mu_law, mu_of
 
     contact = _contacts()[name]
     law = mu_law(contact)
@@ -103,7 +103,7 @@ def test_every_caller_goes_through_mu_at_with_the_old_results(name):
 
 
 def test_rho_rad_and_the_wedge_go_through_the_law():
-    from wormsim.friction import rho_group_rad
+    from wormsim.physics.friction import rho_group_rad
 
     for group, (a, b, c) in GROUPS.items():
         for vs in SPEEDS:
@@ -113,7 +113,7 @@ def test_rho_rad_and_the_wedge_go_through_the_law():
 def test_group_i_follows_the_handbook_curve_within_25_percent():
     """Group I (hardened steel worm, tin bronze wheel) against the handbook's hard steel on phosphor bronze (module
     docstring): the seed's fit lies 7-25 % below it over 0.5-20 m/s, the gap growing with the speed."""
-    from wormsim.friction import friction_coefficient
+    from wormsim.physics.friction import friction_coefficient
 
     contact = _contacts()["group I"]
     ratio = [friction_coefficient(contact, vs) / mu for vs, mu in HANDBOOK]

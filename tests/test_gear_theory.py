@@ -1,4 +1,4 @@
-"""wormsim.gear_theory: each shared formula pinned against values computed by hand from its source (DIN 3975-2,
+"""wormsim.physics.gear_theory: each shared formula pinned against values computed by hand from its source (DIN 3975-2,
 seed 000, ADAMS STEP), so that a level that calls it and a copy that drifts both show here."""
 
 from __future__ import annotations
@@ -8,8 +8,8 @@ import math
 import numpy as np
 import pytest
 
-from wormsim import gear_theory as gt
-from wormsim.scenario import Material, Materials, load_scenario
+from wormsim.physics import gear_theory as gt
+from wormsim.scenario import Material, Materials, ScenarioError, load_scenario
 
 DEG = math.pi / 180
 
@@ -83,55 +83,62 @@ def test_din_3975_force_components():
 def test_working_wheel_torque_of_the_seat_motor(scenario_dir):
     sc = load_scenario(scenario_dir / "seat_motor.yaml")
     # load.torque_nm 24 of scenarios/seat_motor.yaml
-    assert gt.working_wheel_torque_nm(sc, 53.0) == 24.0  # the load on the wheel
+    assert gt.working_wheel_torque_of(sc.drive, sc.load, 53.0) == 24.0  # the load on the wheel
     on_worm = sc.model_copy(update={"load": sc.load.model_copy(update={"on": "worm", "torque_nm": 0.5})})
-    assert gt.working_wheel_torque_nm(on_worm, 53.0) == pytest.approx(26.5)  # 0.5 N m x ratio 53
+    assert gt.working_wheel_torque_of(on_worm.drive, on_worm.load, 53.0) == pytest.approx(26.5)  # 0.5 N m x ratio 53
 
 
 def test_commands_follow_adams_step_and_the_load_resists(scenario_dir):
     sc = load_scenario(scenario_dir / "seat_motor.yaml")  # 36 rpm over 0.3 s; 24 N m from 0 over 0.3 s
-    c = gt.commands(sc, direction=1)
+    c = gt.duty(sc, direction=1).commands
     w = 36 * 2 * math.pi / 60
     assert c.drive(0.0) == 0.0 and c.drive(0.3) == pytest.approx(w) and c.drive(1.0) == pytest.approx(w)
     assert c.drive(0.15) == pytest.approx(w / 2)  # STEP is half way at mid-ramp
     # load.torque_nm 24 of scenarios/seat_motor.yaml, reached at the end of its 0.3 s ramp
     assert c.load(0.3) == pytest.approx(-24.0)  # resists the positive motion
-    assert gt.commands(sc, direction=-1).load(0.3) == pytest.approx(24.0)
+    assert gt.duty(sc, direction=-1).commands.load(0.3) == pytest.approx(24.0)
     t = np.array([0.0, 0.075, 0.15, 0.3])
     # STEP: s^2 (3 - 2 s) at s = 0.25 -> 0.15625; float and array paths agree exactly
     assert c.drive(t)[1] == pytest.approx(0.15625 * w)
     assert list(c.drive(t)) == [c.drive(float(x)) for x in t]
-    # ramp_s 0.3 of scenarios/seat_motor.yaml; + LOCK_SETTLE_S 0.02 of wormsim/gear_theory.py
-    assert gt.ramps_end_s(sc) == 0.3 and gt.lock_check_start_s(sc) == pytest.approx(0.32)
+    # ramp_s 0.3 of scenarios/seat_motor.yaml; + LOCK_SETTLE_S 0.02 of wormsim/physics/gear_theory.py
+    d = gt.duty(sc, direction=1)
+    assert d.ramps_end_s == 0.3 and d.lock_check_start_s == pytest.approx(0.32)
 
 
 def test_servo_gain_gives_the_speed_droop_at_the_expected_torque(scenario_dir):
     sc = load_scenario(scenario_dir / "seat_motor.yaml")
     g, an, mu, i = 4.79 * DEG, 10 * DEG, 0.05, 53.0
     eta = gt.efficiency_theory(g, an, mu)
-    t_exp = gt.expected_drive_torque_nm(sc, i, g, an, mu)
+    t_exp = gt.expected_drive_torque_of(sc.drive, sc.load, i, g, an, mu)
     # T1 = T2 / (i eta): power balance with the theory efficiency; 24 N m of scenarios/seat_motor.yaml
     assert t_exp == pytest.approx(24.0 / i / eta)
-    kv = gt.servo_gain_nm_s(sc, i, g, an, mu)
+    kv = gt.servo_gain_of(sc.drive, t_exp)
     w = 36 * 2 * math.pi / 60
     assert kv * gt.SPEED_DROOP * w == pytest.approx(t_exp)  # the torque at a 0.1 % droop
     # back-driving a self-locking pair (eta 0): the efficiency floor keeps the gain finite
     back = sc.model_copy(update={"drive": sc.drive.model_copy(update={"on": "wheel"})})
-    assert gt.expected_drive_torque_nm(back, i, g, an, 0.2) == pytest.approx(24.0 * i / gt.MIN_EFFICIENCY)
+    assert gt.expected_drive_torque_of(back.drive, back.load, i, g, an, 0.2) == pytest.approx(
+        24.0 * i / gt.MIN_EFFICIENCY
+    )
 
 
-def test_duty_holds_what_the_scenario_functions_give(scenario_dir):
-    """gear_theory.duty derives the drive and load once: its commands, ramps, lock start and working flank are the
-    scenario functions' own, for both drive sides and both hands."""
+def test_duty_holds_what_the_drive_and_load_functions_give(scenario_dir):
+    """gear_theory.duty derives the drive and load once: its commands, ramps, lock start and working flank are those
+    of the drive and load functions, for both drive sides and both hands; a scenario without drive: is refused."""
     sc = load_scenario(scenario_dir / "seat_motor.yaml")
     back = sc.model_copy(update={"drive": sc.drive.model_copy(update={"on": "wheel"})})
     for s in (sc, back):
         for hand in (1, -1):
             d = gt.duty(s, hand)
-            assert d.commands == gt.commands(s, hand) and d.working_flank == gt.working_flank(s, hand)
-            assert (d.ramps_end_s, d.lock_check_start_s) == (gt.ramps_end_s(s), gt.lock_check_start_s(s))
+            assert d.commands == gt.commands_of(s.drive, s.load, hand)
+            assert d.working_flank == gt.working_flank_of(s.drive, hand)
+            ramps = gt.ramps_end_of(s.drive, s.load)
+            assert (d.ramps_end_s, d.lock_check_start_s) == (ramps, gt.lock_check_after(ramps))
             assert d.speed_driven and d.drive is s.drive and d.load is s.load
     assert gt.duty(sc, 1).working_flank == 1 and gt.duty(back, 1).working_flank == -1
+    with pytest.raises(ScenarioError, match="drive: model wedge needs a drive: block"):
+        gt.duty(sc.model_copy(update={"model": "wedge", "drive": None}), 1)
     # the worm's commanded speed: 36 rpm of scenarios/seat_motor.yaml on the worm, x the ratio from the wheel
     w = 36 * 2 * math.pi / 60
     assert gt.worm_speed_command_rad_s(sc.drive, 53.0) == pytest.approx(w)

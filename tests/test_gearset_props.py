@@ -11,7 +11,7 @@ from conftest import ROOT, SCENARIOS
 
 from meshgen import wheel
 from wormsim.contact3d import mjcf
-from wormsim.geometry import gear_set
+from wormsim.physics.geometry import gear_set
 from wormsim.scenario import load_scenario
 
 

@@ -6,9 +6,9 @@ from __future__ import annotations
 import pytest
 from conftest import ROOT
 
+from tools.schema_doc import markdown
 from wormsim import cli
 from wormsim.scenario import Materials, ScenarioError, load_scenario
-from wormsim.schema_doc import markdown
 
 MINIMAL = ROOT / "tests" / "assets" / "minimal_contact3d.yaml"
 # exit codes asserted: 0 ok, 2 invalid input, 3 simulation failed, 130 / 143 interrupted (docs/cli.md, INTERFACE.md)

@@ -1,4 +1,4 @@
-"""The compiled kernels' cache (wormsim.jit_cache): keyed by the code the compiled functions read, one folder per
+"""The compiled kernels' cache (wormsim.runtime.jit_cache): keyed by the code the compiled functions read, one folder per
 machine for every process, filled once under a lock, and the progress line's "compiling". The long test compiles on a
 fresh cache: two processes at once compile once, and a later process's contact3d runs compile nothing."""
 
@@ -17,7 +17,8 @@ from pathlib import Path
 
 import pytest
 
-from wormsim import jit_cache, progress
+from wormsim.runfolder import progress
+from wormsim.runtime import jit_cache
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -32,10 +33,10 @@ def test_key_follows_the_compiled_code_and_not_the_rest(tmp_path, monkeypatch):
     monkeypatch.setattr(jit_cache, "_ROOT", _copy_tree(tmp_path))
     k0 = jit_cache.cache_key()
     assert k0 == jit_cache.cache_key() and len(k0) == 16
-    cli = tmp_path / "wormsim" / "cli.py"
+    cli = tmp_path / "wormsim" / "cli" / "entry.py"
     cli.write_text(cli.read_text() + "\n# a comment\n")
     assert jit_cache.cache_key() == k0  # the command line is not compiled code
-    for rel in ("wormsim/friction.py", "wormsim/tooth/gap.py", "meshgen/worm_forms_jit.py"):
+    for rel in ("wormsim/physics/friction.py", "wormsim/tooth/gap.py", "meshgen/worm_forms_jit.py"):
         f = tmp_path / rel
         text = f.read_text()
         f.write_text(text + "\n# changed\n")
@@ -50,7 +51,7 @@ def test_the_key_is_remembered_by_the_files_stamps(tmp_path, monkeypatch):
     root.mkdir()
     k0 = jit_cache._key_memo(root)
     assert k0 == jit_cache.cache_key() and json.loads((root / "keys.json").read_text()) == {jit_cache._stamp(): k0}
-    f = tmp_path / "src" / "wormsim" / "friction.py"
+    f = tmp_path / "src" / "wormsim" / "physics" / "friction.py"
     f.write_text(f.read_text() + "\n# changed\n")
     k1 = jit_cache._key_memo(root)
     assert k1 != k0 and k1 == jit_cache.cache_key() and len(json.loads((root / "keys.json").read_text())) == 2

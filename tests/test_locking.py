@@ -1,4 +1,4 @@
-"""Self-locking is a result, not a failure (wormsim.locking; issue 31): a speed-driven wheel against a pair that
+"""Self-locking is a result, not a failure (wormsim.physics.locking; issue 31): a speed-driven wheel against a pair that
 self-locks at standstill stalls, the mesh holds, and the run says so with status ok and exit 0: `locked` true, the
 holding torque and the worm's creep speed, at torsional and contact3d. No message blames the contact stiffness.
 
@@ -15,8 +15,9 @@ from conftest import SCENARIOS
 
 from meshgen.geometry import derive
 from wormsim import cli
-from wormsim import gear_theory as gt
-from wormsim.locking import backdrive_self_locks, stall_torque_nm
+from wormsim.physics import gear_theory as gt
+from wormsim.physics.locking import backdrive_self_locks, stall_torque_nm
+from wormsim.physics.plan import gear_plan
 from wormsim.run import simulate
 from wormsim.scenario import load_scenario
 
@@ -56,10 +57,11 @@ def test_self_locking_condition_is_din_3975s():
     assert 0.082 < mu_star < 0.083
     for mu, locks in ((mu_star * 1.01, True), (mu_star * 0.99, False)):
         sc = load_scenario(DEMO, [*BACKDRIVE, f"contact.friction={mu}"])
-        assert backdrive_self_locks(sc, g.gamma, g.alpha_n) is locks
-    assert not backdrive_self_locks(
-        load_scenario(DEMO, ["contact.friction_static=0.2", "contact.friction_dynamic=0.2"]), g.gamma, g.alpha_n
-    )
+        assert gear_plan(sc).backdrive_self_locks is locks
+        assert backdrive_self_locks(sc.drive, g.gamma, gear_plan(sc).rho_static_rad) is locks
+    assert not gear_plan(
+        load_scenario(DEMO, ["contact.friction_static=0.2", "contact.friction_dynamic=0.2"])
+    ).backdrive_self_locks
 
 
 def test_torsional_backdrive_of_a_self_locking_pair_is_held_exit_0(tmp_path, capsys):
@@ -89,7 +91,7 @@ def test_torsional_backdrive_below_the_boundary_runs_and_is_not_locked():
 
 def test_contact3d_backdrive_of_a_self_locking_pair_is_held_exit_0(tmp_path, capsys):
     """contact3d (coarse), the same back-drive, 0.09 s: exit 0 with `locked` true; no "contact too soft". The held
-    mesh's working torque for the friction rows' hardness is the stalled servo's (wormsim.locking.stall_torque_nm):
+    mesh's working torque for the friction rows' hardness is the stalled servo's (wormsim.physics.locking.stall_torque_nm):
     measured creep 0.079 rpm (7.5e-5 of 1060 rpm); with the worm load's 0 N m (impratio 1) it crept at 65 rpm."""
     rc, s = _run(tmp_path, "contact3d", 0.1, ["simulation.duration_s=0.09", "simulation.resolution=coarse"])
     err = capsys.readouterr().err

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from conftest import SCENARIOS
 
-from wormsim.geometry import derive
+from wormsim.physics.geometry import derive
 from wormsim.scenario import load_scenario
 from wormsim.tooth import ltca
 

@@ -16,13 +16,13 @@ import pytest
 from conftest import SCENARIOS
 
 from wormsim import cli
-from wormsim import gear_theory as gt
 from wormsim.contact3d import mass_scaling as msm
 from wormsim.contact3d.mjcf import prepare
 from wormsim.contact3d.runner import simulate
 from wormsim.contact3d.timestep import choose_timestep
-from wormsim.errors import RingingError
-from wormsim.gear_theory import round_down_125
+from wormsim.exceptions import RingingError
+from wormsim.physics import gear_theory as gt
+from wormsim.physics.gear_theory import round_down_125
 from wormsim.scenario import ScenarioError, load_scenario
 
 SEAT = SCENARIOS / "seat_motor.yaml"
@@ -46,10 +46,10 @@ def run(ms: str) -> dict:
 @pytest.mark.parametrize("ms", ["300", "auto"])
 def test_scaled_run_keeps_the_closed_forms(ms):
     """At a step >= 10 x the unscaled default: mean F_t within 1 % of T2 / r2 (DIN 3975-2, statics), the efficiency
-    within 1 % of tan(g_r) / tan(g_r + rho') at the contacts' radius (wormsim.gear_theory.efficiency_at_radius), the
+    within 1 % of tan(g_r) / tan(g_r + rho') at the contacts' radius (wormsim.physics.gear_theory.efficiency_at_radius), the
     ratio within 0.01 % of z2 / z1. Measured (S = 300 / 200): 1e-6 off the efficiency, 1e-4 off F_t."""
     from meshgen.geometry import derive
-    from wormsim.gear_theory import efficiency_at_radius
+    from wormsim.physics.gear_theory import efficiency_at_radius
 
     s = run(ms)
     sc1 = load_scenario(SEAT, CFG)
@@ -191,13 +191,13 @@ def test_ringing_guard_on_efficiency_above_one():
     sc = load_scenario(SEAT, CFG + ["simulation.mass_scaling=300"])
     duty, req = gt.duty(sc, 1), sc.simulation.mass_scaling
     c = msm.ScalingCheck(300.0, 555.0, 3.0, 0.1, 0.008, {})
-    meta = {"mass_scaling_check": c, "shaft_inertias_kg_m2": (300 * 7.8e-8, 300 * 1.35e-6)}
+    ine = (300 * 7.8e-8, 300 * 1.35e-6)
     ok = {"efficiency": 0.613, "timestep_s": 1e-4, "timestep_stable_limit_s": 2.8e-4}
-    assert msm.run_summary(S, duty, req, meta, ok)["kinetic_energy_share"] < msm.KE_SHARE_TARGET
+    assert msm.run_summary(S, duty, req, c, ine, ok)["kinetic_energy_share"] < msm.KE_SHARE_TARGET
     with pytest.raises(RingingError, match="efficiency 1.83 > 1"):
-        msm.run_summary(S, duty, req, meta, {**ok, "efficiency": 1.83})
-    heavy = {**meta, "shaft_inertias_kg_m2": (1e5 * 7.8e-8, 1e5 * 1.35e-6)}
+        msm.run_summary(S, duty, req, c, ine, {**ok, "efficiency": 1.83})
+    heavy = (1e5 * 7.8e-8, 1e5 * 1.35e-6)
     with pytest.raises(RingingError, match="kinetic energy"):
-        msm.run_summary(S, duty, req, heavy, ok)
-    unscaled = {**meta, "mass_scaling_check": msm.ScalingCheck(1.0, 9620.0, 3.0, 0.1, 3e-5, {})}
-    assert msm.run_summary(S, duty, req, unscaled, {**ok, "efficiency": 1.83})["mass_scaling"] == 1
+        msm.run_summary(S, duty, req, c, heavy, ok)
+    unscaled = msm.ScalingCheck(1.0, 9620.0, 3.0, 0.1, 3e-5, {})
+    assert msm.run_summary(S, duty, req, unscaled, ine, {**ok, "efficiency": 1.83})["mass_scaling"] == 1

@@ -40,7 +40,7 @@ def test_mesh_command_writes_geometry(name, tmp_path, capsys):
     ww = worm.copy().apply_transform(Tw)
     assert ww.bounds[0][1] == pytest.approx(-a - worm.bounds[1][0], rel=1e-3)
     assert wheel.bounds[1][0] == pytest.approx(data["derived"]["r_e2_mm"] / 1000, rel=1e-3)
-    from wormsim.recording import recorded_entities
+    from wormsim.results.recording import recorded_entities
 
     ents = recorded_entities(out / "recording.rrd")
     assert {"/assembly/worm", "/assembly/wheel"} <= ents

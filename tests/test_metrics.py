@@ -1,12 +1,12 @@
-"""wormsim.metrics on synthetic signals whose answers are known in closed form."""
+"""wormsim.results.metrics on synthetic signals whose answers are known in closed form."""
 
 import math
 
 import numpy as np
 import pytest
 
-from wormsim.gear_theory import efficiency_theory
-from wormsim.metrics import dominant_frequency, steady_window
+from wormsim.physics.gear_theory import efficiency_theory
+from wormsim.results.metrics import dominant_frequency, steady_window
 
 
 @pytest.mark.parametrize("f_true", [7.3, 12.0, 31.77])

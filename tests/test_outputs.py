@@ -1,4 +1,4 @@
-"""The output-key reference (wormsim.outputs, docs/outputs.md): every key a level writes has an entry, the doc is
+"""The output-key reference (wormsim.results.summary_keys, docs/outputs.md): every key a level writes has an entry, the doc is
 current, and forces carry one sign convention in summary.json and the time series."""
 
 from __future__ import annotations
@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 from conftest import ROOT, SCENARIOS
 
-from wormsim import outputs
+from tools import outputs_doc
+from wormsim.results import summary_keys as outputs
 from wormsim.run import run_scenario
 from wormsim.scenario import load_scenario
 
@@ -41,7 +42,7 @@ def runs(tmp_path_factory):
 
 def test_docs_outputs_md_is_current():
     text = (ROOT / "docs" / "outputs.md").read_text()
-    assert text == outputs.markdown(), "docs/outputs.md is stale: python -m wormsim.outputs > docs/outputs.md"
+    assert text == outputs_doc.markdown(), "docs/outputs.md is stale: python -m tools.outputs_doc > docs/outputs.md"
 
 
 def test_every_table_entry_names_known_levels_and_a_unit():
@@ -113,3 +114,16 @@ def test_a_left_hand_worm_gives_the_same_force_signs_at_torsional_and_contact3d(
         means[level] = [float(np.mean(r.series[f"{c}_force_n"][sl])) for c in ("tangential", "radial", "axial")]
     for level, (ft, fr, fa) in means.items():
         assert ft < 0 and fr > 0 and fa < 0, (level, ft, fr, fa)
+
+
+def test_level_summary_merges_in_order_and_refuses_a_key_without_the_levels_entry():
+    """wormsim.results.summary_keys.level_summary, every level's summary builder: later groups replace earlier keys; a key with
+    no entry, or whose entry does not name the level, raises KeyError naming it."""
+    s = outputs.level_summary("torsional", {"ratio": 1.0, "efficiency": 0.5}, {"efficiency": 0.6})
+    assert s == {"ratio": 1.0, "efficiency": 0.6}
+    with pytest.raises(KeyError, match="no_such_key"):
+        outputs.level_summary("contact3d", {"ratio": 1.0}, {"no_such_key": 1})
+    wedge_only = next(k for k, e in outputs.KEYS.items() if e.levels == ("wedge",))
+    with pytest.raises(KeyError, match=wedge_only):
+        outputs.level_summary("torsional", {wedge_only: 1.0})
+    assert outputs.level_summary("wedge", {wedge_only: 1.0}) == {wedge_only: 1.0}

@@ -102,3 +102,49 @@ def test_non_editable_install_runs_from_another_directory(tmp_path):
     assert (out / "timeseries.npz").exists() and (out / "report.png").exists()
     bench = subprocess.run([str(exe), "bench", "--help"], cwd=elsewhere, capture_output=True, text=True)
     assert bench.returncode == 0 and "--quick" in bench.stdout
+
+
+def test_source_checkout_runs_without_installing(tmp_path):
+    """`PYTHONPATH=. python -c "import wormsim; ..."` and `python -m wormsim` from a source checkout, in a clean
+    environment where no wormsim is installed: the models/ and scenarios/ folders are found in the source tree."""
+    env = tmp_path / "venv"
+    venv.create(env, with_pip=False)
+    py = str(env / "bin" / "python")
+    site = subprocess.run(
+        [py, "-c", "import sysconfig; print(sysconfig.get_paths()['purelib'])"],
+        check=True,
+        capture_output=True,
+        text=True,
+    ).stdout.strip()
+    Path(site, "_test_deps.pth").write_text(sysconfig.get_paths()["purelib"] + "\n")  # the dependencies only
+    clean = {"PATH": "/usr/bin:/bin", "HOME": str(tmp_path), "WORMSIM_CACHE": str(tmp_path / "cache")}
+    none = subprocess.run(
+        [py, "-c", "import importlib.util; print(importlib.util.find_spec('wormsim'))"],
+        cwd=tmp_path,
+        env=clean,
+        capture_output=True,
+        text=True,
+    )
+    assert none.stdout.strip() == "None", none.stdout + none.stderr  # not installed there
+    code = (
+        "import wormsim; from wormsim.runtime.data import data_dir; "
+        "sc = wormsim.load_scenario('scenarios/screw_jack.yaml'); "
+        "print(wormsim.__file__); print(data_dir('models')); print(sc.name)"
+    )
+    src = {**clean, "PYTHONPATH": "."}
+    r = subprocess.run([py, "-c", code], cwd=ROOT, env=src, capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr[-2000:]
+    where, models, name = r.stdout.splitlines()
+    assert Path(where) == ROOT / "wormsim" / "__init__.py" and Path(models) == ROOT / "models" and name == "screw_jack"
+    cli = subprocess.run(
+        [py, "-m", "wormsim", "check", "scenarios/screw_jack.yaml"], cwd=ROOT, env=src, capture_output=True, text=True
+    )
+    assert cli.returncode == 0 and "flank slices across the face" in cli.stdout, cli.stderr[-2000:]
+    bad = subprocess.run(
+        [py, "-m", "wormsim", "check", "scenarios/screw_jack.yaml", "--set", "gear.wheel_teeth=-1"],
+        cwd=ROOT,
+        env=src,
+        capture_output=True,
+        text=True,
+    )
+    assert bad.returncode == 2 and "wheel_teeth" in bad.stderr, bad.stderr[-2000:]

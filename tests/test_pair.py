@@ -212,7 +212,7 @@ def test_pair_forces_and_efficiency_match_contact3d_on_the_same_gear():
     efficiency 0.6389 / 0.6388, pair / contact3d); 0.5 % allows for the machine's velocity servo (kv = 1 against
     contact3d's stiffer one). F_a2 also against DIN 3975's F_t2 tan(gamma + rho') at the mesh's mean friction, 5 %."""
     from meshgen.geometry import derive
-    from wormsim import gear_theory as gt
+    from wormsim.physics import gear_theory as gt
     from wormsim.run import simulate
 
     sc = _jack()

@@ -1,4 +1,4 @@
-"""The background warm-ups (wormsim.prewarm, wormsim.contact3d.jit_warmup): no figure made, no rcParam changed, the
+"""The background warm-ups (wormsim.runtime.prewarm, wormsim.contact3d.jit_warmup): no figure made, no rcParam changed, the
 gate holds, a failure does not fail the run (and leaves the GIL switch interval as it was), a failed run's thread does
 no work."""
 
@@ -12,9 +12,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from wormsim import prewarm, run
+from wormsim import run
 from wormsim.contact3d import jit_warmup
-from wormsim.result import Result
+from wormsim.results.result import Result
+from wormsim.runtime import prewarm
 from wormsim.scenario import load_scenario
 
 ROOT = Path(__file__).resolve().parents[1]

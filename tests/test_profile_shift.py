@@ -121,8 +121,8 @@ def test_positive_shift_lifts_the_undercut():
 def test_torsional_on_the_shifted_gear(tmp_path):
     """involute_41 shifted by x2 = +0.5 at torsional: ratio, F_t2 = T2 / (d2 / 2) (0.5 %) and the efficiency of the
     wedge law at the operating lead angle gamma_m (it differs from the unshifted gamma's)."""
-    from wormsim import gear_theory as gt
     from wormsim import simulate
+    from wormsim.physics import gear_theory as gt
 
     sc = load_scenario(
         SCENARIOS / "involute_41.yaml",
@@ -160,7 +160,7 @@ def test_contact3d_on_the_shifted_1x40(name):
 
 
 def test_report_header_gives_the_shift():
-    from wormsim.report_header import gear_line
+    from wormsim.results.report_header import gear_line
 
     assert "x2" not in gear_line(_g(0.0))
     line = gear_line(_g(0.5))

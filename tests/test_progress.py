@@ -3,7 +3,7 @@ once it has taken LOG_AFTER_S of wall time; short runs and --no-progress stay si
 
 import io
 
-from wormsim import progress as P
+from wormsim.runfolder import progress as P
 
 
 def _feed(monkeypatch, enabled, elapsed_s):

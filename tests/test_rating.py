@@ -231,3 +231,32 @@ def test_run_with_bad_rating_input_exits_2_before_any_work(tmp_path, capsys):
     )
     assert code == 2 and "rating.worm_speed_rpm" in capsys.readouterr().err
     assert not (tmp_path / "summary.json").exists()
+
+
+def test_rating_files_hold_the_result_and_a_readable_report(tmp_path):
+    """wormsim.rating.output: rating.json is the result with the scenario's name; rating.md has a row per safety
+    factor with the value as rated, every factor with its source, and the warnings."""
+    from wormsim.rating.output import SAFETY_ROWS, write_rating
+    from wormsim.scenario import load_scenario
+
+    res = rate(load_scenario(SCENARIOS / "screw_jack.yaml"))
+    json_path, md_path = write_rating(tmp_path, res, "screw_jack")
+    assert json.loads(json_path.read_text()) == json.loads(json.dumps({"scenario": "screw_jack", **res}))
+    md = md_path.read_text()
+    for key, sym, what in SAFETY_ROWS:
+        if key in res and res[key] is not None:
+            assert f"| {what} | {sym} | {res[key]:.4g} |" in md
+    assert all(f["source"] in md for f in res["factors"]) and md.count("\n| ") >= len(res["factors"])
+
+
+def test_a_plastic_wheel_is_refused_with_the_reason():
+    """wormsim.rating.plastic: a POM wheel gets no safety factor, and the reason names the standards' scope."""
+    from wormsim.rating import plastic
+    from wormsim.scenario import load_scenario
+
+    res = rate(load_scenario(SCENARIOS / "seat_motor.yaml"))
+    reason = plastic.refusal_reason("POM")
+    assert "ISO/TS 14521" in reason and "VDI 2736" in reason
+    assert res["inputs"]["wheel_material"] == "POM"  # the seat motor's wheel (seed 001)
+    assert res["refused"] == plastic.refusal_reason("POM")
+    assert res["safety_pitting"] is None and res["sliding_speed_m_s"] > 0

@@ -11,7 +11,7 @@ import pytest
 from conftest import SCENARIOS
 
 from wormsim import cli
-from wormsim.geometry import derive
+from wormsim.physics.geometry import derive
 from wormsim.rating import fe_root
 from wormsim.scenario import load_scenario
 

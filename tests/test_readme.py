@@ -37,7 +37,7 @@ def test_readme_template_is_a_valid_scenario(tmp_path):
 def test_readme_template_is_what_wormsim_init_writes(tmp_path, monkeypatch):
     """`wormsim init my_gear.yaml` writes the README's template character for character, and its profile comment
     names all five flank forms."""
-    from wormsim.init_cmd import write_template
+    from wormsim.cli.init import write_template
 
     block = README.split("```yaml\n", 1)[1].split("```", 1)[0]
     monkeypatch.chdir(tmp_path)

@@ -14,10 +14,11 @@ import numpy as np
 import pytest
 from conftest import ROOT
 
-from wormsim import cli, output, run
-from wormsim.errors import SimulationError
-from wormsim.output import FolderLock
-from wormsim.result import Result
+from wormsim import cli, run
+from wormsim.exceptions import SimulationError
+from wormsim.results.result import Result
+from wormsim.runfolder import writer as output
+from wormsim.runfolder.writer import FolderLock
 
 MINIMAL = ROOT / "tests" / "assets" / "minimal_contact3d.yaml"
 MOV = ROOT / "scenarios" / "mov_1.yaml"

@@ -1,9 +1,9 @@
 """recording.rrd of two identical runs (issue 10): the content is identical; the bytes are not, because rerun
-stamps rows and chunks with time-based ids (wormsim.recording.recorded_data, docs/recording.md)."""
+stamps rows and chunks with time-based ids (wormsim.results.recording.recorded_data, docs/recording.md)."""
 
 from conftest import SCENARIOS
 
-from wormsim.recording import recorded_data
+from wormsim.results.recording import recorded_data
 from wormsim.run import run_scenario
 from wormsim.scenario import load_scenario
 

@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 from conftest import ROOT
 
-from wormsim.output import RESULT_FILES
+from wormsim.runfolder.writer import RESULT_FILES
 
 SEAT = ROOT / "scenarios" / "seat_motor.yaml"
 WORMSIM = Path(sys.executable).with_name("wormsim")
@@ -128,3 +128,28 @@ def test_second_run_into_the_same_folder_is_refused(good, tmp_path):
         first.communicate(timeout=120)
     assert first.returncode == 143
     assert snapshot(out) == before
+
+
+def test_interrupt_is_sticky_and_restored():
+    """wormsim.runfolder.interrupt: the handler raises Interrupted and records the signal, so a KeyboardInterrupt swallowed
+    somewhere (a lazy import's `except BaseException`) resurfaces at the next check(); restore() puts the old
+    handlers back and clears it."""
+    import pytest
+
+    from wormsim.runfolder import interrupt
+
+    old = interrupt.install()
+    try:
+        assert signal.getsignal(signal.SIGTERM) is interrupt._handler
+        try:
+            os.kill(os.getpid(), signal.SIGTERM)
+            time.sleep(1.0)  # (the handler runs at the next bytecode)
+        except interrupt.Interrupted as exc:
+            assert exc.signum == signal.SIGTERM and isinstance(exc, KeyboardInterrupt)
+        assert interrupt.pending() == signal.SIGTERM
+        with pytest.raises(interrupt.Interrupted):
+            interrupt.check()  # swallowed once, raised again
+    finally:
+        interrupt.restore(old)
+    assert interrupt.pending() is None and signal.getsignal(signal.SIGTERM) is old.get(signal.SIGTERM, signal.SIG_DFL)
+    interrupt.check()  # nothing pending: no raise

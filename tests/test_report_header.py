@@ -1,4 +1,4 @@
-"""report.png's header panel and axes (wormsim.report_header) and the contact pattern's band (flank_outputs):
+"""report.png's header panel and axes (wormsim.results.report_header) and the contact pattern's band (flank_outputs):
 self-locking from rho' against gamma, the shafts' powers, axes scaled to the steady window, no holes in the band."""
 
 from __future__ import annotations
@@ -10,7 +10,7 @@ import pytest
 from conftest import SCENARIOS
 
 from meshgen.geometry import derive
-from wormsim import report_header as RH
+from wormsim.results import report_header as RH
 from wormsim.scenario import load_scenario
 
 

@@ -1,4 +1,4 @@
-"""REXS in and out (wormsim.rexs): the FVA Workbench worm stage (tests/assets/rexs, Apache-2.0, NOTICE.md) and a
+"""REXS in and out (wormsim.scenario.rexs): the FVA Workbench worm stage (tests/assets/rexs, Apache-2.0, NOTICE.md) and a
 second stage written for these tests (other_worm_stage.rexsj: ZA, 1/40, m_n given, x2 from a = 63 mm, finite bearing
 stiffnesses), both encodings, the round trip, bad files with exit 2, and the levels' F_t2 = T2 / (d2 / 2)."""
 
@@ -11,10 +11,10 @@ from pathlib import Path
 
 import pytest
 
-from wormsim import cli, rexs
-from wormsim.geometry import derive
-from wormsim.output import write_rexs
-from wormsim.scenario import ScenarioError, load_scenario, scenario_from_dict
+from wormsim import cli
+from wormsim.physics.geometry import derive
+from wormsim.runfolder.writer import write_rexs
+from wormsim.scenario import ScenarioError, load_scenario, rexs, scenario_from_dict
 
 ASSETS = Path(__file__).parent / "assets" / "rexs"
 FVA_XML = ASSETS / "FVA_worm_stage_1-4.rexs"

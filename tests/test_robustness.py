@@ -75,7 +75,7 @@ def test_random_gear_runs_or_is_refused(gear, tmp_path_factory, capsys):
     assert abs(s["ratio"] / s["ratio_theory"] - 1) < 1e-3, (gear, s["ratio"], s["ratio_theory"])
     # torque balance from the mesh force, not from the load command: the mean tangential force of the mesh spring
     # times r2 carries the load (statics of the wheel: its mean acceleration over the window is zero), within 2 %;
-    # tangential_force_theory_n = T2 / r2 (DIN 3975-2, wormsim.gear_theory.tangential_force_n)
+    # tangential_force_theory_n = T2 / r2 (DIN 3975-2, wormsim.physics.gear_theory.tangential_force_n)
     assert abs(s["tangential_force_mean_n"] / s["tangential_force_theory_n"] - 1) < 0.02, (
         gear,
         s["tangential_force_mean_n"],
@@ -165,7 +165,7 @@ FUZZ_WORKER = r"""
 import json, random, sys, traceback
 from pathlib import Path
 from wormsim.scenario import ScenarioError, load_scenario
-from wormsim.validate import validate_geometry
+from wormsim.physics.validate import validate_geometry
 
 seeds, n, tmp = [Path(p) for p in json.loads(sys.argv[1])], int(sys.argv[2]), Path(sys.argv[3])
 rng = random.Random(20251123)

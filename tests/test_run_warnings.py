@@ -1,4 +1,4 @@
-"""Warnings of a finished run (wormsim.run_warnings): F_t p2p above half its mean, contacts outside the wheel
+"""Warnings of a finished run (wormsim.results.run_warnings): F_t p2p above half its mean, contacts outside the wheel
 flanks; in summary.json's `warnings` and on stderr."""
 
 from __future__ import annotations
@@ -11,8 +11,8 @@ from conftest import SCENARIOS
 
 from meshgen import wheel
 from meshgen.geometry import derive
-from wormsim import run_warnings as W
 from wormsim.cli import main
+from wormsim.results import run_warnings as W
 from wormsim.scenario import load_scenario
 
 

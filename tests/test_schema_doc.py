@@ -2,10 +2,10 @@
 
 from pathlib import Path
 
-from wormsim.schema_doc import markdown
+from tools.schema_doc import markdown
 
 DOC = Path(__file__).resolve().parents[1] / "docs" / "scenario.md"
 
 
 def test_scenario_reference_is_up_to_date():
-    assert DOC.read_text() == markdown(), "regenerate: python -m wormsim.schema_doc > docs/scenario.md"
+    assert DOC.read_text() == markdown(), "regenerate: python -m tools.schema_doc > docs/scenario.md"

@@ -19,7 +19,7 @@ import pytest
 from meshgen import assembly
 from wormsim.contact3d import shafts
 from wormsim.contact3d.mjcf import build_model
-from wormsim.geometry import derive
+from wormsim.physics.geometry import derive
 from wormsim.run import simulate
 from wormsim.scenario import Scenario, ScenarioError, load_scenario
 
@@ -162,9 +162,9 @@ def test_shaft_log_series_equal_the_per_sample_formulas(block):
     statics; the deflections from the joints): bit for bit, up to a few ulps where numpy's matrix products round."""
     import mujoco
 
-    from wormsim import gear_theory as gt
     from wormsim.contact3d.flank_step import FlankContacts
     from wormsim.contact3d.native import split_forward
+    from wormsim.physics import gear_theory as gt
 
     sc = _scenario(json.loads(block))
     sc.drive.ramp_s, sc.load.ramp_s = 0.001, 0.001  # loaded within the samples
@@ -173,7 +173,7 @@ def test_shaft_log_series_equal_the_per_sample_formulas(block):
     d = mujoco.MjData(m)
     fc = FlankContacts(bm, bm.law.contacts_per_pair)
     split_forward(m, d, fc.add)
-    cmds = gt.commands(sc, bm.direction)
+    cmds = gt.duty(sc, bm.direction).commands
     n, every = 12, 25
     log = shafts.ShaftLog(m, bm.meta["shafts"], n)
     ref: dict[str, list[float]] = {}

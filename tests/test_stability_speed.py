@@ -34,7 +34,7 @@ from wormsim.contact3d import guards as sim_mod
 from wormsim.contact3d.mjcf import build_model
 from wormsim.contact3d.runner import run_model, simulate
 from wormsim.contact3d.timestep import MAX_WORM_TURN_PER_STEP_RAD, OVERSPEED_GUARD, choose_timestep
-from wormsim.errors import ScenarioError, SimulationError
+from wormsim.exceptions import ScenarioError, SimulationError
 from wormsim.scenario import load_scenario
 
 JACK = SCENARIOS / "screw_jack.yaml"
@@ -184,7 +184,7 @@ def test_speculative_contacts_tunnel_sooner_beyond_the_speed_limit(monkeypatch):
     def run(rpm, h, *extra):
         sc = _jack(rpm, 0.02, *extra, *PIECES)
         bm = build_model(sc, timestep_s=h)  # past choose_timestep's speed check
-        return run_model(bm, sc)
+        return run_model(bm)
 
     plain = run(66500, 1e-5)
     # 66500 rpm x 2 pi / 60 x 1e-5 s = 0.0696 rad per step (kinematics); ratio 24 = z2 / z1 of the screw jack

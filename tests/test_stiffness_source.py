@@ -12,7 +12,7 @@ from conftest import SCENARIOS
 from meshgen.geometry import derive
 from wormsim.contact3d.mjcf import prepare
 from wormsim.contact3d.timestep import choose_timestep
-from wormsim.gear_theory import effective_modulus_pa
+from wormsim.physics.gear_theory import effective_modulus_pa
 from wormsim.scenario import load_scenario
 from wormsim.tooth import stiffness as ST
 

@@ -87,9 +87,9 @@ def test_points_are_validated_and_hashed():
     assert load_sweep(SWEEP).points[0].scenario_hash == sw.points[0].scenario_hash
 
 
-@pytest.mark.parametrize("path", sorted((ROOT / "sweeps").glob("*.yaml")), ids=lambda p: p.stem)
+@pytest.mark.parametrize("path", sorted((ROOT / "studies").glob("*.yaml")), ids=lambda p: p.stem)
 def test_shipped_sweeps_validate(path):
-    """Every study in sweeps/ expands into valid points (they run for minutes, so CI only validates them)."""
+    """Every study in studies/ expands into valid points (they run for minutes, so CI only validates them)."""
     sw = load_sweep(path)
     assert sw.spec.name == path.stem and len(sw.points) >= 3
     assert len({p.scenario_hash for p in sw.points}) == len(sw.points)

@@ -60,3 +60,55 @@ def test_an_invalid_point_exits_2_with_the_cluster_started(tmp_path, capsys):
     f.write_text(SWEEP.format(base=ROOT / "scenarios" / "screw_jack.yaml", n=2) + "  gear.wheel_teeth: [30, 5]\n")
     code = cli.main(["sweep", str(f), "--out", str(tmp_path / "o"), "--workers", "1"])
     assert code == 2 and "gear.wheel_teeth = 5" in capsys.readouterr().err
+
+
+def test_local_workers_start_warm_from_the_fork_server(tmp_path):
+    """A contact3d sweep's local workers are forked from a fork server that loaded the compiled kernels once
+    (wormsim.sweep.preload_warm): each point finds them loaded before it starts, on every worker."""
+    import subprocess
+    import sys
+
+    f = tmp_path / "s.yaml"
+    f.write_text(
+        "name: warm\nbase: {base}\nset: {{model: contact3d, simulation.duration_s: 0.004}}\n"
+        "grid:\n  drive.speed_rpm: [1000, 1500]\n".format(base=ROOT / "scenarios" / "screw_jack.yaml")
+    )
+    wormsim = Path(sys.executable).parent / "wormsim"
+    cp = subprocess.run(
+        [str(wormsim), "sweep", str(f), "--out", str(tmp_path / "o"), "--workers", "2", "--no-progress"],
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    assert cp.returncode == 0, cp.stderr
+    doc = json.loads((tmp_path / "o" / "sweep.json").read_text())
+    timing = [p["timing"] for p in doc["points"]]
+    assert len(timing) == 2, timing
+    warmed_by = {t["warmed_by_pid"] for t in timing}
+    assert len(warmed_by) == 1 and None not in warmed_by and not warmed_by & {t["pid"] for t in timing}, timing
+
+
+def test_warm_worker_runs_once_per_process(monkeypatch):
+    """wormsim.sweep.warm.warm_worker: ensure_warm and the short run once; later calls (a worker forked from a warm
+    fork server, the plugin after the preload) skip; a failure is reported, not raised, and leaves it to retry."""
+    import os
+
+    from wormsim.contact3d import runner as c3d_runner
+    from wormsim.runtime import jit_cache
+    from wormsim.sweep import warm
+
+    calls = []
+    monkeypatch.setattr(warm, "_warm_pid", None)
+    monkeypatch.setattr(jit_cache, "ensure_warm", lambda runs: calls.append("ensure") or False)
+    monkeypatch.setattr(c3d_runner, "warm_runs", lambda runs: calls.append(("run", len(runs))))
+
+    def fails(runs):
+        raise RuntimeError("no cache")
+
+    monkeypatch.setattr(c3d_runner, "warm_runs", fails)
+    assert warm.warm_worker()["error"] == "RuntimeError: no cache" and warm.warm_pid() is None
+    monkeypatch.setattr(c3d_runner, "warm_runs", lambda runs: calls.append(("run", len(runs))))
+    assert warm.warm_worker() == {"compiled": False, "error": None, "skipped": False}
+    assert warm.warm_pid() == os.getpid()
+    assert warm.warm_worker()["skipped"] is True
+    assert calls == ["ensure", "ensure", ("run", 1)]

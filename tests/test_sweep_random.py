@@ -1,7 +1,7 @@
 """The sweep file's random block with list draws (size: N, one value per wheel tooth) and the tolerance study's
-sweep files (sweeps/tolerance_grade.py, issue 12): reproducible draws within the limits, bad input exit 2."""
+sweep files (studies/tolerance_grade.py, issue 12): reproducible draws within the limits, bad input exit 2."""
 
-import importlib.util
+import importlib
 from pathlib import Path
 
 import pytest
@@ -56,10 +56,7 @@ def test_bad_random_block_exits_2_naming_the_field(case, tmp_path, capsys):
 
 
 def _tolerance_module():
-    spec = importlib.util.spec_from_file_location("tolerance_grade", ROOT / "sweeps" / "tolerance_grade.py")
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
+    return importlib.import_module("studies.tolerance_grade")
 
 
 @pytest.mark.parametrize("name", ["screw_jack", "seat_motor"])
@@ -68,7 +65,7 @@ def test_tolerance_sweep_files_match_the_grade_formulas(name):
     runouts in [0, F_r / 2], tooth shifts within f_pT / 2 (single pitch deviations within f_pT), one shift per
     wheel tooth."""
     mod = _tolerance_module()
-    path = ROOT / "sweeps" / f"{name}_tolerance.yaml"
+    path = ROOT / "studies" / f"{name}_tolerance.yaml"
     assert path.read_text() == mod.sweep_yaml(name, 8, 100, 12)
     t = mod.tolerances(name, 8)
     sw = load_sweep(path)

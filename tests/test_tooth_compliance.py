@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 from conftest import SCENARIOS
 
-from wormsim.gear_theory import effective_modulus_pa
-from wormsim.geometry import derive
+from wormsim.physics.gear_theory import effective_modulus_pa
+from wormsim.physics.geometry import derive
 from wormsim.scenario import load_scenario
 from wormsim.tooth import compliance, mesh_stiffness
 from wormsim.tooth import stiffness as ST

@@ -13,8 +13,8 @@ import pytest
 from conftest import ROOT
 
 from meshgen.geometry import derive
-from wormsim.friction import friction_coefficient, friction_coefficient_scalar
-from wormsim.gear_theory import effective_modulus_pa
+from wormsim.physics.friction import friction_coefficient, friction_coefficient_scalar
+from wormsim.physics.gear_theory import effective_modulus_pa
 from wormsim.run import run_scenario
 from wormsim.scenario import load_scenario
 from wormsim.tooth import mesh_stiffness as M
@@ -108,13 +108,13 @@ def test_efficiency_is_the_wedge_law(seed_runs, name):
         "seat_motor",
         "screw_jack",
         # its TCA's k(theta) has a larger 2nd than 1st harmonic (0.032 against 0.022 of the mean): the meshing line,
-        # not the spectrum's largest peak (wormsim.metrics.mesh_line)
+        # not the spectrum's largest peak (wormsim.results.metrics.mesh_line)
         "involute_41",
     ],
 )
 def test_mesh_frequency_is_z1_n1_over_60(seed_runs, name):
     s = seed_runs[name][0]
-    # 0.5 % of z1 n1 / 60 (seed 001), the meshing line refined on the continuous spectrum (wormsim.metrics.mesh_line)
+    # 0.5 % of z1 n1 / 60 (seed 001), the meshing line refined on the continuous spectrum (wormsim.results.metrics.mesh_line)
     assert abs(s["mesh_frequency_hz"] / s["mesh_frequency_theory_hz"] - 1) <= 0.005, (
         s["mesh_frequency_hz"],
         s["mesh_frequency_theory_hz"],
@@ -177,7 +177,7 @@ def test_not_self_locking_worm_runs_back():
 
 
 def test_speed_driven_wheel_of_self_locking_pair_is_held():
-    """A speed-driven wheel of a self-locking pair stalls and the mesh holds (wormsim.locking): the run ends held
+    """A speed-driven wheel of a self-locking pair stalls and the mesh holds (wormsim.physics.locking): the run ends held
     with `locked` true (before: the servo wound the mesh up until the teeth would skip, exit 3)."""
     sc = scen(
         "seat_motor",
@@ -278,7 +278,7 @@ def test_variants_hand_profile_starts_direction(overrides):
     assert abs(s["ratio"] / g.ratio - 1) < 1e-3
     assert abs(s["tangential_force_mean_n"] * g.r2 / sc.load.torque_nm - 1) < 0.02
     assert abs(s["efficiency"] / (math.tan(g.gamma) / math.tan(g.gamma + rho_prime(s, g))) - 1) < 0.03
-    # 0.5 % of z1 n1 / 60 (seed 001), the meshing line refined on the continuous spectrum (wormsim.metrics.mesh_line)
+    # 0.5 % of z1 n1 / 60 (seed 001), the meshing line refined on the continuous spectrum (wormsim.results.metrics.mesh_line)
     assert abs(s["mesh_frequency_hz"] / s["mesh_frequency_theory_hz"] - 1) <= 0.005, (
         s["mesh_frequency_hz"],
         s["mesh_frequency_theory_hz"],
@@ -293,14 +293,13 @@ def test_driven_machine_inertia_adds_to_the_loaded_shaft():
 
     base = load_scenario(ROOT / "scenarios" / "seat_motor.yaml")
     g = derive(base.gear)
-    i1, i2 = inertias(base, g)
-    j1, j2 = inertias(load_scenario(ROOT / "scenarios" / "seat_motor.yaml", ["load.inertia_kg_m2=2e-4"]), g)
+    i1, i2 = inertias(base.materials, base.load, g)
+    heavy = load_scenario(ROOT / "scenarios" / "seat_motor.yaml", ["load.inertia_kg_m2=2e-4"])
+    j1, j2 = inertias(heavy.materials, heavy.load, g)
     # the load.inertia_kg_m2=2e-4 input adds to the loaded shaft only
     assert j1 == i1 and abs(j2 - i2 - 2e-4) < 1e-15
-    k1, k2 = inertias(
-        load_scenario(
-            ROOT / "scenarios" / "seat_motor.yaml", ["load.inertia_kg_m2=2e-4", "load.on=worm", "drive.on=wheel"]
-        ),
-        g,
+    on_worm = load_scenario(
+        ROOT / "scenarios" / "seat_motor.yaml", ["load.inertia_kg_m2=2e-4", "load.on=worm", "drive.on=wheel"]
     )
+    k1, k2 = inertias(on_worm.materials, on_worm.load, g)
     assert k2 == i2 and abs(k1 - i1 - 2e-4) < 1e-15

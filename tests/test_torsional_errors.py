@@ -11,15 +11,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from wormsim import gear_theory as gt
-from wormsim.geometry import derive, displaced_pair
+from wormsim.physics import gear_theory as gt
+from wormsim.physics.geometry import derive, displaced_pair
 from wormsim.scenario import load_scenario
 from wormsim.tooth.mesh_stiffness import mesh_stiffness, stiffness_at
 from wormsim.tooth.stiffness import per_length_stiffness
 from wormsim.torsional import loaded_tca as lt
 
 SCEN = Path(__file__).resolve().parents[1] / "scenarios"
-# contact3d (exact flanks) on the same gear with the same shaft angles: the record of sweeps/errors_shaft_angle.py
+# contact3d (exact flanks) on the same gear with the same shaft angles: the record of studies/errors_shaft_angle.py
 # (docs/data/errors_shaft_angle.json, with its provenance): rows for 0, +0.1 and -0.1 deg
 CONTACT3D = {
     r["shaft_angle_deg"]: r
@@ -60,9 +60,9 @@ def test_shaft_angle_narrows_the_loaded_band_as_contact3d_shows():
     sc, g, kp, src = _pair("screw_jack", ["errors.shaft_angle_deg=0.1"])
     dev, kin = displaced_pair(sc.errors, g)
     ms = mesh_stiffness(g, kp, src, sc.simulation.mesh_stiffness_samples)
-    t2 = gt.working_wheel_torque_nm(sc, g.ratio)
+    t2 = gt.working_wheel_torque_of(sc.drive, sc.load, g.ratio)
     tab = lt.loaded_tca(g, dev, kin, kp * g.face_width, t2, float(np.mean(ms.k_theta_fwd_nm_per_rad)))
-    side = gt.working_flank(sc, g.hand)
+    side = gt.duty(sc, g.hand).working_flank
     T = tab.torque_fwd_nm if side > 0 else tab.torque_rev_nm
     ev = lt.Evaluator(g, dev, kp * g.face_width, tab.slices)
     hz = g.hand * g.z1 / g.z2

@@ -12,9 +12,9 @@ import pytest
 from conftest import ROOT
 
 import wormsim
-from wormsim import run_warnings as W
-from wormsim.metrics import MIN_MESH_CYCLES, dominant_frequency, mesh_line, mesh_line_keys
-from wormsim.result import Result
+from wormsim.results import run_warnings as W
+from wormsim.results.metrics import MIN_MESH_CYCLES, dominant_frequency, mesh_line, mesh_line_keys
+from wormsim.results.result import Result
 from wormsim.scenario import load_scenario
 
 USER_GEAR = [
@@ -32,7 +32,7 @@ USER_GEAR = [
 
 @pytest.fixture(scope="module")
 def template(tmp_path_factory):
-    from wormsim.init_cmd import write_template
+    from wormsim.cli.init import write_template
 
     return write_template(tmp_path_factory.mktemp("trust") / "user_gear.yaml")
 
@@ -125,7 +125,7 @@ def test_overhauling_load_reports_the_reverse_flow_efficiency(template):
     0.5719), and the run warns."""
     s, sc = user_run(template, "simulation.duration_s=0.5", "load.torque_nm=-150")
     assert s["power_flow"] == "wheel to worm"
-    from wormsim.geometry import derive
+    from wormsim.physics.geometry import derive
 
     g = derive(sc.gear)
     rho = math.atan(s["friction_coefficient_mean"] / math.cos(g.alpha_n))
@@ -180,7 +180,7 @@ def test_contact_pressure_above_the_wheel_material_warns(template):
 def test_force_keys_have_one_meaning_each():
     """The headline F_r2 and F_a2 are DIN 3975's at every level; the resultant's components are their own keys, and
     docs/outputs.md says which is which."""
-    from wormsim.outputs import KEYS
+    from wormsim.results.summary_keys import KEYS
 
     assert "radial_force_line_of_centres_mean_n" not in KEYS
     for k in ("radial_force_resultant_mean_n", "axial_force_resultant_mean_n"):
@@ -220,7 +220,7 @@ def test_api_md_lists_every_public_name():
 
 
 def test_scenario_md_has_every_block():
-    from wormsim.schema_doc import BLOCKS
+    from tools.schema_doc import BLOCKS
 
     doc = (ROOT / "docs" / "scenario.md").read_text()
     titles = [t for t, _ in BLOCKS]

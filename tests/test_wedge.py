@@ -15,8 +15,8 @@ import pytest
 from conftest import ROOT
 from scipy.optimize import brentq
 
-from wormsim.errors import SimulationError
-from wormsim.recording import recorded_entities
+from wormsim.exceptions import SimulationError
+from wormsim.results.recording import recorded_entities
 from wormsim.run import run_scenario
 from wormsim.scenario import load_scenario, scenario_from_dict
 from wormsim.wedge import dynamics as wedge
@@ -279,7 +279,7 @@ def test_kd_uses_the_rated_forces():
     res = run_wedge(load={"force_n": -10000.0, "start_s": 0.1, "ramp_s": 0.02})
     p, sm = params(res), res.summary
     rho_n = wedge.rho_of_speed(7.59, p)
-    # Ft1 = nominal_force_n 990 N, Vs_n 7.59 m/s: wedge defaults (wormsim/scenario.py), seed 000 MOV (M_n / R1)
+    # Ft1 = nominal_force_n 990 N, Vs_n 7.59 m/s: wedge defaults (wormsim/scenario/schema.py), seed 000 MOV (M_n / R1)
     assert sm["Ft1_n"] == 990.0
     assert sm["Ft2_n"] == pytest.approx(990.0 / math.tan(G + rho_n), rel=1e-12)
     assert sm["Kd1"] == pytest.approx(abs(sm["S1_peak_n"]) / 990.0, rel=1e-12)

@@ -16,12 +16,12 @@ The reference: docs/api.md (generated from these docstrings), docs/scenario.md, 
 The worm pair as a component of a MuJoCo model of one's own: wormsim.WormPair (wormsim.pair, docs/multibody.md).
 """
 
-from wormsim import jit_cache as _jit_cache
+from wormsim.runtime import jit_cache as _jit_cache
 
 _jit_cache.configure()  # numba's cache: this machine's folder for this code, before any compiled function exists
 
-from wormsim.errors import ScenarioError, SimulationError  # noqa: E402
-from wormsim.result import Result  # noqa: E402
+from wormsim.exceptions import ScenarioError, SimulationError  # noqa: E402
+from wormsim.results.result import Result  # noqa: E402
 from wormsim.run import LEVELS, run_scenario, simulate  # noqa: E402
 from wormsim.scenario import Scenario, load_scenario  # noqa: E402
 

@@ -60,8 +60,8 @@ from wormsim.contact3d.flank_step import FlankContacts
 from wormsim.contact3d.mjcf import Prepared, prepare
 from wormsim.contact3d.native import split_step
 from wormsim.contact3d.timestep import MAX_WORM_TURN_PER_STEP_RAD, OVERSPEED_GUARD, default_timestep
-from wormsim.friction import friction_coefficient, friction_coefficient_scalar
-from wormsim.geometry import displaced_pair
+from wormsim.physics.friction import friction_coefficient_scalar
+from wormsim.physics.geometry import displaced_pair
 from wormsim.scenario import Scenario, load_scenario
 from wormsim.tooth.window import window_size
 
@@ -275,7 +275,7 @@ class WormPair:
         else:
             Tw = np.asarray(assembly.worm_to_assembly(0.0, geo), dtype=float)
             mounts = {"worm": (Tw, np.eye(4)), "wheel": (np.eye(4), np.eye(4))}
-        mu0 = float(friction_coefficient(self.scenario.contact, 0.0))
+        mu0 = p.gear.mu_static
         meshes = {"worm": p.pieces.worm_visual, "wheel": p.pieces.wheel_visual}
         props = {
             "worm": (ine.worm_mass_kg, ine.worm_inertia_kg_m2, geo.worm_length, (0.55, 0.6, 0.7, 1)),
@@ -360,7 +360,8 @@ class WormPair:
         """(ft, fr, fa) [N]: the resultant of the pair's tooth forces on the wheel at the last step (the contact
         forces of the constraint solve: normal and two friction rows of each flank contact), resolved in the pair's
         assembly frame as it sits in the parent body now, in the sign convention of docs/outputs.md
-        (wormsim.outputs.FORCE_SIGNS, as contact3d's series tangential_force_n, radial_force_n, axial_force_n):
+        (wormsim.results.summary_keys.FORCE_SIGNS, as contact3d's series tangential_force_n, radial_force_n,
+        axial_force_n):
         tangential along +x (the wheel's positive sense at the pitch point on the line of centres), radial positive
         towards the wheel axis (+y, the separating force), axial along -hand z (F_a2 = F_t2 tan(gamma + rho') with
         its sign); contact3d's tangential_force_mean_n, radial_force_resultant_mean_n and axial_force_resultant_mean_n

@@ -1,5 +1,5 @@
 """Run one scenario end to end: simulate at the requested fidelity, then write the time series,
-report.png, recording.rrd and summary.json atomically (wormsim.output)."""
+report.png, recording.rrd and summary.json atomically (wormsim.runfolder.writer)."""
 
 from __future__ import annotations
 
@@ -11,14 +11,16 @@ from types import ModuleType
 
 import numpy as np
 
-from wormsim import interrupt, outputs, prewarm
-from wormsim.errors import ScenarioError, SimulationError
-from wormsim.output import ResultDir
-from wormsim.progress import Progress
-from wormsim.result import Result
-from wormsim.run_warnings import run_warnings
+from wormsim.exceptions import ScenarioError, SimulationError
+from wormsim.physics.validate import validate_geometry
+from wormsim.results import summary_keys as outputs
+from wormsim.results.result import Result
+from wormsim.results.run_warnings import run_warnings
+from wormsim.runfolder import interrupt
+from wormsim.runfolder.progress import Progress
+from wormsim.runfolder.writer import ResultDir
+from wormsim.runtime import prewarm
 from wormsim.scenario import Scenario, ignored_inputs
-from wormsim.validate import validate_geometry
 
 # fidelity level -> its package, which exports simulate(scenario, progress) -> Result, write_report(result, path) and
 # write_recording(result, path). Imported on first use (importlib, not at the top): a wedge run does not load MuJoCo.
@@ -38,12 +40,12 @@ def simulate(scenario: Scenario, progress: Progress | None = None) -> Result:
 
     Args:
         scenario: a validated Scenario (load_scenario, or Scenario.model_validate of a dict).
-        progress: an optional wormsim.progress.Progress bar (None: silent).
+        progress: an optional wormsim.runfolder.progress.Progress bar (None: silent).
 
     Returns:
         Result: `summary` (the keys of docs/outputs.md without the run's status / wall-time keys), `series` (numpy
         arrays on `series["t_s"]` in s; units in the names: `_rad`, `_rpm`, `_nm`, `_n`, `_m`, ...), `steps`,
-        `sim_time_s`; `summary["warnings"]` lists results that need care (wormsim.run_warnings). Forces follow
+        `sim_time_s`; `summary["warnings"]` lists results that need care (wormsim.results.run_warnings). Forces follow
         the sign convention of docs/outputs.md.
 
     Raises:
@@ -53,6 +55,25 @@ def simulate(scenario: Scenario, progress: Progress | None = None) -> Result:
     res = model_module(scenario.model).simulate(scenario, progress=progress)
     res.summary["warnings"] = run_warnings(res, scenario)
     return res
+
+
+def _failed(rd: ResultDir, warm: prewarm.Writers, exc: BaseException, message: str, base: dict, t0: float) -> None:
+    """A run that raised exc: the writers' warm-up cancelled; an interrupt that came back as another exception leaves
+    out_dir as it was (raised as interrupt.Interrupted), anything else writes a "failed" summary.json with message."""
+    warm.cancel()
+    if (sig := interrupt.pending()) is not None:
+        rd.abandon()
+        raise interrupt.Interrupted(sig) from exc
+    rd.fail(
+        {
+            "status": "failed",
+            "message": message,
+            **base,
+            "wall_time_s": time.perf_counter() - t0,
+            "sim_time_s": None,
+            "steps": None,
+        }
+    )
 
 
 def run_scenario(scenario: Scenario, out_dir: str | Path, progress: bool | None = None) -> dict:
@@ -87,7 +108,8 @@ def run_scenario(scenario: Scenario, out_dir: str | Path, progress: bool | None 
     rd = ResultDir(out_dir)
     base = {"model": scenario.model, "scenario": scenario.name}
     t0 = time.perf_counter()
-    # the writers' imports and matplotlib's text warm-up, in a thread while the simulation runs (wormsim.prewarm)
+    # the writers' imports and matplotlib's text warm-up, in a thread while the simulation runs
+    # (wormsim.runtime.prewarm)
     warm = prewarm.Writers(gated=getattr(mod, "GIL_FREE_LOOP", False))
     try:
         with Progress(
@@ -108,36 +130,10 @@ def run_scenario(scenario: Scenario, out_dir: str | Path, progress: bool | None 
         rd.abandon()
         raise
     except (SimulationError, ScenarioError) as exc:  # a diagnosis (exit 3) or input found invalid (exit 2)
-        warm.cancel()
-        if (sig := interrupt.pending()) is not None:
-            rd.abandon()
-            raise interrupt.Interrupted(sig) from exc
-        rd.fail(
-            {
-                "status": "failed",
-                "message": str(exc),
-                **base,
-                "wall_time_s": time.perf_counter() - t0,
-                "sim_time_s": None,
-                "steps": None,
-            }
-        )
+        _failed(rd, warm, exc, str(exc), base, t0)
         raise
     except BaseException as exc:  # never leave a result that looks complete
-        warm.cancel()
-        if (sig := interrupt.pending()) is not None:  # the interrupt came back as another exception
-            rd.abandon()
-            raise interrupt.Interrupted(sig) from exc
-        rd.fail(
-            {
-                "status": "failed",
-                "message": f"internal error: {exc.__class__.__name__}: {exc}",
-                **base,
-                "wall_time_s": time.perf_counter() - t0,
-                "sim_time_s": None,
-                "steps": None,
-            }
-        )
+        _failed(rd, warm, exc, f"internal error: {exc.__class__.__name__}: {exc}", base, t0)
         raise
     summary = {
         "status": "ok",
@@ -151,7 +147,7 @@ def run_scenario(scenario: Scenario, out_dir: str | Path, progress: bool | None 
         **rated,
     }
     missing = outputs.undocumented(summary)
-    if missing:  # every key has its entry in wormsim.outputs (docs/outputs.md); never written silently
+    if missing:  # every key has its entry in wormsim.results.summary_keys (docs/outputs.md); never written silently
         print(f"wormsim: summary keys without an entry in docs/outputs.md: {', '.join(missing)}", file=sys.stderr)
     rd.commit(summary)
     # never silence: what the level does not use is said after the run (a failed run prints its error alone)

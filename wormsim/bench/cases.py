@@ -4,16 +4,16 @@ from __future__ import annotations
 
 import importlib.util
 from dataclasses import dataclass, field, replace
-from importlib.resources import files
 
 import numpy as np
 
 from wormsim.contact3d.mjcf import prepare
 from wormsim.contact3d.timestep import default_timestep
 from wormsim.run import LEVELS
+from wormsim.runtime.data import data_dir
 from wormsim.scenario import Scenario, ScenarioError, load_scenario
 
-SCENARIOS = files("wormsim.scenarios")  # the seed scenarios, shipped as package data
+SCENARIOS = data_dir("scenarios")  # the seed scenarios, shipped as package data
 ERROR_KEYS = ("ratio", "tangential_force_mean_n", "tangential_force_p2p_n", "mesh_frequency_hz", "efficiency")
 
 

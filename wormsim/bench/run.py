@@ -37,10 +37,10 @@ from wormsim.bench.cases import (
     relative_errors,
 )
 from wormsim.bench.stability import stability_map
-from wormsim.errors import SimulationError
-from wormsim.output import write_json_atomic
-from wormsim.provenance import provenance
+from wormsim.exceptions import SimulationError
+from wormsim.results.provenance import provenance
 from wormsim.run import simulate
+from wormsim.runfolder.writer import write_json_atomic
 from wormsim.scenario import ScenarioError
 
 
@@ -266,7 +266,7 @@ def run_bench(
         summaries[id(rec)] = summary
         records.append(rec)
     meta = {
-        "provenance": provenance(),  # command, commit, date, machine (wormsim.provenance; docs/data records)
+        "provenance": provenance(),  # command, commit, date, machine (wormsim.results.provenance; docs/data records)
         "machine": machine_start,
         "load_average_1min_end": machine_info()["load_average_1min"],
         "quick": quick,

@@ -10,7 +10,7 @@ from wormsim.bench.cases import SCENARIOS, VARIANTS, relative_errors
 from wormsim.contact3d.mjcf import prepare
 from wormsim.contact3d.runner import simulate
 from wormsim.contact3d.timestep import default_timestep
-from wormsim.errors import (
+from wormsim.exceptions import (
     DivergedError,
     LockedError,
     OverspeedError,
@@ -31,7 +31,7 @@ STABILITY_TOLERANCES = {"ratio_angles": 1e-3, "tangential_force_mean_n": 0.02}
 # docs/contact3d.md "Validation")
 STABILITY_RESOLUTION = {"seat_motor": "coarse", "screw_jack": "coarse", "involute_41": "fine"}
 STABILITY_DURATION_S = 0.05
-# each guard's exception (wormsim.errors) -> the class name bench_meta.json holds
+# each guard's exception (wormsim.exceptions) -> the class name bench_meta.json holds
 FAILURE_CLASSES: tuple[tuple[type[SimulationError], str], ...] = (
     (DivergedError, "diverged"),
     (TeethJumpedError, "teeth_jumped"),

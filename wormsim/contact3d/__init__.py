@@ -6,7 +6,7 @@ guards), metrics.py (summary), report.py (report.png, recording.rrd)."""
 from wormsim.contact3d.report import write_recording, write_report
 from wormsim.contact3d.runner import simulate
 
-# the stepping loop runs without the GIL: wormsim.run's warm-up thread waits for it (wormsim.prewarm)
+# the stepping loop runs without the GIL: wormsim.run's warm-up thread waits for it (wormsim.runtime.prewarm)
 GIL_FREE_LOOP = True
 
 __all__ = ["simulate", "write_report", "write_recording"]

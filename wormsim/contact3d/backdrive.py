@@ -13,8 +13,8 @@ The probe costs a second run of simulation.duration_s.
 
 from __future__ import annotations
 
-from wormsim.errors import LockedError
-from wormsim.result import Result
+from wormsim.exceptions import LockedError
+from wormsim.results.result import Result
 from wormsim.scenario import Scenario
 
 HELD_BELOW = 0.5  # worm speed / (wheel command x ratio) below this: the pair holds (as the lock guard's criterion)

@@ -2,7 +2,7 @@
 
 The wheel tooth is thinned by the circumferential backlash j at d2, j / 2 per flank (meshgen.wheel). Along the
 flank normal at the pitch point that is the clearance per flank (DIN 3975 force directions, as
-wormsim.gear_theory.mesh_arms_m)
+wormsim.physics.gear_theory.mesh_arms_m)
 
     c = (j / 2) cos(alpha_n) cos(gamma).                                                          (1)
 
@@ -36,8 +36,8 @@ import numpy as np
 
 from meshgen.geometry import GearGeometry
 from wormsim.contact3d.slots import repose_window
+from wormsim.physics.units import MM
 from wormsim.scenario import ScenarioError
-from wormsim.units import MM
 
 UM = 1e-3 * MM  # m per micrometre (piece_error_um)
 

@@ -23,7 +23,7 @@ import math
 import numba
 import numpy as np
 
-from wormsim import gear_theory as gt
+from wormsim.physics import gear_theory as gt
 from wormsim.tooth.pose import N_WORM_PARAMS, to_wheel_body, tooth_angle
 
 
@@ -68,7 +68,7 @@ class RadiusLog:
         return fr, radius_mean(W, wr)
 
     def truncate(self, n: int) -> None:
-        """Drop the rows of samples n and later (a run that ended early: wormsim.locking)."""
+        """Drop the rows of samples n and later (a run that ended early: wormsim.physics.locking)."""
         keep = self.buf[: self.m][self.buf[: self.m, 0] < n]
         self.buf[: len(keep)] = keep
         self.m = len(keep)

@@ -1,14 +1,13 @@
 """The messages of the run's guards (wormsim.contact3d.guards): each builds its SimulationError subclass
-(wormsim.errors) with the diagnosis and what to change."""
+(wormsim.exceptions) with the diagnosis and what to change."""
 
 from __future__ import annotations
 
 import math
 
-from wormsim import gear_theory as gt
 from wormsim.contact3d.mjcf import BuiltModel
 from wormsim.contact3d.timestep import MAX_WORM_TURN_PER_STEP_RAD, default_timestep, speed_timestep_limit_s
-from wormsim.errors import (
+from wormsim.exceptions import (
     DivergedError,
     LockedError,
     OverspeedError,
@@ -16,9 +15,7 @@ from wormsim.errors import (
     SimulationError,
     TeethJumpedError,
 )
-from wormsim.friction import friction_coefficient
-from wormsim.scenario import Scenario
-from wormsim.units import rad_s_to_rpm
+from wormsim.physics.units import rad_s_to_rpm
 
 JUMP_PITCH = 0.5  # transmission error (in pitches) that counts as teeth jumping
 
@@ -44,7 +41,7 @@ def diverged_error(t: float, dt: float, bm: BuiltModel, what: str) -> Simulation
     )
 
 
-def jump_error(t: float, te_pitch: float, dt: float, bm: BuiltModel, scenario: Scenario) -> SimulationError:
+def jump_error(t: float, te_pitch: float, dt: float, bm: BuiltModel) -> SimulationError:
     """Transmission error beyond half a pitch. Above the stable timestep this is the integration running away
     (reported as divergence: a stiffer contact would make it worse); within it the teeth really passed each
     other: the load overpowers the mesh. With contact.geometry flanks (the working flanks only: no tips, edges or
@@ -55,13 +52,14 @@ def jump_error(t: float, te_pitch: float, dt: float, bm: BuiltModel, scenario: S
     flanks_note = (
         "; contact.geometry flanks models the working flanks only (no tips or edges), so the jump itself is not "
         "simulated: contact.geometry pieces models it"
-        if bm.meta.get("contact_geometry") == "flanks"
+        if bm.plan.flanks
         else ""
     )
+    load = bm.plan.duty.load
     return TeethJumpedError(
         f"teeth jumped a pitch at t = {t:.4g} s (transmission error {te_pitch:.2f} pitch) at timestep {dt:.3g} s, "
-        f"within the contact's stable limit {lim:.3g} s: the load overpowers the mesh (load {scenario.load.torque_nm} "
-        f"N m over {scenario.load.ramp_s} s, contact stiffness {bm.law.pair_stiffness_n_per_m:.3g} N/m per tooth "
+        f"within the contact's stable limit {lim:.3g} s: the load overpowers the mesh (load {load.torque_nm} "
+        f"N m over {load.ramp_s} s, contact stiffness {bm.law.pair_stiffness_n_per_m:.3g} N/m per tooth "
         f"pair); lower load.torque_nm or lengthen load.ramp_s, or raise contact.stiffness_n_per_m (with a smaller "
         f"simulation.timestep_s){flanks_note}"
     )
@@ -80,18 +78,17 @@ def overspeed_error(t: float, w1: float, dt: float) -> SimulationError:
     )
 
 
-def locked_error(t: float, w_drive: float, w_cmd: float, bm: BuiltModel, scenario: Scenario) -> SimulationError:
+def locked_error(t: float, w_drive: float, w_cmd: float, bm: BuiltModel) -> SimulationError:
     """A speed-driven drive held below half its command. When the wheel drives and the pair is self-locking at
     standstill, rho' = atan(mu_static / cos alpha_n) >= gamma (DIN 3975: back-driving efficiency
     tan(gamma - rho') / tan(gamma) <= 0), the diagnosis says so; otherwise the mesh is jammed."""
-    geo = bm.geometry
+    geo, gp = bm.geometry, bm.plan.gear
     head = (
-        f"the drive locked at t = {t:.4g} s: the {scenario.drive.on} turns at {rad_s_to_rpm(w_drive):.3g} rpm "
+        f"the drive locked at t = {t:.4g} s: the {gp.duty.drive.on} turns at {rad_s_to_rpm(w_drive):.3g} rpm "
         f"against a command of {rad_s_to_rpm(w_cmd):.3g} rpm"
     )
-    mu0 = float(friction_coefficient(scenario.contact, 0.0))
-    rho = gt.virtual_friction_angle_rad(mu0, geo.alpha_n)
-    if scenario.drive.on == "wheel" and rho >= geo.gamma_m:
+    mu0, rho = gp.mu_static, gp.rho_static_rad
+    if gp.duty.drive.on == "wheel" and rho >= geo.gamma_m:
         mu_max = math.tan(geo.gamma_m) * math.cos(geo.alpha_n)
         return LockedError(
             f"{head}: the pair is self-locking (rho' = atan(mu / cos alpha_n) = {math.degrees(rho):.2f} deg at "
@@ -101,7 +98,7 @@ def locked_error(t: float, w_drive: float, w_cmd: float, bm: BuiltModel, scenari
             f"{math.degrees(rho):.2f} deg"
         )
     return LockedError(
-        f"{head}: the mesh is jammed; check gear.backlash_mm, the load torque {scenario.load.torque_nm} N m "
+        f"{head}: the mesh is jammed; check gear.backlash_mm, the load torque {gp.duty.load.torque_nm} N m "
         f"against what the drive can deliver, and the friction"
     )
 

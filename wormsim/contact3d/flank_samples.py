@@ -5,11 +5,11 @@ the per-sample Python (~45-60 us a sample: dispatch, guards, the series column) 
 Per sample, in the runner's order and with its floating-point operations (bit-identical series, pattern and radius
 logs, contact points: tests/test_flank_samples.py): the steps; the state read from d (shaft angles and speeds,
 d.time); the runner's Guards.state checks (non-finite state or MuJoCo's bad-qacc warning, overspeed, teeth jumped);
-mu from the friction law (wormsim.friction.mu_at); flank_loop.sample_flanks (with
-displaced poses, errors: or shafts:, the points go into tooth 0's frame through the displaced wheel body's frame);
-the penetration and lock checks of Guards.contact; the shafts' log (ShaftLog.record: mj_rnePostConstraint by address
-where a bearing is rigid, then its raw values, wormsim.contact3d.shafts.gather); the series column (series.SERIES
-order).
+mu from the friction law with its stick state (wormsim.physics.friction.mu_at, stuck_after);
+flank_loop.sample_flanks (with displaced poses, errors: or shafts:, the points go into tooth 0's frame through the
+displaced wheel body's frame); the penetration and lock checks of Guards.contact; the shafts' log (ShaftLog.record:
+mj_rnePostConstraint by address where a bearing is rigid, then its raw values, wormsim.contact3d.shafts.gather); the
+series column (series.SERIES order).
 
 Anything else hands the sample back to the runner's Python path, after its steps and before any of its per-sample
 work: a guard that would act (it raises or keeps state: a stuck drive, the friction guard's next check), a friction
@@ -39,18 +39,18 @@ from wormsim.contact3d.guards import PENETRATED, RUNNING, STUCK, contact_event, 
 from wormsim.contact3d.native import address, call_stage, f1, f64_at, i1, i32_at, i64_at, mjdata_offsets
 from wormsim.contact3d.series import column
 from wormsim.contact3d.shafts import gather
-from wormsim.friction import MuLaw, mu_at
+from wormsim.physics.friction import MuLaw, mu_at, stuck_after
 from wormsim.tooth.merge import split_forces
 
 ENABLED = True  # the runner's switch (tests compare against the per-sample path)
 ADR_CAP = 4096  # contacts per step the compiled sample reads (more: the sample goes to the Python path)
 
 # io: what changes between calls (in) and what run_samples hands back (out), by slot
-IO_NEXT, IO_PENDING, IO_TURN_MAX, IO_PM, IO_RM, IO_DROPPED, IO_EVENT = range(
-    7
-)  # out (IO_TURN_MAX, IO_PM, IO_RM in too)
-IO_NEXT_CHECK, IO_MU, IO_E_STAR, IO_LOCKED = range(7, 11)  # in (IO_MU out too: the contacts' mu after the call)
-IO_LEN = 11
+# out (IO_TURN_MAX, IO_PM, IO_RM in too)
+IO_NEXT, IO_PENDING, IO_TURN_MAX, IO_PM, IO_RM, IO_DROPPED, IO_EVENT = range(7)
+# in (IO_MU and IO_STUCK out too: the contacts' mu and the friction law's stick state after the call)
+IO_NEXT_CHECK, IO_MU, IO_E_STAR, IO_LOCKED, IO_STUCK = range(7, 12)
+IO_LEN = 12
 # io[IO_EVENT]: why run_samples handed a sample back to the runner's Python path (0: it did not)
 EV_NONE, EV_GUARD, EV_FRICTION_CHECK, EV_CONE, EV_LOG_FULL, EV_DROPPED = range(6)
 
@@ -68,7 +68,8 @@ class SampleParams(NamedTuple):
     lock_fraction: float
     r1: float
     cos_gamma: float
-    mu_law: MuLaw  # wormsim.friction.mu_at's law
+    mu_law: MuLaw  # wormsim.physics.friction.mu_at's law
+    stick_v: float  # the friction law's stick state: v_stick (Prepared.stick_velocity_m_s; 0: none)
     rpm: float  # (rad/s) per rpm
     a: float
     speed_driven: bool
@@ -175,8 +176,11 @@ def run_samples(tables, mj, cmds, span, S, p, room, io, mrg, shaft):
         if t > io[IO_NEXT_CHECK]:  # the friction guard's next check
             io[IO_EVENT] = EV_FRICTION_CHECK
             return
+        vs = abs(w1) * p.r1 / p.cos_gamma  # the sliding speed Vs
+        stuck = stuck_after(io[IO_STUCK] != 0.0, vs, p.stick_v)  # idempotent: a hand-back repeats it
+        io[IO_STUCK] = 1.0 if stuck else 0.0
         law = p.mu_law
-        mu = mu_at(abs(w1) * p.r1 / p.cos_gamma, law.kind, law.a, law.b, law.c)  # at the sliding speed Vs
+        mu = mu_at(0.0 if stuck else vs, law.kind, law.a, law.b, law.c)
         if mu != mu_now:  # FlankContacts.set_friction: the records' friction, where the cone's dimension stays
             if (mu > 0.0) != (mu_now > 0.0):  # the cone's dimension changes (FlankContacts.set_friction)
                 io[IO_EVENT] = EV_CONE
@@ -220,8 +224,8 @@ class FlankSamples:
     def __init__(self, loop, guards, bm, rec: int, series: np.ndarray, store: tuple, slog=None):
         """The parameters from the guards and the run's plan (bm.plan: the friction law, the drive's kind); the run's
         series, point store (FlankLoop.sample's) and shaft log (wormsim.contact3d.shafts.ShaftLog, or None)."""
-        from wormsim import gear_theory as gt
-        from wormsim.units import RPM
+        from wormsim.physics import gear_theory as gt
+        from wormsim.physics.units import RPM
 
         fc, geo = loop.fc, bm.geometry
         self.loop, self.fc, self.guards, self.rec, self.S = loop, fc, guards, rec, series
@@ -238,6 +242,7 @@ class FlankSamples:
             r1=float(geo.r1),
             cos_gamma=math.cos(geo.gamma),
             mu_law=bm.plan.mu_law,
+            stick_v=float(bm.plan.stick_velocity_m_s),
             rpm=RPM,
             a=float(geo.a),
             speed_driven=bool(guards.speed_driven),
@@ -269,6 +274,7 @@ class FlankSamples:
         k = fc.kernel
         io[IO_NEXT_CHECK], io[IO_MU], io[IO_E_STAR] = guards.friction.next_check, fc.mu, pattern.e_star
         io[IO_LOCKED] = float(guards.locked_since is not None)
+        io[IO_STUCK] = float(guards.stuck)
         io[IO_TURN_MAX], io[IO_PM], io[IO_RM] = guards.turn_max, pattern.m, rlog.m
         room = (self.off, fc.frame, fc.pos, self.adr, pattern.buf, rlog.buf)
         mrg = (k.grp, k.share, k.mfric, k.mwrap, fc.slice_adr, fc.slice_efc) if fc.merge else None
@@ -280,5 +286,6 @@ class FlankSamples:
             fc.template.friction = [fc.mu, fc.mu, 0.0, 0.0, 0.0]
         loop.dropped += int(io[IO_DROPPED])
         guards.turn_max = float(io[IO_TURN_MAX])
+        guards.stuck = bool(io[IO_STUCK] != 0.0)
         pattern.m, rlog.m = int(io[IO_PM]), int(io[IO_RM])
         return int(io[IO_NEXT]), int(io[IO_EVENT])

@@ -15,7 +15,7 @@ and the self-locking worm was back-driven at 700-900 rpm; with c_f = c_c (the pi
 The guard: after the ramps, the friction-weighted mean of cos(f_t, -v_t) over the contacts that slide (on the
 cone, slip faster than contact.transition_velocity_m_s, above which law (3) makes friction Coulomb's) must stay at or
 above ALIGN_MIN; below it for HOLD_S the run stops (SimulationError; where a speed-driven wheel drives a pair that
-is self-locking, the cause of the overload, the run ends held instead: wormsim.locking). Valid runs measured at
+is self-locking, the cause of the overload, the run ends held instead: wormsim.physics.locking). Valid runs measured at
 1.000 (screw jack, seat demo, involute_41 forward; the back-driven screw jack at mu 0.02).
 """
 
@@ -26,12 +26,10 @@ import math
 import mujoco
 import numba
 
-from wormsim import gear_theory as gt
 from wormsim.contact3d.diagnosis import locked_error
-from wormsim.errors import SimulationError
-from wormsim.friction import friction_coefficient
-from wormsim.locking import Held, backdrive_self_locks
-from wormsim.units import rad_s_to_rpm, rpm_to_rad_s
+from wormsim.exceptions import SimulationError
+from wormsim.physics.locking import Held
+from wormsim.physics.units import rad_s_to_rpm, rpm_to_rad_s
 
 ALIGN_MIN = 0.5  # friction-weighted cos(f_t, -v_t) of the sliding contacts below this ...
 HOLD_S = 0.02  # ... for this long (start-up transients measured: under 6 ms of misalignment, seat demo)
@@ -78,11 +76,11 @@ def _alignment(adr, dim, friction, f, v, v_min):
 class FrictionGuard:
     """The check of the module docstring, one call per sample."""
 
-    def __init__(self, bm, rec_interval_s: float, scenario):
-        """bm.plan: the ramps' end, the transition velocity, the working load's normal force; the scenario only for
-        the error's message (friction_error)."""
+    def __init__(self, bm, rec_interval_s: float):
+        """bm.plan: the ramps' end, the transition velocity, the working load's normal force, the self-locking
+        back-drive and what the error's message quotes (friction_error)."""
         plan = bm.plan
-        self.scenario, self.bm = scenario, bm
+        self.bm = bm
         self.start = plan.ramps_end_s
         self.hold = max(HOLD_S, 5 * rec_interval_s)
         self.v_min = plan.transition_velocity_m_s
@@ -100,16 +98,13 @@ class FrictionGuard:
             return
         self.since = t if self.since is None else self.since
         if t - self.since > self.hold:
-            geo = self.bm.geometry
-            if backdrive_self_locks(
-                self.scenario, geo.gamma_m, geo.alpha_n
-            ):  # the held mesh's overload (wormsim.locking)
+            if self.bm.plan.gear.backdrive_self_locks:  # the held mesh's overload (wormsim.physics.locking)
                 raise Held(t, self.since)
-            raise friction_error(t, cos, fn, w1, w2, self.f_nominal, self.bm, self.scenario, self.hold)
+            raise friction_error(t, cos, fn, w1, w2, self.f_nominal, self.bm, self.hold)
 
 
 def friction_error(
-    t: float, cos: float, fn: float, w1: float, w2: float, f_nominal: float, bm, scenario, hold_s: float = HOLD_S
+    t: float, cos: float, fn: float, w1: float, w2: float, f_nominal: float, bm, hold_s: float = HOLD_S
 ) -> SimulationError:
     """Friction against the slip: where the wheel drives a pair that is self-locking at standstill, the drive is
     locked (wormsim.contact3d.diagnosis.locked_error's diagnosis, with what was measured); otherwise the load is
@@ -124,11 +119,10 @@ def friction_error(
         f"c_f = {law.friction_damping:.3g} N s/m was sized for (wormsim.contact3d.law (4)); the worm turns at "
         f"{rad_s_to_rpm(w1):.4g} rpm, the wheel at {rad_s_to_rpm(w2):.4g} rpm"
     )
-    drv = scenario.drive
+    drv = bm.plan.duty.drive
     if drv.on == "wheel" and drv.speed_rpm is not None:
-        mu0 = float(friction_coefficient(scenario.contact, 0.0))
-        if gt.virtual_friction_angle_rad(mu0, geo.alpha_n) >= geo.gamma_m:
-            err = locked_error(t, w2, rpm_to_rad_s(drv.speed_rpm), bm, scenario)
+        if bm.plan.gear.rho_static_rad >= geo.gamma_m:
+            err = locked_error(t, w2, rpm_to_rad_s(drv.speed_rpm), bm)
             return type(err)(f"{err} (caught by the friction guard: {what}; the back-driving is not physical)")
     pieces = " or run contact.geometry=pieces (friction rows with c_f = c_c)" if law.friction_damping_n_s_per_m else ""
     return SimulationError(

@@ -3,7 +3,7 @@ MuJoCo's bad-qacc warning (divergence), the worm turning more than OVERSPEED_GUA
 step (overspeed), the transmission error passing JUMP_PITCH of a pitch (teeth jumped), the sliding contacts'
 friction against their slip (wormsim.contact3d.friction_guard), penetration beyond gear_theory.penetration_limit_m,
 and a speed-driven drive stuck below half its command (locked). Each raises its SimulationError subclass
-(wormsim.errors) with what to change; the messages are built in wormsim.contact3d.diagnosis."""
+(wormsim.exceptions) with what to change; the messages are built in wormsim.contact3d.diagnosis."""
 
 from __future__ import annotations
 
@@ -12,7 +12,6 @@ import math
 import mujoco
 import numba
 
-from wormsim import gear_theory as gt
 from wormsim.contact3d.diagnosis import (
     JUMP_PITCH,
     diverged_error,
@@ -24,9 +23,9 @@ from wormsim.contact3d.diagnosis import (
 from wormsim.contact3d.friction_guard import FrictionGuard
 from wormsim.contact3d.mjcf import BuiltModel
 from wormsim.contact3d.timestep import MAX_WORM_TURN_PER_STEP_RAD, OVERSPEED_GUARD
-from wormsim.locking import Held, backdrive_self_locks
-from wormsim.scenario import Scenario
-from wormsim.units import rad_s_to_rpm
+from wormsim.physics import gear_theory as gt
+from wormsim.physics.locking import Held
+from wormsim.physics.units import rad_s_to_rpm
 
 DIVERGED, OVERSPEED, JUMPED = 1, 2, 3  # state_event's codes (0: none)
 PENETRATED, STUCK, RUNNING = 4, 5, 6  # contact_event's codes (0: none)
@@ -67,11 +66,11 @@ def contact_event(t, pen, pen_lim, w_drive, cmd, speed_driven, lock_start, lock_
 class Guards:
     """The checks after every record interval (module docstring); each raises its SimulationError subclass. What they
     check against comes from the run's plan (bm.plan: the timestep, the drive's kind, the guards' times, the working
-    load); the scenario only completes the error messages (wormsim.contact3d.diagnosis quotes its inputs)."""
+    load, the values the error messages quote: wormsim.contact3d.diagnosis)."""
 
-    def __init__(self, bm: BuiltModel, rec: int, scenario: Scenario):
+    def __init__(self, bm: BuiltModel, rec: int):
         plan = bm.plan
-        self.bm, self.scenario, self.dt = bm, scenario, plan.timestep_s
+        self.bm, self.dt = bm, plan.timestep_s
         geo = bm.geometry
         self.pen_lim = gt.penetration_limit_m(geo.m_x)
         self.pitch_angle = 2 * math.pi / geo.z2
@@ -81,10 +80,11 @@ class Guards:
         self.lock_hold = max(gt.LOCK_HOLD_S, 20 * rec * self.dt)
         self.speed_driven = plan.speed_driven
         self.locked_since: float | None = None
-        self.self_locking_backdrive = backdrive_self_locks(scenario, geo.gamma_m, geo.alpha_n)
+        self.self_locking_backdrive = plan.gear.backdrive_self_locks
         self.turn_max = 0.0
+        self.stuck = plan.stick_velocity_m_s > 0.0  # the friction law's stick state: a run starts at rest
         # sliding contacts' friction against their slip (wormsim.contact3d.friction_guard)
-        self.friction = FrictionGuard(bm, rec * self.dt, scenario)
+        self.friction = FrictionGuard(bm, rec * self.dt)
 
     def state(self, d: mujoco.MjData, t: float, th1: float, th2: float, w1: float, w2: float) -> float:
         """Divergence, overspeed, teeth jumped, friction against the slip; returns the transmission error (rad)."""
@@ -101,18 +101,19 @@ class Guards:
                 raise diverged_error(t, dt, bm, f"the worm ran away to {rad_s_to_rpm(abs(w1)):.0f} rpm")
             raise overspeed_error(t, w1, dt)
         if code == JUMPED:
-            raise jump_error(t, te / self.pitch_angle, dt, bm, self.scenario)
+            raise jump_error(t, te / self.pitch_angle, dt, bm)
         self.friction.check(d, t, w1, w2)
         return te
 
     def _creeping(self, w_worm: float) -> bool:
         """The worm's sliding speed below 10 transition velocities (the static friction's reach)."""
         geo = self.bm.geometry
-        return abs(w_worm) * geo.r_m1 / math.cos(geo.gamma_m) < 10 * self.scenario.contact.transition_velocity_m_s
+        return abs(w_worm) * geo.r_m1 / math.cos(geo.gamma_m) < 10 * self.bm.plan.transition_velocity_m_s
 
     def contact(self, t: float, pen: float, w_drive: float, cmd: float, w_worm: float = 0.0) -> None:
         """Penetration beyond the limit; a speed-driven drive stuck below half its command (locked) for lock_hold.
-        A wheel back-driving a self-locking pair ends the run as held (wormsim.locking.Held) when it stalls, or when
+        A wheel back-driving a self-locking pair ends the run as held (wormsim.physics.locking.Held) when it stalls, or
+        when
         its servo pushes the held mesh past the penetration limit while the worm (speed w_worm) creeps."""
         code = contact_event(
             t, pen, self.pen_lim, w_drive, cmd, self.speed_driven, self.lock_start, gt.LOCK_SPEED_FRACTION
@@ -124,8 +125,8 @@ class Guards:
         if code == STUCK:
             self.locked_since = t if self.locked_since is None else self.locked_since
             if t - self.locked_since > self.lock_hold:
-                if self.self_locking_backdrive:  # the answer, not a failure (wormsim.locking)
+                if self.self_locking_backdrive:  # the answer, not a failure (wormsim.physics.locking)
                     raise Held(t, self.locked_since)
-                raise locked_error(t, w_drive, cmd, self.bm, self.scenario)
+                raise locked_error(t, w_drive, cmd, self.bm)
         elif code == RUNNING:
             self.locked_since = None

@@ -50,8 +50,10 @@ from the sliding speed Vs = omega1 r1 / cos(gamma) (seed 000):
   friction: mu                           constant
   friction_static/_dynamic: mu(Vs) = STEP(|Vs|, 0, mu_s, v_t, mu_d)   (ADAMS-style cubic blend over
                                           the transition velocity v_t = contact.transition_velocity_m_s)
-  friction_group: mu(Vs) = tan(rho(Vs)), rho of seed 000 (wormsim.friction)
+  friction_group: mu(Vs) = tan(rho(Vs)), rho of seed 000 (wormsim.physics.friction)
   none given: mu = 0.05 (lubricated steel/bronze, DEFAULT_FRICTION).
+Where the wheel drives a pair that self-locks at rest, mu keeps its static value mu(0) until Vs reaches v_t
+(the stick state, wormsim.physics.friction.stuck_after; docs/decisions/0039-static-holding.md).
 
 Friction hardness (opt.impratio). MuJoCo's elliptic friction rows have no position term: their reference
 acceleration is a_ref = -b v_t (b = B / d, the normal row's damping) and their regulariser is
@@ -97,7 +99,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from meshgen.geometry import GearGeometry
-from wormsim.gear_theory import DEFAULT_DAMPING_RATIO, MAX_DAMPING_RATIO
+from wormsim.physics.gear_theory import DEFAULT_DAMPING_RATIO, MAX_DAMPING_RATIO
 from wormsim.scenario import Contact, Materials
 from wormsim.tooth.stiffness import hertz_per_length_n_per_m2, pair_stiffness_n_per_m
 

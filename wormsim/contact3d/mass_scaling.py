@@ -41,10 +41,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from wormsim import gear_theory as gt
-from wormsim.errors import RingingError
+from wormsim.exceptions import RingingError
+from wormsim.physics import gear_theory as gt
+from wormsim.physics.units import rpm_to_rad_s
 from wormsim.scenario import ScenarioError
-from wormsim.units import rpm_to_rad_s
 
 KE_SHARE_TARGET = 0.01  # kinetic energy at most 1 % of the drive's work
 MODE_TO_MESH_MIN = 100.0  # scaled mesh mode at least 100 x the meshing frequency (seat motor, 36 rpm: at 50 x
@@ -213,14 +213,16 @@ def floor_2_digits(x: float) -> float:
     return float(f"{math.floor(x / 10**e * (1 + 1e-12))}e{e}")
 
 
-def run_summary(S: dict, duty: gt.Duty, requested, meta: dict, summary: dict) -> dict:
+def run_summary(
+    S: dict, duty: gt.Duty, requested, c: ScalingCheck, inertias_kg_m2: tuple[float, float], summary: dict
+) -> dict:
     """Summary keys of the run's scaling (mass_scaling, kinetic_energy_share, ..., requested: the scenario's
-    simulation.mass_scaling) and the ringing guard: a scaled run whose efficiency exceeds 1 (output power above input:
+    simulation.mass_scaling; c: the scaling's check, inertias_kg_m2: the shafts' scaled (I1, I2) with the driven
+    machine's) and the ringing guard: a scaled run whose efficiency exceeds 1 (output power above input:
     the power balance broken) or whose measured kinetic-energy share exceeds RINGING_KE_SHARE raises RingingError
     (exit 3)."""
-    c: ScalingCheck = meta["mass_scaling_check"]
     drive_power = S["worm_power_w"] if duty.drive.on == "worm" else S["wheel_power_w"]
-    share = measured_ke_share(S, meta["shaft_inertias_kg_m2"], duty.ramps_end_s, drive_power)
+    share = measured_ke_share(S, inertias_kg_m2, duty.ramps_end_s, drive_power)
     out = {
         "mass_scaling": c.factor,
         "kinetic_energy_share": share,

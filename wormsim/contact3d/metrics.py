@@ -1,4 +1,4 @@
-"""contact3d summary metrics: the common drive summary (wormsim.metrics) plus the meshing line of the tangential
+"""contact3d summary metrics: the common drive summary (wormsim.results.metrics) plus the meshing line of the tangential
 force near z1 n1 / 60, contact statistics, the radial and axial forces as DIN 3975 defines them and as resultants,
 the efficiency theory at the contacts' radius and the start-up peak."""
 
@@ -6,11 +6,18 @@ from __future__ import annotations
 
 import numpy as np
 
-from wormsim import gear_theory as gt
-from wormsim.metrics import dominant_frequency, drive_summary, mean_speeds_rpm, mesh_line, mesh_line_keys, window_after
+from wormsim.physics import gear_theory as gt
+from wormsim.results.metrics import (
+    dominant_frequency,
+    drive_summary,
+    mean_speeds_rpm,
+    mesh_line,
+    mesh_line_keys,
+    window_after,
+)
 
 
-def contact3d_summary(S: dict, scenario, bm) -> dict:
+def contact3d_summary(S: dict, bm) -> dict:
     """drive_summary plus the meshing frequency from the tangential force and contact statistics; the steady window
     after the ramps of the run's plan (bm.plan.duty)."""
     geo, duty = bm.geometry, bm.plan.duty
@@ -21,10 +28,11 @@ def contact3d_summary(S: dict, scenario, bm) -> dict:
     f_theory = geo.z1 * n1 / 60.0
     f_full, _, _, _ = dominant_frequency(t[sl], S["tangential_force_n"][sl])
     # shaft powers: the interval means of T w over every step (the runner's worm_power_w, wheel_power_w)
-    drive = drive_summary(S, scenario, geo, i0, i1, n1, n2, shaft_powers_w=(S["worm_power_w"], S["wheel_power_w"]))
+    drive = drive_summary(S, bm.plan.gear, i0, i1, n1, n2, shaft_powers_w=(S["worm_power_w"], S["wheel_power_w"]))
     return {
         **drive,
-        # the meshing line near z1 n1 / 60 (wormsim.metrics.mesh_line): the pieces' facets, the contact mode's ringing
+        # the meshing line near z1 n1 / 60 (wormsim.results.metrics.mesh_line): the pieces' facets, the contact mode's
+        # ringing
         # and the meshing harmonics lie outside its band
         **mesh_line_keys(t, S, sl, f_theory, "tangential_force_n"),
         "force_peak_full_band_hz": f_full,

@@ -28,7 +28,6 @@ from __future__ import annotations
 import functools
 import math
 from dataclasses import astuple, dataclass, field, replace
-from importlib.resources import files
 from pathlib import Path
 
 import mujoco
@@ -40,7 +39,6 @@ from meshgen.displaced import Deviations, wheel_mount, worm_mount
 from meshgen.geometry import GearGeometry
 from meshgen.kinematic_tca import KinematicTCA
 from meshgen.pieces import GearSet
-from wormsim import gear_theory as gt
 from wormsim.contact3d import mass_scaling, shafts
 from wormsim.contact3d.backlash import check_backlash, check_conjugate_interference
 from wormsim.contact3d.law import (
@@ -52,14 +50,17 @@ from wormsim.contact3d.law import (
 )
 from wormsim.contact3d.mass_scaling import ScalingCheck
 from wormsim.contact3d.timestep import timestep_for
-from wormsim.friction import friction_coefficient, mu_law
-from wormsim.geometry import derive, displaced_pair, gear_set, solid_set
-from wormsim.locking import backdrive_self_locks, stall_torque_nm, wheel_start_rad
-from wormsim.scenario import Scenario, ScenarioError, Simulation
+from wormsim.physics import gear_theory as gt
+from wormsim.physics.friction import mu_law
+from wormsim.physics.geometry import derive, gear_set, solid_set
+from wormsim.physics.locking import stall_torque_nm, wheel_start_rad
+from wormsim.physics.plan import GearPlan, gear_plan
+from wormsim.runtime.data import data_dir
+from wormsim.scenario import Load, Materials, Scenario, ScenarioError, Simulation
 from wormsim.tooth.grid import SLICES_MASS_SCALED, FlankGrid, default_slices, flank_grid
 from wormsim.tooth.window import slot_quat, window_size, window_teeth_at
 
-TEMPLATE = files("wormsim.models") / "worm_pair.xml"  # models/, shipped as package data
+TEMPLATE = data_dir("models") / "worm_pair.xml"  # models/, shipped as package data
 MESH_SENSOR_DATA = 1 | 2 | 4 | 16  # contact sensor fields found, force, torque, pos (mjtConDataField bits)
 INTEGRATORS = {
     "implicitfast": mujoco.mjtIntegrator.mjINT_IMPLICITFAST,
@@ -116,10 +117,10 @@ class Inertias:
 
 @dataclass(frozen=True)
 class Prepared:
-    """The run's plan, derived once from the scenario before the model is built and handed down: geometry, pieces,
-    inertias, the shafts' supports, the contact law, the flank grid, the drive and load (gear_theory.Duty: their
-    commands, the drive's kind and the guards' times), the working loads the law and the guards are sized for;
-    build_model adds the timestep and the window."""
+    """The run's plan, derived once from the scenario before the model is built and handed down: the gear-level
+    plan (wormsim.physics.plan.GearPlan: geometry, the drive and load with their commands, ramps and working flank,
+    the friction values, the working loads), pieces, inertias, the shafts' supports, the contact law, the flank
+    grid; build_model adds the timestep and the window. After it is built no contact3d helper reads the scenario."""
 
     geometry: GearGeometry
     pieces: GearSet
@@ -127,20 +128,51 @@ class Prepared:
     law: ContactLaw
     inv_mass_worm: float  # arm1^2 / (I1 + J1): the worm's share of A_hat
     inv_mass_wheel: float  # arm2^2 / (I2 + J2)
-    scaling: ScalingCheck | None = None  # simulation.mass_scaling: the factor used and its checks (inertias x it)
+    gear: GearPlan  # the gear-level plan (wormsim.physics.plan.gear_plan)
+    scaling: ScalingCheck  # simulation.mass_scaling: the factor used and its checks (inertias x it)
     normal_force_n: float = 0.0  # nominal_normal_force_n: the whole mesh's normal force at the working load
-    duty: gt.Duty | None = None  # the drive and load, their commands, ramps and working flank (gear_theory.duty)
     grid: FlankGrid | None = None  # contact.geometry flanks: the flank grid of law.contacts_per_pair slices
-    mu_law: tuple = ()  # the friction law mu(Vs) (wormsim.friction.MuLaw)
-    transition_velocity_m_s: float = 0.0  # contact.transition_velocity_m_s
+    mu_law: tuple = ()  # the friction law mu(Vs) (wormsim.physics.friction.MuLaw)
     e_star_pa: float = 0.0  # the pair's effective modulus (gear_theory.effective_modulus_pa)
     timestep_s: float = 0.0  # the model's timestep (build_model: timestep_for's or the one given)
     window_teeth: int = 0  # the wheel tooth slots with collision (build_model)
-    worm_speed_rad_s: float | None = None  # the commanded worm speed (gear_theory.worm_speed_command_rad_s)
-    wheel_torque_nm: float = 0.0  # T2 at the working load (gear_theory.working_wheel_torque_of)
-    drive_torque_nm: float = 0.0  # the drive's torque at the full load (gear_theory.expected_drive_torque_of)
-    servo_gain_nm_s: float | None = None  # a speed drive's kv (gear_theory.servo_gain_of); None for a torque drive
+    wheel_torque_nm: float = 0.0  # T2 the friction rows are sized for: the working one, a held stall's when larger
     supports: dict = field(default_factory=dict)  # part -> its Support (wormsim.contact3d.shafts.support) or None
+
+    @property
+    def duty(self) -> gt.Duty:
+        """The drive and load, their commands, ramps and working flank (gear_theory.Duty)."""
+        return self.gear.duty
+
+    @property
+    def flanks(self) -> bool:
+        """contact.geometry flanks (the exact flanks; else the convex pieces)."""
+        return self.gear.contact.geometry == "flanks"
+
+    @property
+    def worm_speed_rad_s(self) -> float | None:
+        """The commanded worm speed (gear_theory.worm_speed_command_rad_s); None for a torque drive."""
+        return self.gear.worm_speed_rad_s
+
+    @property
+    def drive_torque_nm(self) -> float:
+        """The drive's torque at the full load (gear_theory.expected_drive_torque_of)."""
+        return self.gear.drive_torque_nm
+
+    @property
+    def servo_gain_nm_s(self) -> float | None:
+        """A speed drive's kv (gear_theory.servo_gain_of); None for a torque drive."""
+        return self.gear.servo_gain_nm_s
+
+    @property
+    def stick_velocity_m_s(self) -> float:
+        """The friction law's stick state (wormsim.physics.locking.stick_velocity_m_s); 0: none."""
+        return self.gear.stick_velocity_m_s
+
+    @property
+    def transition_velocity_m_s(self) -> float:
+        """contact.transition_velocity_m_s."""
+        return self.gear.transition_velocity_m_s
 
     @property
     def commands(self) -> gt.Commands:
@@ -276,11 +308,17 @@ def _pieces_angle(pieces) -> float:
 
 
 def shaft_inertias(scenario: Scenario, geo: GearGeometry, gs: GearSet) -> Inertias:
-    mats = scenario.materials
+    """inertias_of the scenario's materials and load."""
+    return inertias_of(scenario.materials, scenario.load, geo, gs)
+
+
+def inertias_of(mats: Materials, load: Load, geo: GearGeometry, gs: GearSet) -> Inertias:
+    """The shafts' Inertias: the visual meshes' (cached, _visual_inertia) and the driven machine's on the loaded
+    shaft."""
     m1, I1 = _visual_inertia(gs, "worm_visual", mats.worm.density_kg_m3, 0.0, geo.r1, geo.worm_length)
     m2, I2 = _visual_inertia(gs, "wheel_visual", mats.wheel.density_kg_m3, 0.0, geo.r2, geo.face_width)
-    j_load = scenario.load.inertia_kg_m2
-    J1, J2 = (j_load, 0.0) if scenario.load.on == "worm" else (0.0, j_load)
+    j_load = load.inertia_kg_m2
+    J1, J2 = (j_load, 0.0) if load.on == "worm" else (0.0, j_load)
     return Inertias(m1, I1, m2, I2, J1, J2)
 
 
@@ -291,24 +329,27 @@ def prepare(scenario: Scenario, gs: GearSet | None = None) -> Prepared:
         raise ScenarioError("model: contact3d needs gear: and drive: blocks")
     flanks = scenario.contact.geometry == "flanks"  # the flank contacts need the solid meshes only, no pieces
     geo, gs = (derive(scenario.gear), gs) if gs is not None else (solid_set if flanks else gear_set)(scenario)
-    ine = shaft_inertias(scenario, geo, gs)
-    supports = {part: shafts.support(scenario, geo, part) for part in ("worm", "wheel")}
     # n_ref: the pieces across the face width, or with contact.geometry flanks the flank contacts' slices
-    slabs = flank_slices(scenario, geo) if scenario.contact.geometry == "flanks" else max(1, _slabs_per_flank(gs))
-    direction = expected_direction(geo)
-    mu0, mu1 = float(friction_coefficient(scenario.contact, 0.0)), float(friction_coefficient(scenario.contact, 1.0))
-    # the drive and load, once (gear_theory): their commands, the worm's speed, the working and the drive's torques
-    duty = gt.duty(scenario, direction)
-    drv, load = duty.drive, duty.load
-    w1 = gt.worm_speed_command_rad_s(drv, geo.ratio)
-    t_drive = gt.expected_drive_torque_of(drv, load, geo.ratio, geo.gamma_m, geo.alpha_n, mu1)
-    t2 = gt.working_wheel_torque_of(drv, load, geo.ratio)
-    held = backdrive_self_locks(scenario, geo.gamma_m, geo.alpha_n)
-    if held:  # the mesh holds the stalled wheel servo's torque (wormsim.locking): the friction rows' hardness for it
+    slabs = flank_slices(scenario, geo) if flanks else max(1, _slabs_per_flank(gs))
+    return _prepare(gear_plan(scenario, geo), gs, slabs)
+
+
+def _prepare(gp: GearPlan, gs: GearSet, slabs: int) -> Prepared:
+    """prepare's derivations from the gear-level plan, the pieces and the slices."""
+    geo, contact, mats = gp.geometry, gp.contact, gp.materials
+    flanks = contact.geometry == "flanks"
+    ine = inertias_of(mats, gp.duty.load, geo, gs)
+    supports = {part: shafts.support(gp.shafts, mats, geo, part) for part in ("worm", "wheel")}
+    mu0, mu1 = gp.mu_static, gp.mu_nominal
+    # the drive and load, once (wormsim.physics.plan): their commands, the worm's speed, the working and the
+    # drive's torques
+    w1, t_drive, t2 = gp.worm_speed_rad_s, gp.drive_torque_nm, gp.working_wheel_torque_nm
+    held = gp.backdrive_self_locks
+    if (
+        held
+    ):  # the mesh holds the stalled wheel servo's torque (wormsim.physics.locking): the friction rows' hardness for it
         t2 = max(t2, stall_torque_nm(t_drive))
-    kv = gt.servo_gain_of(drv, t_drive) if duty.speed_driven else None
     arm1, arm2 = gt.mesh_arms_m(geo.r_m1, geo.r2, geo.alpha_n, geo.gamma_m)
-    e_star = gt.effective_modulus_pa(scenario.materials)
     f_n, v_s = nominal_normal_force_n(t2, geo), nominal_sliding_speed_m_s(w1, geo)
     if held:  # the worm stands: no sliding speed to size the friction rows' damping by (law (4): c_f = c_c)
         v_s = 0.0
@@ -316,10 +357,10 @@ def prepare(scenario: Scenario, gs: GearSet | None = None) -> Prepared:
     I1 = ine.worm_inertia_kg_m2 + ine.worm_load_inertia_kg_m2
     I2 = ine.wheel_inertia_kg_m2 + ine.wheel_load_inertia_kg_m2
     # simulation.mass_scaling (wormsim.contact3d.mass_scaling): every inertia x S before the law takes them
-    k_pair, _ = pair_stiffness_n_per_m(scenario.contact, geo, scenario.materials)
+    k_pair, _ = pair_stiffness_n_per_m(contact, geo, mats)
     scaling = mass_scaling.resolve(
-        scenario.simulation.mass_scaling,
-        duty,
+        gp.simulation.mass_scaling,
+        gp.duty,
         ratio=geo.ratio,
         z1=geo.z1,
         worm_speed_rad_s=w1,
@@ -327,22 +368,22 @@ def prepare(scenario: Scenario, gs: GearSet | None = None) -> Prepared:
         pair_stiffness_n_per_m=k_pair,
         inv_mass_hat=arm1**2 / I1 + arm2**2 / I2,
         inertias_kg_m2=(I1, I2),
-        segments_per_turn=0 if scenario.contact.geometry == "flanks" else gs.resolution.worm_segments_per_turn or 0,
+        segments_per_turn=0 if flanks else gs.resolution.worm_segments_per_turn or 0,
     )
     S = scaling.factor
     a1, a2 = arm1**2 / (S * I1), arm2**2 / (S * I2)
     if S != 1:  # the scaled inertias
         ine = Inertias(*(S * v for v in astuple(ine)))
-        if flanks and not scenario.contact.slices:
+        if flanks and not contact.slices:
             slabs = min(slabs, SLICES_MASS_SCALED)  # a scaled run keeps means only (tooth.grid.SLICES_MASS_SCALED)
-    law = contact_law(scenario.contact, scenario.materials, geo, slabs, a1 + a2)  # the law, once
+    law = contact_law(contact, mats, geo, slabs, a1 + a2)  # the law, once
     mu_max = max(mu0, mu1)
     if flanks:  # the flank contacts' own friction-row damping, law (4)
         law = replace(
             law,
             friction_damping_n_s_per_m=friction_damping_n_s_per_m(law, mu_max, f_n, v_s),
         )
-    law = replace(law, impratio=friction_impratio(law, mu_max, f_n, scenario.contact.transition_velocity_m_s))
+    law = replace(law, impratio=friction_impratio(law, mu_max, f_n, contact.transition_velocity_m_s))
     grid = flank_grid(geo, law.contacts_per_pair) if flanks else None
     return Prepared(
         geo,
@@ -351,17 +392,13 @@ def prepare(scenario: Scenario, gs: GearSet | None = None) -> Prepared:
         law,
         a1,
         a2,
+        gp,
         scaling,
         f_n,
-        duty,
         grid,
-        mu_law=mu_law(scenario.contact),
-        transition_velocity_m_s=scenario.contact.transition_velocity_m_s,
-        e_star_pa=e_star,
-        worm_speed_rad_s=w1,
+        mu_law=mu_law(contact),
+        e_star_pa=gt.effective_modulus_pa(mats),
         wheel_torque_nm=t2,
-        drive_torque_nm=t_drive,
-        servo_gain_nm_s=kv,
         supports=supports,
     )
 
@@ -376,76 +413,44 @@ def build_model(
     window_teeth: int | None = None,
     timestep_s: float | None = None,
 ) -> BuiltModel:
-    """The compiled contact3d model. check_backlash_vs_pieces=False skips wormsim.contact3d.backlash's checks (only
-    to measure what happens below their limit). window_teeth: wheel tooth slots with collision (default
-    window_size; geo.z2 = every tooth, for a standalone file that the viewer can turn without re-posing).
-    timestep_s: the timestep to build with (default: timestep_for's)."""
-    p = prepare(scenario, gs)
-    geo, gs, law = p.geometry, p.pieces, p.law
-    flanks = scenario.contact.geometry == "flanks"
-    if flanks:
+    """The compiled contact3d model of the scenario's plan (prepare, build). check_backlash_vs_pieces=False skips
+    wormsim.contact3d.backlash's checks (only to measure what happens below their limit). window_teeth: wheel tooth
+    slots with collision (default window_size; geo.z2 = every tooth, for a standalone file that the viewer can turn
+    without re-posing). timestep_s: the timestep to build with (default: timestep_for's)."""
+    return build(prepare(scenario, gs), check_backlash_vs_pieces, window_teeth, timestep_s)
+
+
+def build(
+    p: Prepared, check_backlash_vs_pieces: bool = True, window_teeth: int | None = None, timestep_s: float | None = None
+) -> BuiltModel:
+    """The compiled contact3d model of a plan (build_model)."""
+    gp, geo, gs, law = p.gear, p.geometry, p.pieces, p.law
+    sim = gp.simulation
+    if p.flanks:
         check_backlash_vs_pieces = False  # no pieces collide (wormsim.contact3d.flank_step)
     # backlash against the pieces' residual bulge (wormsim.contact3d.backlash (2)): exit 2 before the teeth start jammed
     backlash_meta = (
-        check_backlash(geo, gs.piece_error_um, scenario.simulation.resolution)
-        if check_backlash_vs_pieces and gs.piece_error_um
-        else {}
+        check_backlash(geo, gs.piece_error_um, sim.resolution) if check_backlash_vs_pieces and gs.piece_error_um else {}
     )
     h, h_source = (
-        timestep_for(scenario.simulation.timestep_s, p.worm_speed_rad_s, law, p.scaling.factor)
+        timestep_for(sim.timestep_s, p.worm_speed_rad_s, law, p.scaling.factor)
         if timestep_s is None
         else (timestep_s, "given to build_model")
     )
-
-    pair = displaced_pair(scenario.errors, geo)  # the errors: block; None for the perfect pair
-    dev, kin = pair if pair is not None else (None, None)
+    dev, kin = gp.displaced if gp.displaced is not None else (None, None)  # the errors: block; None: the perfect pair
     shift = dev.tooth_angle_shift(geo, np.arange(geo.z2)) if dev is not None and any(dev.tooth_shift) else None
-
-    spec = mujoco.MjSpec.from_file(str(TEMPLATE))
-    spec.modelname = scenario.name
-    _place_bodies(spec, geo, p.inertias, dev)
-    sups = shafts.mount(spec, p.supports, geo) if scenario.shafts is not None else None  # bearings, bending
-    worm_names, slot_names, W = _add_geoms(
-        spec, geo, gs, law, float(friction_coefficient(scenario.contact, 0.0)), window_teeth, shift, flanks
-    )
-    kv, drive_sign = _add_actuators(spec, p.duty, p.servo_gain_nm_s)
-    spec.joint(f"{scenario.load.on}_hinge").armature = max(
-        p.inertias.worm_load_inertia_kg_m2, p.inertias.wheel_load_inertia_kg_m2
-    )  # x mass_scaling
-    _set_options(spec, scenario.simulation, law, h)
-    if sups is not None:
-        shafts.set_solver(spec, sups)  # CG where shaft joints move (wormsim.contact3d.shafts.SOLVER)
-    _add_mesh_sensor(spec)
+    spec, W, worm_names, slot_names, sups, drive_sign = _spec(p, window_teeth, dev, shift, h)
     model = spec.compile()
-
-    ine = p.inertias
-    meta = {
-        "contact_geometry": scenario.contact.geometry,
-        "flank_contacts": scenario.contact.flank_contacts,
-        "worm_mass_kg": ine.worm_mass_kg,
-        "wheel_mass_kg": ine.wheel_mass_kg,
-        "worm_inertia_kg_m2": ine.worm_inertia_kg_m2,
-        "wheel_inertia_kg_m2": ine.wheel_inertia_kg_m2,
-        "window_teeth": W,
-        "worm_pieces": len(gs.worm_pieces),
-        "tooth_pieces": len(gs.wheel_tooth_pieces),
-        **backlash_meta,
-    }
-    if kv is not None:
-        meta["drive_kv_nm_s"] = kv
-    meta["load_inertia_kg_m2"] = scenario.load.inertia_kg_m2
-    # a torque-driven wheel starts on its loaded flank (wormsim.locking.wheel_start_rad): the hinge's initial angle
-    meta["wheel_start_rad"] = wheel_start_rad(scenario, geo.backlash, geo.r2, dev is None and sups is None)
+    meta = {"flank_contacts": gp.contact.flank_contacts, **backlash_meta}
+    # a torque-driven wheel starts on its loaded flank (wormsim.physics.locking.wheel_start_rad): the hinge's
+    # initial angle
+    meta["wheel_start_rad"] = wheel_start_rad(
+        p.duty.drive, p.flanks, geo.backlash, geo.r2, dev is None and sups is None
+    )
     jw = model.jnt_qposadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, "wheel_hinge")]
     model.qpos0[jw] += meta["wheel_start_rad"]
-    meta["mass_scaling"] = p.scaling.factor
-    meta["mass_scaling_check"] = p.scaling
     if sups is not None:  # the shafts' joints (wormsim.contact3d.shafts): the kernel takes the poses from the data
         meta.update(shafts.model_meta(model, sups, p.normal_force_n, geo, h))
-    meta["shaft_inertias_kg_m2"] = (
-        ine.worm_inertia_kg_m2 + ine.worm_load_inertia_kg_m2,
-        ine.wheel_inertia_kg_m2 + ine.wheel_load_inertia_kg_m2,
-    )
 
     def oid(kind: mujoco.mjtObj, name: str) -> int:
         return mujoco.mj_name2id(model, kind, name)
@@ -484,10 +489,28 @@ def build_model(
     )
     if check_backlash_vs_pieces:
         # the model itself at the rigid-conjugate pose (wormsim.contact3d.backlash.check_conjugate_interference): exit 2
-        meta["conjugate_interference_m"] = check_conjugate_interference(
-            bm, scenario.simulation.resolution, p.normal_force_n
-        )
+        meta["conjugate_interference_m"] = check_conjugate_interference(bm, sim.resolution, p.normal_force_n)
     return bm
+
+
+def _spec(p: Prepared, window_teeth: int | None, dev: Deviations | None, shift: np.ndarray | None, h: float):
+    """The model's MjSpec from the template: bodies, the shafts' mounts, geoms, actuators, options, the sensor.
+    Returns (spec, W, worm geom names, slot geom names, the shafts' mounts or None, the drive command's sign)."""
+    gp, geo, law = p.gear, p.geometry, p.law
+    spec = mujoco.MjSpec.from_file(str(TEMPLATE))
+    spec.modelname = gp.name
+    _place_bodies(spec, geo, p.inertias, dev)
+    sups = shafts.mount(spec, p.supports, geo) if gp.shafts is not None else None  # bearings, bending
+    worm_names, slot_names, W = _add_geoms(spec, geo, p.pieces, law, gp.mu_static, window_teeth, shift, p.flanks)
+    _, drive_sign = _add_actuators(spec, p.duty, p.servo_gain_nm_s)
+    spec.joint(f"{p.duty.load.on}_hinge").armature = max(
+        p.inertias.worm_load_inertia_kg_m2, p.inertias.wheel_load_inertia_kg_m2
+    )  # x mass_scaling
+    _set_options(spec, gp.simulation, law, h)
+    if sups is not None:
+        shafts.set_solver(spec, sups)  # CG where shaft joints move (wormsim.contact3d.shafts.SOLVER)
+    _add_mesh_sensor(spec)
+    return spec, W, worm_names, slot_names, sups, drive_sign
 
 
 def _place_bodies(spec: mujoco.MjSpec, geo: GearGeometry, ine: Inertias, dev: Deviations | None = None) -> None:

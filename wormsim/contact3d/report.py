@@ -5,7 +5,7 @@ speeds; the FFT amplitude spectrum of the tangential force over the steady windo
 meshing frequency marked; the contact pattern on a wheel tooth (contact points of the steady window,
 mapped into the frame of tooth 0: axial position across the face against radius, coloured by force).
 
-recording.rrd (wormsim.recording layout): /series/* time series on the sim_time timeline; the worm and
+recording.rrd (wormsim.results.recording layout): /series/* time series on the sim_time timeline; the worm and
 wheel meshes under /assembly/worm and /assembly/wheel moved by their 4x4 transforms; contact points
 (/assembly/contacts/points) and force arrows on the wheel (/assembly/contacts/forces, 1 mm per
 `ARROW_N_PER_MM` newtons) at up to MAX_FRAMES instants. With exact flanks: the steady-window contact
@@ -20,9 +20,9 @@ import numpy as np
 
 from meshgen import assembly
 from wormsim.contact3d.mjcf import visual_vertex_normals
-from wormsim.metrics import dominant_frequency
-from wormsim.recording import log_mesh, log_series, log_transforms, recording
-from wormsim.report_header import (
+from wormsim.results.metrics import dominant_frequency
+from wormsim.results.recording import log_mesh, log_series, log_transforms, recording
+from wormsim.results.report_header import (
     draw_header,
     gear_line,
     header_rows,
@@ -32,7 +32,7 @@ from wormsim.report_header import (
     steady_ylim,
     warning_text,
 )
-from wormsim.result import Result
+from wormsim.results.result import Result
 
 MAX_FRAMES = 1500
 ARROW_N_PER_MM = None  # chosen per run: the mean tooth force maps to 5 mm
@@ -84,7 +84,25 @@ def write_report(result: Result, path) -> None:
         f"contacts {s.get('contact_geometry', '')}, steady window {w0:.3g}-{w1:.3g} s",
         warn=warn,
     )
-    a = ax[0, 0]
+    _draw_forces(ax[0, 0], S, s)
+    _draw_speeds(ax[0, 1], S, s)
+    _draw_spectrum(ax[1, 0], S, s, sl)
+    _draw_pattern(ax[1, 1], fig, result, sl)
+    if ms is not None:  # the tooth pair's stiffness and load shares (wormsim.tooth.stiffness_plot), as at torsional
+        from wormsim.tooth.stiffness_plot import draw_load_shares, draw_mesh_stiffness
+
+        draw_mesh_stiffness(fig.add_subplot(gs[3, 0]), ms, result.extra.get("ltca"))
+        draw_load_shares(fig.add_subplot(gs[3, 1]), result.extra.get("ltca"), ms.stiffness_source)
+    fig.tight_layout()
+    fig.set_layout_engine(None)  # tight_layout leaves a placeholder engine: savefig would draw twice
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def _draw_forces(a, S: dict, s: dict) -> None:
+    """The tooth forces on the wheel against time, the axes fitted to the steady window."""
+    t = S["t_s"]
+    w0, w1 = s["steady_window_s"]
     forces = [S[k] for k in ("tangential_force_n", "radial_force_n", "axial_force_n")]
     for y, lab in zip(forces, ("tangential", "radial", "axial"), strict=True):
         a.plot(t, y, lw=0.6, label=lab)
@@ -99,8 +117,13 @@ def write_report(result: Result, path) -> None:
         a.plot([], [], " ", label=f"start-up peak F_t {peak:.4g} N{off}")
     a.set(xlabel="time [s]", ylabel="force on the wheel [N]", title="tooth forces on the wheel (axes: steady window)")
     a.legend(fontsize=7, loc="best")
-    a = ax[0, 1]
-    # raw traces faint (the wheel rattles at the contact frequencies and would hide the worm), interval means bold
+
+
+def _draw_speeds(a, S: dict, s: dict) -> None:
+    """The wheel's and the worm's (over the ratio) speeds: raw traces faint (the wheel rattles at the contact
+    frequencies and would hide the worm), interval means bold."""
+    t = S["t_s"]
+    w0, w1 = s["steady_window_s"]
     worm, wheel = np.abs(S["worm_speed_rpm"]) / s["ratio_theory"], np.abs(S["wheel_speed_rpm"])
     tm, worm_m, wheel_m = _interval_means(t, worm, wheel, n=SPEED_INTERVALS)
     a.plot(t, wheel, lw=0.4, color="C1", alpha=0.25)
@@ -118,8 +141,11 @@ def write_report(result: Result, path) -> None:
         f"(ratio {s['ratio']:.5g})",
     )
     a.legend(fontsize=8, loc="lower right")
-    a = ax[1, 0]
-    _, df, fr, sp = dominant_frequency(t[sl], S["tangential_force_n"][sl])
+
+
+def _draw_spectrum(a, S: dict, s: dict, sl) -> None:
+    """The tangential force's spectrum over the steady window (sl) with the theory's and the found meshing line."""
+    _, df, fr, sp = dominant_frequency(S["t_s"][sl], S["tangential_force_n"][sl])
     if len(fr):
         a.semilogy(fr[1:], np.maximum(sp[1:], 1e-9), lw=0.7)
         a.axvline(
@@ -140,10 +166,16 @@ def write_report(result: Result, path) -> None:
         a.set_xlim(0, min(fr[-1], max(10 * max(s["mesh_frequency_theory_hz"], df), 1.2 * s["mesh_frequency_hz"])))
     a.set(xlabel="frequency [Hz]", ylabel="|F_t| amplitude [N]", title="spectrum of the tangential force (Hann)")
     a.legend(fontsize=8)
-    a = ax[1, 1]
+
+
+def _draw_pattern(a, fig, result: Result, sl) -> None:
+    """The contact pattern on a wheel tooth over the steady window (sl): the exact flanks' loaded band coloured by
+    pressure (wormsim.tooth.hertz), or the pieces' contact points coloured by force."""
+    s = result.summary
+    geo = result.extra["built"].geometry
     P = result.extra.get("points_tooth0")
     F = result.extra.get("forces_world")
-    if "flank_pattern" in result.extra:  # exact flanks: the loaded band coloured by pressure (wormsim.tooth.hertz)
+    if "flank_pattern" in result.extra:
         from wormsim.tooth.hertz import draw_pattern
 
         draw_pattern(a, fig, result.extra["flank_pattern"], result.extra["built"].geometry, s)
@@ -162,15 +194,6 @@ def write_report(result: Result, path) -> None:
         lo, hi = min(geo.r_f2 * 1e3, float(rr.min())), max(geo.r_e2 * 1e3, float(rr.max()))
         a.set_ylim(lo - 0.15 * (hi - lo), hi + 0.1 * (hi - lo))
         a.set(xlabel="across the face (wheel z) [mm]", ylabel="radius [mm]", title="contact pattern on a wheel tooth")
-    if ms is not None:  # the tooth pair's stiffness and load shares (wormsim.tooth.stiffness_plot), as at torsional
-        from wormsim.tooth.stiffness_plot import draw_load_shares, draw_mesh_stiffness
-
-        draw_mesh_stiffness(fig.add_subplot(gs[3, 0]), ms, result.extra.get("ltca"))
-        draw_load_shares(fig.add_subplot(gs[3, 1]), result.extra.get("ltca"), ms.stiffness_source)
-    fig.tight_layout()
-    fig.set_layout_engine(None)  # tight_layout leaves a placeholder engine: savefig would draw twice
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
 
 
 def write_recording(result: Result, path) -> None:

@@ -46,7 +46,7 @@ import numpy as np
 
 from meshgen.geometry import GearGeometry
 from wormsim.contact3d.native import f64_at
-from wormsim.scenario import Scenario, ScenarioError, ShaftSupport
+from wormsim.scenario import Materials, ScenarioError, Shafts, ShaftSupport
 
 DAMPING_RATIO = 0.05  # bearings' and bending's damping, share of critical against the shaft's mass (an assumption:
 # rolling-bearing supports are lightly damped; it only settles the shaft modes, the static results do not use it)
@@ -85,9 +85,8 @@ class Support:
         return self.radial_n_per_m is not None or self.axial_n_per_m is not None or self.bend_n_per_m is not None
 
 
-def support(scenario: Scenario, geo: GearGeometry, part: str) -> Support | None:
-    """The part's Support from the scenario's shafts: block (None without one)."""
-    sh = scenario.shafts
+def support(sh: Shafts | None, materials: Materials, geo: GearGeometry, part: str) -> Support | None:
+    """The part's Support from the scenario's shafts: block sh (None without one); materials: the worm's."""
     s: ShaftSupport | None = getattr(sh, part) if sh is not None else None
     if s is None:
         return None
@@ -96,9 +95,9 @@ def support(scenario: Scenario, geo: GearGeometry, part: str) -> Support | None:
     bend = mass = None
     if part == "worm":
         d_f1 = 2 * geo.r_f1
-        mass = scenario.materials.worm.density_kg_m3 * math.pi * d_f1**2 / 4 * L
+        mass = materials.worm.density_kg_m3 * math.pi * d_f1**2 / 4 * L
         if s.bending:
-            E = scenario.materials.worm.youngs_modulus_gpa * 1e9
+            E = materials.worm.youngs_modulus_gpa * 1e9
             bend = beam_stiffness_n_per_m(E, root_second_moment_m4(d_f1), -b[0], b[1])
     return Support(
         bearings_m=b,
@@ -345,7 +344,7 @@ class ShaftLog:
         gather(self.addresses(d), self.raw, i)
 
     def truncate(self, n: int) -> None:
-        """Keep the first n samples (a run that ended early: wormsim.locking)."""
+        """Keep the first n samples (a run that ended early: wormsim.physics.locking)."""
         self.raw = self.raw[:n]
         self.n = n
 

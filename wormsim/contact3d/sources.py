@@ -117,7 +117,7 @@ class FlankSource:
         """The loaded contact pattern and Hertz stress over the steady window (wormsim.tooth.hertz)."""
         summary.update(self.pattern.summary(S["t_s"], summary["steady_window_s"]))
         extra["flank_pattern"] = self.pattern.grid(S["t_s"], summary["steady_window_s"])
-        extra["flank_pattern_log"] = self.pattern  # its table() per contact and sample (sweeps/slice_convergence_*)
+        extra["flank_pattern_log"] = self.pattern  # its table() per contact and sample (studies/slice_convergence_*)
 
 
 def _store_points(i: int, p0, F, pw, rlog, store: tuple, a: float) -> tuple[float, float]:

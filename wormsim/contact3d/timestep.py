@@ -13,9 +13,9 @@ from __future__ import annotations
 from meshgen.geometry import GearGeometry
 from wormsim.contact3d.law import ContactLaw
 from wormsim.contact3d.mass_scaling import SCALED_STEP_FRACTION, floor_2_digits
-from wormsim.gear_theory import gear_drive, round_down_125, worm_speed_command_rad_s
+from wormsim.physics.gear_theory import duty, round_down_125, worm_speed_command_rad_s
+from wormsim.physics.units import rad_s_to_rpm
 from wormsim.scenario import Scenario, ScenarioError
-from wormsim.units import rad_s_to_rpm
 
 DEFAULT_FRACTION = 0.4  # default timestep: this fraction of the stable limit, rounded down to 1-2-5
 MAX_WORM_TURN_PER_STEP_RAD = 0.035  # largest worm rotation per step contact3d resolves (2.0 deg;
@@ -41,7 +41,7 @@ def choose_timestep(
 ) -> tuple[float, str]:
     """timestep_for the scenario's simulation.timestep_s and its drive's worm speed
     (gear_theory.worm_speed_command_rad_s)."""
-    w1 = worm_speed_command_rad_s(gear_drive(scenario), geo.ratio)
+    w1 = worm_speed_command_rad_s(duty(scenario, geo.hand).drive, geo.ratio)
     return timestep_for(scenario.simulation.timestep_s, w1, law, mass_scaling)
 
 

@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
-from wormsim.output import check_writable_dir
 from wormsim.rating.output import write_rating
 from wormsim.rating.rate import rate
+from wormsim.runfolder.writer import check_writable_dir
 from wormsim.scenario import load_scenario
 
 
@@ -16,7 +16,7 @@ def rate_command(scenario_path: str, out_dir: str, overrides: list[str], fe: boo
         # teeth that cannot be made (a pointed or undercut thread, no tooth at the face edges) are refused naming the
         # field (exit 2), as `wormsim check` and `run` refuse them: no rating of a gear that does not exist, and no
         # FE solid that gmsh refuses
-        from wormsim.validate import validate_geometry
+        from wormsim.physics.validate import validate_geometry
 
         validate_geometry(sc.model_copy(update={"model": "torsional"}))
     result = rate(sc)

@@ -39,7 +39,7 @@ import numpy as np
 from meshgen import wheel
 from meshgen.cache import cached
 from meshgen.geometry import GearGeometry
-from wormsim.errors import SimulationError
+from wormsim.exceptions import SimulationError
 
 CODE_VERSION = "fe-root-4"
 FILLET_COEF = 0.38  # rho_fP / m: ISO 53 profile A root radius of the basic rack
@@ -680,13 +680,13 @@ def add_fe_root_stress(scenario, result: dict) -> dict:
     of wormsim.rating.rate: the wheel of materials.wheel (E, nu) at the rated torque K_A T2 on the working flank."""
     import time
 
-    from wormsim import gear_theory
-    from wormsim.geometry import derive
+    from wormsim.physics import gear_theory
+    from wormsim.physics.geometry import derive
     from wormsim.rating.rate import rating_inputs
 
     r = rating_inputs(scenario)
     g = derive(scenario.gear)
-    side = gear_theory.working_flank(scenario, g.hand)
+    side = gear_theory.duty(scenario, g.hand).working_flank
     t2 = result["inputs"]["wheel_torque_rated_nm"]
     t0 = time.perf_counter()
     fe = root_stress(

@@ -1,10 +1,10 @@
-"""rating.json and rating.md of `wormsim rate`, written atomically into a locked folder (wormsim.output)."""
+"""rating.json and rating.md of `wormsim rate`, written atomically into a locked folder (wormsim.runfolder.writer)."""
 
 from __future__ import annotations
 
 from pathlib import Path
 
-from wormsim.output import locked_dir, write_json_atomic, write_text_atomic
+from wormsim.runfolder.writer import locked_dir, write_json_atomic, write_text_atomic
 
 RATING_FILES = ("rating.json", "rating.md")
 

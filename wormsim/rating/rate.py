@@ -7,8 +7,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-from wormsim import gear_theory
-from wormsim.geometry import derive
+from wormsim.physics import gear_theory
+from wormsim.physics.geometry import derive
 from wormsim.rating import agma6034 as agma
 from wormsim.rating import iso14521 as iso
 from wormsim.rating import plastic
@@ -98,7 +98,7 @@ def rate(scenario: Scenario) -> dict:
     f = Factors()
     geo = derive(scenario.gear)
     ratio = geo.ratio
-    t2_nom = gear_theory.working_wheel_torque_nm(scenario, ratio)
+    t2_nom = gear_theory.working_wheel_torque_of(scenario.drive, scenario.load, ratio)
     if t2_nom <= 0:
         raise ScenarioError(
             "load.torque_nm = 0: a rating needs the nominal load; allowed: load.torque_nm != 0 (or a torque drive "
@@ -107,64 +107,17 @@ def rate(scenario: Scenario) -> dict:
     n1 = worm_speed_rpm(scenario, r, ratio)
     mat = wheel_material(scenario, r, warnings)
 
-    # geometry in the public formulas' units (mm); with the wheel's profile shift x2 the worm meshes on its mean
-    # diameter d_m1 = d1 + 2 x2 m_x at the lead angle gamma_m (DIN 3975-1; d1 and gamma when x2 = 0)
-    a = geo.a * MM_PER_M
-    d1, d2 = 2.0 * geo.r_m1 * MM_PER_M, geo.d2 * MM_PER_M
-    m_x, q, z2, u = geo.m_x * MM_PER_M, geo.q, geo.z2, geo.z2 / geo.z1
-    b2h = geo.face_width * MM_PER_M
-    gamma = geo.gamma_m
-    x2 = geo.x2
+    gm = _Mesh.of(geo)
+    a, d1, d2, m_x, q, z2, u, b2h, gamma, x2 = gm.a, gm.d1, gm.d2, gm.m_x, gm.q, gm.z2, gm.u, gm.b2h, gm.gamma, gm.x2
     t2 = r.application_factor * t2_nom
-    inputs = {
-        "wheel_torque_nominal_nm": t2_nom,
-        "application_factor": r.application_factor,
-        "wheel_torque_rated_nm": t2,
-        "worm_speed_rpm": n1,
-        "life_h": r.life_h,
-        "lubricant": r.lubricant,
-        "oil_viscosity_40_mm2_s": r.oil_viscosity_40_mm2_s,
-        "oil_viscosity_100_mm2_s": r.oil_viscosity_100_mm2_s,
-        "oil_sump_temperature_given_c": r.oil_sump_temperature_c,
-        "wheel_material": mat.name,
-        "wheel_material_designation": mat.designation,
-        "wheel_material_source": mat.source,
-        "wheel_casting": r.wheel_casting,
-        "ambient_c": r.ambient_c,
-        "roughness_worm_um": r.roughness_worm_um,
-        "centre_distance_mm": a,
-        "worm_diameter_mm": geo.d1 * MM_PER_M,
-        "worm_mean_diameter_mm": d1,
-        "wheel_diameter_mm": d2,
-        "axial_module_mm": m_x,
-        "diameter_quotient": q,
-        "worm_starts": geo.z1,
-        "wheel_teeth": z2,
-        "lead_angle_deg": math.degrees(geo.gamma),
-        "lead_angle_mean_deg": math.degrees(gamma),
-        "normal_pressure_angle_deg": math.degrees(geo.alpha_n),
-        "face_width_mm": b2h,
-        "profile_shift_x2": x2,
-        "worm_youngs_modulus_gpa": scenario.materials.worm.youngs_modulus_gpa,
-        "worm_poisson_ratio": scenario.materials.worm.poisson_ratio,
-    }
+    inputs = _inputs(scenario, r, mat, geo, gm, t2_nom, n1)
     v_gm = f.add(
         "sliding_speed_m_s", "v_gm", iso.sliding_speed_m_s(d1, n1, gamma), "m/s", "mean sliding speed", iso.PORT
     )
-    if a < iso.METHOD_B_CENTRE_DISTANCE_MIN_MM:
-        warnings.append(
-            f"centre distance a = {a:.4g} mm < {iso.METHOD_B_CENTRE_DISTANCE_MIN_MM:g} mm: ISO/TS 14521 recommends "
-            "method A (measurements) below it; method B is applied outside its recommended range"
-        )
-    if v_gm > iso.SLIDING_SPEED_MAX_M_S:
-        warnings.append(
-            f"sliding speed v_gm = {v_gm:.4g} m/s > {iso.SLIDING_SPEED_MAX_M_S:g} m/s: outside the validity of "
-            "ISO/TS 14521"
-        )
     out: dict = {k: None for k in RATING_KEYS}
     out["sliding_speed_m_s"] = v_gm
     out["refused"] = None
-
+    _range_warnings(a, v_gm, warnings)
     if mat.kind == "plastic":
         out["refused"] = plastic.refusal_reason(mat.name)
         warnings.append(out["refused"])
@@ -197,10 +150,10 @@ def rate(scenario: Scenario) -> dict:
     )  # fmt: skip
 
     out["contact_stress_mean_iso_mpa"] = sigma_hm
-    mu, eta = _friction(f, r, mat, v_gm, gamma, q, z2, x2, u, b2h, m_x, a)
+    mu, eta = _friction(f, r, mat, v_gm, gm)
     out["friction_iso"], out["efficiency_iso"] = mu, eta
     out["safety_pitting"] = _pitting(f, r, mat, v_gm, a, sigma_hm)
-    out["safety_wear"] = _wear(f, r, u, gamma, sigma_hm, a, e_red, n1, m_x, v_gm, warnings)
+    out["safety_wear"] = _wear(f, r, gm, sigma_hm, e_red, n1, v_gm, warnings)
     f_tm2, out["safety_root"] = _root(f, geo, mat, t2, d2, b2h, m_x, gamma)
     out["safety_deflection"] = _deflection(f, r, geo, f_tm2, gamma, mu, e1, m_x, warnings)
     out["oil_temperature_c"], out["safety_temperature"] = _temperature(f, r, a, n1, d1, t2, u, eta)
@@ -209,8 +162,93 @@ def rate(scenario: Scenario) -> dict:
     return _finish(out, f, inputs, warnings)
 
 
-def _friction(f: Factors, r: Rating, mat: WheelMaterial, v_gm, gamma, q, z2, x2, u, b2h, m_x, a) -> tuple:
+@dataclass(frozen=True)
+class _Mesh:
+    """The geometry in the public formulas' units (mm); with the wheel's profile shift x2 the worm meshes on its mean
+    diameter d_m1 = d1 + 2 x2 m_x at the lead angle gamma_m (DIN 3975-1; d1 and gamma when x2 = 0)."""
+
+    a: float  # centre distance, mm
+    d1: float  # the worm's mean diameter d_m1, mm
+    d2: float
+    m_x: float
+    q: float
+    z2: int
+    u: float  # z2 / z1
+    b2h: float  # face width, mm
+    gamma: float  # gamma_m, rad
+    x2: float
+
+    @classmethod
+    def of(cls, geo) -> _Mesh:
+        return cls(
+            geo.a * MM_PER_M,
+            2.0 * geo.r_m1 * MM_PER_M,
+            geo.d2 * MM_PER_M,
+            geo.m_x * MM_PER_M,
+            geo.q,
+            geo.z2,
+            geo.z2 / geo.z1,
+            geo.face_width * MM_PER_M,
+            geo.gamma_m,
+            geo.x2,
+        )
+
+
+def _range_warnings(a: float, v_gm: float, warnings: list[str]) -> None:
+    """Method B's recommended centre distances and ISO/TS 14521's sliding speeds."""
+    if a < iso.METHOD_B_CENTRE_DISTANCE_MIN_MM:
+        warnings.append(
+            f"centre distance a = {a:.4g} mm < {iso.METHOD_B_CENTRE_DISTANCE_MIN_MM:g} mm: ISO/TS 14521 recommends "
+            "method A (measurements) below it; method B is applied outside its recommended range"
+        )
+    if v_gm > iso.SLIDING_SPEED_MAX_M_S:
+        warnings.append(
+            f"sliding speed v_gm = {v_gm:.4g} m/s > {iso.SLIDING_SPEED_MAX_M_S:g} m/s: outside the validity of "
+            "ISO/TS 14521"
+        )
+
+
+def _inputs(scenario: Scenario, r: Rating, mat: WheelMaterial, geo, gm: _Mesh, t2_nom: float, n1: float) -> dict:
+    """The rating's `inputs`: the loads, the rating: block, the material and the geometry (mm)."""
+    t2 = r.application_factor * t2_nom
+    a, d1, d2, m_x, q, z2, b2h, gamma, x2 = gm.a, gm.d1, gm.d2, gm.m_x, gm.q, gm.z2, gm.b2h, gm.gamma, gm.x2
+    return {
+        "wheel_torque_nominal_nm": t2_nom,
+        "application_factor": r.application_factor,
+        "wheel_torque_rated_nm": t2,
+        "worm_speed_rpm": n1,
+        "life_h": r.life_h,
+        "lubricant": r.lubricant,
+        "oil_viscosity_40_mm2_s": r.oil_viscosity_40_mm2_s,
+        "oil_viscosity_100_mm2_s": r.oil_viscosity_100_mm2_s,
+        "oil_sump_temperature_given_c": r.oil_sump_temperature_c,
+        "wheel_material": mat.name,
+        "wheel_material_designation": mat.designation,
+        "wheel_material_source": mat.source,
+        "wheel_casting": r.wheel_casting,
+        "ambient_c": r.ambient_c,
+        "roughness_worm_um": r.roughness_worm_um,
+        "centre_distance_mm": a,
+        "worm_diameter_mm": geo.d1 * MM_PER_M,
+        "worm_mean_diameter_mm": d1,
+        "wheel_diameter_mm": d2,
+        "axial_module_mm": m_x,
+        "diameter_quotient": q,
+        "worm_starts": geo.z1,
+        "wheel_teeth": z2,
+        "lead_angle_deg": math.degrees(geo.gamma),
+        "lead_angle_mean_deg": math.degrees(gamma),
+        "normal_pressure_angle_deg": math.degrees(geo.alpha_n),
+        "face_width_mm": b2h,
+        "profile_shift_x2": x2,
+        "worm_youngs_modulus_gpa": scenario.materials.worm.youngs_modulus_gpa,
+        "worm_poisson_ratio": scenario.materials.worm.poisson_ratio,
+    }
+
+
+def _friction(f: Factors, r: Rating, mat: WheelMaterial, v_gm, gm: _Mesh) -> tuple:
     """Friction and efficiency: mu_zm = mu_0T Y_S Y_G Y_W Y_R and the mesh efficiencies; returns (mu_zm, eta_z)."""
+    gamma, q, z2, x2, u, b2h, m_x, a = gm.gamma, gm.q, gm.z2, gm.x2, gm.u, gm.b2h, gm.m_x, gm.a
     grey = mat.kind == "grey_iron"
     h_star = f.add(
         "h_star", "h*", iso.film_thickness_factor(q, z2, x2, u, b2h, m_x), "-",
@@ -268,8 +306,9 @@ def _pitting(f: Factors, r: Rating, mat: WheelMaterial, v_gm, a, sigma_hm) -> fl
     return f.add("safety_pitting", "S_H", sigma_hg / sigma_hm, "-", "sigma_HG / sigma_Hm", iso.PORT)
 
 
-def _wear(f: Factors, r: Rating, u, gamma, sigma_hm, a, e_red, n1, m_x, v_gm, warnings: list[str]) -> float | None:
+def _wear(f: Factors, r: Rating, gm: _Mesh, sigma_hm, e_red, n1, v_gm, warnings: list[str]) -> float | None:
     """Wear: S_W = delta_Wlim,n / delta_Wn, None without rating.wear_intensity (J_W's tables are not public)."""
+    u, gamma, a, m_x = gm.u, gm.gamma, gm.a, gm.m_x
     s_star = f.add("s_star", "s*", iso.sliding_path_factor(u, gamma), "-", "sliding path factor", iso.PORT)
     n_l = f.add("n_l", "N_L", iso.wheel_load_cycles(r.life_h, n1, u), "-", "wheel revolutions over the life", iso.PORT)
     s_wm = f.add(

@@ -27,7 +27,7 @@ from pathlib import Path
 
 from tqdm import tqdm
 
-from wormsim.output import ResultDir, write_json_atomic
+from wormsim.runfolder.writer import ResultDir, write_json_atomic
 from wormsim.scenario import ScenarioError
 from wormsim.sweep.spec import Point, Sweep
 
@@ -49,7 +49,10 @@ def run_point(scenario: dict, keep_files: bool) -> dict:
     """One point, on a worker: simulate (and with keep_files write the result folder into a temporary directory
     and return its files). Never raises for a failed simulation: returns status "failed" and the message."""
     t_start = time.time()
-    from wormsim.errors import SimulationError
+    from wormsim.sweep.warm import warm_pid
+
+    warmed_by = warm_pid()
+    from wormsim.exceptions import SimulationError
     from wormsim.run import run_scenario, simulate
     from wormsim.scenario import Scenario
 
@@ -95,7 +98,7 @@ def run_point(scenario: dict, keep_files: bool) -> dict:
             **base,
             "wall_time_s": time.perf_counter() - t0,
         }
-    from wormsim import jit_cache
+    from wormsim.runtime import jit_cache
 
     jit = jit_cache.dispatcher_stats()
     return {
@@ -106,7 +109,11 @@ def run_point(scenario: dict, keep_files: bool) -> dict:
             "start": t_start,
             "end": time.time(),
             "setup_s": t_setup,
-            # this worker process's totals so far: seconds compiling, signatures compiled / loaded (wormsim.jit_cache)
+            # the pid that loaded the kernels before this point: the fork server's for a worker forked warm
+            "warmed_by_pid": warmed_by,
+            "pid": os.getpid(),
+            # this worker process's totals so far: seconds compiling, signatures compiled / loaded
+            # (wormsim.runtime.jit_cache)
             "compile_s": jit_cache.compile_seconds(),
             "jit_misses": jit["misses"],
             "jit_hits": jit["hits"],
@@ -152,7 +159,7 @@ def row_of(point: Point, summary: dict) -> dict:
         "message": summary.get("message", ""),
     }
     row.update({k: v for k, v in summary.items() if k not in _NOT_COLUMNS and _scalar(v)})
-    if summary.get("warnings"):  # the run's warnings (wormsim.run_warnings) as one cell
+    if summary.get("warnings"):  # the run's warnings (wormsim.results.run_warnings) as one cell
         row["warnings"] = "; ".join(summary["warnings"])
     row["wall_time_s"] = summary.get("wall_time_s")
     row["scenario_hash"] = point.scenario_hash
@@ -171,7 +178,8 @@ def columns(rows: list[dict], swept: list[str]) -> list[str]:
 
 
 def write_csv_atomic(path: Path, rows: list[dict], cols: list[str]) -> None:
-    """The whole table into a temporary file beside `path`, then os.replace (as wormsim.output.write_json_atomic)."""
+    """The whole table into a temporary file beside `path`, then os.replace (as
+    wormsim.runfolder.writer.write_json_atomic)."""
     buf = io.StringIO()
     w = csv.DictWriter(buf, fieldnames=cols, extrasaction="ignore", lineterminator="\n")
     w.writeheader()
@@ -203,7 +211,7 @@ def read_csv(path: Path) -> list[dict]:
 
 class SweepProgress:
     """Points done / total: a tqdm bar on a terminal; otherwise a log line per 10 % of the points (house style of
-    wormsim.progress; both off with WORMSIM_NO_PROGRESS)."""
+    wormsim.runfolder.progress; both off with WORMSIM_NO_PROGRESS)."""
 
     def __init__(self, name: str, total: int, done: int, enabled: bool | None = None, stream=None):
         self._stream = stream or sys.stderr
@@ -287,6 +295,17 @@ def default_workers() -> int:
 LOCAL_START_METHOD = "forkserver"
 
 
+def start_fork_server(warm: bool) -> None:
+    """Start multiprocessing's fork server now, preloading the workers' imports (wormsim.sweep.preload) and with
+    `warm` the compiled contact3d kernels (wormsim.sweep.preload_warm), once for all workers, on another core while
+    this process validates the points. A server that runs already (an earlier sweep in this process) is kept."""
+    import multiprocessing
+    from multiprocessing import forkserver
+
+    multiprocessing.set_forkserver_preload(["wormsim.sweep.preload_warm" if warm else "wormsim.sweep.preload"])
+    forkserver.ensure_running()
+
+
 def open_client(scheduler: str | None, workers: int | None):
     """(client, cluster or None, info). scheduler None: a LocalCluster of `workers` single-threaded processes.
     Raises ScenarioError for a bad --workers or a scheduler that does not answer."""
@@ -357,12 +376,14 @@ class ClusterStart:
     """open_client in a thread, started before the sweep file is validated (the cluster's start overlaps it);
     `get()` waits for it (and re-raises its error), `close()` closes what it opened."""
 
-    def __init__(self, scheduler: str | None, workers: int | None):
+    def __init__(self, scheduler: str | None, workers: int | None, warm: bool = True):
         import threading
 
         self._result: tuple | None = None
         self._error: BaseException | None = None
         scheduler = scheduler or os.environ.get(SCHEDULER_ENV) or None
+        if scheduler is None:
+            start_fork_server(warm)
         self._thread = threading.Thread(
             target=self._run, args=(scheduler, workers), name="wormsim-cluster-start", daemon=True
         )
@@ -455,16 +476,7 @@ def run_sweep(
     csv_path = out / CSV_NAME
     swept = sweep.swept_paths
     earlier = read_csv(csv_path)
-    ok_rows = {r.get("scenario_hash"): r for r in earlier if r.get("status") == "ok"}
-    rows: dict[int, dict] = {}
-    todo: list[Point] = []
-    for p in sweep.points:
-        old = ok_rows.get(p.scenario_hash)
-        if old is not None:
-            kept = {k: v for k, v in old.items() if "." not in k}  # dotted names: swept paths of that sweep
-            rows[p.index] = {**kept, "point": p.index, **p.values}
-        else:
-            todo.append(p)
+    rows, todo = _resume(sweep, earlier)
     resumed = len(rows)
     machine = machine_info()
     state = {
@@ -495,7 +507,7 @@ def run_sweep(
     try:
         if todo:
             if started is None:
-                started = ClusterStart(scheduler, workers)
+                started = ClusterStart(scheduler, workers, warm=any(p.scenario.model == "contact3d" for p in todo))
             client, cluster, cluster_info = started.get()
             started = None
             if any(p.scenario.model == "contact3d" for p in todo):
@@ -505,53 +517,8 @@ def run_sweep(
                 f"on {cluster_info['workers']} workers ({cluster_info['kind']} {cluster_info['scheduler']})"
             )
             write_json_atomic(out / JSON_NAME, _json_doc(sweep, rows, timing, machine, cluster_info, state))
-            from distributed import as_completed
 
-            # Only as many points in flight as the cluster has threads: a point waits on the scheduler, not in
-            # a worker's queue, so a worker that dies (segfault, OOM killer) fails the point it ran and no other.
-            futures = {}
-            queue = list(todo)
-
-            threads = _free_threads(client)
-            chunk = chunk_size(len(todo), threads)
-            cluster_info["points_per_task"] = chunk
-
-            def submit_next():
-                ps = queue[:chunk]
-                del queue[:chunk]
-                scs = [p.scenario.model_dump(mode="json") for p in ps]
-                key = f"wormsim-point-{ps[0].index}-{ps[0].scenario_hash}"
-                if chunk == 1:
-                    fut = client.submit(run_point, scs[0], keep_runs, pure=False, key=key)
-                else:
-                    fut = client.submit(run_points, scs, keep_runs, pure=False, key=f"{key}-{len(ps)}")
-                futures[fut] = (ps, time.time())
-                return fut
-
-            pending = as_completed([submit_next() for _ in range(min(-(-len(queue) // chunk), threads))])
-            png.start()  # matplotlib's import while the points run (this thread waits on them)
-            for fut in pending:
-                if queue:
-                    pending.add(submit_next())
-                ps, t_submit = futures[fut]
-                try:
-                    out_ = fut.result()
-                    results = [out_] if chunk == 1 else out_
-                except Exception as exc:  # (the worker died or the task could not run)
-                    results = [
-                        {
-                            "summary": {
-                                "status": "failed",
-                                "wall_time_s": None,
-                                "model": p.scenario.model,
-                                "message": f"worker lost: {exc.__class__.__name__}: {exc}",
-                            },
-                            "files": {},
-                            "timing": None,
-                        }
-                        for p in ps
-                    ]
-                received = time.time()
+            def on_results(ps: list[Point], results: list[dict], t_submit: float, received: float) -> None:
                 for p, res in zip(ps, results):
                     summary = res["summary"]
                     if keep_runs and res["files"]:
@@ -565,6 +532,8 @@ def run_sweep(
                     }
                     bar.point_done(summary.get("status") != "ok")
                 flush_csv()
+
+            _dispatch(client, todo, keep_runs, cluster_info, png, on_results)
     except KeyboardInterrupt:
         interrupted = True
     finally:
@@ -575,31 +544,96 @@ def run_sweep(
             finished=time.strftime("%Y-%m-%dT%H:%M:%S%z"), interrupted=interrupted, wall_s=time.perf_counter() - t_sweep
         )
         write_json_atomic(out / JSON_NAME, _json_doc(sweep, rows, timing, machine, cluster_info, state))
-        # the results are safe: the cluster closes in a thread while sweep.png is drawn
-        import threading
-
-        closing = threading.Thread(target=_close, args=(client, cluster), name="wormsim-cluster-close", daemon=True)
-        closing.start()
-        ordered = [rows[i] for i in sorted(rows)]
-        try:
-            png.join()
-            if not interrupted:
-                from wormsim.sweep.plot import write_sweep_png
-
-                write_sweep_png(ordered, swept, sweep.spec.plot, out / PNG_NAME, title=sweep.spec.name)
-        finally:
-            closing.join()
+        _close_and_plot(client, cluster, png, sweep, [rows[i] for i in sorted(rows)], None if interrupted else out)
     if interrupted:
         raise KeyboardInterrupt
     n_ok = sum(1 for r in rows.values() if r.get("status") == "ok")
-    return {
-        "points": len(sweep.points),
-        "ok": n_ok,
-        "failed": len(rows) - n_ok,
-        "resumed": resumed,
-        "ran": len(todo),
-        "cluster": cluster_info,
-    }
+    return {"points": len(sweep.points), "ok": n_ok, "failed": len(rows) - n_ok, "resumed": resumed,
+            "ran": len(todo), "cluster": cluster_info}  # fmt: skip
+
+
+def _close_and_plot(client, cluster, png: _PlotImport, sweep: Sweep, ordered: list[dict], out: Path | None) -> None:
+    """The results are safe: the cluster closes in a thread while sweep.png is drawn into out (None: not drawn, an
+    interrupted sweep)."""
+    import threading
+
+    closing = threading.Thread(target=_close, args=(client, cluster), name="wormsim-cluster-close", daemon=True)
+    closing.start()
+    try:
+        png.join()
+        if out is not None:
+            from wormsim.sweep.plot import write_sweep_png
+
+            write_sweep_png(ordered, sweep.swept_paths, sweep.spec.plot, out / PNG_NAME, title=sweep.spec.name)
+    finally:
+        closing.join()
+
+
+def _resume(sweep: Sweep, earlier: list[dict]) -> tuple[dict[int, dict], list[Point]]:
+    """(rows kept from an earlier sweep.csv, by point index; the points still to run): a point whose scenario hash
+    has an ok row there is not run again."""
+    ok_rows = {r.get("scenario_hash"): r for r in earlier if r.get("status") == "ok"}
+    rows: dict[int, dict] = {}
+    todo: list[Point] = []
+    for p in sweep.points:
+        old = ok_rows.get(p.scenario_hash)
+        if old is not None:
+            kept = {k: v for k, v in old.items() if "." not in k}  # dotted names: swept paths of that sweep
+            rows[p.index] = {**kept, "point": p.index, **p.values}
+        else:
+            todo.append(p)
+    return rows, todo
+
+
+def _dispatch(client, todo: list[Point], keep_runs: bool, cluster_info: dict, png: _PlotImport, on_results) -> None:
+    """Run the points of todo on the cluster in chunks (chunk_size; cluster_info gets points_per_task); each finished
+    chunk goes to on_results(points, results, submitted, received), a lost worker's chunk as failed results.
+    Only as many points in flight as the cluster has threads: a point waits on the scheduler, not in a worker's
+    queue, so a worker that dies (segfault, OOM killer) fails the point it ran and no other."""
+    from distributed import as_completed
+
+    futures = {}
+    queue = list(todo)
+    threads = _free_threads(client)
+    chunk = chunk_size(len(todo), threads)
+    cluster_info["points_per_task"] = chunk
+
+    def submit_next():
+        ps = queue[:chunk]
+        del queue[:chunk]
+        scs = [p.scenario.model_dump(mode="json") for p in ps]
+        key = f"wormsim-point-{ps[0].index}-{ps[0].scenario_hash}"
+        if chunk == 1:
+            fut = client.submit(run_point, scs[0], keep_runs, pure=False, key=key)
+        else:
+            fut = client.submit(run_points, scs, keep_runs, pure=False, key=f"{key}-{len(ps)}")
+        futures[fut] = (ps, time.time())
+        return fut
+
+    pending = as_completed([submit_next() for _ in range(min(-(-len(queue) // chunk), threads))])
+    png.start()  # matplotlib's import while the points run (this thread waits on them)
+    for fut in pending:
+        if queue:
+            pending.add(submit_next())
+        ps, t_submit = futures[fut]
+        try:
+            out_ = fut.result()
+            results = [out_] if chunk == 1 else out_
+        except Exception as exc:  # (the worker died or the task could not run)
+            results = [
+                {
+                    "summary": {
+                        "status": "failed",
+                        "wall_time_s": None,
+                        "model": p.scenario.model,
+                        "message": f"worker lost: {exc.__class__.__name__}: {exc}",
+                    },
+                    "files": {},
+                    "timing": None,
+                }
+                for p in ps
+            ]
+        on_results(ps, results, t_submit, time.time())
 
 
 class _PlotImport:

@@ -304,10 +304,11 @@ def _yaml12_numbers(obj):
     return obj
 
 
-def load_sweep(path: str | Path, max_errors: int = 5, on_parsed: Callable[[], None] | None = None) -> Sweep:
-    """Read, expand and validate a sweep file; ScenarioError (exit 2) on the first problems found. on_parsed() is
-    called once the file and its base scenario have been read, before the points are validated (`wormsim sweep`
-    starts its cluster there, so the start overlaps the validation)."""
+def load_sweep(path: str | Path, max_errors: int = 5, on_parsed: Callable[[bool], None] | None = None) -> Sweep:
+    """Read, expand and validate a sweep file; ScenarioError (exit 2) on the first problems found.
+    on_parsed(contact3d) is called once the file and its base scenario have been read, before the points are
+    validated (`wormsim sweep` starts its cluster there, so the start overlaps the validation); contact3d: whether
+    points may run at contact3d (the base's model, or a swept model)."""
     path = Path(path)
     if not path.is_file():
         raise ScenarioError(f"{path}: no such sweep file")
@@ -344,7 +345,7 @@ def load_sweep(path: str | Path, max_errors: int = 5, on_parsed: Callable[[], No
     for p, v in spec.set.items():
         set_path(base, p.split("."), v, f"{path.name}: set.{p}")
     if on_parsed is not None:
-        on_parsed()
+        on_parsed(base.get("model", "contact3d") == "contact3d" or "model" in spec.grid or "model" in spec.zip)
 
     points, errors = [], []
     for i, values in enumerate(expand(spec)):

@@ -2,7 +2,8 @@
 
 `WarmKernels.setup` runs on every worker that joins (distributed's WorkerPlugin, registered by the sweep when its
 points include contact3d runs) in a thread of the worker, so the worker's event loop keeps answering the scheduler:
-wormsim.jit_cache.ensure_warm (the machine's first worker compiles, holding the cache's lock; the others wait for it
+wormsim.runtime.jit_cache.ensure_warm (the machine's first worker compiles, holding the cache's lock; the others wait
+for it
 and load), then one short run (jit_cache.WARM_RUNS' first, WARM_STEPS steps) that loads every compiled function,
 numba's start-up and the imports into the worker process. A worker's first point then costs what its others cost.
 A failure is dropped: the point compiles or loads for itself.
@@ -11,21 +12,35 @@ A failure is dropped: the point compiles or loads for itself.
 from __future__ import annotations
 
 import asyncio
+import os
 
 from distributed.diagnostics.plugin import WorkerPlugin
 
+_warm_pid: int | None = None  # the process that ran the short run: this one, or the fork server it was forked from
+
+
+def warm_pid() -> int | None:
+    """The pid of the process that ran the short run in this process's memory (os.getpid(), or the fork server's
+    for a worker forked from a warm one); None before it."""
+    return _warm_pid
+
 
 def warm_worker() -> dict:
-    """ensure_warm and the short run in this process; returns {"compiled": bool, "error": str | None}."""
-    from wormsim import jit_cache
+    """ensure_warm and the short run in this process, unless done here already (a worker forked from the warm fork
+    server: wormsim.sweep.preload); returns {"compiled": bool, "error": str | None, "skipped": bool}."""
+    global _warm_pid
+    if _warm_pid is not None:
+        return {"compiled": False, "error": None, "skipped": True}
     from wormsim.contact3d.runner import warm_runs
+    from wormsim.runtime import jit_cache
 
     try:
         compiled = jit_cache.ensure_warm(warm_runs)
         warm_runs(jit_cache.WARM_RUNS[:1])
     except Exception as exc:  # (the points compile or load for themselves)
-        return {"compiled": False, "error": f"{exc.__class__.__name__}: {exc}"}
-    return {"compiled": compiled, "error": None}
+        return {"compiled": False, "error": f"{exc.__class__.__name__}: {exc}", "skipped": False}
+    _warm_pid = os.getpid()
+    return {"compiled": compiled, "error": None, "skipped": False}
 
 
 class WarmKernels(WorkerPlugin):

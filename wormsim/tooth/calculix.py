@@ -47,6 +47,7 @@ import numpy as np
 
 from meshgen import assembly, wheel, worm
 from meshgen.geometry import GearGeometry
+from wormsim.scenario import Materials
 
 CODE_VERSION = "calculix-1"
 SECTIONS = 41  # face-width sections of the wheel loft (the flank nodes are moved to the exact surface afterwards)
@@ -681,10 +682,7 @@ def root_stress_mpa(case: Case, stress: np.ndarray) -> dict:
 
 def solve(
     g: GearGeometry,
-    e_wheel_pa: float,
-    nu_wheel: float,
-    e_worm_pa: float,
-    nu_worm: float,
+    materials: Materials,
     side: int,
     theta1_rad: float,
     lag_rad: float,
@@ -695,9 +693,11 @@ def solve(
     """One CalculiX contact case (module docstring): the wheel turned by lag_rad from the kinematic touch at worm
     angle theta1 against the worm. Returns the torque, the mesh stiffness (secant from the touch and tangent of the
     last increment), the torque per wheel tooth and the load shares, the torque balance, the root stress and the
-    model's size."""
+    model's size. materials: the scenario's (E, nu of the wheel and the worm)."""
     import time
 
+    e_wheel_pa, nu_wheel = materials.wheel.youngs_modulus_gpa * 1e9, materials.wheel.poisson_ratio
+    e_worm_pa, nu_worm = materials.worm.youngs_modulus_gpa * 1e9, materials.worm.poisson_ratio
     t0 = time.perf_counter()
     case = build_case(g, side, theta1_rad, density)
     t_mesh = time.perf_counter() - t0

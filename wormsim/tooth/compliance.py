@@ -21,7 +21,7 @@ Sainsot, Velex & Duverger, J. Mech. Des. 126 (2004) 748): the normal approach of
       w_flat = 2 q (1 - nu^2) / (pi E) [ ln(2 h / b) - nu / (2 (1 - nu)) ],   b = sqrt(4 q rho' / (pi E*))   (2)
 
   q the line load (N/m), b the Hertz half-width (Johnson, Contact Mechanics, eq. 4.43), rho' the relative radius of
-  curvature across the contact line (wormsim.tooth.hertz), E* = wormsim.gear_theory.effective_modulus_pa. The
+  curvature across the contact line (wormsim.tooth.hertz), E* = wormsim.physics.gear_theory.effective_modulus_pa. The
   bracket is taken at least 0 (it is > 1 for every load below the tooth's strength). Weber's formula is chosen over
   Lundberg's or the plain Hertz k' = pi E* / 4 because it is the one whose reference point (the centre line at depth
   h) is the point where the FE displacement is read: the two parts meet there and nothing is counted twice.
@@ -371,7 +371,7 @@ def _moduli(materials) -> tuple[float, float, float, float]:
 def compute(g: GearGeometry, materials, density: int = 1, teeth: int = TEETH) -> ToothCompliance:
     """The FE models and the grid (module docstring); teeth: the wheel sector's teeth (1 for the study of the
     neighbours' effect)."""
-    from wormsim.gear_theory import effective_modulus_pa
+    from wormsim.physics.gear_theory import effective_modulus_pa
 
     t0 = time.perf_counter()
     e2, nu2, e1, nu1 = _moduli(materials)

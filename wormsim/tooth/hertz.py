@@ -23,7 +23,7 @@ Hertz line contact (Johnson eq. 4.45; DIN 3996 and ISO/TS 14521 use the same p_H
 
     p_H = sqrt(w E* / (pi rho')),   w = F_n / L                                                                (3)
 
-F_n = the contact's normal force (its constraint row), E* = wormsim.gear_theory.effective_modulus_pa.
+F_n = the contact's normal force (its constraint row), E* = wormsim.physics.gear_theory.effective_modulus_pa.
 
 Run outputs (`PatternLog`, one record per runner sample at the sample's end, every contact of the kernel): the
 summary over the steady window, each sample weighted equally (samples are equally spaced in time, so this is the
@@ -46,7 +46,7 @@ divides a vanishing force by a vanishing length, and MuJoCo's constraint force k
 (the impedance term D J qacc, D from solimp and A_hat); in (4) a window whose line is shorter than l_H counts its load
 over l_H. Measured with (3) per contact (the maximum over contacts above 1 % of the mean F_n), S against 2 S slices:
 4-start-z41 187 / 2841 MPa, random gear 0 153 / 1967 MPa (a contact of 0.08 N at the profile's end); with (4)
-131 / 131 and 127 / 131 MPa (sweeps/slice_convergence_default.py, docs/contact3d.md "Default slice count").
+131 / 131 and 127 / 131 MPa (studies/slice_convergence_default.py, docs/contact3d.md "Default slice count").
 """
 
 from __future__ import annotations
@@ -238,7 +238,7 @@ class PatternLog:
             self.buf = np.concatenate([self.buf, np.zeros_like(self.buf)])
 
     def truncate(self, n: int) -> None:
-        """Drop the rows of samples n and later (a run that ended early: wormsim.locking)."""
+        """Drop the rows of samples n and later (a run that ended early: wormsim.physics.locking)."""
         keep = self.buf[: self.m][self.buf[: self.m, 0] < n]
         self.buf[: len(keep)] = keep
         self.m = len(keep)

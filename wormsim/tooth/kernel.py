@@ -62,10 +62,10 @@ def _excess(x0, y0, zeta, ca, sa, P, tmp):
 
 
 @numba.njit(cache=True)
-def find_contacts(
-    xy, c, c_range, span, zeta, ks, theta1, theta2, margin, P, pos, nrm, depth, meta, line, taper_rad=0.0, memo=None
-):
-    """Contacts of the window teeth ks at worm angle theta1, wheel angle theta2 (module docstring). Writes per contact
+def find_contacts(grid, ks, theta1, theta2, margin, P, out, taper_rad=0.0, memo=None):
+    """Contacts of the window teeth ks at worm angle theta1, wheel angle theta2 (module docstring); grid = (xy, c,
+    c_range, span, zeta), the flank grid's arrays (wormsim.tooth.grid.FlankGrid), out = (pos, nrm, depth, meta,
+    line), the arrays written. Writes per contact
     the assembly position pos (n, 3), unit normal nrm (n, 3) (worm -> wheel), depth (n,) > 0 and meta (n, 4) =
     (tooth k, flank sigma, slice j, fractional profile index), and line (n, 2) = (excess of the contact line's point
     in slice widths, e / |de| with de its change across one slice width (_face_slope; e / dz, dz the slice width, where
@@ -77,15 +77,13 @@ def find_contacts(
     margin; with assembly errors the caller passes TAPER_SHARE x the error-free margin, so contacts that the errors
     move past the nominal conjugate range keep their full depth). memo (`flank_memo`, optional): the open-slice memo
     that skips slices whose flanks are clearly apart (`_find_contacts`); the contacts are the same with and without."""
-    N = c.shape[2]
+    N = grid[1].shape[2]
     if taper_rad <= 0.0:
         taper_rad = TAPER_SHARE * margin
     work = (np.empty(6), np.empty(N), np.empty(N), np.empty((N, 3)), np.empty((N, 3)), np.empty(N, dtype=np.int64))
     if memo is None:
         memo = (np.zeros((0, 2, 1, MEMO_COLS)), np.zeros(MEMO_CONSTS))
-    return _find_contacts(
-        xy, c, c_range, span, zeta, ks, theta1, theta2, margin, taper_rad, P, (pos, nrm, depth, meta, line), work, memo
-    )
+    return _find_contacts(grid, ks, theta1, theta2, margin, taper_rad, P, out, work, memo)
 
 
 def flank_memo(grid: FlankGrid, z2: int) -> tuple[np.ndarray, np.ndarray]:
@@ -102,7 +100,7 @@ def flank_memo(grid: FlankGrid, z2: int) -> tuple[np.ndarray, np.ndarray]:
 
 
 @numba.njit(cache=True, _nrt=False)
-def _find_contacts(xy, c, c_range, span, zeta, ks, theta1, theta2, margin, taper_rad, P, out, work, memo):
+def _find_contacts(grid, ks, theta1, theta2, margin, taper_rad, P, out, work, memo):
     """find_contacts with its work arrays passed in, compiled without numba's reference counting (_nrt=False): the
     inlined helpers take arrays, and with it every helper call cost an atomic incref/decref pair per array (about
     60 % of the kernel's time; docs/contact3d.md, "Exact flanks: cost"). Per window tooth, flank and slice in the
@@ -122,6 +120,7 @@ def _find_contacts(xy, c, c_range, span, zeta, ks, theta1, theta2, margin, taper
     (the same factor 2), so the nominal bound holds with 2 (delta + delta_e) more; delta = 0 for the nominal poses. A
     skipped slice gives no contact, as its evaluation would: tests/test_flank_kernel_memo.py compares with and without
     over mesh cycles, nominal and with moving poses."""
+    xy, c, c_range, span, zeta = grid
     tmp, gaps, exc, pts, nrs, stamp = work
     mtab, mc = memo
     use_memo = mtab.shape[0] > 0
@@ -161,7 +160,7 @@ def _find_contacts(xy, c, c_range, span, zeta, ks, theta1, theta2, margin, taper
                 i_s = _start_point(c, span, sg, j, target)
                 sid += 1
                 memo_row = (use_memo, mtab, te, drift)
-                n, full = _slice_contact(ev, span, zeta, sg, j, k, i_s, sid, taper, memo_row, out, n)
+                n, full = _slice_contact(ev, span, zeta, (sg, j, k), i_s, sid, taper, memo_row, out, n)
                 if full:
                     return n
     return n
@@ -278,11 +277,12 @@ def _g(ev, sg, j, i, zj, sid):
 
 
 @numba.njit(cache=True, inline="always")
-def _slice_contact(ev, span, zeta, sg, j, k, i_s, sid, taper, memo_row, out, n):
-    """The contact of (tooth k, flank sg, slice j) from the start point i_s (module docstring): the gap's minimum
-    along the profile (`_descend`), the parabola through it (`_line_parabola`), the worm's edge where the minimum
-    lies past it (`_edge_minimum`); written as contact n (`_write_contact`) where it touches, else the slice
+def _slice_contact(ev, span, zeta, slc, i_s, sid, taper, memo_row, out, n):
+    """The contact of slc = (flank sg, slice j, tooth k) from the start point i_s (module docstring): the gap's
+    minimum along the profile (`_descend`), the parabola through it (`_line_parabola`), the worm's edge where the
+    minimum lies past it (`_edge_minimum`); written as contact n (`_write_contact`) where it touches, else the slice
     memorised where it is open (memo_row = (use_memo, table, TE)). Returns (the contacts written, out full)."""
+    sg, j, k = slc
     exc = ev[7]
     zj = zeta[j]
     ib, best = _descend(ev, sg, j, zj, i_s, sid)
@@ -293,7 +293,7 @@ def _slice_contact(ev, span, zeta, sg, j, k, i_s, sid, taper, memo_row, out, n):
     nb = ib + 1 if x > 0.0 else ib - 1
     e_x = exc[ib] if x == 0.0 else exc[ib] + abs(x) * (exc[nb] - exc[ib])
     x_l = x
-    gmin, x = _edge_minimum(ev, sg, j, zj, ib, nb, best, qa, qb, x, e_x, par, gm, gp, sid)
+    gmin, x = _edge_minimum(ev, sg, j, zj, (ib, nb, best, e_x), (qa, qb, x, par, gm, gp), sid)
     gline = best + qa * x_l + qb * x_l * x_l
     if gmin >= 0.0 and gline >= 0.0:
         use_memo, mtab, te, drift = memo_row
@@ -306,7 +306,7 @@ def _slice_contact(ev, span, zeta, sg, j, k, i_s, sid, taper, memo_row, out, n):
         x = x_l  # no edge inside reach: the line's point (only its weight can make it carry)
     if n >= out[2].shape[0]:
         return n, True
-    _write_contact(ev, zeta, sg, j, k, ib, x, x_l, e_x, gmin, gline, taper, out, n)
+    _write_contact(ev, zeta, slc, (ib, x, x_l, e_x), (gmin, gline, taper), out, n)
     return n + 1, False
 
 
@@ -387,10 +387,13 @@ def _line_parabola(ev, sg, j, zj, ib, best, sid):
 
 
 @numba.njit(cache=True, inline="always")
-def _edge_minimum(ev, sg, j, zj, ib, nb, best, qa, qb, x, e_x, par, gm, gp, sid):
+def _edge_minimum(ev, sg, j, zj, at, parab, sid):
     """The slice's gap minimum inside the threaded region and its fractional offset x from ib: the parabola's where
     the line's point (excess e_x) lies inside; else the worm's edge on the wheel flank, where the excess crosses
-    zero (between ib and nb, or walking inwards from ib); +inf where no edge lies within reach."""
+    zero (between ib and nb, or walking inwards from ib); +inf where no edge lies within reach. at = (ib, nb, the
+    gap at ib, e_x), parab = (qa, qb, x, par, gm, gp) (_line_parabola's, x clamped to [-1, 1])."""
+    ib, nb, best, e_x = at
+    qa, qb, x, par, gm, gp = parab
     gaps, exc = ev[6], ev[7]
     if e_x <= 0.0:
         return best + qa * x + qb * x * x, x
@@ -424,10 +427,15 @@ def _edge_minimum(ev, sg, j, zj, ib, nb, best, qa, qb, x, e_x, par, gm, gp, sid)
 
 
 @numba.njit(cache=True, inline="always")
-def _write_contact(ev, zeta, sg, j, k, ib, x, x_l, e_x, gmin, gline, taper, out, n):
-    """Contact n of (tooth k, flank sg, slice j) at fractional profile index ib + x: its point and normal linear
-    between the grid points around it, moved half the depth along the normal (find_contacts' fields)."""
-    xy, ca, sa, theta1, P, tmp, pts, nrs = ev[0], ev[1], ev[2], ev[3], ev[4], ev[5], ev[8], ev[9]
+def _write_contact(ev, zeta, slc, at, gap, out, n):
+    """Contact n of slc = (flank sg, slice j, tooth k) at at = (ib, x, x_l, e_x): fractional profile index ib + x,
+    the line's point at ib + x_l with its excess e_x; gap = (the edge's gap minimum gmin, the line's gline, the
+    taper): its point and normal linear between the grid points around it, moved half the depth along the normal
+    (find_contacts' fields)."""
+    sg, j, k = slc
+    ib, x, x_l, e_x = at
+    gmin, gline, taper = gap
+    xy, ca, sa, P, tmp, pts, nrs = ev[0], ev[1], ev[2], ev[4], ev[5], ev[8], ev[9]
     pos, nrm, depth, meta, line = out
     N = xy.shape[2]
     f = ib + x
@@ -463,13 +471,13 @@ def _write_contact(ev, zeta, sg, j, k, ib, x, x_l, e_x, gmin, gline, taper, out,
         # is kept instead of the slope's two evaluations
         line[n, 0] = e_x / dz
     else:
-        line[n, 0] = _excess_in_slices(e_x, _face_slope(xy, sg, j, ib + x_l, zj, dz, ca, sa, theta1, P, tmp))
+        line[n, 0] = _excess_in_slices(e_x, _face_slope(xy, sg, j, ib + x_l, zj, dz, ca, sa, P, tmp))
     line[n, 1] = -gline * taper
     meta[n, 0], meta[n, 1], meta[n, 2], meta[n, 3] = k, sg, j, f
 
 
 @numba.njit(cache=True, inline="always")
-def _face_slope(xy, sg, j, f, zj, dz, ca, sa, theta1, P, tmp):
+def _face_slope(xy, sg, j, f, zj, dz, ca, sa, P, tmp):
     """Change of the excess (worm_gap_ext) across one slice width at the line's point: the wheel point at fractional
     profile index f of (flank sg, slice j), its (x, y) linear between the grid points, moved by -dz/2 and +dz/2
     along the wheel axis. A property of the point alone, so each slice's weight is continuous in the mesh angle
@@ -694,11 +702,7 @@ def find_packed(fb, ib, theta1, theta2, margin, taper_rad):
     if taper_rad <= 0.0:
         taper_rad = TAPER_SHARE * margin
     n = _find_contacts(
-        xy,
-        c,
-        c_range,
-        span,
-        zeta,
+        (xy, c, c_range, span, zeta),
         ks,
         theta1,
         theta2,
@@ -712,7 +716,8 @@ def find_packed(fb, ib, theta1, theta2, margin, taper_rad):
     n = slice_weights(meta, line, n, S, pos, nrm, depth, weight)
     contact_frames(nrm, n, frame)
     if ib[6]:  # one contact per tooth flank (wormsim.tooth.merge)
-        nm = merge_flanks(meta, n, pos, nrm, depth, weight, grp, share, mpos, mnrm, mdepth, mweight, mfric, mwrap, axes)
+        merged = (mpos, mnrm, mdepth, mweight, mfric, mwrap)
+        nm = merge_flanks(meta, n, (pos, nrm, depth, weight), grp, share, merged, axes)
         ib[7] = nm
         contact_frames(mnrm, nm, mframe)
     return n

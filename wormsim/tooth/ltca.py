@@ -225,7 +225,7 @@ def compute(
     tooth_compliance(g, materials, density) (for studies of its parts)."""
     import contourpy
 
-    from wormsim.gear_theory import effective_modulus_pa
+    from wormsim.physics.gear_theory import effective_modulus_pa
     from wormsim.tooth import mesh_stiffness as ms
     from wormsim.tooth.compliance import tooth_compliance
 

@@ -29,12 +29,15 @@ import numpy as np
 
 
 @numba.njit(cache=True)
-def merge_flanks(meta, n, pos, nrm, depth, weight, grp, share, mpos, mnrm, mdepth, mweight, mfric, mwrap, axes):
-    """The merged contacts of the n slice contacts (module docstring): mpos, mnrm, mdepth, mweight, mfric (the
-    friction coefficient's factor), mwrap (1 / c_w) per tooth flank; grp[c] the merged contact of slice contact c,
-    share[c] = a_c / sum a (its share of the slices' spring forces); axes = (a point on the worm axis, its
-    direction, a point on the wheel axis, its direction, the wheel's speed per worm speed): the hinges for the
-    moment-arm and friction corrections (module docstring). Returns the number of merged contacts."""
+def merge_flanks(meta, n, slices, grp, share, merged, axes):
+    """The merged contacts of the n slice contacts slices = (pos, nrm, depth, weight) (module docstring): merged =
+    (mpos, mnrm, mdepth, mweight, mfric (the friction coefficient's factor), mwrap (1 / c_w)) per tooth flank;
+    grp[c] the merged contact of slice contact c, share[c] = a_c / sum a (its share of the slices' spring forces);
+    axes = (a point on the worm axis, its direction, a point on the wheel axis, its direction, the wheel's speed per
+    worm speed): the hinges for the moment-arm and friction corrections (module docstring). Returns the number of
+    merged contacts."""
+    pos, nrm, depth, weight = slices
+    mpos, mnrm, mdepth, mweight, mfric, mwrap = merged
     g = 0
     i = np.int64(0)  # not a literal: _match_arms compiles once (int64), not also for Literal[int](0)
     while i < n:

@@ -19,8 +19,8 @@ import math
 import numpy as np
 
 from meshgen.geometry import GearGeometry
-from wormsim.errors import SimulationError
-from wormsim.gear_theory import effective_modulus_pa
+from wormsim.exceptions import SimulationError
+from wormsim.physics.gear_theory import effective_modulus_pa
 from wormsim.scenario import Contact, Materials
 from wormsim.tooth import compliance, ltca, mesh_stiffness
 from wormsim.tooth.mesh_stiffness import MeshStiffness
@@ -30,7 +30,8 @@ LTCA_SAMPLES = 16  # loaded TCA samples per mesh cycle (line_stiffness_n_per_m2'
 
 
 def hertz_per_length_n_per_m2(materials: Materials) -> float:
-    """k' = pi E* / 4 (Hertz line contact of two cylinders, seed 001; E* = wormsim.gear_theory.effective_modulus_pa)."""
+    """k' = pi E* / 4 (Hertz line contact of two cylinders, seed 001; E* =
+    wormsim.physics.gear_theory.effective_modulus_pa)."""
     return math.pi * effective_modulus_pa(materials) / 4.0
 
 
@@ -113,7 +114,8 @@ def stiffness_outputs(
     errors: bool = False,
 ) -> tuple[dict, object | None]:
     """(summary keys, the LTCA result or None): the keys of the tooth pair's stiffness and load sharing
-    (wormsim.outputs), the same at torsional and contact3d: mesh_stiffness_source and _mean_n_per_m (this TCA with the
+    (wormsim.results.summary_keys), the same at torsional and contact3d: mesh_stiffness_source and _mean_n_per_m (this
+    TCA with the
     k' the run uses), the mean per face width in N/(mm um) (ISO 6336-1's unit of c' and c_gamma), and from the loaded
     tooth contact analysis of the teeth's compliance at the working wheel torque (wormsim.tooth.ltca.loaded_contact)
     the loaded TE p2p and the largest share of one tooth, on the working flank `side`. The LTCA runs only where the

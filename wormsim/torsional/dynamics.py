@@ -66,7 +66,7 @@ servo and the friction regularisation are many decades faster than the motion (s
 follows the motion and the quasi-static mesh force at steps of one k(theta) sample's worth of worm rotation
 (default_timestep) and damps the kHz modes. scipy solve_ivp (LSODA, BDF, Radau; `simulate(..., method=)`)
 resolves them and serves as the accuracy reference; it is 20-500x slower (docs/torsional.md).
-Summary keys and their computation: those of contact3d (wormsim.metrics: steady window, FFT peak), except
+Summary keys and their computation: those of contact3d (wormsim.results.metrics: steady window, FFT peak), except
 that mesh_frequency_hz is the meshing line of the transmission error, not of the tangential force (see
 torsional_summary; the force's peak is reported as force_peak_full_band_hz).
 """
@@ -80,17 +80,18 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from meshgen.geometry import GearGeometry
-from wormsim import gear_theory as gt
-from wormsim.errors import DivergedError, LockedError, PenetrationError, SimulationError
-from wormsim.friction import friction_coefficient, friction_coefficient_scalar, friction_mode
-from wormsim.geometry import derive, displaced_pair
-from wormsim.locking import Held, backdrive_self_locks, held_keys, run_keys
-from wormsim.metrics import dominant_frequency, drive_summary, mean_speeds_rpm, mesh_line_keys, window_of
-from wormsim.result import Result
-from wormsim.scenario import Scenario
+from wormsim.exceptions import DivergedError, LockedError, PenetrationError, SimulationError
+from wormsim.physics import gear_theory as gt
+from wormsim.physics.friction import friction_coefficient_scalar
+from wormsim.physics.locking import Held, held_keys, run_keys
+from wormsim.physics.plan import GearPlan, gear_plan
+from wormsim.physics.units import rad_s_to_rpm, step
+from wormsim.results.metrics import dominant_frequency, drive_summary, mean_speeds_rpm, mesh_line_keys, window_of
+from wormsim.results.result import Result
+from wormsim.results.summary_keys import level_summary
+from wormsim.scenario import Contact, Load, Materials, Scenario
 from wormsim.tooth.mesh_stiffness import MeshStiffness
 from wormsim.tooth.stiffness import mesh_stiffness_table, stiffness_outputs
-from wormsim.units import rad_s_to_rpm, step
 
 CHORD_ITER = 4  # backward Euler: Newton iterations that reuse the first Jacobian of a step
 MAX_SAMPLES = 20000
@@ -99,10 +100,10 @@ RTOL, ATOL_ANGLE = 1e-7, 1e-10
 SIGN_VELOCITY_FRACTION = 0.1  # v_s / v_t: friction-direction regularisation (module docstring)
 
 
-def inertias(scenario: Scenario, g: GearGeometry) -> tuple[float, float]:
+def inertias(materials: Materials, load: Load, g: GearGeometry) -> tuple[float, float]:
     """(I1, I2) in kg m^2: solid cylinders (module docstring), plus the driven-machine inertia
     load.inertia_kg_m2 on the loaded shaft (rigid on it, as contact3d's joint armature)."""
-    return gt.shaft_inertias_kg_m2(scenario, g.r1, g.worm_length, g.r2, g.face_width)
+    return gt.shaft_inertias_kg_m2(materials, load, g.r1, g.worm_length, g.r2, g.face_width)
 
 
 class _TorqueTable:
@@ -135,10 +136,7 @@ class _TorqueTable:
 class _Mesh:
     """The force element (module docstring); scalar call for the ODE, array call for the outputs."""
 
-    def __init__(
-        self, scenario: Scenario, g: GearGeometry, ms: MeshStiffness, I1: float, I2: float, kin=None, ltca=None
-    ):
-        c = scenario.contact
+    def __init__(self, c: Contact, g: GearGeometry, ms: MeshStiffness, I1: float, I2: float, kin=None, ltca=None):
         self.g, self.ms = g, ms
         self.hz = g.hand * g.z1 / g.z2
         self.gap = g.backlash / (2 * g.r2)
@@ -404,39 +402,54 @@ def simulate(scenario: Scenario, progress=None, method: str = "implicit") -> Res
     scipy_method = SCIPY_METHODS.get(method.lower())
     if scipy_method is None and method != "implicit":
         raise ValueError(f"torsional method {method!r}: allowed implicit, {', '.join(SCIPY_METHODS.values())}")
-    g = derive(scenario.gear)
-    t_ms = time.perf_counter()
-    ms = mesh_stiffness_table(scenario.contact, g, scenario.materials, scenario.simulation.mesh_stiffness_samples)
-    kp = ms.stiffness_per_length_n_per_m2
-    t_ms = time.perf_counter() - t_ms
-    I1, I2 = inertias(scenario, g)
-    pair = displaced_pair(scenario.errors, g)
-    kin = pair[1] if pair is not None else None
-    ltca, t_lt = None, 0.0
-    if pair is not None:
-        from wormsim.torsional.loaded_tca import loaded_tca  # only with errors
+    return run_plan(gear_plan(scenario), progress, scipy_method)
 
-        t_lt = time.perf_counter()
-        t2w = gt.working_wheel_torque_nm(scenario, g.ratio)
-        ltca = loaded_tca(g, pair[0], kin, kp * g.face_width, t2w, float(np.mean(ms.k_theta_fwd_nm_per_rad)))
-        t_lt = time.perf_counter() - t_lt
-    mesh = _Mesh(scenario, g, ms, I1, I2, kin, ltca)
-    drv = scenario.drive
-    cmds = gt.commands(scenario, g.hand)
-    speed_driven = drv.speed_rpm is not None
-    kv = (
-        gt.servo_gain_nm_s(scenario, g.ratio, g.gamma_m, g.alpha_n, float(friction_coefficient(scenario.contact, 1.0)))
-        if speed_driven
-        else 0.0
-    )
-    worm_drive = drv.on == "worm"
-    drive_f, load_f = cmds.drive, cmds.load
 
-    def shaft_torques(t, w1, w2):
-        cmd = drive_f(t)
-        td = kv * (cmd - (w1 if worm_drive else w2)) if speed_driven else cmd
-        tl = load_f(t)
-        return (td, tl) if worm_drive else (tl, td)
+class _Setup:
+    """What the run integrates, from its plan: mesh stiffness, inertias, the displaced pair's TCAs, the force
+    element, the commands and the servo."""
+
+    def __init__(self, plan: GearPlan):
+        g = self.g = plan.geometry
+        t_ms = time.perf_counter()
+        ms = self.ms = mesh_stiffness_table(plan.contact, g, plan.materials, plan.simulation.mesh_stiffness_samples)
+        kp = ms.stiffness_per_length_n_per_m2
+        self.t_ms = time.perf_counter() - t_ms
+        self.I1, self.I2 = inertias(plan.materials, plan.duty.load, g)
+        pair = self.pair = plan.displaced
+        self.kin = pair[1] if pair is not None else None
+        self.ltca, self.t_lt = None, 0.0
+        if pair is not None:
+            from wormsim.torsional.loaded_tca import loaded_tca  # only with errors
+
+            t_lt = time.perf_counter()
+            t2w = plan.working_wheel_torque_nm
+            self.ltca = loaded_tca(
+                g, pair[0], self.kin, kp * g.face_width, t2w, float(np.mean(ms.k_theta_fwd_nm_per_rad))
+            )
+            self.t_lt = time.perf_counter() - t_lt
+        self.mesh = _Mesh(plan.contact, g, ms, self.I1, self.I2, self.kin, self.ltca)
+        drv = plan.duty.drive
+        cmds = plan.duty.commands
+        self.speed_driven = drv.speed_rpm is not None
+        self.kv = plan.servo_gain_nm_s if self.speed_driven else 0.0
+        self.worm_drive = drv.on == "worm"
+        self.drive_f, self.load_f = cmds.drive, cmds.load
+        w_full = abs(cmds.drive_target) if self.speed_driven else 2 * math.pi
+        self.w1_full = w_full * (g.ratio if (self.speed_driven and not self.worm_drive) else 1.0)
+
+    def shaft_torques(self, t, w1, w2):
+        cmd = self.drive_f(t)
+        td = self.kv * (cmd - (w1 if self.worm_drive else w2)) if self.speed_driven else cmd
+        tl = self.load_f(t)
+        return (td, tl) if self.worm_drive else (tl, td)
+
+
+def run_plan(plan: GearPlan, progress=None, scipy_method: str | None = None) -> Result:
+    """The torsional run of a plan (wormsim.physics.plan.gear_plan): integrate, guard, summarise."""
+    su = _Setup(plan)
+    g, ms, mesh = su.g, su.ms, su.mesh
+    I1, I2, shaft_torques = su.I1, su.I2, su.shaft_torques
 
     def acc(t, th1, w1, th2, w2):
         T2m, T1m = mesh.torques(th1, w1, th2, w2)
@@ -447,13 +460,11 @@ def simulate(scenario: Scenario, progress=None, method: str = "implicit") -> Res
         a1, a2 = acc(t, *y)
         return (y[1], a1, y[3], a2)
 
-    duration = scenario.simulation.duration_s
-    w_full = abs(cmds.drive_target) if speed_driven else 2 * math.pi
-    w1_full = w_full * (g.ratio if (speed_driven and not worm_drive) else 1.0)
-    h = scenario.simulation.timestep_s or default_timestep(g, ms, w1_full, duration)
+    duration = plan.simulation.duration_s
+    h = plan.simulation.timestep_s or default_timestep(g, ms, su.w1_full, duration)
     t_wall = time.perf_counter()
     if scipy_method is not None:
-        t, Y, nfev = _integrate_scipy(rhs, duration, h, ms, w1_full, scipy_method)
+        t, Y, nfev = _integrate_scipy(rhs, duration, h, ms, su.w1_full, scipy_method)
         solver = f"scipy {scipy_method} rtol {RTOL}"
     else:
         t, Y, nfev = integrate_backward_euler(acc, duration, h)
@@ -461,17 +472,35 @@ def simulate(scenario: Scenario, progress=None, method: str = "implicit") -> Res
     wall = time.perf_counter() - t_wall
     if progress is not None:
         progress.update(duration)
-    th1, w1, th2, w2 = Y
     if not np.all(np.isfinite(Y)):
         raise DivergedError(f"torsional integration diverged (timestep {h:.3g} s); lower simulation.timestep_s")
-    out = mesh.outputs(th1, w1, th2, w2)
-    cmd = np.array([drive_f(x) for x in t])
-    held = _guards(scenario, g, t, w1, w2, out, cmd)
-    if held is not None:  # a self-locking pair held the back-driving wheel: the run ends there (wormsim.locking)
+    S, held = _series(plan, su, t, Y)
+    solver_keys = {"timestep_s": h, "solver": solver, "solver_rhs_evaluations": int(nfev), "solve_wall_s": wall}
+    summary, lt_teeth = _summary(plan, su, S, held, solver_keys)
+    return Result(
+        model="torsional",
+        summary=summary,
+        series=S,
+        steps=len(S["t_s"]) - 1,
+        sim_time_s=float(S["t_s"][-1]),
+        extra={"mesh_stiffness": ms, "geometry": g, "ltca": lt_teeth},
+    )
+
+
+def _series(plan: GearPlan, su: _Setup, t: np.ndarray, Y: np.ndarray) -> tuple[dict, Held | None]:
+    """The run's series from the integrated states (up to the hold when a self-locking pair held) and the hold."""
+    th1, w1, th2, w2 = Y
+    ms = su.ms
+    out = su.mesh.outputs(th1, w1, th2, w2)
+    cmd = np.array([su.drive_f(x) for x in t])
+    held = _guards(plan, t, w1, w2, out, cmd)
+    if (
+        held is not None
+    ):  # a self-locking pair held the back-driving wheel: the run ends there (wormsim.physics.locking)
         n = int(np.searchsorted(t, held.t_s, side="right"))
         t, th1, w1, th2, w2, cmd = t[:n], th1[:n], w1[:n], th2[:n], w2[:n], cmd[:n]
         out = {k: v[:n] for k, v in out.items()}
-    tq = np.array([shaft_torques(ti, a, b) for ti, a, b in zip(t, w1, w2)])
+    tq = np.array([su.shaft_torques(ti, a, b) for ti, a, b in zip(t, w1, w2)])
     S = {
         "t_s": t,
         "worm_angle_rad": th1,
@@ -492,67 +521,64 @@ def simulate(scenario: Scenario, progress=None, method: str = "implicit") -> Res
         ),
         **out,
     }
-    summary = torsional_summary(S, scenario, g, ms)
-    t2_work = gt.working_wheel_torque_nm(scenario, g.ratio)
+    return S, held
+
+
+def _summary(plan: GearPlan, su: _Setup, S: dict, held: Held | None, solver_keys: dict) -> tuple[dict, object]:
+    """The torsional keys of the run (solver_keys: the integration's) and the teeth's LTCA for the report."""
+    g, ms, mesh, kin = su.g, su.ms, su.mesh, su.kin
+    t = S["t_s"]
+    drive = torsional_summary(S, plan, ms)
+    t2_work = plan.working_wheel_torque_nm
     st_keys, lt_teeth = stiffness_outputs(
-        ms, g, scenario.materials, t2_work, gt.working_flank(scenario, g.hand), errors=pair is not None
+        ms, g, plan.materials, t2_work, plan.duty.working_flank, errors=su.pair is not None
     )
-    summary.update(
-        run_keys(scenario, g, t, S["worm_speed_rpm"])
+    lock = (
+        run_keys(plan.duty.drive, plan.rho_static_rad, plan.transition_velocity_m_s, g, t, S["worm_speed_rpm"])
         if held is None
         else held_keys(t, S["worm_speed_rpm"], S["wheel_torque_nm"], held.stuck_since_s or held.t_s)
     )
-    summary.update(
-        {
-            "scenario": scenario.name,
-            "timestep_s": h,
-            "solver": solver,
-            "solver_rhs_evaluations": int(nfev),
-            "solve_wall_s": wall,
-            "mesh_stiffness_wall_s": t_ms,
-            "worm_inertia_kg_m2": I1,
-            "wheel_inertia_kg_m2": I2,
-            "inertia_source": "solid cylinders r1 x b1, r2 x b2 (+ load.inertia_kg_m2 on the loaded shaft)",
-            "mesh_natural_frequency_hz": mesh.omega_mesh / (2 * math.pi),
-            "contact_damping_requested_n_s_per_m": mesh.c_req,
-            "contact_damping_used_n_s_per_m": mesh.c_lin,
-            "contact_damping_ratio": mesh.c_lin / mesh.c_crit,
-            "drive_kv_nm_s": kv if speed_driven else None,
-            "backlash_angle_rad": 2 * mesh.gap,
-            "friction": friction_mode(scenario.contact),
-            **ms.summary(),
-            **st_keys,
-        }
-    )
+    used = {
+        "scenario": plan.name,
+        **solver_keys,
+        "mesh_stiffness_wall_s": su.t_ms,
+        "worm_inertia_kg_m2": su.I1,
+        "wheel_inertia_kg_m2": su.I2,
+        "inertia_source": "solid cylinders r1 x b1, r2 x b2 (+ load.inertia_kg_m2 on the loaded shaft)",
+        "mesh_natural_frequency_hz": mesh.omega_mesh / (2 * math.pi),
+        "contact_damping_requested_n_s_per_m": mesh.c_req,
+        "contact_damping_used_n_s_per_m": mesh.c_lin,
+        "contact_damping_ratio": mesh.c_lin / mesh.c_crit,
+        "drive_kv_nm_s": su.kv if su.speed_driven else None,
+        "backlash_angle_rad": 2 * mesh.gap,
+        "friction": plan.friction_mode,
+        **ms.summary(),
+        **st_keys,
+    }
+    errors: dict = {}
     if kin is not None:
-        side = gt.working_flank(scenario, g.hand)
-        summary.update(kin.summary(g, side))
-        k_lt = ltca.secant_stiffness_nm_per_rad(side, t2w) / ms.arm0_m**2
-        summary["mesh_stiffness_loaded_tca_mean_n_per_m"] = float(np.nanmean(k_lt)) if np.isfinite(k_lt).any() else None
-        summary["loaded_tca_wall_s"] = t_lt
+        side = plan.duty.working_flank
+        errors.update(kin.summary(g, side))
+        k_lt = su.ltca.secant_stiffness_nm_per_rad(side, t2_work) / ms.arm0_m**2
+        errors["mesh_stiffness_loaded_tca_mean_n_per_m"] = float(np.nanmean(k_lt)) if np.isfinite(k_lt).any() else None
+        errors["loaded_tca_wall_s"] = su.t_lt
         te = kin.te_rad(side)
         S["transmission_error_kinematic_rad"] = np.interp(
-            np.mod(th1, kin.period_rad), np.append(kin.theta1_rad, kin.period_rad), np.append(te, te[0])
+            np.mod(S["worm_angle_rad"], kin.period_rad), np.append(kin.theta1_rad, kin.period_rad), np.append(te, te[0])
         )
-    return Result(
-        model="torsional",
-        summary=summary,
-        series=S,
-        steps=len(t) - 1,
-        sim_time_s=float(t[-1]),
-        extra={"mesh_stiffness": ms, "geometry": g, "ltca": lt_teeth},
-    )
+    return level_summary("torsional", drive, lock, used, errors), lt_teeth
 
 
-def _guards(scenario, g, t, w1, w2, out, cmd) -> Held | None:
+def _guards(plan: GearPlan, t, w1, w2, out, cmd) -> Held | None:
     """Teeth would skip (deflection past 0.4 m_x, gear_theory.penetration_limit_m, contact3d's penetration limit);
     a speed-driven drive stuck below half its command for 0.05 s after the ramps (locked: a jam, LockedError; or a
-    wheel back-driving a self-locking pair: returned as Held, the run's result, wormsim.locking). The deflection is
+    wheel back-driving a self-locking pair: returned as Held, the run's result, wormsim.physics.locking). The
+    deflection is
     checked up to the end of the run (the hold when held)."""
-    drv = scenario.drive
+    g, drv = plan.geometry, plan.duty.drive
     held = None
     if drv.speed_rpm is not None:
-        held = _locked_guard(scenario, g, t, w1, w2, cmd)
+        held = _locked_guard(plan, t, w1, w2, cmd)
     n = len(t) if held is None else int(np.searchsorted(t, held.t_s, side="right"))
     dmax = float(np.max(out["mesh_deflection_m"][:n]))
     lim = gt.penetration_limit_m(g.m_x)
@@ -560,9 +586,9 @@ def _guards(scenario, g, t, w1, w2, out, cmd) -> Held | None:
         i = int(np.argmax(out["mesh_deflection_m"] > lim))
         why = "raise contact.stiffness_n_per_m or lower load.torque_nm"
         vs = abs(float(w1[i])) * g.r_m1 / math.cos(g.gamma_m)
-        creeping = drv.on == "wheel" and vs < 10 * scenario.contact.transition_velocity_m_s
-        if creeping and i > 0 and backdrive_self_locks(scenario, g.gamma_m, g.alpha_n):
-            return Held(float(t[i - 1]), _stuck_since(scenario, t, w2, cmd))  # the stalled wheel's servo pushed on
+        creeping = drv.on == "wheel" and vs < 10 * plan.transition_velocity_m_s
+        if creeping and i > 0 and plan.backdrive_self_locks:
+            return Held(float(t[i - 1]), _stuck_since(plan, t, w2, cmd))  # the stalled wheel's servo pushed on
         if creeping:
             rho = gt.virtual_friction_angle_rad(float(out["friction_coefficient"][i]), g.alpha_n)
             why = (
@@ -577,44 +603,45 @@ def _guards(scenario, g, t, w1, w2, out, cmd) -> Held | None:
     return held
 
 
-def _stuck_since(scenario, t, w_drive, cmd) -> float | None:
+def _stuck_since(plan: GearPlan, t, w_drive, cmd) -> float | None:
     """The first time after the lock check's start at which the speed-driven drive is stuck (None: never)."""
-    bad = (t > gt.lock_check_start_s(scenario)) & gt.drive_stuck(w_drive, cmd)
+    bad = (t > plan.duty.lock_check_start_s) & gt.drive_stuck(w_drive, cmd)
     return float(t[int(np.argmax(bad))]) if bad.any() else None
 
 
-def _locked_guard(scenario, g, t, w1, w2, cmd) -> Held | None:
-    w_drive = w1 if scenario.drive.on == "worm" else w2
-    bad = (t > gt.lock_check_start_s(scenario)) & gt.drive_stuck(w_drive, cmd)
+def _locked_guard(plan: GearPlan, t, w1, w2, cmd) -> Held | None:
+    w_drive = w1 if plan.duty.drive.on == "worm" else w2
+    bad = (t > plan.duty.lock_check_start_s) & gt.drive_stuck(w_drive, cmd)
     if bad.any():
         i0 = int(np.argmax(bad))
         run = np.nonzero(~bad[i0:])[0]
         i1 = i0 + (int(run[0]) if len(run) else len(bad) - i0) - 1
         if t[i1] - t[i0] >= gt.LOCK_HOLD_S or (not len(run) and t[-1] - t[i0] > 0):
-            if backdrive_self_locks(scenario, g.gamma_m, g.alpha_n):  # the answer, not a failure (wormsim.locking)
+            if plan.backdrive_self_locks:  # the answer, not a failure (wormsim.physics.locking)
                 i_end = int(np.searchsorted(t, t[i0] + gt.LOCK_HOLD_S))
                 return Held(float(t[min(i_end, i1)]), float(t[i0]))
             raise LockedError(
                 f"the drive locked at t = {t[i0]:.4g} s: {rad_s_to_rpm(float(w_drive[i0])):.3g} rpm against a "
                 f"command of {rad_s_to_rpm(float(cmd[i0])):.3g} rpm (self-locking: the wheel cannot drive the worm "
-                f"when rho' > gamma; or the load {scenario.load.torque_nm} N m is too high)"
+                f"when rho' > gamma; or the load {plan.duty.load.torque_nm} N m is too high)"
             )
     return None
 
 
-def torsional_summary(S: dict, scenario: Scenario, g: GearGeometry, ms: MeshStiffness) -> dict:
-    """contact3d's summary keys, computed by the same functions (wormsim.metrics), with one difference:
-    the meshing line is taken from the transmission error (wormsim.metrics.mesh_line). The mesh force element's
+def torsional_summary(S: dict, plan: GearPlan, ms: MeshStiffness) -> dict:
+    """contact3d's summary keys, computed by the same functions (wormsim.results.metrics), with one difference:
+    the meshing line is taken from the transmission error (wormsim.results.metrics.mesh_line). The mesh force element's
     tangential force is quasi-static: its fluctuation is the inertial part, the 2nd time derivative of the
     transmission error, which weights the harmonics of k(theta)'s tooth-entry kinks by n^2 and puts the
     force's peak on a harmonic (reported as force_peak_full_band_hz)."""
+    g = plan.geometry
     t = S["t_s"]
-    i0, i1, _ = window_of(S, scenario, g)
+    i0, i1, _ = window_of(S, plan.duty, g)
     sl = slice(i0, i1)
     n1, n2 = mean_speeds_rpm(S, i0, i1)
     f_force, _, _, _ = dominant_frequency(t[sl], S["tangential_force_n"][sl])
     return {
-        **drive_summary(S, scenario, g, i0, i1, n1, n2),
+        **drive_summary(S, plan, i0, i1, n1, n2),
         **mesh_line_keys(t, S, sl, g.z1 * n1 / 60.0, "transmission_error_rad"),
         "mesh_frequency_source": "transmission error",
         "force_peak_full_band_hz": f_force,

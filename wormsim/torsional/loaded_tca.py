@@ -38,7 +38,7 @@ import numpy as np
 from meshgen import assembly, displaced
 from meshgen.cache import cached
 from meshgen.geometry import GearGeometry
-from wormsim.errors import SimulationError
+from wormsim.exceptions import SimulationError
 from wormsim.tooth import gap as tooth_gap
 from wormsim.tooth import grid as tooth_grid
 from wormsim.tooth import kernel as tooth_kernel
@@ -119,8 +119,8 @@ class Evaluator:
             self.o, self.a = _poses(self.g, self.dev, th1, th2, self.P)
         gr = self.grid
         n = find_contacts(
-            gr.xy, gr.c, gr.c_range, gr.span, gr.zeta, self.ks, th1, th2, self.margin, self.P,
-            self.pos, self.nrm, self.depth, self.meta, self.line, self.taper_rad,
+            (gr.xy, gr.c, gr.c_range, gr.span, gr.zeta), self.ks, th1, th2, self.margin, self.P,
+            (self.pos, self.nrm, self.depth, self.meta, self.line), self.taper_rad,
         )  # fmt: skip
         self.n = n = slice_weights(self.meta, self.line, n, self.slices, self.pos, self.nrm, self.depth, self.weight)
         if n == 0:

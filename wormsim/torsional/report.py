@@ -7,8 +7,8 @@ from pathlib import Path
 
 import numpy as np
 
-from wormsim.recording import save_series_recording
-from wormsim.report_header import (
+from wormsim.results.recording import save_series_recording
+from wormsim.results.report_header import (
     draw_header,
     gear_line,
     header_rows,
@@ -18,7 +18,7 @@ from wormsim.report_header import (
     steady_ylim,
     warning_text,
 )
-from wormsim.result import Result
+from wormsim.results.result import Result
 from wormsim.tooth.mesh_stiffness import MeshStiffness
 from wormsim.tooth.stiffness_plot import draw_load_shares, draw_mesh_stiffness
 

@@ -6,7 +6,7 @@ From gear:, materials:, contact:, drive:, load: (docs/wedge.md, "Derived from ge
 - lead angle gamma, pitch radii r1, r2 and normal pressure angle alpha_n from the gear geometry (meshgen);
 - reduced masses m1 = I1 / r1^2 (worm at its pitch radius), m2 = I2 / r2^2 (wheel at its pitch radius), with the
   shaft inertias of the torsional level (gear_theory.shaft_inertias_kg_m2: solid cylinders, plus load.inertia_kg_m2);
-- friction: the contact's law mu(Vs) (wormsim.friction) with the gear levels' friction angle rho' = atan(mu /
+- friction: the contact's law mu(Vs) (wormsim.physics.friction) with the gear levels' friction angle rho' = atan(mu /
   cos alpha_n), so one friction input gives one friction angle at every level (seed 000's wedge: block takes rho =
   atan(mu));
 - load: F2 = -load.torque_nm / r2 on the wheel, with load.start_s / load.ramp_s (STEP);
@@ -28,11 +28,12 @@ import math
 
 import numpy as np
 
-from wormsim import gear_theory as gt
-from wormsim.friction import friction_coefficient, friction_mode
-from wormsim.geometry import derive
-from wormsim.result import Result
-from wormsim.units import DEG, rad_s_to_rpm, rpm_to_rad_s
+from wormsim.physics import gear_theory as gt
+from wormsim.physics.friction import friction_coefficient, friction_mode
+from wormsim.physics.geometry import derive
+from wormsim.physics.units import DEG, rad_s_to_rpm, rpm_to_rad_s
+from wormsim.results.result import Result
+from wormsim.results.summary_keys import level_summary
 from wormsim.wedge.dynamics import STEADY_FRACTION, WedgeParams, simulate_params
 
 KLOSS_PEAK_FACTOR = 3.0  # peak force / working force: a stiff curve, far from the motor's pull-out
@@ -43,7 +44,7 @@ RUNUP_S = 0.01  # the peak force also runs the reduced masses up to speed in abo
 def params_from_gear(scenario) -> tuple[WedgeParams, dict]:
     """(WedgeParams, what was derived: summary keys) of a gear scenario (module docstring)."""
     g = derive(scenario.gear)
-    I1, I2 = gt.shaft_inertias_kg_m2(scenario, g.r1, g.worm_length, g.r2, g.face_width)
+    I1, I2 = gt.shaft_inertias_kg_m2(scenario.materials, scenario.load, g.r1, g.worm_length, g.r2, g.face_width)
     # the worm meshes at its operating radius r_m1 and lead angle gamma_m (r1, gamma unshifted; DIN 3975-1)
     m1, m2 = I1 / g.r_m1**2, I2 / g.r2**2
     gamma, tg = g.gamma_m, math.tan(g.gamma_m)
@@ -120,7 +121,9 @@ def simulate_derived(scenario, progress=None) -> Result:
     p_in, p_out = mean(S["F1_n"] * S["v1_m_s"]), mean(-S["F2_n"] * S["v2_m_s"])
     mu = mean(S["friction_coefficient"])
     T_load = scenario.load.torque_nm
-    res.summary.update(
+    res.summary = level_summary(
+        "wedge",
+        res.summary,
         {
             "ratio": n1 / n2 if n2 > 0 else float("inf"),
             "ratio_theory": g.ratio,
@@ -139,6 +142,6 @@ def simulate_derived(scenario, progress=None) -> Result:
             "friction_coefficient_mean": mu,
             "friction": friction_mode(scenario.contact),
             **d,
-        }
+        },
     )
     return res

@@ -27,7 +27,7 @@ Standstill (x1' = 0): the pair sticks (regime "locked", x1'' = 0) while the fric
     N0 = F1 sin g - F2 cos g,   T0 = -F1 cos g - F2 sin g,   |T0| <= tan(rho(0)) |N0|,
 
 is available, i.e. while F1/F2 lies between psi1 and psi2 at rho(0). Otherwise it slides in the
-direction s = -sign(T0). rho(Vs) is rho_rad of wormsim.friction (seed 000's fit; its value at
+direction s = -sign(T0). rho(Vs) is rho_rad of wormsim.physics.friction (seed 000's fit; its value at
 Vs = 0 is the static friction angle).
 
 Motor (seed 000, Kloss): F1 = 2 Fmax / (V + 1/V),  V = (V0 - x1') / (V0 - Vmax).
@@ -58,11 +58,12 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.integrate import solve_ivp, trapezoid
 
-from wormsim import gear_theory as gt
-from wormsim.errors import SimulationError
-from wormsim.friction import friction_coefficient, rho_rad
-from wormsim.result import Result
-from wormsim.units import DEG, step
+from wormsim.exceptions import SimulationError
+from wormsim.physics import gear_theory as gt
+from wormsim.physics.friction import friction_coefficient, rho_rad
+from wormsim.physics.units import DEG, step
+from wormsim.results.result import Result
+from wormsim.results.summary_keys import level_summary
 
 TRACTIVE, INVERSE, LOCKED, UNLOADED = "tractive", "inverse", "locked", "unloaded"
 REGIME_CODE = {LOCKED: 0, TRACTIVE: 1, INVERSE: 2, UNLOADED: 3}
@@ -283,7 +284,8 @@ def simulate(scenario, progress=None) -> Result:
     summary; a scenario without one goes to wormsim.wedge.derive (wormsim.wedge.level picks)."""
     p = params_from_scenario(scenario)
     res = simulate_params(p, progress=progress, name=scenario.name)
-    res.summary["wedge_source"] = "wedge: block (seed 000: rho = atan(mu), forces reduced to the pitch radii)"
+    source = "wedge: block (seed 000: rho = atan(mu), forces reduced to the pitch radii)"
+    res.summary = level_summary("wedge", res.summary, {"wedge_source": source})
     return res
 
 
@@ -308,17 +310,7 @@ def simulate_params(p: WedgeParams, progress=None, name: str = "wedge") -> Resul
         t_end = next(b for b in stops if b > t * (1 + 1e-12) + 1e-15)
         F1, F2 = motor_force_n(v, p), load_force_n(t, p)
         if segs and segs[-1]["regime"] == UNLOADED and _unloaded_equilibrium(t, t_end, p):
-            ts = _segment_times(grid, t, t_end)  # still no load past a breakpoint: stay on the equilibrium
-            segs.append(
-                {
-                    "regime": UNLOADED,
-                    "t": ts,
-                    "x": x + v * (ts - t),
-                    "v": np.full_like(ts, v),
-                    "a": np.zeros_like(ts),
-                    "k": 0,
-                }
-            )
+            segs.append(_unloaded_segment(grid, t, t_end, x, v))  # still no load past a breakpoint: stay on it
             t, x = t_end, float(x + v * (t_end - t))
             continue
         if v == 0.0 and not seed_monitor:
@@ -326,16 +318,8 @@ def simulate_params(p: WedgeParams, progress=None, name: str = "wedge") -> Resul
                 t_break = _locked_until(t, t_end, F1, p, rho0)
                 t_stop = t_end if t_break is None else t_break
                 ts = _segment_times(grid, t, t_stop)
-                segs.append(
-                    {
-                        "regime": LOCKED,
-                        "t": ts,
-                        "x": np.full_like(ts, x),
-                        "v": np.zeros_like(ts),
-                        "a": np.zeros_like(ts),
-                        "k": 0,
-                    }
-                )
+                zero = np.zeros_like(ts)
+                segs.append({"regime": LOCKED, "t": ts, "x": np.full_like(ts, x), "v": zero, "a": zero.copy(), "k": 0})
                 t = t_stop
                 sigma_hint = None
                 if progress is not None:
@@ -393,17 +377,7 @@ def simulate_params(p: WedgeParams, progress=None, name: str = "wedge") -> Resul
         if hit_stop:
             v = 0.0
         elif hit_phi and _unloaded_equilibrium(t, t_end, p):
-            ts = _segment_times(grid, t, t_end)
-            segs.append(
-                {
-                    "regime": UNLOADED,
-                    "t": ts,
-                    "x": x + v * (ts - t),
-                    "v": np.full_like(ts, v),
-                    "a": np.zeros_like(ts),
-                    "k": 0,
-                }
-            )
+            segs.append(_unloaded_segment(grid, t, t_end, x, v))
             t, x = t_end, float(x + v * (t_end - t))
         elif hit_phi:
             sigma_hint = -sigma
@@ -411,6 +385,19 @@ def simulate_params(p: WedgeParams, progress=None, name: str = "wedge") -> Resul
             progress.update(t)
 
     return _assemble(segs, p, steps, name)
+
+
+def _unloaded_segment(grid: np.ndarray, t: float, t_end: float, x: float, v: float) -> dict:
+    """The segment from t to t_end on the unloaded equilibrium: constant speed v from x."""
+    ts = _segment_times(grid, t, t_end)
+    return {
+        "regime": UNLOADED,
+        "t": ts,
+        "x": x + v * (ts - t),
+        "v": np.full_like(ts, v),
+        "a": np.zeros_like(ts),
+        "k": 0,
+    }
 
 
 # ----------------------------------------------------------------------------- results
@@ -465,32 +452,35 @@ def _assemble(segs: list[dict], p: WedgeParams, steps: int, name: str) -> Result
     i1, i2 = int(np.argmax(np.abs(S1))), int(np.argmax(np.abs(S2)))
     Ft1, Ft2 = rated_forces_n(p)
     rho0 = rho_static(p)
-    summary = {
-        "speed_steady_m_s": v_ss,
-        "S1_peak_n": float(S1[i1]),
-        "S2_peak_n": float(S2[i2]),
-        "S1_peak_time_s": float(t[i1]),
-        "S2_peak_time_s": float(t[i2]),
-        "S1_steady_n": _time_mean(t, S1, t_ss),
-        "S2_steady_n": _time_mean(t, S2, t_ss),
-        "Kd1": abs(float(S1[i1])) / Ft1,
-        "Kd2": abs(float(S2[i2])) / Ft2,
-        "Ft1_n": Ft1,
-        "Ft2_n": Ft2,
-        **_summary_efficiencies(g, rho_ss, rho0),
-        "rho_steady_deg": rho_ss / DEG,
-        "rho_static_deg": rho0 / DEG,
-        **gt.backdrive_keys(g, rho0, rho_ss),
-        "stalled": bool(np.max(np.abs(x1)) == 0.0),
-        "locked_at_end": bool(code[-1] == 0),
-        "x1_end_m": float(x1[-1]),
-        "min_speed_m_s": float(np.min(v1)),
-        "max_speed_m_s": float(np.max(v1)),
-        "regimes": regimes,
-        "regime_timeline": [{"regime": r, "start_s": t0, "end_s": t1} for r, t0, t1 in timeline],
-        "monitor": p.monitor,
-        "steady_window_s": [t_ss, p.duration_s],
-    }
+    summary = level_summary(
+        "wedge",
+        {
+            "speed_steady_m_s": v_ss,
+            "S1_peak_n": float(S1[i1]),
+            "S2_peak_n": float(S2[i2]),
+            "S1_peak_time_s": float(t[i1]),
+            "S2_peak_time_s": float(t[i2]),
+            "S1_steady_n": _time_mean(t, S1, t_ss),
+            "S2_steady_n": _time_mean(t, S2, t_ss),
+            "Kd1": abs(float(S1[i1])) / Ft1,
+            "Kd2": abs(float(S2[i2])) / Ft2,
+            "Ft1_n": Ft1,
+            "Ft2_n": Ft2,
+            **_summary_efficiencies(g, rho_ss, rho0),
+            "rho_steady_deg": rho_ss / DEG,
+            "rho_static_deg": rho0 / DEG,
+            **gt.backdrive_keys(g, rho0, rho_ss),
+            "stalled": bool(np.max(np.abs(x1)) == 0.0),
+            "locked_at_end": bool(code[-1] == 0),
+            "x1_end_m": float(x1[-1]),
+            "min_speed_m_s": float(np.min(v1)),
+            "max_speed_m_s": float(np.max(v1)),
+            "regimes": regimes,
+            "regime_timeline": [{"regime": r, "start_s": t0, "end_s": t1} for r, t0, t1 in timeline],
+            "monitor": p.monitor,
+            "steady_window_s": [t_ss, p.duration_s],
+        },
+    )
     return Result(
         model="wedge",
         summary=summary,

@@ -3,7 +3,7 @@ gear:, drive:, load: when the scenario has no wedge: block (wormsim.wedge.derive
 
 from __future__ import annotations
 
-from wormsim.result import Result
+from wormsim.results.result import Result
 from wormsim.wedge import derive, dynamics
 
 

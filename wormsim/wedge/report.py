@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-from wormsim.recording import save_series_recording
-from wormsim.report_header import (
+from wormsim.results.recording import save_series_recording
+from wormsim.results.report_header import (
     draw_header,
     gear_line,
     header_rows,
@@ -13,7 +13,7 @@ from wormsim.report_header import (
     speed_ylim,
     warning_text,
 )
-from wormsim.result import Result
+from wormsim.results.result import Result
 from wormsim.wedge.dynamics import INVERSE, LOCKED, TRACTIVE, UNLOADED
 
 # ----------------------------------------------------------------------------- report, recording
@@ -94,6 +94,6 @@ def write_report(result: Result, path) -> None:
 
 
 def write_recording(result: Result, path) -> None:
-    """recording.rrd: the same time series on the sim_time timeline (wormsim.recording layout)."""
+    """recording.rrd: the same time series on the sim_time timeline (wormsim.results.recording layout)."""
     s = result.series
     save_series_recording(path, result.extra.get("name", "wedge"), s["t_s"], {k: v for k, v in s.items() if k != "t_s"})
