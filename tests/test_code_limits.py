@@ -14,12 +14,6 @@ MAX_LINES = 100
 MAX_PARAMS = 10
 PACKAGES = ("wormsim", "meshgen")
 PENDING = {
-    ("wormsim/contact3d/flank_handoff.py", "_fill_add"),
-    ("wormsim/contact3d/flank_handoff.py", "add"),
-    ("wormsim/contact3d/flank_loop.py", "run_interval"),
-    ("wormsim/contact3d/flank_loop.py", "sample_flanks"),
-    ("wormsim/contact3d/flank_loop.py", "sample_table"),
-    ("wormsim/contact3d/flank_samples.py", "run_samples"),
     ("wormsim/contact3d/series.py", "column"),  # called by flank_samples.run_samples
     ("wormsim/tooth/merge.py", "split_forces"),  # called by flank_step and flank_samples
 }
