@@ -1,4 +1,4 @@
-"""Per step (flank_step.split_step, the stages called from Python) and per kernel call (FlankContacts.find), this
+"""Per step (native.split_step, the stages called from Python) and per kernel call (FlankContacts.find), this
 kernel.py against another version of it (--ref FILE), both contact modes (per slice, one per tooth flank); seat motor
 unscaled (5 us steps, 32 slices) and screw jack (16 slices), medium resolution, 5 ms ramps. Each version runs the
 same steps from the same start (the kernels agree, so do the trajectories); versions interleaved, best of --repeats
