@@ -75,23 +75,21 @@ def worm_params(g: GearGeometry) -> np.ndarray:
 
 
 def _t_of_r(g: GearGeometry, r):
-    return np.sqrt(np.maximum(np.asarray(r, dtype=float) ** 2 / g.r_b**2 - 1.0, 0.0))
+    return worm_forms_jit.zi_t(np.asarray(r, dtype=float), g.r_b)
 
 
 def half_thickness(g: GearGeometry, r):
-    """H(r): axial half-thickness of the thread at radius r (equations (1), (2) above; ZN, ZK, ZC: the table's
-    compiled evaluation, meshgen.worm_forms_jit), m. ZA and ZI stay in numpy here: the compiled closed form
-    (worm_forms_jit.thread_half_thickness, the contact kernel's) differs from it by an ulp at some radii (numpy's
-    arctan against the C library's atan), which moves the runs' results at the 1e-12 level."""
+    """H(r): axial half-thickness of the thread at radius r, m: equations (1), (2) above, written once in
+    meshgen.worm_forms_jit (ZA, ZI: evaluated here on numpy arrays, compiled in the contact kernel; ZN, ZK, ZC: the
+    table's compiled evaluation)."""
     r = np.asarray(r, dtype=float)
     if g.profile in worm_forms.TABLE_FORMS:
         H = worm_forms.form_table(g).half_thickness(r)
         return H[()] if r.ndim == 0 else H
     if g.profile == "ZA":
-        return g.p_x / 4 - (r - g.r1) * math.tan(g.alpha_x)
-    t, t1 = _t_of_r(g, r), float(_t_of_r(g, g.r1))
-    ap = abs(g.p)
-    return g.p_x / 4 - ap * ((t - np.arctan(t)) - (t1 - math.atan(t1)))
+        return worm_forms_jit.za_half_thickness(r, g.p_x, g.r1, math.tan(g.alpha_x))
+    t1 = float(_t_of_r(g, g.r1))
+    return worm_forms_jit.zi_half_thickness(_t_of_r(g, r), abs(g.p), g.p_x, t1 - math.atan(t1))
 
 
 def half_thickness_dr(g: GearGeometry, r):

@@ -2,7 +2,8 @@
 radius r (meshgen.worm's equations (1), (2): ZI the involute helicoid, ZA straight; ZN, ZK, ZC the Chebyshev table of
 meshgen.worm_forms.FormTable), on the worm's scalars P (meshgen.worm.worm_params). The contact kernel's worm gap
 (wormsim.tooth.gap) calls `thread_half_thickness`, FormTable (and so meshgen.worm.half_thickness for ZN, ZK, ZC) the
-table's `half_thickness`; meshgen.worm keeps ZA and ZI in numpy (its half_thickness says why).
+table's `half_thickness`; ZA's and ZI's closed forms are written once here (za_half_thickness, zi_half_thickness) and
+meshgen.worm evaluates the same text on numpy arrays.
 
 The kernel's scalars P carry the table at P[TABLE_AT:TABLE_AT + 2 + N_CHEB] = [r_lo, r_hi, Chebyshev coefficients]
 (FormTable.params); `half_thickness` evaluates the series by Clenshaw's recurrence with its derivative, continued
@@ -11,9 +12,8 @@ linearly outside [r_lo, r_hi] (tests/test_flank_forms_contact.py).
 
 from __future__ import annotations
 
-import math
-
 import numba
+import numpy as np
 
 N_CHEB = 40  # Chebyshev terms of the H(r) table
 TABLE_LEN = 2 + N_CHEB  # entries of FormTable.params()
@@ -46,6 +46,29 @@ def half_thickness(r, P, off):
     return H + (r - rc) * dH, dH
 
 
+def za_half_thickness(r, p_x, r1, tan_alpha_x):
+    """ZA's H(r), equation (1): straight flanks at the axial pressure angle. Written once: meshgen.worm calls it on
+    numpy arrays, the kernel compiled (thread_half_thickness)."""
+    return p_x / 4 - (r - r1) * tan_alpha_x
+
+
+def zi_t(r, r_b):
+    """ZI's involute parameter t = sqrt(r^2 / r_b^2 - 1), 0 below the base radius (numpy arrays or compiled)."""
+    return np.sqrt(np.maximum(r * r / (r_b * r_b) - 1.0, 0.0))
+
+
+def zi_half_thickness(t, ap, p_x, t1_term):
+    """ZI's H(r), equation (2), at t = zi_t(r): p_x / 4 - |p| ((t - atan t) - (t1 - atan t1)), t1_term = t1 - atan t1.
+    Written once: meshgen.worm calls it on numpy arrays (numpy's arctan), the kernel compiled (the C library's atan;
+    the two differ by an ulp at some radii, as they did before the two paths shared this text)."""
+    return p_x / 4 - ap * ((t - np.arctan(t)) - t1_term)
+
+
+_za = numba.njit(cache=True, inline="always")(za_half_thickness)
+_zi_t = numba.njit(cache=True, inline="always")(zi_t)
+_zi = numba.njit(cache=True, inline="always")(zi_half_thickness)
+
+
 @numba.njit(cache=True, inline="always")
 def thread_half_thickness(r, P):
     """(H(r), dH/dr) of the worm (module docstring): ZI equation (2) with t = sqrt(r^2 / r_b^2 - 1) (0 below r_b),
@@ -53,12 +76,10 @@ def thread_half_thickness(r, P):
     if P[P_FORM] > 1.5:
         return half_thickness(r, P, TABLE_AT)
     if P[P_FORM] > 0.5:
-        r_b = P[P_RB]
-        x = r * r / (r_b * r_b) - 1.0
-        t = math.sqrt(x) if x > 0.0 else 0.0
+        t = _zi_t(r, P[P_RB])
         ap = abs(P[P_P])
-        return P[P_PX] / 4 - ap * ((t - math.atan(t)) - P[P_T1]), -ap * t / r
-    return P[P_PX] / 4 - (r - P[P_R1]) * P[P_TAN_ALPHA_X], -P[P_TAN_ALPHA_X]
+        return _zi(t, ap, P[P_PX], P[P_T1]), -ap * t / r
+    return _za(r, P[P_PX], P[P_R1], P[P_TAN_ALPHA_X]), -P[P_TAN_ALPHA_X]
 
 
 @numba.njit(cache=True)
