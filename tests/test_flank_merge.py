@@ -73,7 +73,7 @@ def test_split_gives_each_slice_its_spring_share():
     efc = np.array([0.0, 0.0, 0.0, 50.0, 2.0, -1.0, 80.0, 3.0, 0.5])  # rows of contacts 1, 2 (contact 0: other)
     adr = np.array([-1, 3, 6])
     adr_out, efc_out = np.zeros(n, dtype=np.int64), np.zeros(3 * n)
-    split_forces(adr, efc, 1, True, grp, share, mfric, mwrap, n, adr_out, efc_out)
+    split_forces(adr, efc, 1, True, (grp, share, mfric, mwrap), n, (adr_out, efc_out))
     assert np.array_equal(adr_out, 3 * np.arange(n))
     f = efc_out.reshape(n, 3)
     g = grp.astype(int)

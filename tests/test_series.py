@@ -23,7 +23,7 @@ def test_sums_over_an_interval_are_the_column_means():
     for sd, w1, w2 in steps:
         sums = add_step(sums, act, sd, 1, 2, 0, w1, w2)
     assert len(sums) == N_SUMS == len(SUMS)
-    col = column(0.1, 1.0, 2.0, 10.0, -0.5, 0.7, sums, 2, 2, 1e-6, 0.05, 1e-5, 33.0, 0.012, np.pi / 30)
+    col = column((0.1, 1.0, 2.0, 10.0, -0.5, 0.7), sums, 2, (2, 1e-6, 0.05, 1e-5, 33.0, 0.012), np.pi / 30)
     row = dict(zip(SERIES, col))
     assert len(col) == len(SERIES)
     assert row["worm_torque_nm"] == pytest.approx(2.0) and row["wheel_torque_nm"] == pytest.approx(-30.0)

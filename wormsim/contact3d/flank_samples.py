@@ -121,7 +121,7 @@ def contact_rows(d_addr, off, adr, ncon, n_fc, cone3, frame, pos, nh, mrg):
     efc = numba.carray(f64_at(i64_at(d_addr + off[4])[0]), (max(i32_at(d_addr + off[2])[0], 0),))
     if mrg is not None:
         grp, share, mfric, mwrap, adr_m, efc_m = mrg
-        split_forces(adr[:ncon], efc, ncon - min(nh, ncon), cone3, grp, share, mfric, mwrap, n_fc, adr_m, efc_m)
+        split_forces(adr[:ncon], efc, ncon - min(nh, ncon), cone3, (grp, share, mfric, mwrap), n_fc, (adr_m, efc_m))
         return ContactRows(adr_m[:n_fc], efc_m, frame, pos, n_fc, n_fc, True, True)
     return ContactRows(adr[:ncon], efc, frame, pos, np.int64(ncon), n_fc, True, cone3)
 
@@ -206,7 +206,7 @@ def run_samples(tables, mj, cmds, span, S, p, room, io, mrg, shaft):
         turn_max = max(turn_max, turn)
         r_c = wr / W if W > 0 else math.nan
         sums = (acc[0], acc[1], acc[2], acc[3], acc[4], acc[5], acc[6], acc[7], acc[8], acc[9])
-        col = column(t, th1, th2, w1, w2, cmd_i, sums, rec, nteeth, pen2, mu, te, fr, r_c, p.rpm)
+        col = column((t, th1, th2, w1, w2, cmd_i), sums, rec, (nteeth, pen2, mu, te, fr, r_c), p.rpm)
         for k in range(len(col)):
             S[k, i] = col[k]
         io[IO_PENDING] = 0.0

@@ -148,7 +148,8 @@ class FlankContacts:
         n = self.n
         nh = min(int(k.ib[7]), d.ncon)
         adr, efc, k0 = self.slice_adr, self.slice_efc, d.ncon - nh
-        split_forces(d.contact.efc_address, d.efc_force, k0, dim3, k.grp, k.share, k.mfric, k.mwrap, n, adr, efc)
+        merged = (k.grp, k.share, k.mfric, k.mwrap)
+        split_forces(d.contact.efc_address, d.efc_force, k0, dim3, merged, n, (adr, efc))
         return self.slice_adr[:n], self.slice_efc, self.frame[:n], self.pos[:n], True
 
     def set_friction(self, mu: float) -> None:

@@ -192,7 +192,7 @@ def _sample(lp: _Loop, i: int, cmd: float, sums) -> None:
     guards.contact(t, pen, w1 if bm.plan.drive_on == "worm" else w2, cmd, w1)
     if lp.slog is not None:
         lp.slog.record(i, d)
-    lp.S_all[:, i] = column(t, th1, th2, w1, w2, cmd, sums, lp.rec, nteeth, pen, mu, te, fr_lc, r_c, RPM)
+    lp.S_all[:, i] = column((t, th1, th2, w1, w2, cmd), sums, lp.rec, (nteeth, pen, mu, te, fr_lc, r_c), RPM)
 
 
 def force_signs(S: dict, hand: int) -> None:

@@ -64,10 +64,14 @@ ZERO_SUMS = (0.0,) * N_SUMS  # the sums at an interval's start
 
 
 @numba.njit(cache=True)
-def column(t, th1, th2, w1, w2, cmd, sums, rec, nteeth, pen, mu, te, fr_lc, r_c, rpm):
-    """One sample's column in SERIES order: the state at the interval's end, the interval's per-step sums
-    sums (SUMS order: T1, T2, P1, P2, contacts, F_x, F_y, F_z, M_z, |F_x| peak) over its rec steps as means, and the
-    sample's contact outputs; rpm = (rad/s) per rpm. The efficiency at the contact radius is filled after the run."""
+def column(state, sums, rec, contact, rpm):
+    """One sample's column in SERIES order: the state at the interval's end, state = (t, th1, th2, w1, w2, cmd), the
+    interval's per-step sums (SUMS order: T1, T2, P1, P2, contacts, F_x, F_y, F_z, M_z, |F_x| peak) over its rec
+    steps as means, and the sample's contact outputs, contact = (teeth in contact, max penetration, mu, TE, radial
+    force on the line of centres, contact radius); rpm = (rad/s) per rpm. The efficiency at the contact radius is
+    filled after the run."""
+    t, th1, th2, w1, w2, cmd = state
+    nteeth, pen, mu, te, fr_lc, r_c = contact
     t1, t2, p1, p2, nc, fx, fy, fz, mz, fpk = sums
     return (
         t,  # t_s

@@ -100,13 +100,16 @@ def merge_flanks(meta, n, slices, grp, share, merged, axes):
 
 
 @numba.njit(cache=True)
-def split_forces(adr, efc_force, k0, cone3, grp, share, mfric, mwrap, n, adr_out, efc_out):
-    """Per-slice constraint forces from the merged contacts' (module docstring): the merged contact grp[c] (d.contact
+def split_forces(adr, efc_force, k0, cone3, merged, n, out):
+    """Per-slice constraint forces from the merged contacts' (module docstring), merged = (grp, share, mfric, mwrap)
+    (merge_flanks' outputs), out = (adr_out, efc_out): the merged contact grp[c] (d.contact
     entry k0 + grp[c], constraint rows from adr[k0 + grp[c]]; normal and, with cone3, the two tangent rows) in its own
     frame as slice c's rows in slice c's own frame: normal x share[c] / c_w (the slices' spring forces sum to the
     merged normal force / c_w), friction x share[c] / (c_w mfric) (a slice's own mu). efc_out[3c:3c+3], adr_out[c]
     = 3c (-1 where the merged contact has no rows). The frames (kernel.contact_frames) turn with the normal about the
     worm axis, so a slice's friction keeps its direction relative to its own normal."""
+    grp, share, mfric, mwrap = merged
+    adr_out, efc_out = out
     for c in range(n):
         g = int(grp[c])
         a = adr[k0 + g] if k0 + g < adr.shape[0] else -1  # -1: not taken (arena full)
