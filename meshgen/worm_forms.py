@@ -57,7 +57,7 @@ Evaluation (`FormTable`): H is interpolated on [r1 - h_f - 0.1 m_x, r1 + h_f + 0
 tip, which cuts the wheel root, meshgen.wheel) by a Chebyshev series of N_CHEB terms through the exact values (2)-(4)
 at the Chebyshev points, and continued linearly (C1) outside. form_table refuses (GeometryError) a flank that does not
 narrow outwards from the root to the hob's tip (the tool undercuts the thread) or that the series misses by more than
-TABLE_TOL_M. tests/test_worm_forms.py pins the series to the exact
+TABLE_TOL_M. tests/meshgen/test_worm_forms.py pins the series to the exact
 solution (max |error| below 1 nm on the seeds' gears) and the exact solution to the definitions: ZN's normal section
 straight, ZK's and ZC's axial sections against an independent simulation of the disc cutting (the tool's positions
 swept densely, the lower envelope of the cut), ZC's axial section concave.

@@ -7,7 +7,7 @@ meshgen.worm evaluates the same text on numpy arrays.
 
 The kernel's scalars P carry the table at P[TABLE_AT:TABLE_AT + 2 + N_CHEB] = [r_lo, r_hi, Chebyshev coefficients]
 (FormTable.params); `half_thickness` evaluates the series by Clenshaw's recurrence with its derivative, continued
-linearly outside [r_lo, r_hi] (tests/test_flank_forms_contact.py).
+linearly outside [r_lo, r_hi] (tests/tooth/test_gap.py).
 """
 
 from __future__ import annotations

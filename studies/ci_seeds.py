@@ -1,4 +1,4 @@
-"""The seeds' CI runs with exact flanks (the configurations of tests/test_contact3d_seeds.py, `contact.geometry:
+"""The seeds' CI runs with exact flanks (the configurations of tests/contact3d/test_seeds_pieces.py, `contact.geometry:
 flanks`): their summaries as the record docs/data/ci_seeds_flanks.json, which README's contact-pattern table renders
 (tools.docs_render). About two minutes on 2 cores.
 

@@ -1,6 +1,6 @@
 """contact3d (exact flanks) on the screw jack at its working point with a shaft angle of 0, +0.1 and -0.1 deg: the
 loaded pattern, pressure, fluctuation, TE and play (docs/errors.md section 6; the torsional level's loaded TCA is
-checked against these in tests/test_torsional_errors.py). Writes the record docs/data/errors_shaft_angle.json.
+checked against these in tests/torsional/test_errors.py). Writes the record docs/data/errors_shaft_angle.json.
 
     .venv/bin/python studies/errors_shaft_angle.py
 """

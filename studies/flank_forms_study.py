@@ -1,6 +1,7 @@
 """The five worm flank forms on the screw jack and the seat motor at the same load (docs/flank_forms.md).
 
-Each form at contact3d (exact flanks, the seeds' CI settings of tests/test_contact3d_seeds.py) and at torsional (the
+Each form at contact3d (exact flanks, the seeds' CI settings of tests/contact3d/test_seeds_pieces.py) and at
+torsional (the
 mesh stiffness); writes docs/data/flank_forms.json with provenance {command, commit, date, machine} and
 docs/img/flank_forms.png (per form: p_H max and mean, efficiency against the theory at the contact radius, F_t p2p,
 TE p2p, mesh stiffness) and docs/img/flank_forms_pattern.png (the loaded contact pattern of each form, as report.png

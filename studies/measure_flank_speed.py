@@ -1,5 +1,5 @@
 """Per-step cost of exact-flank contacts against medium convex pieces (issue 13), measured in one process: the CI
-configurations of tests/test_contact3d_seeds.py shortened to 0.08 s at medium resolution, pieces and flanks
+configurations of tests/contact3d/test_seeds_pieces.py shortened to 0.08 s at medium resolution, pieces and flanks
 alternating twice (flanks with one contact per slice, the default, and with one per tooth flank,
 `contact.flank_contacts: tooth`); wall time per step (summary step_wall_us: the step and the runner's per-sample
 work) and the run's CPU time. Writes docs/data/flank_speed.json; README "Speed of exact flanks against the issue's
@@ -59,7 +59,7 @@ def main(seeds: list[str]) -> dict:
 
 
 def _ci() -> dict:
-    """The CI configurations (tests/test_contact3d_seeds.py)."""
+    """The CI configurations (tests/contact3d/test_seeds_pieces.py)."""
     sys.path.insert(0, str(ROOT / "tests"))
     from test_contact3d_seeds import CI
 

@@ -1,4 +1,4 @@
-"""The self-locking screw jack back-driven by its speed-driven wheel (tests/test_contact3d_guards.py, mu 0.2): per
+"""The self-locking screw jack back-driven by its speed-driven wheel (tests/contact3d/test_guards.py, mu 0.2): per
 sample, the contacts' elliptic-cone rows read after each step (docs/contact3d.md, "Friction against the slip"):
 count, normal force sum, deepest contact, friction utilisation |f_t| / (mu f_n), the worm torque from the normal rows
 and from the friction rows apart, cos(f_t, -v_t), and the friction rows' reference acceleration |a_ref_t| against

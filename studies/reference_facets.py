@@ -11,7 +11,7 @@ docs/decisions/0012-reference-simulator-facets.md.
     k_mesh x deviation at 1x and 0.66x.
 (c) the wheel flank replaced by its facetted version (the grid's polar angles taken from the wheel mesh's facets:
     linear between the STL's vertices): quasi-static F p2p at the fixed lag and the TE p2p at constant load, and the
-    screw jack's CI run (tests/test_contact3d_seeds.py) with that grid, F_t and TE p2p; the same with the worm's
+    screw jack's CI run (tests/contact3d/test_seeds_pieces.py) with that grid, F_t and TE p2p; the same with the worm's
     facets (worm_facet_recess; in the kernel for the runs, worm_facet_kernel) and with both.
 
 Studies: --worm-study, CI runs with the facetted worm at SEGMENTS per turn and a STIFFNESS share (the reference's

@@ -1,6 +1,6 @@
 """F_t p2p and TE p2p of the exact-flank contact against the slice count (issue 13; docs/contact3d.md, "Default slice
-count"): the seeds' CI runs (tests/test_contact3d_seeds.py with contact.geometry flanks) and the variety variants
-(tests/test_contact3d_variety.py), each at the given `contact.slices`, with F_t's p2p below 1 kHz (its meshing band,
+count"): the seeds' CI runs (tests/contact3d/test_seeds_pieces.py with contact.geometry flanks) and the variety variants
+(tests/contact3d/test_variety.py), each at the given `contact.slices`, with F_t's p2p below 1 kHz (its meshing band,
 under the contact modes) and the summary's per-step wall time (compare within one run of this script only: the
 machine is shared). One line per run, flushed, so a long sweep can be cut.
 

@@ -4,10 +4,10 @@ its default `contact.slices` (wormsim.tooth.grid.default_slices) and at twice th
 module of contact line) and, for comparison, the largest p_H of one contact (hertz (3)), and their change from S to
 2 S. Each case at the default contact stiffness, the teeth's compliance (the variety gears' test asset pins Hertz's:
 the sweep sets contact.stiffness_model=teeth); Hertz's where the teeth's compliance fails on the gear (gmsh; the
-record says so, `hertz_fallback`). The cases: the variety gears (tests/test_contact3d_variety.py FLANK_GEARS), three
-random gears (tests/test_contact3d_random_forces.py) and the seeds' CI runs with flanks (tests/test_contact3d_seeds.py
-CI; the seat motor and the screw jack set their own contact.stiffness_n_per_m). Writes docs/data/RECORD.json after
-each case (a long sweep can be cut).
+record says so, `hertz_fallback`). The cases: the variety gears (tests/contact3d/test_variety.py FLANK_GEARS), three
+random gears (tests/contact3d/test_random_forces.py) and the seeds' CI runs with flanks
+(tests/contact3d/test_seeds_pieces.py CI; the seat motor and the screw jack set their own
+contact.stiffness_n_per_m). Writes docs/data/RECORD.json after each case (a long sweep can be cut).
 
     .venv/bin/python studies/slice_convergence_default.py [--cases left-ZA random0 screw_jack ...] [--medium]
         [--record NAME] [--save DIR]

@@ -1,8 +1,8 @@
 """The exact-flank runs against the timestep (issue 13; docs/contact3d.md, "Default step for exact flanks"): the seeds'
-CI runs (tests/test_contact3d_seeds.py with contact.geometry flanks; the seat motor's is the demo's 1800 rpm) and the
-variety variants (tests/test_contact3d_variety.py), at their default slices, per-step samples (record_every 1). One
-JSON line per run, flushed, appended to --out (a run that a guard stops is recorded with its error); the lines of the
-study are collected in docs/data/step_convergence.json. Modes:
+CI runs (tests/contact3d/test_seeds_pieces.py with contact.geometry flanks; the seat motor's is the demo's 1800 rpm)
+and the variety variants (tests/contact3d/test_variety.py), at their default slices, per-step samples (record_every 1).
+One JSON line per run, flushed, appended to --out (a run that a guard stops is recorded with its error); the lines of
+the study are collected in docs/data/step_convergence.json. Modes:
 
     --factors 0.5 1 2 4   multiples of today's default step (0.4 x ContactLaw.stable_limit_s, rounded down to 1-2-5)
     --fraction 0.45       h = the fraction x the stable limit, rounded down to 2 digits, and h/2

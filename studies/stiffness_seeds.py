@@ -1,5 +1,5 @@
 """The seeds with each source of the tooth-pair stiffness (docs/contact3d.md, "Tooth stiffness on the seeds"): the
-CI-sized runs of tests/test_contact3d_seeds.py (`contact.geometry: flanks`) at contact3d and at torsional, each
+CI-sized runs of tests/contact3d/test_seeds_pieces.py (`contact.geometry: flanks`) at contact3d and at torsional, each
 
   seed:   the scenario file as it is where it pins its seed's ADAMS constant (seat_motor, screw_jack:
           contact.stiffness_n_per_m; involute_41 gives none, its file's run is the default, teeth),

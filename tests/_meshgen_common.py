@@ -6,10 +6,10 @@ import math
 from functools import lru_cache
 
 import numpy as np
-from conftest import ROOT
 
 from meshgen import assembly, worm
 from meshgen.geometry import GearGeometry, derive
+from tests.conftest import ROOT
 from wormsim.scenario import load_scenario
 
 

@@ -23,31 +23,33 @@ def scenario_dir() -> Path:
 LONG_TESTS: dict[str, set[str] | None] = {
     # slice and timestep convergence of the flank fluctuation: the seat motor's (step 5e-6 s, ~4 min) is long; the screw
     # jack's and involute_41's stay in `make test` (one CI-sized convergence test per seed)
-    "test_flank_convergence.py": {"seat_motor"},
+    "contact3d/test_convergence.py": {"seat_motor"},
     # the convex-piece validation of the seeds (contact.geometry pieces); the default geometry's (flanks) is in
-    # test_contact3d_seeds_flanks.py and stays in `make test`
-    "test_contact3d_seeds.py": {"seat_motor", "screw_jack", "involute_41"},
-    "test_errors_sidebands.py": None,
-    "test_contact3d_random_forces.py": None,  # four random gears' contact3d runs (issue 31), ~10 s each
+    # tests/contact3d/test_seeds.py and stays in `make test`
+    "contact3d/test_seeds_pieces.py": {"seat_motor", "screw_jack", "involute_41"},
+    "contact3d/test_errors_sidebands.py": None,
+    "contact3d/test_random_forces.py": None,  # four random gears' contact3d runs (issue 31), ~10 s each
     # a set may also name tests (their function names): WormPair against a contact3d run of the same gear (~20 s)
     "test_pair.py": {"test_pair_forces_and_efficiency_match_contact3d_on_the_same_gear"},
-    "test_flank_samples.py": {
+    "contact3d/test_flank_samples.py": {
         "test_held_run_ends_alike_on_the_compiled_and_the_python_path"
     },  # two held runs  # F_t sidebands of a wheel runout over a wheel revolution (~1 min)
-    "test_mass_scaling.py": {"unscaled"},  # the unscaled reference run of the scaled ones (240 000 steps, ~3 min)
+    "contact3d/test_mass_scaling.py": {
+        "unscaled"
+    },  # the unscaled reference run of the scaled ones (240 000 steps, ~3 min)
     # contact3d and `wormsim mesh` per flank form (ZC's stay in `make test`; torsional's of every form too)
-    "test_flank_forms_validation.py": {f"{k}_{f}" for k in ("contact3d", "mesh") for f in ("ZN1", "ZN2", "ZK")},
-    "test_calculix.py": None,  # the CalculiX contact solve of a small case (minutes on one core)
-    # the tooth compliance's FE on the seeds other than the screw jack (~15 s each cold; test_ltca.py marks its own)
-    "test_tooth_compliance.py": {"involute_41", "seat_motor", "test_random_gears_compliance_is_computed"},
+    "contact3d/test_flank_forms.py": {f"{k}_{f}" for k in ("contact3d", "mesh") for f in ("ZN1", "ZN2", "ZK")},
+    "tooth/test_calculix.py": None,  # the CalculiX contact solve of a small case (minutes on one core)
+    # the tooth compliance's FE on the seeds other than the screw jack (~15 s each cold; tests/tooth/test_ltca.py marks its own)
+    "tooth/test_compliance.py": {"involute_41", "seat_motor", "test_random_gears_compliance_is_computed"},
     # contact3d on the shifted 1x40 (~2 min here with the kernel compiled) and the FVA REXS stage with its shafts
     # (~1 min); their torsional / wedge twins stay in `make test`
-    "test_profile_shift.py": {"contact3d_shifted_1x40"},
-    "test_rexs.py": {"contact3d_fva", "contact3d_other"},
+    "meshgen/test_profile_shift.py": {"contact3d_shifted_1x40"},
+    "scenario/test_rexs.py": {"contact3d_fva", "contact3d_other"},
     # the FE mesher's every retry on a 120-tooth wheel (a strict xfail, minutes)
-    "test_contact3d_model.py": {"test_tooth_compliance_on_a_120_tooth_wheel"},
+    "contact3d/test_mjcf.py": {"test_tooth_compliance_on_a_120_tooth_wheel"},
     # 100 random gears through every command (~1 min each); a handful stay in `make test`
-    "test_commands_random.py": {
+    "cli/test_commands_random.py": {
         "test_random_gear_every_command_exits_0_2_or_3_long",
         "test_random_gears_mostly_run_long",
     },
@@ -56,9 +58,9 @@ LONG_TESTS: dict[str, set[str] | None] = {
 
 def pytest_collection_modifyitems(config, items):
     for item in items:
-        if item.path.name not in LONG_TESTS:
+        if item.path.relative_to(ROOT / "tests").as_posix() not in LONG_TESTS:
             continue
-        rule = LONG_TESTS[item.path.name]
+        rule = LONG_TESTS[item.path.relative_to(ROOT / "tests").as_posix()]
         callspec = getattr(item, "callspec", None)
         if rule is None or (callspec is not None and callspec.params.get("name") in rule) or item.originalname in rule:
             item.add_marker(pytest.mark.long)

@@ -7,8 +7,9 @@ from __future__ import annotations
 import ast
 
 import pytest
-from conftest import ROOT
-from test_tooth_layers import _imports
+
+from tests.conftest import ROOT
+from tests.test_tooth_layers import _imports
 
 # the modules at wormsim's top level: the public API (wormsim/__init__.py and the modules behind its names) and the
 # command-line entry (`python -m wormsim`)

@@ -15,7 +15,7 @@ import sysconfig
 import venv
 from pathlib import Path
 
-from conftest import ROOT
+from tests.conftest import ROOT
 
 SKIP = shutil.ignore_patterns(
     ".venv",

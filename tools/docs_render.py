@@ -11,7 +11,7 @@ and each figure of FIGURES is drawn to docs/img/NAME.png from its record (matplo
 metadata: the same record gives the same bytes). The shipped sweeps' tables and charts read their records
 docs/sweeps/*.csv, whose provenance is docs/data/sweeps.json. `python -m tools.docs_render` renders every block
 and figure in place; `--check` only reports the blocks that differ from their records (exit 1).
-tests/test_docs_render.py runs the check. `python -m tools.docs_render record-bench NAME DIR` turns a
+tests/tools/test_docs_render.py runs the check. `python -m tools.docs_render record-bench NAME DIR` turns a
 `wormsim bench --out DIR` into the record docs/data/NAME.json (the provenance bench_meta.json carries).
 """
 

@@ -1,5 +1,5 @@
 """docs/outputs.md, generated from the summary-key table wormsim.results.summary_keys
-(`python -m tools.outputs_doc > docs/outputs.md`); tests/test_outputs.py keeps the file current."""
+(`python -m tools.outputs_doc > docs/outputs.md`); tests/results/test_summary_keys.py keeps the file current."""
 
 from __future__ import annotations
 

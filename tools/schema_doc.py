@@ -1,6 +1,6 @@
 """Markdown reference of the scenario schema, generated from the pydantic models (docs/scenario.md).
 
-`python -m tools.schema_doc > docs/scenario.md` regenerates it; tests/test_schema_doc.py fails when
+`python -m tools.schema_doc > docs/scenario.md` regenerates it; tests/tools/test_schema_doc.py fails when
 the committed file is out of date, so the documentation cannot drift from the code.
 """
 

@@ -53,7 +53,8 @@ DURATION_S = {"seat_motor": 0.25, "screw_jack": 0.3, "involute_41": 0.3}
 QUICK_DURATION_S = 0.15
 GEOMETRIES = ("flanks", "pieces")  # contact3d's contact.geometry, both benched so one run gives the speed-up
 # `bench --shafts`: the shafts: block of the shafted twins (both shafts on compliant bearings, the worm bending: every
-# joint and spring of wormsim.contact3d.shafts; tests/test_shafts.py's balance case), each run against its rigid twin
+# joint and spring of wormsim.contact3d.shafts; tests/contact3d/test_shafts.py's balance case), each run against its
+# rigid twin
 SHAFTS_BLOCK = {
     "worm": {
         "bearings_mm": [-60, 60],

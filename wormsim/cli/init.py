@@ -1,7 +1,7 @@
 """`wormsim init [PATH]`: write a commented scenario template a drive engineer fills in (docs/scenario.md has every
 key). The template is README.md's (tests/test_readme.py keeps the two the same): a 2-start ZA worm gear, 30 teeth,
 axial module 3 mm, q 11, steel on bronze, 1500 rpm, 60 N m, torsional for 0.5 s; it runs as written at every level
-(tests/test_api.py)."""
+(tests/tools/test_api_doc.py)."""
 
 from __future__ import annotations
 

@@ -9,7 +9,7 @@ wormsim.physics.gear_theory.mesh_arms_m)
 meshgen's convex pieces are made conservative (moved inside the exact flanks by their measured bulge), but a
 residual bulge b remains (piece_error_um: the most negative signed distance of dense exact flank points from the
 union of pieces, docs/geometry.md): worm flanks, wheel conjugate flanks, wheel fillet / undercut zone. Worm piece
-against wheel piece the clearance is about c - b_worm - b_wheel (tests/test_pieces.py), so contact3d requires
+against wheel piece the clearance is about c - b_worm - b_wheel (tests/meshgen/test_pieces.py), so contact3d requires
 
     c > b = max(0, -min_signed(worm)) + max(0, -min_signed(wheel), -min_signed(wheel_undercut_zone)),   (2)
 

@@ -5,7 +5,8 @@ numba call, MuJoCo's C stage functions called by address.
 flank contacts in its ADD_CONTACTS slot (`add_flanks`: the window update of FlankContacts.window, with assembly errors
 flank_pose.set_pose, kernel.find_packed (find_contacts with its memo, slice_weights, contact_frames),
 flank_handoff.fill_add). It does what `FlankContacts.step` (wormsim.contact3d.flank_step) does from Python, in the
-same order and with the same floating-point operations, so the results are bit-identical (tests/test_flank_loop.py).
+same order and with the same floating-point operations, so the results are bit-identical
+(tests/contact3d/test_flank_loop.py).
 `run_table` steps an interval: per step the drive and load commands into d.ctrl, the shaft speeds read, flank_step,
 then the runner's per-step sums (actuator torques, shaft powers T w, the contact sensor's count, force and moment,
 the peak |F_x|).

@@ -3,7 +3,7 @@
 the per-sample Python (~45-60 us a sample: dispatch, guards, the series column) is paid once per call.
 
 Per sample, in the runner's order and with its floating-point operations (bit-identical series, pattern and radius
-logs, contact points: tests/test_flank_samples.py): the steps; the state read from d (shaft angles and speeds,
+logs, contact points: tests/contact3d/test_flank_samples.py): the steps; the state read from d (shaft angles and speeds,
 d.time); the runner's Guards.state checks (non-finite state or MuJoCo's bad-qacc warning, overspeed, teeth jumped);
 mu from the friction law with its stick state (wormsim.physics.friction.mu_at, stuck_after);
 flank_loop.sample_flanks (with displaced poses, errors: or shafts:, the points go into tooth 0's frame through the

@@ -1,7 +1,7 @@
 """The exact-flank contacts of one model (wormsim.tooth.kernel) handed to MuJoCo's constraint solver: FlankContacts
 finds them and adds them to d.contact in the stage list's ADD_CONTACTS slot (wormsim.contact3d.native.split_step:
 between mj_collision and mj_makeConstraint). Validated on a 1 kg box with collision off and the contact added by hand
-(tests/test_flank_contact_path.py): static normal force = weight, penetration = the solref mapping, sliding
+(tests/contact3d/test_flank_step.py): static normal force = weight, penetration = the solref mapping, sliding
 deceleration = mu g.
 
 A contact is added by copying a template mjContact with its per-contact fields (dist, pos, frame, solref) written in

@@ -15,7 +15,7 @@ and mj_step2 (actuation, acceleration, constraint solve, mj_sensorAcc, mj_checkA
 integrator: RK4 is not available this way, MuJoCo's mj_step2 falls back to Euler). `split_forward` runs the position
 stages and then mj_forwardSkip from the velocity stage on. Energy is not computed (the template disables it). The
 compiled step loop (wormsim.contact3d.flank_loop) calls the same list by address (`stage_addresses`). Each stage
-list is tested against MuJoCo's own mj_step / mj_forward (tests/test_contact3d_native.py).
+list is tested against MuJoCo's own mj_step / mj_forward (tests/contact3d/test_native.py).
 
 mjData's layout (`mjdata_offsets`): the byte offsets of the scalar fields and arena pointers the compiled samples read
 (wormsim.contact3d.flank_samples), from MuJoCo's own declaration of its structs (mujoco.introspect, the headers'

@@ -28,7 +28,7 @@ the compiled contact3d samples call it, friction_coefficient and rho_rad are its
 friction_coefficient_scalar a float wrapper (the torsional ODE, contact3d's Python samples, wormsim.pair).
 Group I against a handbook curve (Mechanical Engineer's Data Handbook, p. 111, hard steel on phosphor bronze:
 mu 0.06 / 0.05 / 0.035 / 0.023 / 0.017 / 0.014 at 0.5 / 1 / 2 / 5 / 10 / 20 m/s): within 25 %
-(tests/test_friction.py).
+(tests/physics/test_friction.py).
 """
 
 from __future__ import annotations

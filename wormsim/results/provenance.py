@@ -1,6 +1,6 @@
 """Provenance of a measured record (docs/data/*.json): the command that measured it, the commit it ran on, when, and
 on what machine. Every script that writes a record under docs/data/ calls `record(...)`; the docs renderer
-(tools.docs_render) reads only such records, and tests/test_docs_render.py checks that each one carries the four
+(tools.docs_render) reads only such records, and tests/tools/test_docs_render.py checks that each one carries the four
 keys."""
 
 from __future__ import annotations

@@ -45,7 +45,8 @@ DEFAULT_COMPILE_S = 60.0
 _ROOT = Path(__file__).resolve().parents[2]
 _IMPORTS_NUMBA = re.compile(r"^\s*(import numba|from numba)", re.MULTILINE)
 # the modules whose constants the compiled code reads, relative to the repository / site-packages root; every
-# wormsim / meshgen module that imports numba is added (_sources; tests/test_jit_cache.py checks that each constant
+# wormsim / meshgen module that imports numba is added (_sources; tests/runtime/test_jit_cache.py checks that each
+# constant
 # a compiled module imports comes from one of them)
 SOURCES = (
     "wormsim/physics/friction.py",
@@ -57,7 +58,7 @@ SOURCES = (
     "meshgen/worm_forms.py",
 )
 # the warm-up runs: scenario (a seed shipped in wormsim.scenarios) and overrides; together they call every compiled
-# entry point with the signatures a run uses (tests/test_jit_cache.py checks that a later run compiles nothing)
+# entry point with the signatures a run uses (tests/runtime/test_jit_cache.py checks that a later run compiles nothing)
 WARM_STEPS = 40
 WARM_RUNS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("screw_jack", ()),

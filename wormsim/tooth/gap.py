@@ -9,7 +9,7 @@ closed form of meshgen.worm.thread_gap (equations (1), (2) there):
 
 negative inside the thread, valid for r_f1 <= r <= r_a1 and |z_s| <= b1 / 2; worm_gap_ext evaluates it past these
 bounds too (the flank extended) and returns the excess by which the point lies outside. H(r) is meshgen's compiled
-one (meshgen.worm_forms_jit.thread_half_thickness, on meshgen.worm.worm_params); tests/test_flank_contact.py pins the
+one (meshgen.worm_forms_jit.thread_half_thickness, on meshgen.worm.worm_params); tests/tooth/test_kernel.py pins the
 gap to meshgen.worm.thread_gap.
 """
 

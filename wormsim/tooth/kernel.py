@@ -118,7 +118,7 @@ def _find_contacts(grid, ks, theta1, theta2, margin, taper_rad, P, out, work, me
     by delta (`_pose_drift`, now) and delta_e (at the slice's evaluation), the largest distance a wheel grid point
     lies from where the nominal assembly puts it: the gap then differs from the nominal assembly's by at most 2 delta
     (the same factor 2), so the nominal bound holds with 2 (delta + delta_e) more; delta = 0 for the nominal poses. A
-    skipped slice gives no contact, as its evaluation would: tests/test_flank_kernel_memo.py compares with and without
+    skipped slice gives no contact, as its evaluation would: tests/tooth/test_kernel_memo.py compares with and without
     over mesh cycles, nominal and with moving poses."""
     xy, c, c_range, span, zeta = grid
     tmp, gaps, exc, pts, nrs, stamp = work

@@ -15,7 +15,7 @@ and s = A^-1 w in the static worm frame, where the closed form of meshgen.worm.t
 worm's hinge angle theta1: the worm body frame is A^-1 turned by -theta1, and the closed form depends on the angle
 only through phi - theta1, so gap(s, theta1) = gap(body coordinates, 0), the thread on the body's axis (worm runout:
 the body axis is off the hinge axis). The gradient goes back to the world by A's rotation. With zero errors
-X_g = Rz(theta2) and A = Trans(0, -a, 0) R0: the nominal mapping (tests/test_flank_errors.py: contacts within
+X_g = Rz(theta2) and A = Trans(0, -a, 0) R0: the nominal mapping (tests/contact3d/test_flank_errors.py: contacts within
 1e-12 of the nominal path).
 
 The kernel's candidate window (find_contacts' margin) is widened by `error_margin_rad`: the wheel points move

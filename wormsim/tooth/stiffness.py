@@ -56,7 +56,7 @@ def pair_stiffness_n_per_m(contact: Contact, g: GearGeometry, materials: Materia
     """(K = k' b2, the stiffness of one tooth pair whose contact line spans the face width, as contact3d's law reads
     it; its source): per_length_stiffness over the face width."""
     # the scenario's K and Hertz's pi b2 E* / 4 as written (bit for bit: a run above the stable limit rings or not on
-    # the last bit of K, tests/test_contact3d_ringing.py), the teeth's k' b2
+    # the last bit of K, tests/contact3d/test_ringing_check.py), the teeth's k' b2
     if contact.stiffness_n_per_m is not None:
         return contact.stiffness_n_per_m, "scenario"
     if contact.stiffness_model == "hertz":

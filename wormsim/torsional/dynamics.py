@@ -41,7 +41,7 @@ for rho' > gamma a wheel torque makes tan(gamma - s rho') = 0 at Vs = v_s atanh(
 order of v_s. v_s is a tenth of v_t (SIGN_VELOCITY_FRACTION) so that this creep stays below the static -> dynamic
 transition and a pair whose STATIC rho' exceeds gamma holds from rest even where its dynamic rho' is below gamma
 (with v_s = v_t the creep, 1.75 v_t at rho' = gamma + 0.3 deg, reached mu_dynamic and the worm ran back:
-tests/test_stability_backlash_locking.py, docs/stability_backlash_locking.md).
+tests/contact3d/test_backlash.py, docs/stability_backlash_locking.md).
 
 Equations of motion:
 

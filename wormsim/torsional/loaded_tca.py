@@ -21,7 +21,7 @@ below 0 up to X_MAX_FACTOR times the working deflection (doubled until the worki
 angle and the first column is free of contact; at least the perfect pair's torque at MIN_APPROACH_M), and
 SAMPLES_PER_MESH worm angles per mesh cycle over the kinematic TCA's period. T is reported as s T >= 0.
 
-Check on the perfect pair (tests/test_torsional_errors.py): the slope dT/dx against mesh_stiffness's K_theta (4),
+Check on the perfect pair (tests/torsional/test_errors.py): the slope dT/dx against mesh_stiffness's K_theta (4),
 which integrates k' arm^2 along the contact LINE, while (1) sums per slice of the face width (contact3d's slice
 method); docs/errors.md, section 5a, has the measured ratio.
 """

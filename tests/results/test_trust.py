@@ -1,0 +1,249 @@
+"""Outputs a user can trust: the meshing line (never a harmonic), the plausibility warnings, one meaning per force key
+and a front door that agrees with itself. The new user's gear: 1-start ZI, z2 40, m_x 4, q 10, bronze, 1450 rpm,
+150 N m (torsional runs of 0.1-0.5 s, a few seconds each)."""
+
+from __future__ import annotations
+
+import math
+import re
+
+import numpy as np
+import pytest
+
+import wormsim
+from tests.conftest import ROOT
+from wormsim.results import run_warnings as W
+from wormsim.results.metrics import MIN_MESH_CYCLES, dominant_frequency, mesh_line, mesh_line_keys
+from wormsim.results.result import Result
+from wormsim.scenario import load_scenario
+
+USER_GEAR = [
+    "model=torsional",
+    "gear.profile=ZI",
+    "gear.worm_starts=1",
+    "gear.wheel_teeth=40",
+    "gear.axial_module_mm=4",
+    "gear.diameter_quotient=10",
+    "gear.face_width_mm=null",
+    "drive.speed_rpm=1450",
+    "load.torque_nm=150",
+]
+
+
+@pytest.fixture(scope="module")
+def template(tmp_path_factory):
+    from wormsim.cli.init import write_template
+
+    return write_template(tmp_path_factory.mktemp("trust") / "user_gear.yaml")
+
+
+_RUNS: dict[tuple, dict] = {}
+
+
+def user_run(template, *sets: str) -> tuple[dict, object]:
+    if sets not in _RUNS:
+        sc = load_scenario(template, [*USER_GEAR, *sets])
+        _RUNS[sets] = (wormsim.simulate(sc).summary, sc)
+    return _RUNS[sets]
+
+
+# ----------------------------------------------------------------------------- 1. the meshing line
+
+
+def _signal(f0: float, duration_s: float, dt: float = 1e-4):
+    """A meshing signal whose 2nd harmonic is larger than its 1st (the involute_41 TE: 0.032 against 0.022 of the
+    mean), with a larger contact-mode ringing at 1 kHz and noise."""
+    t = np.arange(0.0, duration_s, dt)
+    rng = np.random.default_rng(0)
+    x = (
+        100.0
+        + 0.5 * np.sin(2 * np.pi * f0 * t)
+        + 1.2 * np.sin(2 * np.pi * 2 * f0 * t + 0.3)
+        + 0.2 * np.sin(2 * np.pi * 3 * f0 * t)
+        + 3.0 * np.sin(2 * np.pi * 1000.0 * t)
+        + 0.05 * rng.standard_normal(len(t))
+    )
+    return t, x
+
+
+def test_mesh_line_is_the_fundamental_when_a_harmonic_is_larger():
+    f0 = 24.1425  # z1 n1 / 60 of the user's gear at 1448.55 rpm
+    t, x = _signal(f0, 0.5)
+    assert abs(dominant_frequency(t, x)[0] - 1000.0) < 5  # the largest peak of the spectrum is the ringing
+    line = mesh_line(t, x, f0 * 1.003)  # the theory from a measured speed 0.3 % off
+    assert line["found"]
+    assert abs(line["f_hz"] / f0 - 1) < 0.001, line["f_hz"]
+    # the harmonics' amplitudes, 1st to 4th
+    assert line["amplitudes"][:3] == pytest.approx([0.5, 1.2, 0.2], rel=0.05)
+    assert line["amplitudes"][3] < 0.03
+
+
+def test_mesh_line_keys_and_a_short_window_warns():
+    f0 = 24.1425
+    t, x = _signal(f0, 0.1)  # 2.4 mesh periods
+    S = {"tangential_force_n": x, "transmission_error_rad": 1e-6 * x}
+    keys = mesh_line_keys(t, S, slice(0, len(t)), f0, "tangential_force_n")
+    assert keys["steady_window_mesh_cycles"] == pytest.approx(0.1 * f0, rel=0.01)
+    assert keys["steady_window_mesh_cycles"] < MIN_MESH_CYCLES
+    assert keys["mesh_frequency_resolution_hz"] == pytest.approx(10.0, rel=0.01)
+    for k in range(1, 5):
+        assert f"tangential_force_harmonic{k}_n" in keys and f"transmission_error_harmonic{k}_urad" in keys
+    summary = {**keys, "mesh_frequency_theory_hz": f0, "steady_window_s": [0.0, 0.1], "power_flow": "worm to wheel"}
+    (w,) = W.mesh_window_warnings(summary)
+    assert "fewer than 5" in w and "simulation.duration_s" in w and "resolution 10" in w
+    # a line 1 % off the theory warns; 0.1 % does not
+    ok = {**summary, "steady_window_mesh_cycles": 12.0, "mesh_frequency_hz": 1.001 * f0}
+    assert W.mesh_window_warnings(ok) == []
+    assert "from z1 n1 / 60" in W.mesh_window_warnings({**ok, "mesh_frequency_hz": 1.01 * f0})[0]
+    assert "no meshing line" in W.mesh_window_warnings({**ok, "mesh_frequency_line_found": False})[0]
+
+
+def test_user_gear_torsional_meshing_line_within_half_a_percent(template):
+    """torsional, 0.5 s: the TE's 2nd harmonic is larger than its 1st (measured 0.54 against 0.45 urad), the line
+    24.140 Hz against z1 n1 / 60 = 24.1425 Hz; no warning."""
+    s, _ = user_run(template, "simulation.duration_s=0.5")
+    assert abs(s["mesh_frequency_hz"] / s["mesh_frequency_theory_hz"] - 1) <= 0.005, s["mesh_frequency_hz"]
+    assert s["steady_window_mesh_cycles"] >= MIN_MESH_CYCLES
+    assert s["warnings"] == []
+    assert s["power_flow"] == "worm to wheel"
+    assert s["transmission_error_harmonic1_urad"] > 0 and s["tangential_force_harmonic2_n"] > 0
+
+
+def test_user_gear_torsional_short_window_warns(template):
+    """The window of a 0.1 s run holds about one mesh period: its line is not resolved, and the run says so."""
+    s, _ = user_run(template, "simulation.duration_s=0.1")
+    assert s["steady_window_mesh_cycles"] < MIN_MESH_CYCLES
+    assert any("mesh periods, fewer than 5" in w for w in s["warnings"]), s["warnings"]
+
+
+# ----------------------------------------------------------------------------- 3. plausibility
+
+
+def test_overhauling_load_reports_the_reverse_flow_efficiency(template):
+    """A load that drives the wheel forward (-150 N m) against the worm's speed control: power flows from the
+    wheel, efficiency = worm power out / wheel power in = tan(gamma - rho') / tan(gamma) (measured 0.5719 against
+    0.5719), and the run warns."""
+    s, sc = user_run(template, "simulation.duration_s=0.5", "load.torque_nm=-150")
+    assert s["power_flow"] == "wheel to worm"
+    from wormsim.physics.geometry import derive
+
+    g = derive(sc.gear)
+    rho = math.atan(s["friction_coefficient_mean"] / math.cos(g.alpha_n))
+    assert s["efficiency"] == pytest.approx(math.tan(g.gamma - rho) / math.tan(g.gamma), rel=0.01)
+    assert s["efficiency_theory"] == pytest.approx(s["efficiency"], rel=0.01)
+    assert any("power flows from the wheel to the worm" in w for w in s["warnings"]), s["warnings"]
+
+
+def test_speed_zero_reports_no_ratio_and_no_efficiency(template):
+    s, _ = user_run(template, "drive.speed_rpm=0")
+    assert s["power_flow"] == "none"
+    assert s["ratio"] is None or not math.isfinite(s["ratio"])
+    assert s["efficiency"] is None or not math.isfinite(s["efficiency"])
+    assert [w for w in s["warnings"] if "does not turn" in w], s["warnings"]
+    assert not [w for w in s["warnings"] if "runaway" in w or "mesh periods" in w], s["warnings"]
+
+
+def test_runaway_torque_drive_warns(template):
+    """A torque drive of 10 N m against the 150 N m load (T2 / (i eta) = 5.4 N m holds it): the worm accelerates
+    without bound (measured 1.08e5 rpm at 0.5 s)."""
+    s, _ = user_run(template, "simulation.duration_s=0.3", "drive.speed_rpm=null", "drive.torque_nm=10")
+    assert any(w.startswith("runaway: the torque-driven worm still accelerates") for w in s["warnings"]), s["warnings"]
+
+
+def _result(summary, series=None):
+    return Result("contact3d", summary, series or {}, 0, 0.0)
+
+
+def test_runaway_speed_drive_warns_above_one_and_a_half_times_the_command(template):
+    sc = load_scenario(template, USER_GEAR)
+    t = np.linspace(0, 0.5, 501)
+    ok = {"t_s": t, "worm_speed_rpm": np.full_like(t, 1450.0)}
+    assert W.runaway_warning(_result({"steady_window_s": [0.1, 0.5]}, ok), sc) is None
+    fast = {"t_s": t, "worm_speed_rpm": np.where(t > 0.3, 2500.0, 1450.0)}
+    assert "above 1.5 x its command 1450 rpm" in W.runaway_warning(_result({"steady_window_s": [0.1, 0.5]}, fast), sc)
+
+
+def test_contact_pressure_above_the_wheel_material_warns(template):
+    """Bronze (the rating's default row for a 100 GPa wheel, CuSn12Ni2: sigma_HlimT 520 MPa): p_H max 2636 MPa (the
+    user's gear at 20 000 N m) warns, 290 MPa does not."""
+    sc = load_scenario(template, USER_GEAR)
+    w = W.pressure_warning({"contact_pressure_max_mpa": 2636.0}, sc)
+    assert w is not None and "2636 MPa" in w and "520 MPa" in w and "CuSn12Ni2" in w
+    assert W.pressure_warning({"contact_pressure_max_mpa": 290.0}, sc) is None
+    al = load_scenario(template, [*USER_GEAR, "rating.wheel_material=CuAl10Fe5Ni5"])
+    assert W.pressure_warning({"contact_pressure_max_mpa": 600.0}, al) is None  # sigma_HlimT 660 MPa
+
+
+# ----------------------------------------------------------------------------- 6. force keys
+
+
+def test_force_keys_have_one_meaning_each():
+    """The headline F_r2 and F_a2 are DIN 3975's at every level; the resultant's components are their own keys, and
+    docs/outputs.md says which is which."""
+    from wormsim.results.summary_keys import KEYS
+
+    assert "radial_force_line_of_centres_mean_n" not in KEYS
+    for k in ("radial_force_resultant_mean_n", "axial_force_resultant_mean_n"):
+        assert KEYS[k].levels == ("contact3d",) and "resultant" in KEYS[k].meaning
+    for k in ("tangential_force_mean_n", "radial_force_mean_n", "axial_force_mean_n"):
+        assert (
+            len(KEYS[k].levels) == 3 and "DIN 3975" in KEYS[k].meaning + (k == "tangential_force_mean_n") * "DIN 3975"
+        )
+    doc = (ROOT / "docs" / "outputs.md").read_text()
+    section = doc.split("## Force keys", 1)[1].split("## Keys", 1)[0]
+    for k in (
+        "radial_force_mean_n",
+        "axial_force_mean_n",
+        "radial_force_resultant_mean_n",
+        "axial_force_resultant_mean_n",
+    ):
+        assert k in section, k
+
+
+# ----------------------------------------------------------------------------- 7. front door
+
+
+def _docs() -> list:
+    return [ROOT / "README.md", *sorted((ROOT / "docs").rglob("*.md"))]
+
+
+def test_no_doc_cites_a_file_outside_the_repository():
+    bad = re.compile(r"INTERFACE\.md|shared/|/work/|\.\./\.\./")
+    hits = [f"{p.relative_to(ROOT)}: {m.group(0)}" for p in _docs() for m in bad.finditer(p.read_text())]
+    assert hits == []
+
+
+def test_api_md_lists_every_public_name():
+    doc = (ROOT / "docs" / "api.md").read_text()
+    for name in wormsim.__all__:
+        assert f"`wormsim.{name}`" in doc, name
+
+
+def test_scenario_md_has_every_block():
+    from tools.schema_doc import BLOCKS
+
+    doc = (ROOT / "docs" / "scenario.md").read_text()
+    titles = [t for t, _ in BLOCKS]
+    for block in ("shafts", "shafts.worm / shafts.wheel", "errors", "rating", "simulation", "wedge.motor"):
+        assert block in titles, block
+    for t in titles:
+        assert f"## `{t}`" in doc, t
+
+
+def test_check_prints_the_derived_sizes_timestep_and_slices(template, capsys):
+    """The user's gear: d1 = q m_x = 40 mm, d2 = z2 m_x = 160 mm, a = 100 mm, b2 = 0.75 d_a1 = 36 mm; at contact3d
+    the step and slices its run took (measured: 2e-05 s with the teeth's compliance, 24 slices at medium)."""
+    from wormsim.cli import main
+
+    assert (
+        main(["check", str(template), "--set", "model=contact3d", *sum((["--set", s] for s in USER_GEAR[1:]), [])]) == 0
+    )
+    out = capsys.readouterr().out
+    derived = out.split("# derived (what the run uses):", 1)[1]
+    for text in ("d1: 40 mm", "d2: 160 mm", "centre distance a: 100 mm", "face width b2: 36 mm", "worm length b1:",
+                 "timestep: 2e-05 s", "flank slices across the face:"):  # fmt: skip
+        assert text in derived, text
+    # torsional: the step the run takes
+    run, _ = user_run(template, "simulation.duration_s=0.5")
+    assert main(["check", str(template), *sum((["--set", s] for s in USER_GEAR[1:]), [])]) == 0
+    assert f"timestep: {run['timestep_s']:.3g} s" in capsys.readouterr().out

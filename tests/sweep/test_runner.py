@@ -1,0 +1,114 @@
+"""`wormsim sweep` with several points per task (wormsim.sweep.runner.chunk_size): every point a row of its own with
+its own timing, the same rows as one point per task; and the cluster started while the points are validated
+(an invalid point still exits 2)."""
+
+from __future__ import annotations
+
+import csv
+import json
+from pathlib import Path
+
+import pytest
+
+from wormsim import cli
+from wormsim.sweep import load_sweep, run_sweep
+from wormsim.sweep.runner import MAX_CHUNK, chunk_size
+
+ROOT = Path(__file__).resolve().parents[2]
+SWEEP = """name: chunks
+base: {base}
+set: {{model: torsional, simulation.duration_s: 0.01}}
+grid:
+  load.torque_nm: {{linspace: [4, 12, {n}]}}
+"""
+
+
+@pytest.fixture(autouse=True)
+def _quiet(monkeypatch):
+    monkeypatch.delenv("DASK_SCHEDULER_ADDRESS", raising=False)
+    monkeypatch.setenv("WORMSIM_NO_PROGRESS", "1")
+
+
+def test_chunk_size():
+    assert chunk_size(3, 2) == 1 and chunk_size(15, 2) == 1  # fewer than 8 points per thread: one per task
+    assert chunk_size(16, 2) == 2 and chunk_size(16, 1) == 4 and chunk_size(1000, 4) == MAX_CHUNK
+    assert chunk_size(16, 16) == 1
+
+
+@pytest.mark.long
+def test_points_in_chunks_are_rows_of_their_own(tmp_path):
+    f = tmp_path / "s.yaml"
+    f.write_text(SWEEP.format(base=ROOT / "scenarios" / "screw_jack.yaml", n=8))
+    res = run_sweep(load_sweep(f), tmp_path / "o", workers=1, progress=False)
+    assert res["ok"] == 8 and res["cluster"]["points_per_task"] == 2
+    with (tmp_path / "o" / "sweep.csv").open(newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    assert [int(r["point"]) for r in rows] == list(range(8)) and {r["status"] for r in rows} == {"ok"}
+    # each row is its own point's: the mean tangential force rises with the load torque, point by point
+    forces = [float(r["tangential_force_mean_n"]) for r in rows]
+    assert all(b > a for a, b in zip(forces, forces[1:])), forces
+    doc = json.loads((tmp_path / "o" / "sweep.json").read_text())
+    tim = [p["timing"] for p in doc["points"]]
+    assert all(t["end"] >= t["start"] for t in tim)
+    assert len({t["submitted"] for t in tim}) == 4  # 4 tasks of 2 points
+    assert all("compile_s" in t and "jit_misses" in t for t in tim)
+
+
+@pytest.mark.long
+def test_an_invalid_point_exits_2_with_the_cluster_started(tmp_path, capsys):
+    f = tmp_path / "s.yaml"
+    f.write_text(SWEEP.format(base=ROOT / "scenarios" / "screw_jack.yaml", n=2) + "  gear.wheel_teeth: [30, 5]\n")
+    code = cli.main(["sweep", str(f), "--out", str(tmp_path / "o"), "--workers", "1"])
+    assert code == 2 and "gear.wheel_teeth = 5" in capsys.readouterr().err
+
+
+def test_local_workers_start_warm_from_the_fork_server(tmp_path):
+    """A contact3d sweep's local workers are forked from a fork server that loaded the compiled kernels once
+    (wormsim.sweep.preload_warm): each point finds them loaded before it starts, on every worker."""
+    import subprocess
+    import sys
+
+    f = tmp_path / "s.yaml"
+    f.write_text(
+        "name: warm\nbase: {base}\nset: {{model: contact3d, simulation.duration_s: 0.004}}\n"
+        "grid:\n  drive.speed_rpm: [1000, 1500]\n".format(base=ROOT / "scenarios" / "screw_jack.yaml")
+    )
+    wormsim = Path(sys.executable).parent / "wormsim"
+    cp = subprocess.run(
+        [str(wormsim), "sweep", str(f), "--out", str(tmp_path / "o"), "--workers", "2", "--no-progress"],
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    assert cp.returncode == 0, cp.stderr
+    doc = json.loads((tmp_path / "o" / "sweep.json").read_text())
+    timing = [p["timing"] for p in doc["points"]]
+    assert len(timing) == 2, timing
+    warmed_by = {t["warmed_by_pid"] for t in timing}
+    assert len(warmed_by) == 1 and None not in warmed_by and not warmed_by & {t["pid"] for t in timing}, timing
+
+
+def test_warm_worker_runs_once_per_process(monkeypatch):
+    """wormsim.sweep.warm.warm_worker: ensure_warm and the short run once; later calls (a worker forked from a warm
+    fork server, the plugin after the preload) skip; a failure is reported, not raised, and leaves it to retry."""
+    import os
+
+    from wormsim.contact3d import runner as c3d_runner
+    from wormsim.runtime import jit_cache
+    from wormsim.sweep import warm
+
+    calls = []
+    monkeypatch.setattr(warm, "_warm_pid", None)
+    monkeypatch.setattr(jit_cache, "ensure_warm", lambda runs: calls.append("ensure") or False)
+    monkeypatch.setattr(c3d_runner, "warm_runs", lambda runs: calls.append(("run", len(runs))))
+
+    def fails(runs):
+        raise RuntimeError("no cache")
+
+    monkeypatch.setattr(c3d_runner, "warm_runs", fails)
+    assert warm.warm_worker()["error"] == "RuntimeError: no cache" and warm.warm_pid() is None
+    monkeypatch.setattr(c3d_runner, "warm_runs", lambda runs: calls.append(("run", len(runs))))
+    assert warm.warm_worker() == {"compiled": False, "error": None, "skipped": False}
+    assert warm.warm_pid() == os.getpid()
+    assert warm.warm_worker()["skipped"] is True
+    assert calls == ["ensure", "ensure", ("run", 1)]

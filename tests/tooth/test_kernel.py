@@ -1,0 +1,162 @@
+"""Exact-flank contact of contact3d (wormsim.tooth.kernel, flank_step): the kernel's distance is meshgen.worm's closed
+form, the rigid conjugate pose touches with the backlash as the only gap, and the MuJoCo model built on flank contacts
+shows the specified tooth-pair stiffness (issue 13: within 5 %, as tests/contact3d/test_law.py for pieces)."""
+
+from __future__ import annotations
+
+import math
+
+import mujoco
+import numpy as np
+import pytest
+
+from meshgen import worm
+from meshgen.geometry import derive
+from tests.conftest import SCENARIOS
+from wormsim.contact3d.mjcf import build_model
+from wormsim.scenario import load_scenario
+from wormsim.tooth import gap, grid, kernel
+from wormsim.tooth.window import window_size, window_teeth_at
+
+SCEN = SCENARIOS
+
+
+@pytest.mark.parametrize("name,profile", [("seat_motor", "ZI"), ("screw_jack", "ZA"), ("involute_41", "ZI")])
+def test_kernel_distance_is_meshgen_thread_gap(name, profile):
+    g = derive(load_scenario(SCEN / f"{name}.yaml", [f"gear.profile={profile}"]).gear)
+    rng = np.random.default_rng(1)
+    n = 400
+    r = rng.uniform(g.r_f1, g.r_a1, n)
+    phi = rng.uniform(-math.pi, math.pi, n)
+    z = rng.uniform(-g.worm_length / 2, g.worm_length / 2, n)
+    pts = np.stack([r * np.cos(phi), r * np.sin(phi), z], axis=1)
+    th1 = 0.37
+    ref = worm.thread_gap(g, pts, th1)
+    P = worm.worm_params(g)
+    out = np.zeros(6)
+    got = np.array([gap.worm_gap(x, y, zz, th1, P, out) for x, y, zz in pts])
+    assert np.allclose(got, ref, rtol=0, atol=1e-12 * g.m_x / 1e-3)
+    # the normal, on the flank itself (meshgen.worm.flank_points): along the numerical gradient of the distance
+    for side in (+1, -1):
+        q = worm.flank_points(g, 0.5 * (g.r_f1 + g.r_a1), 0.3, side)
+        R = np.array([[math.cos(th1), math.sin(th1), 0], [-math.sin(th1), math.cos(th1), 0], [0, 0, 1.0]])
+        x, y, zz = R.T @ q  # the flank turned with the worm by theta1
+        assert abs(gap.worm_gap(x, y, zz, th1, P, out)) < 1e-12
+        e = 1e-9
+        grad = np.array(
+            [
+                gap.worm_gap(x + e * (i == 0), y + e * (i == 1), zz + e * (i == 2), th1, P, np.zeros(6))
+                - gap.worm_gap(x - e * (i == 0), y - e * (i == 1), zz - e * (i == 2), th1, P, np.zeros(6))
+                for i in range(3)
+            ]
+        ) / (2 * e)
+        assert np.allclose(out[:3], grad, atol=1e-5)
+
+
+@pytest.mark.parametrize("name", ["seat_motor", "screw_jack", "involute_41"])
+def test_conjugate_pose_touches_across_the_backlash(name):
+    """Wheel turned from the conjugate angle by s times the backlash angle j / (2 r2) (half the backlash per flank):
+    no contact for |s| <= 0.95; at |s| = 2 the depth is the backlash angle times the moment arm of the flank normal
+    (r2 cos(alpha_n) cos(gamma) at the pitch point; the deepest slice within 5 %), on flank A for a lagging wheel."""
+    g = derive(load_scenario(SCEN / f"{name}.yaml").gear)
+    fg = grid.flank_grid(g, 16)
+    W = window_size(g)
+    tooth0 = -math.pi / 2 + math.pi / g.z2
+    cap = 2 * W * 16
+    pos, nrm, dep, meta = np.zeros((cap, 3)), np.zeros((cap, 3)), np.zeros(cap), np.zeros((cap, 4))
+    bl = g.backlash / (2 * g.r2)
+    arm0 = g.r2 * math.cos(g.alpha_n) * math.cos(g.gamma)
+    pitch = 2 * math.pi / g.z2
+    for th1 in (0.0, 1.1, 2.5):
+        th2c = g.hand * th1 * g.z1 / g.z2
+        ks = window_teeth_at(th2c, g.z2, W, tooth0).astype(np.int64)
+        for s in (-0.95, 0.95):
+            n = kernel.find_contacts(
+                (fg.xy, fg.c, fg.c_range, fg.span, fg.zeta),
+                ks,
+                th1,
+                th2c + s * bl,
+                kernel.MARGIN_PITCH * pitch + 3 * bl,
+                fg.params,
+                (pos, nrm, dep, meta, np.zeros((len(dep), 2))),
+            )
+            assert n == 0, (th1, s, dep[:n].max())
+        for s, flank in ((-2.0, 0), (2.0, 1)):
+            n = kernel.find_contacts(
+                (fg.xy, fg.c, fg.c_range, fg.span, fg.zeta),
+                ks,
+                th1,
+                th2c + g.hand * s * bl,
+                kernel.MARGIN_PITCH * pitch + 3 * bl,
+                fg.params,
+                (pos, nrm, dep, meta, np.zeros((len(dep), 2))),
+            )
+            assert n >= 8 and np.all(meta[:n, 1] == flank)
+            assert dep[:n].max() == pytest.approx(bl * arm0, rel=0.05)
+
+
+def _settle(bm, d, torque_nm: float, steps: int, fc):
+    d.ctrl[bm.drive_actuator] = 0.0
+    d.ctrl[bm.load_actuator] = torque_nm
+    for _ in range(steps):
+        fc.step(bm.model, d)
+
+
+@pytest.fixture(scope="module")
+def static_flanks():
+    """Worm held at 0 rpm by its servo, frictionless, wheel torques 21 and 24 N m (tests/contact3d/test_law.py)."""
+    from wormsim.contact3d.flank_step import FlankContacts
+    from wormsim.contact3d.native import split_forward
+
+    sc = load_scenario(
+        SCEN / "seat_motor.yaml",
+        [
+            "drive.speed_rpm=0",
+            "drive.ramp_s=0",
+            "load.ramp_s=0",
+            "contact.geometry=flanks",
+            "contact.friction=0",
+            "contact.friction_static=null",
+            "contact.friction_dynamic=null",
+        ],
+    )
+    bm = build_model(sc)
+    m = bm.model
+    d = mujoco.MjData(m)
+    fc = FlankContacts(bm, bm.law.contacts_per_pair)
+    split_forward(m, d, fc.add)
+    out = []
+    for T in (21.0, 24.0):
+        _settle(bm, d, -T, 6000, fc)
+        rel = d.qpos[fc.qa2] - bm.direction * d.qpos[fc.qa1] / bm.geometry.ratio
+        C = []
+        for i in range(d.ncon):
+            c = d.contact[i]
+            n = np.array(c.frame[:3])
+            w = float(c.solref[0] / bm.law.solref[0])  # the contact's share of its slice (slice_weights)
+            C.append((float(d.efc_force[c.efc_address]), -float(c.dist), c.pos[0] * n[1] - c.pos[1] * n[0], w))
+        out.append((T, float(rel), np.array(C), float(np.abs(d.qvel).max())))
+    return bm, out
+
+
+def test_flank_contact_stiffness_is_k_over_slices(static_flanks):
+    bm, out = static_flanks
+    C = out[-1][2]
+    assert bm.law.contacts_per_pair == 32  # the seat motor's default slices (flanks.default_slices)
+    assert len(C) >= 8
+    assert np.all((C[:, 3] > 0) & (C[:, 3] <= 1)) and np.sum(C[:, 3] == 1) >= 8
+    ratio = C[:, 0] / C[:, 1] / (C[:, 3] * bm.law.contact_stiffness_n_per_m)
+    assert np.all(np.abs(ratio - 1) < 0.05), ratio
+
+
+def test_flank_static_mesh_stiffness_per_pair_within_5_percent(static_flanks):
+    bm, out = static_flanks
+    (Ta, tha, Ca, _), (Tb, thb, Cb, vmax) = out
+    assert vmax < 1e-3
+    k_theta = (Tb - Ta) / abs(thb - tha)
+    arm2 = 0.5 * sum(np.sum(C[C[:, 0] > 1e-3, 3] * C[C[:, 0] > 1e-3, 2] ** 2) for C in (Ca, Cb))
+    k_pair = k_theta * bm.law.contacts_per_pair / arm2
+    print(
+        f"flank tooth-pair stiffness {k_pair:.6g} N/m against K = {bm.law.pair_stiffness_n_per_m:.6g} ({len(Cb)} contacts)"
+    )
+    assert k_pair == pytest.approx(bm.law.pair_stiffness_n_per_m, rel=0.05)
