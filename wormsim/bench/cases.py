@@ -37,7 +37,7 @@ class BenchCase:
         return Scenario.model_validate({**sc.model_dump(), "shafts": SHAFTS_BLOCK})
 
 
-def _level_available(model: str) -> bool:
+def level_available(model: str) -> bool:
     return importlib.util.find_spec(LEVELS[model]) is not None
 
 
@@ -110,7 +110,7 @@ def bench_cases(
     for name in names:
         dur = QUICK_DURATION_S if quick else DURATION_S[name]
         common = VARIANTS[name] + (f"simulation.duration_s={dur}",)
-        if _level_available("contact3d") and (models is None or "contact3d" in models) and geos:
+        if level_available("contact3d") and (models is None or "contact3d" in models) and geos:
             default_geo = load_scenario(SCENARIOS / f"{name}.yaml", list(common)).contact.geometry
             ref_geo = default_geo if default_geo in geos else geos[0]
             for geo in geos:
@@ -122,7 +122,7 @@ def bench_cases(
                     (2.0, 1.0) if quick else (2.0, 1.0, 0.5),
                     reference=geo == ref_geo,
                 )
-        if _level_available("torsional") and (models is None or "torsional" in models):
+        if level_available("torsional") and (models is None or "torsional" in models):
             # resolution = k(theta) samples per mesh cycle; the default timestep is one sample's worth of worm
             # rotation at full speed (wormsim.torsional.dynamics.default_timestep), so this sweeps both
             for n in (16, 64) if quick else (16, 32, 64, 128, 256):

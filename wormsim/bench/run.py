@@ -32,8 +32,8 @@ import numpy as np
 from wormsim.bench.cases import (
     GEOMETRIES,
     BenchCase,
-    _level_available,
     bench_cases,
+    level_available,
     relative_errors,
 )
 from wormsim.bench.stability import stability_map
@@ -294,7 +294,7 @@ def run_bench(
     # flanks against pieces at equal or better accuracy, now that every record has its errors
     meta["speedup_flanks_vs_pieces_equal_accuracy"] = speedups_equal_accuracy(records)
     meta["speedup_flanks_vs_pieces_equal_accuracy_loop"] = speedups_equal_accuracy(records, "loop_wall_s_per_sim_s")
-    if _level_available("contact3d") and (models is None or "contact3d" in models):
+    if level_available("contact3d") and (models is None or "contact3d" in models):
         # the timestep sweep of each seed until a guard fires (stability_edge); quick: the seat motor only
         meta["stability"] = stability_map(
             quick, scenarios, tuple(g for g in GEOMETRIES if geometries is None or g in geometries)

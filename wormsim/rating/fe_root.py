@@ -67,7 +67,7 @@ def _resample(poly: np.ndarray, n: int) -> np.ndarray:
     return np.stack([np.interp(t, s, poly[:, k]) for k in range(poly.shape[1])], axis=-1)
 
 
-def _arc(r: float, a0: float, a1: float, n: int) -> np.ndarray:
+def arc(r: float, a0: float, a1: float, n: int) -> np.ndarray:
     t = np.linspace(a0, a1, n)
     return np.stack([r * np.cos(t), r * np.sin(t)], axis=-1)
 
@@ -147,9 +147,9 @@ def _tooth_top(g: GearGeometry, zeta: float, c: Counts) -> np.ndarray:
     # flanks from their fillet tangent point to the tip
     flank_a = _resample(np.concatenate([fa[-1:], A[sa > ta]]), c.flank)
     flank_b = _resample(np.concatenate([fb[-1:], B[sb > tb]]), c.flank)
-    root_a = _arc(lo, s0, math.atan2(fa[0, 1], fa[0, 0]), c.root)
-    root_b = _arc(lo, math.atan2(fb[0, 1], fb[0, 0]), s1, c.root)
-    tip = _arc(hi, pa[-1], pb[-1], c.tip)
+    root_a = arc(lo, s0, math.atan2(fa[0, 1], fa[0, 0]), c.root)
+    root_b = arc(lo, math.atan2(fb[0, 1], fb[0, 0]), s1, c.root)
+    tip = arc(hi, pa[-1], pb[-1], c.tip)
     return np.concatenate([root_a, fa[1:], flank_a[1:], tip[1:-1], flank_b[::-1], fb[::-1][1:], root_b[1:]])
 
 
@@ -171,7 +171,7 @@ def section_outline(g: GearGeometry, zeta: float, c: Counts, teeth: int = 1) -> 
     r_in = g.r_f2 - RIM_DEPTH_MX * g.m_x
     down = np.linspace(lo, r_in, c.radial + 1)[1:-1]
     side_b = np.stack([down * math.cos(s1), down * math.sin(s1)], -1)
-    inner = _arc(r_in, s1, s0, c.inner + (c.inner - 1) * (teeth - 1))
+    inner = arc(r_in, s1, s0, c.inner + (c.inner - 1) * (teeth - 1))
     side_a = np.stack([down[::-1] * math.cos(s0), down[::-1] * math.sin(s0)], -1)
     return np.concatenate(parts + [side_b, inner, side_a])
 
@@ -179,11 +179,19 @@ def section_outline(g: GearGeometry, zeta: float, c: Counts, teeth: int = 1) -> 
 def tooth_surface(g: GearGeometry, density: int = 1, teeth: int = 1) -> tuple[np.ndarray, np.ndarray]:
     """Watertight triangulated surface (vertices (n, 3) in m, faces (m, 3), outward) of the sector of `teeth` teeth
     (section_outline)."""
-    import manifold3d as mf
 
     c = Counts.at(density)
     zetas = np.linspace(-g.face_width / 2, g.face_width / 2, c.zeta)
     secs = np.stack([section_outline(g, z, c, teeth) for z in zetas])  # (nz, N, 2)
+    return loft(secs, zetas)
+
+
+def loft(secs: np.ndarray, zetas: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The closed surface through the plane sections secs (nz, N, 2) at the heights zetas (nz,): quads between
+    neighbouring sections, each end capped by manifold3d's triangulation; (V (nz N, 3), F (m, 3)), oriented outward
+    (positive signed volume)."""
+    import manifold3d as mf
+
     nz, N = secs.shape[:2]
     V = np.concatenate([secs.reshape(-1, 2), np.repeat(zetas, N)[:, None]], axis=1)
     idx = np.arange(nz * N).reshape(nz, N)
@@ -195,7 +203,6 @@ def tooth_surface(g: GearGeometry, density: int = 1, teeth: int = 1) -> tuple[np
         t = idx[row][tri]
         faces.append(t if up else t[:, ::-1])
     F = np.concatenate(faces)
-    # orient outward: positive signed volume
     vol = np.einsum("ij,ij->i", V[F[:, 0]], np.cross(V[F[:, 1]], V[F[:, 2]])).sum() / 6.0
     if vol < 0:
         F = F[:, ::-1]

@@ -107,7 +107,6 @@ def contact_line_points(g: GearGeometry, side: int, theta2_rad: float) -> np.nda
 def wheel_segment_surface(g: GearGeometry, teeth: list[int]) -> tuple[np.ndarray, np.ndarray]:
     """Watertight triangulated surface (m, wheel frame) of the wheel teeth `teeth` (consecutive) with their rim
     (module docstring), lofted from SECTIONS sections of fe_root's outline."""
-    import manifold3d as mf
 
     from wormsim.rating import fe_root
 
@@ -130,25 +129,10 @@ def wheel_segment_surface(g: GearGeometry, teeth: list[int]) -> tuple[np.ndarray
         lo = float(wheel.root_rho(g, z))
         down = np.linspace(lo, r_in, c.radial + 1)[1:-1]
         side_b = np.stack([down * math.cos(s1), down * math.sin(s1)], -1)
-        inner = fe_root._arc(r_in, s1, s0, c.inner * len(ks))
+        inner = fe_root.arc(r_in, s1, s0, c.inner * len(ks))
         side_a = np.stack([down[::-1] * math.cos(s0), down[::-1] * math.sin(s0)], -1)
         secs.append(np.concatenate(parts + [side_b, inner, side_a]))
-    secs = np.stack(secs)
-    nz, N = secs.shape[:2]
-    V = np.concatenate([secs.reshape(-1, 2), np.repeat(zetas, N)[:, None]], axis=1)
-    idx = np.arange(nz * N).reshape(nz, N)
-    I = np.concatenate([idx, idx[:, :1]], axis=1)
-    a, b, cc, d = I[:-1, :-1], I[1:, :-1], I[1:, 1:], I[:-1, 1:]
-    faces = [np.stack([a, cc, b], -1).reshape(-1, 3), np.stack([a, d, cc], -1).reshape(-1, 3)]
-    for row, up in ((0, False), (nz - 1, True)):
-        tri = np.asarray(mf.triangulate([secs[row]]), dtype=np.int64)
-        t = idx[row][tri]
-        faces.append(t if up else t[:, ::-1])
-    F = np.concatenate(faces)
-    vol = np.einsum("ij,ij->i", V[F[:, 0]], np.cross(V[F[:, 1]], V[F[:, 2]])).sum() / 6.0
-    if vol < 0:
-        F = F[:, ::-1]
-    return V, F
+    return fe_root.loft(np.stack(secs), zetas)
 
 
 def worm_segment_surface(

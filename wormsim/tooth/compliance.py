@@ -363,7 +363,7 @@ def worm_compliance(g: GearGeometry, e_pa: float, nu: float, density: int = 1) -
 # ----------------------------------------------------------------------------- the public entry points
 
 
-def _moduli(materials) -> tuple[float, float, float, float]:
+def moduli(materials) -> tuple[float, float, float, float]:
     w, h = materials.worm, materials.wheel
     return h.youngs_modulus_gpa * 1e9, h.poisson_ratio, w.youngs_modulus_gpa * 1e9, w.poisson_ratio
 
@@ -374,7 +374,7 @@ def compute(g: GearGeometry, materials, density: int = 1, teeth: int = TEETH) ->
     from wormsim.physics.gear_theory import effective_modulus_pa
 
     t0 = time.perf_counter()
-    e2, nu2, e1, nu1 = _moduli(materials)
+    e2, nu2, e1, nu1 = moduli(materials)
     wh = wheel_influence(g, e2, nu2, density, teeth)
     wo = worm_compliance(g, e1, nu1, density)
     return ToothCompliance(
@@ -411,21 +411,21 @@ def _tooth_compliance(g: GearGeometry, moduli: tuple, materials, density: int) -
 def tooth_compliance(g: GearGeometry, materials, density: int = 1) -> ToothCompliance:
     """compute(), cached in process and on disk (meshgen.cache) by geometry, E and nu of both bodies, the mesh
     density and CODE_VERSION."""
-    return _tooth_compliance(g, _moduli(materials), _Frozen(materials), density)
+    return _tooth_compliance(g, moduli(materials), FrozenMaterials(materials), density)
 
 
-class _Frozen:
+class FrozenMaterials:
     """A materials block as an lru_cache argument: hashed and compared by E and nu only (the key)."""
 
     def __init__(self, materials):
         self.worm, self.wheel = materials.worm, materials.wheel
-        self._key = _moduli(materials)
+        self._key = moduli(materials)
 
     def __hash__(self) -> int:
         return hash(self._key)
 
     def __eq__(self, other) -> bool:
-        return isinstance(other, _Frozen) and other._key == self._key
+        return isinstance(other, FrozenMaterials) and other._key == self._key
 
 
 REFERENCE_LINE_LOAD_N_PER_M = 1e5  # 100 N/mm: ISO 6336-1's c' holds from F_t K_A / b = 100 N/mm on

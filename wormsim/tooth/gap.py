@@ -26,7 +26,7 @@ from meshgen.worm_forms_jit import thread_half_thickness
 
 
 @numba.njit(cache=True, inline="always")
-def _wrap(x, period):
+def wrap(x, period):
     """x wrapped to [-period / 2, period / 2): Python's (x + period / 2) % period - period / 2 with floor, inlined
     (numba's float % calls a helper around fmod: 15 % of the kernel's time); equal to it within an ulp of x."""
     w = x + 0.5 * period
@@ -42,7 +42,7 @@ def worm_gap_ext(xs, ys, zs, theta1, P, out):
     ex = max(r - P[3], P[2] - r, abs(zs) - P[4])
     p, p_x = P[0], P[1]
     phi = math.atan2(ys, xs)
-    u = _wrap(zs - p * (phi - theta1), p_x)
+    u = wrap(zs - p * (phi - theta1), p_x)
     H, dH = thread_half_thickness(r, P)
     sg = 1.0 if u >= 0.0 else -1.0
     ir = 1.0 / r

@@ -31,7 +31,7 @@ import math
 import numba
 import numpy as np
 
-from wormsim.tooth.gap import _wrap, worm_gap_ext
+from wormsim.tooth.gap import worm_gap_ext, wrap
 from wormsim.tooth.grid import FlankGrid
 from wormsim.tooth.merge import merge_flanks
 from wormsim.tooth.pose import N_WORM_PARAMS, WHEEL, WORM, static_dir_to_world, to_static, tooth_angle
@@ -126,7 +126,7 @@ def _find_contacts(grid, ks, theta1, theta2, margin, taper_rad, P, out, work, me
     use_memo = mtab.shape[0] > 0
     S = c.shape[1]
     pitch = P[11]
-    te = _wrap(theta2 - P[12] * theta1, pitch)
+    te = wrap(theta2 - P[12] * theta1, pitch)
     drift = _pose_drift(P, theta2, mc[3]) if use_memo and P.shape[0] > N_WORM_PARAMS else 0.0
     taper_end = margin  # edge contacts fade to zero at this distance past the profile's conjugate range
     margin = margin + abs(te)
@@ -142,7 +142,7 @@ def _find_contacts(grid, ks, theta1, theta2, margin, taper_rad, P, out, work, me
         ca, sa = math.cos(ang), math.sin(ang)
         ev = (xy, ca, sa, theta1, P, tmp, gaps, exc, pts, nrs, stamp)
         for sg in range(2):
-            target = _wrap(theta2 + pitch * (k + sg) + dk, 2 * math.pi)
+            target = wrap(theta2 + pitch * (k + sg) + dk, 2 * math.pi)
             lo, hi = target - margin, target + margin
             for j in range(S):
                 if hi < c_range[sg, j, 0] or lo > c_range[sg, j, 1]:

@@ -283,11 +283,11 @@ def loaded_contact(
     """compute(), cached in process and on disk (meshgen.cache). torque_nm: the wheel torque (its magnitude);
     side: the loaded flank (+1 forward drive, wormsim.tooth.mesh_stiffness). deviations: a
     meshgen.displaced.Deviations (assembly errors, pitch deviations), or None for the perfect pair (gaps 0)."""
-    from wormsim.tooth.compliance import _Frozen, _moduli
+    from wormsim.tooth.compliance import FrozenMaterials, moduli
 
     dev = None if deviations is None or deviations.is_zero() else deviations
     if not torque_nm:
         raise ValueError("loaded_contact: torque_nm must be non-zero")
     return _loaded_contact(
-        g, _moduli(materials), _Frozen(materials), abs(float(torque_nm)), samples, side, density, dev
+        g, moduli(materials), FrozenMaterials(materials), abs(float(torque_nm)), samples, side, density, dev
     )
