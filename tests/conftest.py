@@ -21,7 +21,7 @@ def scenario_dir() -> Path:
 # Tests kept out of `make test` for time (the suite must stay under 15 minutes on a 2-core machine); `make test-long`
 # runs them. file name -> None (every test) or the values of the `name` parameter that are long.
 LONG_TESTS: dict[str, set[str] | None] = {
-    # slice and timestep convergence of the flank fluctuation: the seat motor's (step 5e-6 s, ~4 min) is long; the screw
+    # slice and timestep convergence of the flank fluctuation: the seat motor's (step 6.4e-6 s, ~4 min) is long; the screw
     # jack's and involute_41's stay in `make test` (one CI-sized convergence test per seed)
     "contact3d/test_convergence.py": {"seat_motor"},
     # the convex-piece validation of the seeds (contact.geometry pieces); the default geometry's (flanks) is in

@@ -206,7 +206,7 @@ class WormPair:
 
     @property
     def default_timestep_s(self) -> float:
-        """The timestep contact3d would use for this pair [s]: 0.4 x the stable limit, rounded down to 1-2-5
+        """The timestep contact3d would use for this pair [s]: 0.4 x the stable limit, rounded down to two digits
         (wormsim.contact3d.timestep.default_timestep)."""
         return float(default_timestep(self.plan.law))
 

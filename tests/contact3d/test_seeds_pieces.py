@@ -62,12 +62,9 @@ def test_ratio_within_0p1_percent(name):
 
 
 # measured on this CI configuration (docs/contact3d.md): kept strict, marked as expected failures
-MESH_XFAIL = {
-    "involute_41": "F_t's meshing line 24.285 Hz against z1 n1 / 60 = 24.142 Hz (+0.59 %, bin 4.0 Hz, 6.0 mesh "
-    "periods; the run warns): the 41-tooth bronze wheel's mesh mode (5.4e9 N/m Hertz contact, 10 % critical damping) "
-    "rings at ~0.8-2.3 kHz with p2p 55.7 kN on a 13.8 kN mean and leaks into the line (18.2 N); exact flanks give "
-    "24.14 Hz",
-}
+# involute_41 (pieces, fine) failed this at the 1-2-5 default step 5e-5 s (F_t's meshing line 24.285 Hz, +0.59 %: the
+# wheel's mesh mode ringing at ~0.8-2.3 kHz leaked into it); at the two-digit default 8.5e-5 s (decision 0043) it passes
+MESH_XFAIL: dict[str, str] = {}
 EFF_XFAIL = {
     "seat_motor": "efficiency 0.600 against tan(g)/tan(g+rho') = 0.620 at the pitch radius (-3.2 %): the contacts sit "
     "on the worm above its pitch radius (force-weighted 4.40 mm against r1 4.19 mm; the wheel is 58 % "
@@ -106,10 +103,8 @@ def test_mesh_frequency(name):
     assert_mesh_frequency(run(name)["summary"], "mesh_frequency_hz")
 
 
-RADIAL_MESH_XFAIL = {
-    "involute_41": "radial force's meshing line 24.333 Hz against z1 n1 / 60 = 24.142 Hz (+0.79 %, bin 4.0 Hz): the "
-    "pieces' mesh-mode ringing (test above) leaks into it; exact flanks give 24.1426 Hz",
-}
+# involute_41 (pieces): 24.333 Hz, +0.79 %, at 5e-5 s (the mesh-mode ringing above); passes at 8.5e-5 s (decision 0043)
+RADIAL_MESH_XFAIL: dict[str, str] = {}
 
 
 @pytest.mark.parametrize(

@@ -1,10 +1,10 @@
 """contact3d's timestep, chosen once before the model is built (choose_timestep) and passed to it.
 
 Two limits bind: the contact spring-damper's explicit stability limit (ContactLaw.stable_limit_s, three tooth pairs'
-contacts in parallel; the default is 0.4 x it, rounded down to 1-2-5), and the worm's rotation per step: contact3d
-resolves at most MAX_WORM_TURN_PER_STEP_RAD (beyond it the thread's convex pieces pass through the wheel's between
-steps; docs/stability_speed.md). A scenario timestep above the speed limit is refused (ScenarioError naming
-simulation.timestep_s and its allowed range); one above the stable limit is left to the divergence guard, whose
+contacts in parallel; the default is 0.4 x it, rounded down to two significant digits), and the worm's rotation per
+step: contact3d resolves at most MAX_WORM_TURN_PER_STEP_RAD (beyond it the thread's convex pieces pass through the
+wheel's between steps; docs/stability_speed.md). A scenario timestep above the speed limit is refused (ScenarioError
+naming simulation.timestep_s and its allowed range); one above the stable limit is left to the divergence guard, whose
 message names that limit. simulation.speculative does not prevent tunnelling (measured: it fails earlier).
 """
 
@@ -17,18 +17,22 @@ from wormsim.physics.gear_theory import duty, round_down_125, worm_speed_command
 from wormsim.physics.units import rad_s_to_rpm
 from wormsim.scenario import Scenario, ScenarioError
 
-DEFAULT_FRACTION = 0.4  # default timestep: this fraction of the stable limit, rounded down to 1-2-5
+DEFAULT_FRACTION = (
+    0.4  # default timestep: this fraction of the stable limit, rounded down to two digits (decision 0043)
+)
 MAX_WORM_TURN_PER_STEP_RAD = 0.035  # largest worm rotation per step contact3d resolves (2.0 deg;
 # docs/stability_speed.md has the measurements behind it)
 OVERSPEED_GUARD = 1.25  # the running check fires at this multiple of MAX_WORM_TURN_PER_STEP_RAD
-DEFAULT_SOURCE = "default: 0.4 x the stable limit, rounded down to 1-2-5 (docs/bench.md, stability map)"
+DEFAULT_SOURCE = "default: 0.4 x the stable limit, rounded down to two digits (docs/bench.md, stability map)"
 
 
 def default_timestep(law: ContactLaw, contacts: int | None = None) -> float:
     """DEFAULT_FRACTION x the explicit stability limit with `contacts` in parallel (default: three tooth pairs'
-    worth, ContactLaw.stable_limit_s), rounded down to 1-2-5."""
+    worth, ContactLaw.stable_limit_s), rounded down to two significant digits (mass_scaling.floor_2_digits: 1-2-5 lost
+    up to 2.5x of the step; every h <= 0.4 x the limit met decision 0006's criteria, docs/data/step_convergence.json,
+    study "fraction 0.4 of the limit, 2 digits"; decision 0043)."""
     limit = law.stable_limit_s if contacts is None else law.stable_timestep_s(contacts)
-    return round_down_125(DEFAULT_FRACTION * limit)
+    return floor_2_digits(DEFAULT_FRACTION * limit)
 
 
 def speed_timestep_limit_s(w1_rad_s: float) -> float:
