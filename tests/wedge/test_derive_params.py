@@ -30,3 +30,15 @@ def test_reduced_masses_and_working_force_by_hand():
     # the motor curve passes through the working point below its synchronous speed
     assert p.peak_force_n > p.nominal_force_n and p.sync_speed_m_s > v > p.peak_speed_m_s
     assert d["driving_mass_kg"] == p.m1_kg and d["wedge_source"].startswith("derived from gear:")
+
+
+def test_the_derived_run_reads_its_plan_only():
+    """wormsim.wedge.derive.derived_plan: built once from the scenario; run_derived takes nothing else."""
+    from wormsim.wedge.derive import derived_plan, run_derived
+
+    sc = load_scenario(SCENARIOS / "screw_jack.yaml", ["model=wedge", "simulation.duration_s=0.05"])
+    plan = derived_plan(sc)
+    assert plan.load_torque_nm == sc.load.torque_nm and plan.params.duration_s == 0.05 and "geometry" not in plan.keys
+    s = run_derived(plan).summary
+    assert s["tangential_force_theory_n"] == pytest.approx(abs(sc.load.torque_nm) / plan.geometry.r2)
+    assert s["friction"] == plan.friction

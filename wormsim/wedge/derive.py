@@ -25,6 +25,7 @@ F_r2 = |F_t2| tan(alpha_n) cos(rho') / cos(gamma + s rho') (DIN 3975-2; the wedg
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -39,6 +40,25 @@ from wormsim.wedge.dynamics import STEADY_FRACTION, WedgeParams, simulate_params
 KLOSS_PEAK_FACTOR = 3.0  # peak force / working force: a stiff curve, far from the motor's pull-out
 SLIP_SPAN = 0.5  # (synchronous - peak-force speed) / working speed
 RUNUP_S = 0.01  # the peak force also runs the reduced masses up to speed in about this time
+
+
+@dataclass(frozen=True)
+class DerivedPlan:
+    """The derived wedge's plan, built once from the scenario (derived_plan); run_derived reads nothing else."""
+
+    name: str  # the scenario's name
+    params: WedgeParams
+    geometry: object  # meshgen's GearGeometry
+    keys: dict  # what was derived, as summary keys (wedge_source, the reduced masses, the motor curve)
+    load_torque_nm: float  # load.torque_nm (the tangential force's theory)
+    friction: str  # wormsim.physics.friction.friction_mode of contact:
+
+
+def derived_plan(scenario) -> DerivedPlan:
+    """The DerivedPlan of a gear scenario at model wedge (module docstring)."""
+    p, d = params_from_gear(scenario)
+    g = d.pop("geometry")
+    return DerivedPlan(scenario.name, p, g, d, scenario.load.torque_nm, friction_mode(scenario.contact))
 
 
 def params_from_gear(scenario) -> tuple[WedgeParams, dict]:
@@ -95,10 +115,14 @@ def params_from_gear(scenario) -> tuple[WedgeParams, dict]:
 
 
 def simulate_derived(scenario, progress=None) -> Result:
+    """Run the derived wedge of a gear scenario (its plan, derived_plan, built once)."""
+    return run_derived(derived_plan(scenario), progress)
+
+
+def run_derived(plan: DerivedPlan, progress=None) -> Result:
     """Run the derived wedge and add the gear levels' common keys and force series (module docstring)."""
-    p, d = params_from_gear(scenario)
-    g = d.pop("geometry")
-    res = simulate_params(p, progress=progress, name=scenario.name)
+    p, g, d = plan.params, plan.geometry, plan.keys
+    res = simulate_params(p, progress=progress, name=plan.name)
     S = res.series
     t = S["t_s"]
     rho = S["rho_deg"] * DEG
@@ -111,7 +135,7 @@ def simulate_derived(scenario, progress=None) -> Result:
     S["wheel_speed_rpm"] = rad_s_to_rpm(S["v2_m_s"] / g.r2)
     S["friction_coefficient"] = np.tan(rho) * p.cos_alpha_n
 
-    t0 = scenario.simulation.duration_s * (1 - STEADY_FRACTION)
+    t0 = p.duration_s * (1 - STEADY_FRACTION)
     sl = t >= t0
 
     def mean(x):
@@ -120,7 +144,7 @@ def simulate_derived(scenario, progress=None) -> Result:
     n1, n2 = mean(S["worm_speed_rpm"]), mean(S["wheel_speed_rpm"])
     p_in, p_out = mean(S["F1_n"] * S["v1_m_s"]), mean(-S["F2_n"] * S["v2_m_s"])
     mu = mean(S["friction_coefficient"])
-    T_load = scenario.load.torque_nm
+    T_load = plan.load_torque_nm
     res.summary = level_summary(
         "wedge",
         res.summary,
@@ -140,7 +164,7 @@ def simulate_derived(scenario, progress=None) -> Result:
             "efficiency": p_out / p_in if p_in > 0 else float("nan"),
             "efficiency_theory": gt.efficiency_theory(g.gamma_m, g.alpha_n, mu),
             "friction_coefficient_mean": mu,
-            "friction": friction_mode(scenario.contact),
+            "friction": plan.friction,
             **d,
         },
     )
