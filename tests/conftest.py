@@ -19,7 +19,7 @@ def scenario_dir() -> Path:
 
 
 # Tests kept out of `make test` for time (the suite must stay under 15 minutes on a 2-core machine); `make test-long`
-# runs them. file name -> None (every test) or the values of the `name` parameter that are long.
+# runs them. path under tests/ -> None (every test) or the values of the `name` parameter that are long.
 LONG_TESTS: dict[str, set[str] | None] = {
     # slice and timestep convergence of the flank fluctuation: the seat motor's (step 6.4e-6 s, ~4 min) is long; the screw
     # jack's and involute_41's stay in `make test` (one CI-sized convergence test per seed)
@@ -58,9 +58,10 @@ LONG_TESTS: dict[str, set[str] | None] = {
 
 def pytest_collection_modifyitems(config, items):
     for item in items:
-        if item.path.relative_to(ROOT / "tests").as_posix() not in LONG_TESTS:
+        name = item.path.relative_to(ROOT / "tests").as_posix()
+        if name not in LONG_TESTS:
             continue
-        rule = LONG_TESTS[item.path.relative_to(ROOT / "tests").as_posix()]
+        rule = LONG_TESTS[name]
         callspec = getattr(item, "callspec", None)
         if rule is None or (callspec is not None and callspec.params.get("name") in rule) or item.originalname in rule:
             item.add_marker(pytest.mark.long)

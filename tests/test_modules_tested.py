@@ -69,3 +69,10 @@ def test_tests_mirror_the_packages():
             assert d.name in sub | set(PACKAGES) | {"tools"}, f"tests/{d.name}/ mirrors no package"
             for f in d.glob("*.py"):
                 assert f.name == "__init__.py" or f.name.startswith(("test_", "_")), f
+
+
+def test_the_long_test_table_names_existing_files():
+    """tests/conftest.py LONG_TESTS is keyed by the path under tests/: a stale key would run its tests in `make test`."""
+    from tests.conftest import LONG_TESTS
+
+    assert [k for k in LONG_TESTS if not (ROOT / "tests" / k).is_file()] == []

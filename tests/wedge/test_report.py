@@ -3,32 +3,15 @@ its entry (wormsim.wedge.level)."""
 
 from __future__ import annotations
 
-import matplotlib.image as mpimg
-
+from tests._level_report import check_report_and_recording
 from tests.conftest import SCENARIOS
-from wormsim.results.recording import recorded_entities
 from wormsim.scenario import load_scenario
 from wormsim.wedge import level as wedge_level
 from wormsim.wedge import report as wedge_report
 
 
-def _run(model: str, name: str = "screw_jack"):
-    from wormsim.run import simulate
-
-    sc = load_scenario(SCENARIOS / f"{name}.yaml", [f"model={model}", "simulation.duration_s=0.05"])
-    return simulate(sc)
-
-
 def test_report_and_recording_are_written(tmp_path):
-    res = _run("wedge")
-    png, rrd = tmp_path / "report.png", tmp_path / "recording.rrd"
-    wedge_report.write_report(res, png)
-    wedge_report.write_recording(res, rrd)
-    img = mpimg.imread(png)
-    assert img.ndim == 3 and img.shape[0] > 400 and img.shape[1] > 600  # a figure, not an empty file
-    assert not list(tmp_path.glob(".*tmp*")), "the temporary file is renamed into place"
-    entities = recorded_entities(rrd)
-    assert any("speed" in e for e in entities), entities
+    check_report_and_recording("wedge", wedge_report, tmp_path)
 
 
 def test_wedge_level_runs_the_seed_block_or_the_derived_model():
