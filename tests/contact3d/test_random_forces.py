@@ -96,7 +96,7 @@ def test_random_gear_efficiency_at_the_contact_radius_and_radial_force_on_the_li
             g.gamma, g.r1, s["worm_contact_radius_mean_m"], s["friction_coefficient_mean"], g.alpha_n
         )
     )
-    fr = s["radial_force_line_of_centres_mean_n"] / s["radial_force_theory_n"]
+    fr = s["radial_force_mean_n"] / s["radial_force_theory_n"]
     assert abs(s["ratio"] / s["ratio_theory"] - 1) < 1e-3
     assert abs(s["efficiency"] / eta_c - 1) < 0.03, (s["efficiency"], eta_c)
     assert abs(fr - 1) < 0.03, fr
