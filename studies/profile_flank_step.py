@@ -185,7 +185,8 @@ def main() -> None:
     d = mujoco.MjData(m)
     fc = FlankContacts(bm, bm.law.contacts_per_pair)
     native.split_forward(m, d, fc.add)
-    loop = FlankLoop(fc, d, bm.drive_actuator, bm.load_actuator, 0, 1, 0)
+    s0 = int(m.sensor_adr[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SENSOR, "mesh_force")])
+    loop = FlankLoop(fc, d, bm.drive_actuator, bm.load_actuator, 0, 1, s0)
     fc.set_friction(0.05)
     dt = m.opt.timestep
     nw = int(round(a.warm_s / dt))

@@ -40,24 +40,7 @@ import numpy as np
 
 from wormsim.contact3d.contact_sums import contact_forces, radial_and_radius, radius_mean
 from wormsim.contact3d.flank_handoff import Handed, Handoff, fill_add
-from wormsim.contact3d.native import (
-    FIELDS,
-    N_BEFORE,
-    call_stage,
-    f1,
-    f2,
-    f3,
-    f32x3,
-    f64_at,
-    i1,
-    i32_at,
-    i64_at,
-    mjdata_offsets,
-    option_address,
-    stage_addresses,
-)
-from wormsim.contact3d.net_contact import SIZE as SENSOR_SIZE
-from wormsim.contact3d.net_contact import contact_offsets, geom_match, net_contact, sensor_id
+from wormsim.contact3d.native import N_BEFORE, call_stage, f1, f2, f3, f32x3, f64_at, i1, stage_addresses
 from wormsim.contact3d.series import N_SUMS, add_step
 from wormsim.tooth.hertz import pattern_rows
 from wormsim.tooth.kernel import find_packed
@@ -86,17 +69,11 @@ IV = enum.IntEnum(
         "record_size",  # the mjContact record's size
         "record_base",  # the record buffer's address
         "friction_rows",  # solreffriction written into the records
-        "own_sensor",  # the contact sensor computed here (net_contact), MuJoCo's only on an interval's last step
-        "flags_addr",  # the address of m.opt.disableflags
-        "d_ncon",  # mjData's ncon, contact and efc_force at these byte offsets (native.mjdata_offsets)
-        "d_contact",
-        "d_efc_force",
     ),
     start=0,
 )
 FV = enum.IntEnum("FV", ("tooth0", "pitch", "margin", "taper", "mu"), start=0)
 STAGE_ADDRESSES = stage_addresses()  # native.STEP by address, mj_addContact last
-DSBL_SENSOR = int(mujoco.mjtDisableBit.mjDSBL_SENSOR)
 
 
 class StepViews(NamedTuple):
@@ -193,9 +170,6 @@ TABLE = (
     ("iv", "i8", 1),
     ("fv", "f8", 1),
     ("mfric", "f8", 1),  # the merged contacts' friction scale (wormsim.tooth.merge: mfric)
-    ("gmatch", "i8", 1),  # the contact sensor's geoms (net_contact.geom_match)
-    ("coff", "i8", 1),  # mjContact's field offsets (net_contact.contact_offsets)
-    ("sens", "f8", 1),  # the sensor's values (net_contact.SIZE) and net_contact's work (6)
 )
 Row = enum.IntEnum("Row", [name for name, _, _ in TABLE], start=0)  # T[Row.qpos]: numba reads members as constants
 
@@ -234,26 +208,12 @@ def run_table(T, m_addr, d_addr, cmd, load, j0, j1):
     a1, a2, s0 = iv[IV.worm_actuator], iv[IV.wheel_actuator], iv[IV.sensor]
     sums = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
     dropped = 0
-    # the contact sensor: net_contact's values on every step, MuJoCo's sensors (mjDSBL_SENSOR off) only on the last
-    flags = i32_at(iv[IV.flags_addr])
-    fl = flags[0]
-    own = iv[IV.own_sensor] != 0 and (fl & DSBL_SENSOR) == 0
-    sens = f1(T, Row.sens)
-    out, work, gmatch, coff = sens[:SENSOR_SIZE], sens[SENSOR_SIZE:], i1(T, Row.gmatch), i1(T, Row.coff)
-    src, s_src = (out, 0) if own else (sd, s0)
-    on, oc, oe = iv[IV.d_ncon], iv[IV.d_contact], iv[IV.d_efc_force]
     for j in range(j0, j1):
         ctrl[ia_drv] = cmd[j]
         ctrl[ia_load] = load[j]
         w1j, w2j = qvel[dof1], qvel[dof2]
-        if own:
-            flags[0] = fl if j == j1 - 1 else fl | DSBL_SENSOR
         dropped += flank_step(v, m_addr, d_addr)
-        if own:
-            ncon, base, efc = i32_at(d_addr + on)[0], i64_at(d_addr + oc)[0], f64_at(i64_at(d_addr + oe)[0])
-            net_contact(base, ncon, coff, efc, gmatch, out, work)
-        sums = add_step(sums, act, src, a1, a2, s_src, w1j, w2j)  # the per-step sums (wormsim.contact3d.series)
-    flags[0] = fl
+        sums = add_step(sums, act, sd, a1, a2, s0, w1j, w2j)  # the per-step sums (wormsim.contact3d.series)
     acc = f1(T, Row.acc)
     for k in range(N_SUMS):
         acc[k] = sums[k]
@@ -364,7 +324,6 @@ class FlankLoop:
         if runner and m.nv == 2:
             m.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_ISLAND)
         buf = fc.buffer
-        sid = sensor_id(m, sensor_adr) if runner else -1  # the contact sensor net_contact computes (-1: none)
         iv = {
             IV.drive_actuator: drive_actuator,
             IV.load_actuator: load_actuator,
@@ -383,20 +342,12 @@ class FlankLoop:
             IV.record_size: buf.size,
             IV.record_base: buf.address,
             IV.friction_rows: 0,  # `prepare`
-            IV.own_sensor: int(sid >= 0),
-            IV.flags_addr: option_address(m, "disableflags"),
-            IV.d_ncon: self._off("ncon"),
-            IV.d_contact: self._off("contact"),
-            IV.d_efc_force: self._off("efc_force"),
         }
         self.iv = np.array([iv[k] for k in IV], dtype=np.int64)
         fv = {FV.tooth0: float(bm.tooth0_angle_rad), FV.pitch: fc.pitch, FV.margin: fc.margin0, FV.taper: fc.taper_rad}
         self.fv = np.array([fv.get(k, 0.0) for k in FV])  # mu: `prepare`
         self.state = np.array([NO_WINDOW if fc.centre is None else fc.centre, fc.n], dtype=np.int64)
         self.acc = np.zeros(N_SUMS)
-        self.gmatch = geom_match(m, sid) if sid >= 0 else np.zeros(1, dtype=np.int64)
-        self.coff = contact_offsets()
-        self.sens = np.zeros(SENSOR_SIZE + 6)
         self._tables(d, buf)
         self.dropped = 0
         cap = fc.pos.shape[0]
@@ -404,10 +355,6 @@ class FlankLoop:
         self._store = self._pattern = self._sample_kernel = None
         self.z2 = bm.geometry.z2
         self.a = bm.geometry.a
-
-    @staticmethod
-    def _off(name: str) -> int:
-        return int(mjdata_offsets()[FIELDS.index(name)])
 
     def _tables(self, d, buf) -> None:
         """run_table's address table over the kernel's current buffers (FlankContacts repacks them when its params
@@ -440,9 +387,6 @@ class FlankLoop:
             "iv": self.iv,
             "fv": self.fv,
             "mfric": k.mfric,
-            "gmatch": self.gmatch,
-            "coff": self.coff,
-            "sens": self.sens,
         }
         self.arrays = tuple(by_name[name] for name, _, _ in TABLE)
         self.table = address_table(self.arrays)

@@ -61,7 +61,7 @@ from wormsim.tooth.grid import SLICES_MASS_SCALED, FlankGrid, default_slices, fl
 from wormsim.tooth.window import slot_quat, window_size, window_teeth_at
 
 TEMPLATE = data_dir("models") / "worm_pair.xml"  # models/, shipped as package data
-SOLVER_TOLERANCE = 1e-10  # MuJoCo's Newton tolerance (opt.tolerance; docs/contact3d.md, "Solver")
+SOLVER_TOLERANCE = 1e-8  # MuJoCo's Newton tolerance (opt.tolerance; docs/contact3d.md, "Solver")
 MESH_SENSOR_DATA = 1 | 2 | 4 | 16  # contact sensor fields found, force, torque, pos (mjtConDataField bits)
 INTEGRATORS = {
     "implicitfast": mujoco.mjtIntegrator.mjINT_IMPLICITFAST,

@@ -300,20 +300,6 @@ def check(off: np.ndarray) -> list[str]:
     return [k for k, (x, y) in got.items() if x != y]
 
 
-def option_address(m: mujoco.MjModel, field: str) -> int:
-    """The address of the int field `field` of m.opt in the model's memory: m.opt.gravity's array is a view of it,
-    mjOption's declared layout gives the field's place; checked by reading the value back (MjDataLayoutError where
-    it does not check)."""
-    O = _struct("mjOption")
-    addr = int(np.asarray(m.opt.gravity).ctypes.data) - O.gravity.offset + getattr(O, field).offset
-    if ctypes.c_int.from_address(addr).value != int(getattr(m.opt, field)):
-        raise MjDataLayoutError(
-            f"MuJoCo {mujoco.__version__}: mjOption.{field} is not where mujoco.introspect declares it; update "
-            f"wormsim.contact3d.native for this version"
-        )
-    return addr
-
-
 @functools.cache
 def mjdata_offsets() -> np.ndarray:
     """The checked offsets of FIELDS; MjDataLayoutError where they do not check (module docstring)."""
