@@ -170,6 +170,7 @@ def main() -> None:
         help="model.opt FIELD=VALUE[,FIELD=VALUE] (e.g. tolerance=1e-8), interleaved with the default",
     )
     ap.add_argument("--rounds", type=int, default=3)
+    ap.add_argument("--only", default="", help="run this variant alone (default or one of --variant)")
     a = ap.parse_args()
     from wormsim.contact3d.flank_loop import FlankLoop
     from wormsim.contact3d.flank_step import FlankContacts
@@ -215,11 +216,13 @@ def main() -> None:
     variants = [("default", {})] + [
         (v, dict((kv.split("=")[0], float(kv.split("=")[1])) for kv in v.split(","))) for v in a.variant
     ]
+    if a.only:  # one variant alone (e.g. under `perf stat`, whose counts do not depend on the machine's load)
+        variants = [x for x in variants if x[0] == a.only]
     chunk = 10
     nst = (a.steps // chunk) * chunk
     res = {name: [] for name, _ in variants}
     for r in range(a.rounds):
-        for name, opts in variants:
+        for name, opts in variants if r % 2 == 0 else variants[::-1]:  # ABBA: no variant always first
             for f, val in base.items():
                 setattr(m.opt, f, val)
             for f, val in opts.items():
