@@ -61,6 +61,7 @@ from wormsim.tooth.grid import SLICES_MASS_SCALED, FlankGrid, default_slices, fl
 from wormsim.tooth.window import slot_quat, window_size, window_teeth_at
 
 TEMPLATE = data_dir("models") / "worm_pair.xml"  # models/, shipped as package data
+SOLVER_TOLERANCE = 1e-8  # MuJoCo's Newton tolerance (opt.tolerance; docs/contact3d.md, "Solver")
 MESH_SENSOR_DATA = 1 | 2 | 4 | 16  # contact sensor fields found, force, torque, pos (mjtConDataField bits)
 INTEGRATORS = {
     "implicitfast": mujoco.mjtIntegrator.mjINT_IMPLICITFAST,
@@ -651,9 +652,11 @@ def _add_actuators(spec: mujoco.MjSpec, duty: gt.Duty, kv: float | None) -> tupl
 
 
 def _set_options(spec: mujoco.MjSpec, sim: Simulation, law: ContactLaw, timestep_s: float) -> None:
-    """The timestep, impratio and the simulation: block's integrator and speculative contacts."""
+    """The timestep, the solver's tolerance, impratio and the simulation: block's integrator and speculative
+    contacts."""
     o = spec.option
     o.timestep = timestep_s
+    o.tolerance = SOLVER_TOLERANCE
     o.impratio = law.impratio  # friction rows' hardness, wormsim.contact3d.law (3)
     if sim.speculative:
         o.enableflags |= int(mujoco.mjtEnableBit.mjENBL_SPECULATIVE)

@@ -219,6 +219,7 @@ class PatternLog:
         self.e_star = e_star_pa
         self.buf = np.zeros((4096, 6), dtype=np.float32)  # 24 bytes per contact and sample
         self.m = 0
+        self._rows: tuple | None = None  # (m, table(), averaged_pressure_pa of it): `rows`
 
     def record(self, i: int, d) -> None:
         """The kernel's contacts (d.contact's last fc.n entries) at sample i: (i, sigma, j, f, F_n, p_H);
@@ -242,6 +243,7 @@ class PatternLog:
         keep = self.buf[: self.m][self.buf[: self.m, 0] < n]
         self.buf[: len(keep)] = keep
         self.m = len(keep)
+        self._rows = None
 
     def table(self) -> np.ndarray:
         """The log as float64 rows (i, sigma, j, f, F_n, p_H, zeta, rho): zeta the slice centre, rho the flank radius
@@ -252,6 +254,15 @@ class PatternLog:
         j = T[:, 2].astype(np.int64)
         rho = _lerp_rows(self.rho3, T[:, 1].astype(np.int64), j, T[:, 3])
         return np.column_stack([T, self.cv.zeta[j], rho])
+
+    def rows(self) -> tuple[np.ndarray, np.ndarray]:
+        """(table(), averaged_pressure_pa(table())), computed once for the log's rows as they are (summary and grid
+        both read them: about a sample's step in a run that records every step; rows are only appended or
+        truncated, so the row count names the state)."""
+        if self._rows is None or self._rows[0] != self.m:
+            T = self.table()
+            self._rows = (self.m, T, self.averaged_pressure_pa(T))
+        return self._rows[1], self._rows[2]
 
     def averaged_pressure_pa(self, T: np.ndarray) -> np.ndarray:
         """(4) per row of table() rows T (in the log's order: per sample, the kernel's contacts, those of one tooth
@@ -286,10 +297,9 @@ class PatternLog:
 
     def summary(self, t_s: np.ndarray, window_s) -> dict:
         """The summary keys of the module docstring over the samples with t in window_s."""
-        T = self.table()
+        T, pavg = self.rows()
         w0, w1 = window_s
         inwin = (t_s >= w0) & (t_s <= w1)
-        pavg = self.averaged_pressure_pa(T)
         keep = inwin[T[:, 0].astype(int)] & (T[:, 4] > 0) if len(T) else np.zeros(0, dtype=bool)
         sel, pavg = T[keep], pavg[keep]
         nan = float("nan")
@@ -337,13 +347,12 @@ class PatternLog:
 
     def grid(self, t_s: np.ndarray, window_s) -> dict:
         """Per cell (flank, slice, nearest profile point) over the window: summed F_n and the largest p_H."""
-        T = self.table()
+        T, pavg = self.rows()
         S, N = self.cv.rho.shape
         load = np.zeros((2, S, N))
         pmax = np.zeros((2, S, N))
         if len(T):
             inwin = (t_s >= window_s[0]) & (t_s <= window_s[1])
-            pavg = self.averaged_pressure_pa(T)
             keep = inwin[T[:, 0].astype(int)] & (T[:, 4] > 0)
             T, pavg = T[keep], pavg[keep]
             sg, j = T[:, 1].astype(int), T[:, 2].astype(int)
