@@ -8,10 +8,14 @@ and the causes found in docs/contact3d.md ("Fluctuation against slices and step"
 
 from __future__ import annotations
 
+import math
+
+import numpy as np
 import pytest
 
 from tests.conftest import SCENARIOS
 from tests.contact3d.test_seeds_pieces import CI
+from wormsim.contact3d.mjcf import prepare
 from wormsim.contact3d.runner import simulate
 from wormsim.results.metrics import p2p_below
 from wormsim.scenario import load_scenario
@@ -24,6 +28,8 @@ MESH_BAND_HZ = (
 )
 _CACHE: dict[tuple, dict] = {}
 _BAND: dict[tuple, float] = {}
+_PEAK: dict[tuple, float] = {}
+MODE_BAND_HZ = (500.0, 1500.0)  # where involute_41's contact mode lies with the teeth's compliance
 
 
 def _simulate(name: str, extra: tuple) -> None:
@@ -35,6 +41,11 @@ def _simulate(name: str, extra: tuple) -> None:
     m = (t >= t0) & (t <= t1)
     _CACHE[(name, extra)] = res.summary
     _BAND[(name, extra)] = p2p_below(t[m], res.series["tangential_force_n"][m], MESH_BAND_HZ)
+    f = res.series["tangential_force_n"][m]
+    spec = np.abs(np.fft.rfft((f - f.mean()) * np.hanning(len(f))))
+    hz = np.fft.rfftfreq(len(f), float(np.median(np.diff(t[m]))))
+    inside = (hz >= MODE_BAND_HZ[0]) & (hz <= MODE_BAND_HZ[1])
+    _PEAK[(name, extra)] = float(hz[inside][np.argmax(spec[inside])])  # F_t's largest line in MODE_BAND_HZ
 
 
 def run(name: str, *extra: str) -> dict:
@@ -132,3 +143,23 @@ def test_flank_fluctuation_converged_in_timestep(name):
     assert b["timestep_s"] == pytest.approx(a["timestep_s"] / 2)
     for key in KEYS:
         assert b[key] == pytest.approx(a[key], rel=0.10), (key, a[key], b[key])
+
+
+def test_contact_mode_is_the_mesh_stiffness_over_the_effective_mass_at_every_slice_count():
+    """Law (5) of wormsim.contact3d.law: the flank rows' added mass is 1 % of m_eff per tooth pair, not per row, so the
+    contact mode is sqrt(K_mesh / m_eff) whatever the count. involute_41 (the teeth's compliance): K_mesh the zero-load
+    TCA's mean k (wormsim.tooth.mesh_stiffness; 1.65 K, K = 1.01e9 N/m), m_eff 49.0 kg: 930 Hz; F_t's largest line
+    near it (the meshing harmonic nearest the mode, 24.1 Hz apart) 941 Hz at 24 and at 48 slices. With d = 0.01 per row
+    it was 772 and 652 Hz (docs/contact3d.md, "Default slice count")."""
+    from wormsim.tooth.grid import SLICES_TCA_SAMPLES
+    from wormsim.tooth.mesh_stiffness import mesh_stiffness
+
+    name, n = "involute_41", DEFAULT_SLICES["involute_41"]
+    p = prepare(load_scenario(SCENARIOS / f"{name}.yaml", [*CI[name], "contact.geometry=flanks"]))
+    ms = mesh_stiffness(p.geometry, 1.0, "slices", SLICES_TCA_SAMPLES)  # k per unit stiffness per length
+    k_mesh = float(np.mean(ms.k_mesh_fwd_n_per_m)) * p.law.pair_stiffness_n_per_m / p.geometry.face_width
+    f_mode = math.sqrt(k_mesh / p.law.effective_mass_kg) / (2 * math.pi)
+    for extra in ((), (f"contact.slices={2 * n}",)):
+        mesh_band_p2p(name, *extra)
+        # within 3 %: one meshing harmonic (24.1 Hz) either side of the mode, and the 1 % added mass
+        assert _PEAK[(name, extra)] == pytest.approx(f_mode, rel=0.03), (extra, _PEAK[(name, extra)], f_mode)
