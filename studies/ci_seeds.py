@@ -18,8 +18,8 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def main() -> None:
-    sys.path.insert(0, str(ROOT / "tests"))
-    from test_contact3d_seeds import CI
+    sys.path.insert(0, str(ROOT))
+    from tests.contact3d.test_seeds_pieces import CI
 
     runs = {}
     for name, sets in CI.items():

@@ -21,11 +21,10 @@ import tempfile
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "tests"))
-
-from test_contact3d_seeds import CI  # noqa: E402  (the seeds' CI settings)
+sys.path.insert(0, str(ROOT))
 
 from meshgen.geometry import derive  # noqa: E402
+from tests.contact3d.test_seeds_pieces import CI  # noqa: E402  (the seeds' CI settings)
 from wormsim.contact3d.runner import simulate  # noqa: E402
 from wormsim.physics.validate import validate_geometry  # noqa: E402
 from wormsim.run import run_scenario  # noqa: E402

@@ -60,8 +60,8 @@ def main(seeds: list[str]) -> dict:
 
 def _ci() -> dict:
     """The CI configurations (tests/contact3d/test_seeds_pieces.py)."""
-    sys.path.insert(0, str(ROOT / "tests"))
-    from test_contact3d_seeds import CI
+    sys.path.insert(0, str(ROOT))
+    from tests.contact3d.test_seeds_pieces import CI
 
     return CI
 

@@ -21,7 +21,8 @@ import time
 from pathlib import Path
 
 from wormsim.sweep import load_sweep, run_sweep
-from wormsim.sweep.runner import parse_value, read_csv
+from wormsim.sweep.plot import parse_value
+from wormsim.sweep.runner import read_csv
 
 ROOT = Path(__file__).resolve().parents[1]
 SWEEP = """name: speedup

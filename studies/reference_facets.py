@@ -35,12 +35,11 @@ import numpy as np
 import trimesh
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "tests"))
-
-from test_contact3d_seeds import CI  # noqa: E402
+sys.path.insert(0, str(ROOT))
 
 from meshgen import meshes  # noqa: E402
 from meshgen import worm as worm_geo  # noqa: E402
+from tests.contact3d.test_seeds_pieces import CI  # noqa: E402
 from wormsim.contact3d import flank_step  # noqa: E402
 from wormsim.contact3d.flank_step import FlankContacts  # noqa: E402
 from wormsim.contact3d.mjcf import build_model  # noqa: E402

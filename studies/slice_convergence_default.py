@@ -29,13 +29,12 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "tests"))
+sys.path.insert(0, str(ROOT))
 
-from conftest import SCENARIOS  # noqa: E402
-from test_contact3d_random_forces import GEARS, _scenario  # noqa: E402
-from test_contact3d_seeds import CI  # noqa: E402
-from test_contact3d_variety import FAST, FLANK_GEARS, GEAR  # noqa: E402
-
+from tests.conftest import SCENARIOS  # noqa: E402
+from tests.contact3d.test_random_forces import GEARS, _scenario  # noqa: E402
+from tests.contact3d.test_seeds_pieces import CI  # noqa: E402
+from tests.contact3d.test_variety import FAST, FLANK_GEARS, GEAR  # noqa: E402
 from wormsim.contact3d.mjcf import flank_slices  # noqa: E402
 from wormsim.contact3d.runner import simulate  # noqa: E402
 from wormsim.exceptions import SimulationError  # noqa: E402

@@ -46,10 +46,10 @@ DIVERGE_STEPS_S = (1e-5, 2e-5, 5e-5, 1e-4, 2e-4, 5e-4)
 
 def _cases() -> tuple[dict, dict, list, Path, Path]:
     """The test configurations (tests/ on the path only here)."""
-    sys.path.insert(0, str(ROOT / "tests"))
-    from conftest import SCENARIOS
-    from test_contact3d_seeds import CI
-    from test_contact3d_variety import FAST, FLANK_GEARS, GEAR
+    sys.path.insert(0, str(ROOT))
+    from tests.conftest import SCENARIOS
+    from tests.contact3d.test_seeds_pieces import CI
+    from tests.contact3d.test_variety import FAST, FLANK_GEARS, GEAR
 
     return CI, FLANK_GEARS, FAST, GEAR, SCENARIOS
 

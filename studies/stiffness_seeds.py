@@ -97,8 +97,8 @@ def main() -> None:
     args = ap.parse_args()
     modes = [m for m in args.modes.split(",") if m]
     seeds = [n for n in args.seeds.split(",") if n]
-    sys.path.insert(0, str(ROOT / "tests"))
-    from test_contact3d_seeds import CI
+    sys.path.insert(0, str(ROOT))
+    from tests.contact3d.test_seeds_pieces import CI
 
     runs: dict[str, dict] = {}
     warm = False

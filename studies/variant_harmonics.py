@@ -19,10 +19,9 @@ import mujoco
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "tests"))
+sys.path.insert(0, str(ROOT))
 
-from test_contact3d_variety import FAST, FLANK_GEARS, FLANK_MESH_XFAIL, GEAR  # noqa: E402
-
+from tests.contact3d.test_variety import FAST, FLANK_GEARS, GEAR  # noqa: E402
 from wormsim.contact3d.flank_step import FlankContacts  # noqa: E402
 from wormsim.contact3d.mjcf import build_model  # noqa: E402
 from wormsim.scenario import load_scenario  # noqa: E402
@@ -67,7 +66,7 @@ def kernel_harmonics(name: str, slices: int, n_harm: int, samples: int) -> tuple
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--slices", type=int, nargs="+", default=[8, 16, 32])
-    ap.add_argument("--gears", nargs="+", default=list(FLANK_MESH_XFAIL))
+    ap.add_argument("--gears", nargs="+", default=list(FLANK_GEARS))
     ap.add_argument("--harmonics", type=int, default=12)
     ap.add_argument("--samples", type=int, default=800)
     a = ap.parse_args()

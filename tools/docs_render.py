@@ -1147,8 +1147,10 @@ def stiffness_seeds_table(name: str = "stiffness_seeds") -> str:
     return _table(head, rows) + "\n" + _source(name)
 
 
-# studies/slice_convergence_default.py's records at medium: the cases, more variety gears, the seat motor (run apart)
-SLICE_CONVERGENCE_RECORDS = ("slice_convergence_medium", "slice_convergence_variety", "slice_convergence_seat_motor")
+# studies/slice_convergence_default.py's records at medium: the cases and the seat motor (run apart)
+SLICE_CONVERGENCE_RECORDS = ("slice_convergence_medium", "slice_convergence_seat_motor")
+# the same before law (5) (the flank rows' impedance d per row, decision 0044)
+SLICE_CONVERGENCE_PER_ROW = tuple(f"slice_convergence_per_row_{n}" for n in ("medium", "variety", "seat_motor"))
 
 
 def slice_convergence_table(*names: str) -> str:
@@ -1204,6 +1206,7 @@ TABLES: dict[str, Callable[[], str]] = {
     "calculix_check": calculix_check_table,
     "stiffness_seeds": stiffness_seeds_table,
     "slice_convergence": slice_convergence_table,
+    "slice_convergence_per_row": lambda: slice_convergence_table(*SLICE_CONVERGENCE_PER_ROW),
     "slice_convergence_double": lambda: slice_convergence_table("slice_convergence_double"),
     "slice_convergence_impedance": lambda: slice_convergence_table(
         "slice_convergence_impedance", "slice_convergence_impedance_rest"

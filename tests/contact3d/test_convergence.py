@@ -8,10 +8,14 @@ and the causes found in docs/contact3d.md ("Fluctuation against slices and step"
 
 from __future__ import annotations
 
+import math
+
+import numpy as np
 import pytest
 
 from tests.conftest import SCENARIOS
 from tests.contact3d.test_seeds_pieces import CI
+from wormsim.contact3d.mjcf import prepare
 from wormsim.contact3d.runner import simulate
 from wormsim.results.metrics import p2p_below
 from wormsim.scenario import load_scenario
@@ -19,9 +23,13 @@ from wormsim.scenario import load_scenario
 KEYS = ("tangential_force_p2p_n", "transmission_error_p2p_urad")
 # issue 31: F_t p2p and p_H max (wormsim.tooth.hertz (4)) within 10 % of twice the slices; the TE p2p as well
 SLICE_KEYS = (*KEYS, "contact_pressure_max_mpa")
-MESH_BAND_HZ = 1000.0  # F_t's meshing band: below the lowest contact mode measured (involute_41, 1.3-1.8 kHz)
+MESH_BAND_HZ = (
+    1000.0  # F_t's meshing band: below the seeds' contact modes but involute_41's (941 Hz with the teeth's compliance)
+)
 _CACHE: dict[tuple, dict] = {}
 _BAND: dict[tuple, float] = {}
+_PEAK: dict[tuple, float] = {}
+MODE_BAND_HZ = (500.0, 1500.0)  # where involute_41's contact mode lies with the teeth's compliance
 
 
 def _simulate(name: str, extra: tuple) -> None:
@@ -33,6 +41,11 @@ def _simulate(name: str, extra: tuple) -> None:
     m = (t >= t0) & (t <= t1)
     _CACHE[(name, extra)] = res.summary
     _BAND[(name, extra)] = p2p_below(t[m], res.series["tangential_force_n"][m], MESH_BAND_HZ)
+    f = res.series["tangential_force_n"][m]
+    spec = np.abs(np.fft.rfft((f - f.mean()) * np.hanning(len(f))))
+    hz = np.fft.rfftfreq(len(f), float(np.median(np.diff(t[m]))))
+    inside = (hz >= MODE_BAND_HZ[0]) & (hz <= MODE_BAND_HZ[1])
+    _PEAK[(name, extra)] = float(hz[inside][np.argmax(spec[inside])])  # F_t's largest line in MODE_BAND_HZ
 
 
 def run(name: str, *extra: str) -> dict:
@@ -65,12 +78,15 @@ DEFAULT_SLICES = {
 
 
 SLICES_XFAIL = {
-    ("involute_41", "tangential_force_p2p_n"): "whole-band F_t p2p 437.3 N at 24 slices against 293.1 N at 48 "
-    "(+49.2 %; below 1 kHz 373.5 against 289.3 N, +29.1 %): with the teeth's compliance (1.01e9 N/m per tooth pair) "
-    "the contact mode falls to about 770 Hz, where the slices' switching rings it (docs/data/"
-    "slice_convergence_medium.json); its p_H max converges (250.4 -> 253.0 MPa), and so does the TE p2p. The mode "
-    "falls with the count (772 -> 652 Hz) by the contact rows' added mass (impedance d = 0.01 per row); at d = 0.001 "
-    "it stays at 941 Hz and F_t p2p is 558 N against 268 N (+108 %; docs/data/slice_convergence_impedance.json)",
+    ("involute_41", "tangential_force_p2p_n"): "whole-band F_t p2p 583.6 N at 24 slices against 271.7 N at 48 "
+    "(+114.8 %; below 1 kHz 392.4 against 248.0 N, +58.2 %): with the teeth's compliance (1.01e9 N/m per tooth pair) "
+    "the contact mode is at 941 Hz (sqrt(K_mesh / m_eff) 930 Hz), and the leaving tooth's load (about 1.4 kN) falls "
+    "to zero in about 2 ms, slice by slice, ringing it differently at each count (with C1 slice weights 393 / 202 / "
+    "436 N at 24 / 48 / 96; docs/data/slice_convergence_medium.json, docs/decisions/0044-flank-impedance-per-pair.md); "
+    "its p_H max converges (250.0 -> 252.5 MPa)",
+    ("screw_jack", "tangential_force_p2p_n"): "whole-band F_t p2p 1.231 N at 16 slices against 1.617 N at 32 (-23.9 "
+    "%; 0.3-0.4 % of its 400 N mean): the contact mode's ringing; the meshing band below 1 kHz converges (0.359 -> "
+    "0.340 N) and p_H max does (318.2 -> 322.0 MPa) (docs/data/slice_convergence_medium.json)",
 }
 
 
@@ -86,14 +102,9 @@ SLICES_XFAIL = {
 )
 def test_flank_fluctuation_converged_in_slices(name, key):
     """The default slice count (the CI run, medium: flanks.default_slices) against twice it: within 10 % (issue 31:
-    F_t p2p and p_H max, wormsim.tooth.hertz (4); and the TE p2p). p_H max: screw jack 318.3 -> 322.2 MPa, involute_41
-    250.4 -> 253.0 MPa, seat motor 661.9 -> 628.9 MPa (+5.2 %; one contact's p_H, the maximum before: 341.9 -> 338.8,
-    300.7 -> 294.4 and 844.7 -> 856.8 MPa; docs/data/slice_convergence_medium.json, _seat_motor.json). Seat motor
-    (32; F_t p2p 0.07 % of its mean): F_t p2p 0.869 -> 0.851 N (-2.1 %), TE p2p 219.9 -> 203.4 urad (-7.5 %); at 16
-    slices (the default before) F_t p2p was 1.043 N, -16.7 % to 32: the slices' switching rang the contact mode
-    (F_t above 1 kHz p2p 0.313 / 0.189 N at 16 / 32). Screw jack (16): F_t p2p 1.636 -> 1.639 N, TE p2p 8.580 ->
-    8.650 urad; its whole-band F_t p2p is the contact mode's ringing and jumps between other counts (24 -> 48: +38 %,
-    32 -> 64: x2.0; docs/contact3d.md, 'Default slice count'), its meshing band below converges."""
+    F_t p2p and p_H max, wormsim.tooth.hertz (4); and the TE p2p). p_H max: screw jack 318.2 -> 322.0 MPa, involute_41
+    250.0 -> 252.5 MPa, seat motor 661.8 -> 628.8 MPa (+5.2 %); seat motor (32; F_t p2p 0.07 % of its mean): F_t p2p
+    0.884 -> 0.888 N (docs/data/slice_convergence_medium.json, _seat_motor.json; law (5) of wormsim.contact3d.law)."""
     n = DEFAULT_SLICES[name]
     a, b = run(name), run(name, f"contact.slices={2 * n}")
     assert a["flank_slices"] == n and b["flank_slices"] == 2 * n
@@ -101,10 +112,9 @@ def test_flank_fluctuation_converged_in_slices(name, key):
 
 
 MESH_BAND_XFAIL = {
-    "involute_41": "meshing band below 1 kHz: F_t p2p 373.5 N at 24 slices against 289.3 N at 48 (-22.5 %): with the "
-    "teeth's compliance (its default; 1.01e9 N/m per tooth pair against Hertz's 5.41e9) the contact mode falls from "
-    "1.3-1.8 kHz to about 770 Hz, inside the band, where the slices' switching rings it (the F_t peak at the 32nd "
-    "meshing harmonic, 772.6 Hz: tests/contact3d/test_seeds.py's MESH_XFAIL)",
+    "involute_41": "meshing band below 1 kHz: F_t p2p 392.4 N at 24 slices against 248.0 N at 48 (+58.2 %): with the "
+    "teeth's compliance (its default; 1.01e9 N/m per tooth pair against Hertz's 5.41e9) the contact mode is at 941 Hz, "
+    "inside the band, where each leaving tooth's load rings it (docs/data/slice_convergence_medium.json)",
 }
 
 
@@ -117,7 +127,8 @@ MESH_BAND_XFAIL = {
 )
 def test_flank_mesh_band_converged_in_slices(name):
     """F_t's meshing band (below 1 kHz, under the contact modes) at the default against twice the slices, within 10 %:
-    screw jack 0.359 -> 0.341 N (16 -> 32), seat motor 0.815 -> 0.866 N (32 -> 64; studies/slice_convergence.py)."""
+    screw jack 0.359 -> 0.340 N (16 -> 32), seat motor 0.816 -> 0.866 N (32 -> 64; docs/data/slice_convergence_medium.json,
+    _seat_motor.json)."""
     n = DEFAULT_SLICES[name]
     a, b = mesh_band_p2p(name), mesh_band_p2p(name, f"contact.slices={2 * n}")
     assert b == pytest.approx(a, rel=0.10), (a, b)
@@ -132,3 +143,23 @@ def test_flank_fluctuation_converged_in_timestep(name):
     assert b["timestep_s"] == pytest.approx(a["timestep_s"] / 2)
     for key in KEYS:
         assert b[key] == pytest.approx(a[key], rel=0.10), (key, a[key], b[key])
+
+
+def test_contact_mode_is_the_mesh_stiffness_over_the_effective_mass_at_every_slice_count():
+    """Law (5) of wormsim.contact3d.law: the flank rows' added mass is 1 % of m_eff per tooth pair, not per row, so the
+    contact mode is sqrt(K_mesh / m_eff) whatever the count. involute_41 (the teeth's compliance): K_mesh the zero-load
+    TCA's mean k (wormsim.tooth.mesh_stiffness; 1.65 K, K = 1.01e9 N/m), m_eff 49.0 kg: 930 Hz; F_t's largest line
+    near it (the meshing harmonic nearest the mode, 24.1 Hz apart) 941 Hz at 24 and at 48 slices. With d = 0.01 per row
+    it was 772 and 652 Hz (docs/contact3d.md, "Default slice count")."""
+    from wormsim.tooth.grid import SLICES_TCA_SAMPLES
+    from wormsim.tooth.mesh_stiffness import mesh_stiffness
+
+    name, n = "involute_41", DEFAULT_SLICES["involute_41"]
+    p = prepare(load_scenario(SCENARIOS / f"{name}.yaml", [*CI[name], "contact.geometry=flanks"]))
+    ms = mesh_stiffness(p.geometry, 1.0, "slices", SLICES_TCA_SAMPLES)  # k per unit stiffness per length
+    k_mesh = float(np.mean(ms.k_mesh_fwd_n_per_m)) * p.law.pair_stiffness_n_per_m / p.geometry.face_width
+    f_mode = math.sqrt(k_mesh / p.law.effective_mass_kg) / (2 * math.pi)
+    for extra in ((), (f"contact.slices={2 * n}",)):
+        mesh_band_p2p(name, *extra)
+        # within 3 %: one meshing harmonic (24.1 Hz) either side of the mode, and the 1 % added mass
+        assert _PEAK[(name, extra)] == pytest.approx(f_mode, rel=0.03), (extra, _PEAK[(name, extra)], f_mode)

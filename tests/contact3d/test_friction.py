@@ -18,7 +18,7 @@ import pytest
 
 from tests._contact3d_stepper import Stepper
 from tests.conftest import SCENARIOS as SCEN
-from wormsim.contact3d.law import friction_regularisation_velocity_m_s, friction_utilisation
+from wormsim.contact3d.law import IMPEDANCE, friction_regularisation_velocity_m_s, friction_utilisation
 from wormsim.contact3d.mjcf import build_model
 from wormsim.physics.friction import friction_coefficient
 from wormsim.physics.gear_theory import duty, mesh_arms_m
@@ -101,16 +101,23 @@ def test_soft_friction_rows_are_viscous_below_the_cone():
 def test_impratio_follows_the_working_load():
     """(3): impratio = mu_max F_n / (c_f v_t) for the seat motor (by hand: F_n = 24 N m / (r2 cos 10 deg cos 4.79 deg),
     mu_max 0.08, v_t 1e-3 m/s), and the model carries it. c_f of the flank contacts (the default geometry) by (4):
-    min(c_c, 0.01 F_n / (n_ref mu_max Vs)), Vs = omega1 r1 / cos(gamma) at 36 rpm."""
+    min(c_c, 0.01 F_n / (n_ref mu_max Vs)), Vs = omega1 r1 / cos(gamma) at 36 rpm. Then (5): the flank rows'
+    impedance d = IMPEDANCE / S, impratio x IMPEDANCE (1 - d) / (d (1 - IMPEDANCE)) and c_f divided by that factor."""
     sc = load_scenario(SCEN / "seat_motor.yaml", ["simulation.resolution=coarse"])
     bm = build_model(sc)
     g = bm.geometry
     f_n = 24.0 / (g.r2 * math.cos(math.radians(10)) * math.cos(math.radians(4.79)))
     vs = 36 * 2 * math.pi / 60 * g.r1 / math.cos(g.gamma)
     c_f = min(bm.law.contact_damping_n_s_per_m, 0.01 * f_n / (bm.law.contacts_per_pair * 0.08 * vs))
-    assert bm.law.friction_damping == pytest.approx(c_f, rel=1e-3)
-    expected = 0.08 * f_n / (c_f * 1e-3)
-    assert bm.law.impratio == pytest.approx(expected, rel=1e-3)
+    imp = 0.08 * f_n / (c_f * 1e-3)
+    d0, d = IMPEDANCE, bm.law.impedance
+    assert d == pytest.approx(d0 / bm.law.contacts_per_pair)
+    factor = d0 * (1 - d) / (d * (1 - d0))
+    assert bm.law.friction_damping == pytest.approx(c_f / factor, rel=1e-3)
+    assert bm.law.impratio == pytest.approx(imp * factor, rel=1e-3)
+    # (5) keeps the friction rows: the viscous friction impratio c_f (2) and R_f = R / impratio
+    assert bm.law.impratio * bm.law.friction_damping == pytest.approx(imp * c_f, rel=1e-3)
+    assert bm.law.impratio * d / (1 - d) == pytest.approx(imp * d0 / (1 - d0), rel=1e-3)
     assert bm.model.opt.impratio == pytest.approx(bm.law.impratio)
 
 

@@ -26,8 +26,9 @@ def run(name: str) -> dict:
 
 # mesh_frequency_hz is the meshing line near z1 n1 / 60 (wormsim.results.metrics.mesh_line): 29.97 / 22.14 / 24.14 Hz. The
 # largest F_t peak is not always there: involute_41 with the teeth's compliance (1.01e9 N/m per tooth pair against
-# Hertz's 5.41e9) has its contact mode near the 32nd meshing harmonic (772.56 Hz), which it amplifies (F_t p2p 437 N on
-# 13.8 kN; with Hertz 148 N; docs/data/stiffness_seeds.json)
+# Hertz's 5.41e9) has its contact mode among the meshing harmonics (941 Hz, the 39th; law (5) of wormsim.contact3d.law),
+# which it amplifies (F_t p2p 584 N on 13.8 kN, docs/data/slice_convergence_medium.json; with Hertz 148 N before (5),
+# docs/data/stiffness_seeds.json)
 MESH_XFAIL: dict[str, str] = {}
 
 

@@ -89,12 +89,26 @@ their own solreffriction (-S, -B_f) with
 so that f_n,slip stays below EPS_SLIP of a contact's share F_n / n_ref of the nominal normal force at the nominal
 sliding speed Vs = omega1 r1 / cos(gamma); impratio (3) is then taken with c_f, so friction still saturates above
 the transition velocity.
+
+Added mass of the flank contacts. The rows of a mesh act in parallel, so their added masses 1/R sum over the rows in
+contact: with d per row, S slices put about S d/(1-d) m_eff per tooth pair in contact on the mesh's effective mass,
+and the contact mode sqrt(K_mesh / m_eff) fell with the count (involute_41: 772 / 652 Hz at 24 / 48 slices against
+930 Hz from the zero-load TCA's mean k; docs/contact3d.md "Default slice count"). The flank contacts take
+
+    d_row = IMPEDANCE / S  (at least MIN_IMPEDANCE),   impratio' = impratio d0 (1 - d_row) / (d_row (1 - d0)),
+    c_f' = c_f impratio / impratio'   (d0 = IMPEDANCE)                                                        (5)
+
+so that a tooth pair's rows together carry the added mass IMPEDANCE / (1 - IMPEDANCE) m_eff whatever the count
+(involute_41: 941 Hz at 24 and at 48 slices), the spring and damper (1) are unchanged (S and B are taken with
+d_row), and the friction rows are those of d0: their regulariser R_f = R / impratio and the viscous friction
+impratio c_f (2) are both kept (keep_friction_rows), so the stick and slip of static holding (docs/decisions/
+0039-static-holding.md) are unchanged. Pieces keep d = IMPEDANCE per row.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -105,7 +119,9 @@ from wormsim.tooth.stiffness import hertz_per_length_n_per_m2, pair_stiffness_n_
 
 STABLE_LIMIT_PAIRS = 3  # tooth pairs in contact at once that the stable limit allows for
 EPS_SLIP = 0.01  # (4): the sliding contact's spurious normal force, share of its static load
-IMPEDANCE = 0.01  # d: added mass in the contact normal is d/(1-d) = 1 % of the mesh's effective mass
+IMPEDANCE = 0.01  # d: added mass in the contact normal d/(1-d) = 1 % of the mesh's effective mass per row (pieces)
+# or per tooth pair (flanks: each of its S rows d / S, (5))
+MIN_IMPEDANCE = 1e-4  # MuJoCo's mjMINIMP: the smallest impedance its solver takes
 
 
 @dataclass(frozen=True)
@@ -173,7 +189,12 @@ def hertz_line_stiffness_n_per_m(materials: Materials, contact_length_m: float) 
 
 
 def contact_law(
-    contact: Contact, materials: Materials, g: GearGeometry, contacts_per_pair: int, inv_mass_hat: float
+    contact: Contact,
+    materials: Materials,
+    g: GearGeometry,
+    contacts_per_pair: int,
+    inv_mass_hat: float,
+    impedance: float | None = None,
 ) -> ContactLaw:
     """Map the scenario's contact block onto per-contact solref/solimp by (1); K from
     wormsim.tooth.stiffness.pair_stiffness_n_per_m (module docstring).
@@ -191,7 +212,7 @@ def contact_law(
     else:
         c_req = DEFAULT_DAMPING_RATIO * c_crit
     c_c = min(c_req, MAX_DAMPING_RATIO * c_crit)
-    d = IMPEDANCE
+    d = IMPEDANCE if impedance is None else max(impedance, MIN_IMPEDANCE)
     s = k_c * (1 - d) * inv_mass_hat
     b = c_c * (1 - d) * inv_mass_hat
     return ContactLaw(
@@ -208,6 +229,20 @@ def contact_law(
         solref=(-s, -b),
         solimp=(d, d, 0.001, 0.5, 2.0),
     )
+
+
+def flank_impedance(contacts_per_pair: int) -> float:
+    """(5): each flank contact row's impedance, IMPEDANCE / S (at least MIN_IMPEDANCE)."""
+    return max(IMPEDANCE / max(int(contacts_per_pair), 1), MIN_IMPEDANCE)
+
+
+def keep_friction_rows(law: ContactLaw, reference_impedance: float | None = None) -> ContactLaw:
+    """(5): the friction rows of `law` made those of the same law at impedance d0 = reference_impedance: R_f =
+    R / impratio and the viscous friction impratio c_f (2) both kept, by impratio' = impratio d0 (1 - d) / (d (1 - d0))
+    and c_f' = c_f impratio / impratio' (d0 None: IMPEDANCE)."""
+    d, d0 = law.impedance, IMPEDANCE if reference_impedance is None else reference_impedance
+    imp = law.impratio * d0 * (1 - d) / (d * (1 - d0))
+    return replace(law, impratio=imp, friction_damping_n_s_per_m=law.friction_damping * law.impratio / imp)
 
 
 def friction_damping_n_s_per_m(

@@ -44,8 +44,10 @@ from wormsim.contact3d.backlash import check_backlash, check_conjugate_interfere
 from wormsim.contact3d.law import (
     ContactLaw,
     contact_law,
+    flank_impedance,
     friction_damping_n_s_per_m,
     friction_impratio,
+    keep_friction_rows,
     pair_stiffness_n_per_m,
 )
 from wormsim.contact3d.mass_scaling import ScalingCheck
@@ -377,7 +379,7 @@ def _prepare(gp: GearPlan, gs: GearSet, slabs: int) -> Prepared:
         ine = Inertias(*(S * v for v in astuple(ine)))
         if flanks and not contact.slices:
             slabs = min(slabs, SLICES_MASS_SCALED)  # a scaled run keeps means only (tooth.grid.SLICES_MASS_SCALED)
-    law = contact_law(contact, mats, geo, slabs, a1 + a2)  # the law, once
+    law = contact_law(contact, mats, geo, slabs, a1 + a2, flank_impedance(slabs) if flanks else None)  # the law, once
     mu_max = max(mu0, mu1)
     if flanks:  # the flank contacts' own friction-row damping, law (4)
         law = replace(
@@ -385,6 +387,8 @@ def _prepare(gp: GearPlan, gs: GearSet, slabs: int) -> Prepared:
             friction_damping_n_s_per_m=friction_damping_n_s_per_m(law, mu_max, f_n, v_s),
         )
     law = replace(law, impratio=friction_impratio(law, mu_max, f_n, contact.transition_velocity_m_s))
+    if flanks:  # the flank rows' added mass per tooth pair, the friction rows as at IMPEDANCE: law (5)
+        law = keep_friction_rows(law)
     grid = flank_grid(geo, law.contacts_per_pair) if flanks else None
     return Prepared(
         geo,
