@@ -1149,7 +1149,7 @@ def stiffness_seeds_table(name: str = "stiffness_seeds") -> str:
 
 # studies/slice_convergence_default.py's records at medium: the cases and the seat motor (run apart)
 SLICE_CONVERGENCE_RECORDS = ("slice_convergence_medium", "slice_convergence_seat_motor")
-# the same before law (5) (the flank rows' impedance d per row, decision 0044)
+# the same before law (5) (the flank rows' impedance d per row, decision 0045)
 SLICE_CONVERGENCE_PER_ROW = tuple(f"slice_convergence_per_row_{n}" for n in ("medium", "variety", "seat_motor"))
 
 

@@ -82,7 +82,7 @@ SLICES_XFAIL = {
     "(+114.8 %; below 1 kHz 392.4 against 248.0 N, +58.2 %): with the teeth's compliance (1.01e9 N/m per tooth pair) "
     "the contact mode is at 941 Hz (sqrt(K_mesh / m_eff) 930 Hz), and the leaving tooth's load (about 1.4 kN) falls "
     "to zero in about 2 ms, slice by slice, ringing it differently at each count (with C1 slice weights 393 / 202 / "
-    "436 N at 24 / 48 / 96; docs/data/slice_convergence_medium.json, docs/decisions/0044-flank-impedance-per-pair.md); "
+    "436 N at 24 / 48 / 96; docs/data/slice_convergence_medium.json, docs/decisions/0045-flank-impedance-per-pair.md); "
     "its p_H max converges (250.0 -> 252.5 MPa)",
     ("screw_jack", "tangential_force_p2p_n"): "whole-band F_t p2p 1.231 N at 16 slices against 1.617 N at 32 (-23.9 "
     "%; 0.3-0.4 % of its 400 N mean): the contact mode's ringing; the meshing band below 1 kHz converges (0.359 -> "
