@@ -100,15 +100,16 @@ def test_warm_worker_runs_once_per_process(monkeypatch):
     calls = []
     monkeypatch.setattr(warm, "_warm_pid", None)
     monkeypatch.setattr(jit_cache, "ensure_warm", lambda runs: calls.append("ensure") or False)
-    monkeypatch.setattr(c3d_runner, "warm_runs", lambda runs: calls.append(("run", len(runs))))
+    monkeypatch.setattr(c3d_runner, "warm_friction_check", lambda: calls.append("friction"))
 
-    def fails(runs):
+    def fails(runs, steps=None):
         raise RuntimeError("no cache")
 
     monkeypatch.setattr(c3d_runner, "warm_runs", fails)
     assert warm.warm_worker()["error"] == "RuntimeError: no cache" and warm.warm_pid() is None
-    monkeypatch.setattr(c3d_runner, "warm_runs", lambda runs: calls.append(("run", len(runs))))
+    monkeypatch.setattr(c3d_runner, "warm_runs", lambda runs, steps=None: calls.append(("run", len(runs), steps)))
     assert warm.warm_worker() == {"compiled": False, "error": None, "skipped": False}
     assert warm.warm_pid() == os.getpid()
     assert warm.warm_worker()["skipped"] is True
-    assert calls == ["ensure", "ensure", ("run", 1)]
+    # one run of the machine's warm-up, long enough to sample, and the friction check
+    assert calls == ["ensure", "ensure", ("run", 1, warm.SAMPLED_STEPS), "friction"]

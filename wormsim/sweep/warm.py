@@ -16,6 +16,9 @@ import os
 
 from distributed.diagnostics.plugin import WorkerPlugin
 
+# the short run's steps: enough for the samples that leave the compiled stretch (the guards' and friction's Python
+# path, the series' columns), which a point reaches in its first milliseconds and WARM_STEPS does not
+SAMPLED_STEPS = 400
 _warm_pid: int | None = None  # the process that ran the short run: this one, or the fork server it was forked from
 
 
@@ -31,12 +34,13 @@ def warm_worker() -> dict:
     global _warm_pid
     if _warm_pid is not None:
         return {"compiled": False, "error": None, "skipped": True}
-    from wormsim.contact3d.runner import warm_runs
+    from wormsim.contact3d.runner import warm_friction_check, warm_runs
     from wormsim.runtime import jit_cache
 
     try:
         compiled = jit_cache.ensure_warm(warm_runs)
-        warm_runs(jit_cache.WARM_RUNS[:1])
+        warm_runs(jit_cache.WARM_RUNS[:1], steps=SAMPLED_STEPS)
+        warm_friction_check()
     except Exception as exc:  # (the points compile or load for themselves)
         return {"compiled": False, "error": f"{exc.__class__.__name__}: {exc}", "skipped": False}
     _warm_pid = os.getpid()
