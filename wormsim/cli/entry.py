@@ -241,13 +241,17 @@ def _cmd_sweep(args) -> int:
         if early and not started:  # an invalid sweep file: its fork server's preload is not waited for
             stop_fork_server()
         raise
-    c = run_sweep(
-        sw,
-        args.out,
-        keep_runs=args.keep_runs,
-        progress=False if args.no_progress else None,
-        started=started[0] if started else None,
-    )
+    try:
+        c = run_sweep(
+            sw,
+            args.out,
+            keep_runs=args.keep_runs,
+            progress=False if args.no_progress else None,
+            started=started[0] if started else None,
+        )
+    finally:
+        if early and not (started and started[0].used):  # no point ran (all done earlier): not waited for either
+            stop_fork_server()
     out = Path(args.out)
     print(
         f"sweep {sw.spec.name}: {c['points']} points: {c['ok']} ok, {c['failed']} failed "

@@ -317,10 +317,10 @@ def warm_runs(runs: tuple[tuple[str, tuple[str, ...]], ...] = jit_cache.WARM_RUN
         sc.simulation.duration_s = (steps or jit_cache.WARM_STEPS) * (sc.simulation.timestep_s or 1e-4)
         simulate(sc)
     if runs == jit_cache.WARM_RUNS:  # the friction check, due later in a run than the warm-up's steps
-        warm_friction_check()
+        _warm_friction_check()
 
 
-def warm_friction_check() -> None:
+def _warm_friction_check() -> None:
     """friction_guard.friction_alignment on MuJoCo's contact arrays (a box resting on a plane: 4 contacts)."""
     import mujoco
 

@@ -203,13 +203,14 @@ def warm_workers(client, info: dict) -> None:
 
 class ClusterStart:
     """open_client in a thread, started before the sweep file is validated (the cluster's start overlaps it);
-    `get()` waits for it (and re-raises its error), `close()` closes what it opened."""
+    `get()` waits for it (and re-raises its error; `used` then True), `close()` closes what it opened."""
 
     def __init__(self, scheduler: str | None, workers: int | None, warm: bool = True):
         import threading
 
         self._result: tuple | None = None
         self._error: BaseException | None = None
+        self.used = False
         scheduler = scheduler or os.environ.get(SCHEDULER_ENV) or None
         if scheduler is None:
             start_fork_server(warm)
@@ -225,6 +226,7 @@ class ClusterStart:
             self._error = exc
 
     def get(self):
+        self.used = True
         self._thread.join()
         if self._error is not None:
             raise self._error

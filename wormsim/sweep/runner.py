@@ -422,8 +422,8 @@ def run_sweep(
 
 
 def _close_and_plot(client, cluster, png: _PlotImport, sweep: Sweep, ordered: list[dict], out: Path | None) -> None:
-    """The results are safe: the cluster closes in a thread while sweep.png is drawn into out (None: not drawn, an
-    interrupted sweep)."""
+    """The results are safe (sweep.csv and sweep.json final): the cluster closes in a thread while sweep.png is drawn
+    into out (None: not drawn, an interrupted sweep). A figure that fails raises, with no sweep.png left in out."""
     import threading
 
     closing = threading.Thread(target=close_cluster, args=(client, cluster), name="wormsim-cluster-close", daemon=True)
@@ -431,9 +431,13 @@ def _close_and_plot(client, cluster, png: _PlotImport, sweep: Sweep, ordered: li
     try:
         png.join()
         if out is not None:
-            from wormsim.sweep.plot import write_sweep_png
+            from wormsim.sweep import plot
 
-            write_sweep_png(ordered, sweep.swept_paths, sweep.spec.plot, out / PNG_NAME, title=sweep.spec.name)
+            try:
+                plot.write_sweep_png(ordered, sweep.swept_paths, sweep.spec.plot, out / PNG_NAME, title=sweep.spec.name)
+            except BaseException:  # the tables stay; an earlier sweep.png would look like theirs
+                (out / PNG_NAME).unlink(missing_ok=True)
+                raise
     finally:
         closing.join()
 
