@@ -10,6 +10,5 @@ from __future__ import annotations
 import distributed.nanny  # noqa: F401  (the worker's own imports, once in the server)
 import distributed.worker  # noqa: F401
 
-import wormsim.cli  # noqa: F401  (a forked worker runs the console script's top, `from wormsim.cli import main`)
 import wormsim.rating.rate  # noqa: F401  (a run's plausibility warnings rate the wheel's pressure)
 import wormsim.run  # noqa: F401
