@@ -7,14 +7,18 @@ model to 16 workers and to a cluster. Writes docs/data/sweep_scaling.json; docs/
 
 Per command, from its wall time and sweep.json's timing records (worker and client clocks are the same machine's):
 - span_s: the first point's start on a worker to the last point's end;
-- fixed_s: the command's wall time less span_s (interpreter and imports, validation, the cluster's start where it
-  does not overlap the validation, the workers' warm-up, the cluster's close, sweep.png);
+- fixed_s: the command's wall time less span_s (the fork server's preload of the workers' imports and kernels, or
+  the client's interpreter, imports and validation where they take longer, the workers' start and connection, the
+  tables written, sweep.png beside the cluster's close, the process's exit);
 - point_wall_median_s: a point's simulate() on its worker (sweep.csv wall_time_s); step_wall_us: its loop's step;
 - idle_per_point_s: span_s x workers less the points' task time, per point (hand-back, dispatch, imbalance);
 - first_point_extra_s: each worker's first point less the median of its others;
-- before_first_point_s, after_last_point_s: the command's start to the first point's start (interpreter, imports,
-  validation, the cluster's start, the workers' warm-up) and the last point's end to the command's exit (hand-back,
-  csv/json, the cluster's close beside sweep.png, the interpreter's exit): fixed_s is their sum.
+- cluster_start_s: sweep.json's cluster start, from the sweep file read (the cluster's thread started) to the
+  workers connected (it waits for the fork server, started at the command's start);
+- before_first_point_s, after_last_point_s: the command's start to the first point's start (the fork server's
+  preload beside the client's interpreter, imports, validation and cluster start; the workers forked and connected)
+  and the last point's end to the command's exit (hand-back, csv/json, the cluster's close beside sweep.png, the
+  process's end): fixed_s is their sum.
 With --repeats R the commands run R times, 1 and 2 workers taking turns, and the record keeps each worker count's
 fastest command (the machine is shared: the least disturbed reading) and every command's wall time.
 The model (docs/sweeps.md, "Scaling"): T(N) = fixed_s + ceil(P / N) x t_point x g(N), t_point the 1-worker run's

@@ -16,14 +16,19 @@ The reference: docs/api.md (generated from these docstrings), docs/scenario.md, 
 The worm pair as a component of a MuJoCo model of one's own: wormsim.WormPair (wormsim.pair, docs/multibody.md).
 """
 
+from typing import TYPE_CHECKING
+
 from wormsim.runtime import jit_cache as _jit_cache
 
 _jit_cache.configure()  # numba's cache: this machine's folder for this code, before any compiled function exists
 
 from wormsim.exceptions import ScenarioError, SimulationError  # noqa: E402
-from wormsim.results.result import Result  # noqa: E402
-from wormsim.run import LEVELS, run_scenario, simulate  # noqa: E402
-from wormsim.scenario import Scenario, load_scenario  # noqa: E402
+
+if TYPE_CHECKING:
+    from wormsim.pair import WormPair, step
+    from wormsim.results.result import Result
+    from wormsim.run import LEVELS, run_scenario, simulate
+    from wormsim.scenario import Scenario, load_scenario
 
 __version__ = "0.1.0"
 __all__ = [
@@ -39,12 +44,30 @@ __all__ = [
     "step",
 ]
 
-_PAIR = ("WormPair", "step")  # wormsim.pair, imported on first use (it loads MuJoCo and the compiled kernel)
+# Each public name is imported on first use, so that `import wormsim.x` of a light module (the console script's
+# parser, `wormsim sweep`'s cluster start) does not load the simulation's modules (numba, MuJoCo, pydantic's schema).
+_LAZY = {
+    "LEVELS": "wormsim.run",
+    "run_scenario": "wormsim.run",
+    "simulate": "wormsim.run",
+    "Result": "wormsim.results.result",
+    "Scenario": "wormsim.scenario",
+    "load_scenario": "wormsim.scenario",
+    "WormPair": "wormsim.pair",  # MuJoCo and the compiled kernel
+    "step": "wormsim.pair",
+}
 
 
 def __getattr__(name: str):
-    if name in _PAIR:
-        from wormsim import pair
+    module = _LAZY.get(name)
+    if module is None:
+        raise AttributeError(f"module 'wormsim' has no attribute {name!r}")
+    import importlib
 
-        return getattr(pair, name)
-    raise AttributeError(f"module 'wormsim' has no attribute {name!r}")
+    value = getattr(importlib.import_module(module), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))

@@ -1,11 +1,13 @@
 """`wormsim sweep` with several points per task (wormsim.sweep.runner.chunk_size): every point a row of its own with
-its own timing, the same rows as one point per task; and the cluster started while the points are validated
-(an invalid point still exits 2)."""
+its own timing, the same rows as one point per task; the cluster started while the points are validated (an invalid
+point still exits 2); workers forked warm; sweep.png drawn after the results are final; the command line's exit."""
 
 from __future__ import annotations
 
 import csv
 import json
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -65,9 +67,6 @@ def test_an_invalid_point_exits_2_with_the_cluster_started(tmp_path, capsys):
 def test_local_workers_start_warm_from_the_fork_server(tmp_path):
     """A contact3d sweep's local workers are forked from a fork server that loaded the compiled kernels once
     (wormsim.sweep.preload_warm): each point finds them loaded before it starts, on every worker."""
-    import subprocess
-    import sys
-
     f = tmp_path / "s.yaml"
     f.write_text(
         "name: warm\nbase: {base}\nset: {{model: contact3d, simulation.duration_s: 0.004}}\n"
@@ -100,15 +99,83 @@ def test_warm_worker_runs_once_per_process(monkeypatch):
     calls = []
     monkeypatch.setattr(warm, "_warm_pid", None)
     monkeypatch.setattr(jit_cache, "ensure_warm", lambda runs: calls.append("ensure") or False)
-    monkeypatch.setattr(c3d_runner, "warm_runs", lambda runs: calls.append(("run", len(runs))))
+    monkeypatch.setattr(c3d_runner, "_warm_friction_check", lambda: calls.append("friction"))
 
-    def fails(runs):
+    def fails(runs, steps=None):
         raise RuntimeError("no cache")
 
     monkeypatch.setattr(c3d_runner, "warm_runs", fails)
     assert warm.warm_worker()["error"] == "RuntimeError: no cache" and warm.warm_pid() is None
-    monkeypatch.setattr(c3d_runner, "warm_runs", lambda runs: calls.append(("run", len(runs))))
+    monkeypatch.setattr(c3d_runner, "warm_runs", lambda runs, steps=None: calls.append(("run", len(runs), steps)))
     assert warm.warm_worker() == {"compiled": False, "error": None, "skipped": False}
     assert warm.warm_pid() == os.getpid()
     assert warm.warm_worker()["skipped"] is True
-    assert calls == ["ensure", "ensure", ("run", 1)]
+    # one run of the machine's warm-up, long enough to sample, and the friction check
+    assert calls == ["ensure", "ensure", ("run", 1, warm.SAMPLED_STEPS), "friction"]
+
+
+def test_the_figure_comes_after_the_results_and_a_failing_one_keeps_them(tmp_path, monkeypatch):
+    """sweep.png is drawn once sweep.csv holds every row and sweep.json is final; a figure that fails leaves both as
+    they are and no sweep.png beside them (not an earlier one that looks current)."""
+    from wormsim.sweep import plot
+
+    f = tmp_path / "s.yaml"
+    f.write_text(SWEEP.format(base=ROOT / "scenarios" / "screw_jack.yaml", n=2).replace("0.01", "0.004"))
+    out = tmp_path / "o"
+    seen = []
+    draw = plot.write_sweep_png
+
+    def recorded(rows, *args, **kwargs):
+        with (out / "sweep.csv").open(newline="") as fh:
+            on_disk = list(csv.DictReader(fh))
+        doc = json.loads((out / "sweep.json").read_text())
+        seen.append(([r["status"] for r in on_disk], doc["finished"] is not None, doc["interrupted"]))
+        draw(rows, *args, **kwargs)
+
+    monkeypatch.setattr(plot, "write_sweep_png", recorded)
+    assert run_sweep(load_sweep(f), out, workers=1, progress=False)["ok"] == 2
+    assert seen == [(["ok", "ok"], True, False)] and (out / "sweep.png").is_file()
+    csv_text, doc = (out / "sweep.csv").read_text(), json.loads((out / "sweep.json").read_text())
+
+    def fails(*args, **kwargs):
+        raise RuntimeError("no figure")
+
+    monkeypatch.setattr(plot, "write_sweep_png", fails)
+    with pytest.raises(RuntimeError, match="no figure"):
+        run_sweep(load_sweep(f), out, progress=False)  # resumed: both points done, no cluster
+    assert (out / "sweep.csv").read_text() == csv_text
+    again = json.loads((out / "sweep.json").read_text())
+    assert [p["status"] for p in again["points"]] == ["ok", "ok"] and again["resumed_points"] == 2
+    assert again["finished"] is not None and not again["interrupted"] and doc["finished"] is not None
+    assert not (out / "sweep.png").exists()
+
+
+def test_the_command_line_ends_the_process_after_its_output(tmp_path):
+    """wormsim.cli.entry.exit_now: the atexit handlers run and stdout is flushed, then the process ends with the
+    command's code (no finalization)."""
+    code = (
+        "import atexit, sys\n"
+        "from wormsim.cli.entry import exit_now\n"
+        "atexit.register(lambda: print('atexit ran', file=sys.stderr))\n"
+        "print('written', end='')\n"
+        "exit_now(3)\n"
+        "print('not reached')\n"
+    )
+    cp = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert (cp.returncode, cp.stdout, cp.stderr.strip()) == (3, "written", "atexit ran")
+
+
+def test_main_from_the_command_line_exits_a_sweep_itself(tmp_path, monkeypatch):
+    """main() with no argv (the console script) ends a sweep with exit_now; main(argv) returns the code."""
+    from wormsim.cli import entry
+
+    f = tmp_path / "s.yaml"
+    f.write_text(SWEEP.format(base=ROOT / "scenarios" / "screw_jack.yaml", n=1).replace("0.01", "0.004"))
+    out = tmp_path / "o"
+    assert entry.main(["sweep", str(f), "--out", str(out), "--workers", "1"]) == 0
+    ended = []
+    monkeypatch.setattr(entry, "exit_now", ended.append)
+    monkeypatch.setattr(sys, "argv", ["wormsim", "sweep", str(f), "--out", str(out)])
+    assert entry.main() == 0 and ended == [0]  # resumed: the point is done, no cluster
+    monkeypatch.setattr(sys, "argv", ["wormsim", "schema", "--out", str(tmp_path / "schema.json")])
+    assert entry.main() == 0 and ended == [0]  # other commands return

@@ -18,12 +18,11 @@ import traceback
 import warnings
 from pathlib import Path
 
-import yaml
-
 from wormsim.exceptions import ScenarioError, SimulationError
-from wormsim.run import run_scenario
 from wormsim.runfolder import interrupt
-from wormsim.scenario import ignored_inputs, json_schema, load_scenario
+
+# Each command imports what it uses (the scenario's schema, the levels, the mesh generator, MuJoCo) when it runs:
+# `wormsim sweep` starts its cluster's fork server before any of them is imported (wormsim.sweep.cluster).
 
 EXIT_OK, EXIT_INTERNAL, EXIT_INPUT, EXIT_SIM = 0, 1, 2, 3
 
@@ -115,6 +114,9 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def _cmd_run(args) -> int:
+    from wormsim.run import run_scenario
+    from wormsim.scenario import load_scenario
+
     sc = load_scenario(args.scenario, args.overrides)
     if Path(args.scenario).suffix.lower() in (".rexs", ".rexsj"):  # what the import assumed, as `wormsim import` says
         from wormsim.scenario import rexs
@@ -177,6 +179,7 @@ def _cmd_import(args) -> int:
 def _cmd_mesh(args) -> int:
     from wormsim.cli.mesh import write_mesh_outputs
     from wormsim.runfolder.writer import locked_dir
+    from wormsim.scenario import load_scenario
 
     sc = load_scenario(args.scenario, args.overrides)
     with locked_dir(args.out, names=("worm.stl", "wheel.stl", "assembly.json", "recording.rrd", "section.png")):
@@ -187,6 +190,7 @@ def _cmd_mesh(args) -> int:
 def _cmd_model(args) -> int:
     from wormsim.contact3d.mjcf import write_model
     from wormsim.runfolder.writer import locked_dir
+    from wormsim.scenario import load_scenario
 
     sc = load_scenario(args.scenario, args.overrides)
     with locked_dir(args.out, names=("model.xml",)):
@@ -215,29 +219,39 @@ def _cmd_bench(args) -> int:
 
 
 def _cmd_sweep(args) -> int:
-    from wormsim.sweep import load_sweep, run_sweep
-    from wormsim.sweep.runner import ClusterStart
+    from wormsim.sweep.cluster import ClusterStart, early_fork_server, stop_fork_server
 
     if args.workers is not None and args.workers < 1:
         raise ScenarioError(f"--workers {args.workers}: allowed an integer >= 1")
-    started: list[ClusterStart] = []  # the cluster starts while the points are validated
+    # the local cluster's fork server first (it preloads the workers' imports and kernels on another core), then
+    # this process's imports; the cluster itself starts while the points are validated
+    early = early_fork_server(args.sweep, args.scheduler)
+    started: list[ClusterStart] = []
 
     def start(contact3d: bool) -> None:
         started.append(ClusterStart(args.scheduler, args.workers, warm=contact3d))
 
     try:
+        from wormsim.sweep import load_sweep, run_sweep
+
         sw = load_sweep(args.sweep, on_parsed=start)
     except BaseException:
         for s in started:
             s.close()
+        if early and not started:  # an invalid sweep file: its fork server's preload is not waited for
+            stop_fork_server()
         raise
-    c = run_sweep(
-        sw,
-        args.out,
-        keep_runs=args.keep_runs,
-        progress=False if args.no_progress else None,
-        started=started[0] if started else None,
-    )
+    try:
+        c = run_sweep(
+            sw,
+            args.out,
+            keep_runs=args.keep_runs,
+            progress=False if args.no_progress else None,
+            started=started[0] if started else None,
+        )
+    finally:
+        if early and not (started and started[0].used):  # no point ran (all done earlier): not waited for either
+            stop_fork_server()
     out = Path(args.out)
     print(
         f"sweep {sw.spec.name}: {c['points']} points: {c['ok']} ok, {c['failed']} failed "
@@ -265,6 +279,7 @@ def _cmd_rate(args) -> int:
 
 def _cmd_schema(args) -> int:
     from wormsim.runfolder.writer import check_writable_file, write_text_atomic
+    from wormsim.scenario import json_schema
 
     text = json.dumps(json_schema(), indent=2)
     if args.out:
@@ -275,7 +290,10 @@ def _cmd_schema(args) -> int:
 
 
 def _cmd_check(args) -> int:
+    import yaml
+
     from wormsim.physics.validate import validate_geometry
+    from wormsim.scenario import ignored_inputs, load_scenario
 
     sc = load_scenario(args.scenario, args.overrides)
     validate_geometry(sc)  # the same geometric checks as mesh and run
@@ -322,8 +340,40 @@ def _is_under(filename, root: Path | None) -> bool:
     return p == root or root in p.parents
 
 
+# commands that end the process themselves when run from the command line (exit_now)
+EXIT_NOW = ("sweep",)
+
+
 def main(argv: list[str] | None = None) -> int:
+    """Run one command; returns its exit code. argv None: the command line (the console script, `python -m
+    wormsim`): a command of EXIT_NOW then ends the process once its files are written (exit_now), without the
+    interpreter's finalization."""
     args = build_parser().parse_args(argv)
+    code = _main(args)
+    if argv is None and args.command in EXIT_NOW:
+        exit_now(code)
+    return code
+
+
+def exit_now(code: int) -> None:
+    """End this process with `code` once its output is out: stdout / stderr flushed and the atexit handlers run
+    (logging, dask, multiprocessing), then os._exit, without Python's finalization (freeing every object of numba,
+    distributed and matplotlib costs about a second after `wormsim sweep`). The command's files are written and
+    closed before it returns (atomic renames)."""
+    import atexit
+
+    try:
+        atexit._run_exitfuncs()
+    finally:
+        for stream in (sys.stdout, sys.stderr):
+            try:
+                stream.flush()
+            except (OSError, ValueError):  # (a closed pipe)
+                pass
+        os._exit(code)
+
+
+def _main(args) -> int:
     old_handlers = interrupt.install()
     caught: list[warnings.WarningMessage] = []
     try:

@@ -300,9 +300,9 @@ def simulate(scenario: Scenario, progress=None) -> Result:
     return res
 
 
-def warm_runs(runs: tuple[tuple[str, tuple[str, ...]], ...] = jit_cache.WARM_RUNS) -> None:
+def warm_runs(runs: tuple[tuple[str, tuple[str, ...]], ...] = jit_cache.WARM_RUNS, steps: int | None = None) -> None:
     """The short contact3d runs of `runs` (default wormsim.runtime.jit_cache.WARM_RUNS, the machine's warm-up: every
-    compiled entry point with the signatures the runs use)."""
+    compiled entry point with the signatures the runs use), `steps` steps each (default jit_cache.WARM_STEPS)."""
     from wormsim.runtime.data import data_dir
     from wormsim.scenario import load_scenario
 
@@ -314,7 +314,7 @@ def warm_runs(runs: tuple[tuple[str, tuple[str, ...]], ...] = jit_cache.WARM_RUN
         grid._flank_grid(derive(load_scenario(seeds / "screw_jack.yaml").gear), 2, 6)
     for name, overrides in runs:
         sc = load_scenario(seeds / f"{name}.yaml", ["model=contact3d", *overrides])
-        sc.simulation.duration_s = jit_cache.WARM_STEPS * (sc.simulation.timestep_s or 1e-4)
+        sc.simulation.duration_s = (steps or jit_cache.WARM_STEPS) * (sc.simulation.timestep_s or 1e-4)
         simulate(sc)
     if runs == jit_cache.WARM_RUNS:  # the friction check, due later in a run than the warm-up's steps
         _warm_friction_check()

@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import csv
 import io
-import logging
 import os
 import platform
 import shutil
@@ -29,12 +28,21 @@ from tqdm import tqdm
 
 from wormsim.runfolder.writer import ResultDir, write_json_atomic
 from wormsim.scenario import ScenarioError
+from wormsim.sweep.cluster import (  # noqa: F401  (the cluster's names, as they were here)
+    CONNECT_TIMEOUT_S,
+    LOCAL_START_METHOD,
+    SCHEDULER_ENV,
+    WORKER_WAIT_S,
+    ClusterStart,
+    close_cluster,
+    default_workers,
+    open_client,
+    start_fork_server,
+    warm_workers,
+)
 from wormsim.sweep.spec import Point, Sweep
 
 CSV_NAME, JSON_NAME, PNG_NAME, RUNS_DIR = "sweep.csv", "sweep.json", "sweep.png", "runs"
-SCHEDULER_ENV = "DASK_SCHEDULER_ADDRESS"
-CONNECT_TIMEOUT_S = 20.0  # to reach an existing scheduler
-WORKER_WAIT_S = 60.0  # for the first worker of an existing cluster
 MAX_CHUNK = 4  # points per task at most (chunk_size)
 _FIRST = ("point",)
 _AFTER_SWEPT = ("status", "message")
@@ -278,146 +286,6 @@ def machine_info() -> dict:
     }
 
 
-def default_workers() -> int:
-    """One worker per core this process may use."""
-    try:
-        return max(1, len(os.sched_getaffinity(0)))
-    except AttributeError:
-        return max(1, os.cpu_count() or 1)
-
-
-# The local cluster's workers are forked from multiprocessing's fork server (a clean single-threaded process that
-# imports distributed once) instead of spawned, each a fresh interpreter: a worker then starts without its own
-# interpreter start-up, and ends with os._exit, without Python's finalization of a process that holds numba's and
-# MuJoCo's state (about 0.8 s each; the cluster's close waited for it). Measured on the 2-CPU machine under load,
-# 2 workers with the warm-up: start 3.5 s -> 1.9 s, close 2.3 s -> 0.1 s. A worker that the nanny restarts after a
-# death starts by dask's default (spawn).
-LOCAL_START_METHOD = "forkserver"
-
-
-def start_fork_server(warm: bool) -> None:
-    """Start multiprocessing's fork server now, preloading the workers' imports (wormsim.sweep.preload) and with
-    `warm` the compiled contact3d kernels (wormsim.sweep.preload_warm), once for all workers, on another core while
-    this process validates the points. A server that runs already (an earlier sweep in this process) is kept."""
-    import multiprocessing
-    from multiprocessing import forkserver
-
-    multiprocessing.set_forkserver_preload(["wormsim.sweep.preload_warm" if warm else "wormsim.sweep.preload"])
-    forkserver.ensure_running()
-
-
-def open_client(scheduler: str | None, workers: int | None):
-    """(client, cluster or None, info). scheduler None: a LocalCluster of `workers` single-threaded processes.
-    Raises ScenarioError for a bad --workers or a scheduler that does not answer."""
-    if workers is not None and workers < 1:
-        raise ScenarioError(f"--workers {workers}: allowed an integer >= 1")
-    from distributed import Client, LocalCluster
-
-    t0 = time.perf_counter()
-    if scheduler:
-        try:
-            client = Client(scheduler, timeout=CONNECT_TIMEOUT_S)
-        except (OSError, TimeoutError) as exc:
-            raise ScenarioError(
-                f"--scheduler {scheduler}: no dask scheduler answered within {CONNECT_TIMEOUT_S:g} s "
-                f"({exc.__class__.__name__}); start one with `dask scheduler` or leave "
-                f"--scheduler and {SCHEDULER_ENV} unset for a local cluster"
-            ) from None
-        try:
-            client.wait_for_workers(workers or 1, timeout=WORKER_WAIT_S)
-        except TimeoutError:
-            client.close()
-            raise ScenarioError(
-                f"--scheduler {scheduler}: fewer than {workers or 1} workers connected within "
-                f"{WORKER_WAIT_S:g} s (start them with `dask worker {scheduler}`)"
-            ) from None
-        cluster, kind = None, "existing scheduler"
-    else:
-        import dask
-
-        n = workers or default_workers()
-        # dask's own log lines stay off stderr up to ERROR: on a loaded machine a worker's heartbeat times out and
-        # distributed logs it with a traceback, though the worker reconnects and the sweep ends well (a point that
-        # fails, or a lost worker, is a row with its message in sweep.csv / sweep.json)
-        with dask.config.set({"distributed.worker.multiprocessing-method": LOCAL_START_METHOD}):
-            cluster = LocalCluster(
-                n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0", silence_logs=logging.CRITICAL
-            )
-        client = Client(cluster)
-        kind = "LocalCluster (processes)"
-    ws = client.scheduler_info().get("workers", {})
-    info = {
-        "kind": kind,
-        "scheduler": client.scheduler.address,
-        "start_s": time.perf_counter() - t0,
-        "workers": len(ws),
-        "threads": sum(w.get("nthreads", 0) for w in ws.values()),
-        "worker_list": [
-            {"address": a, "nthreads": w.get("nthreads"), "memory_limit": w.get("memory_limit")} for a, w in ws.items()
-        ],
-    }
-    return client, cluster, info
-
-
-def warm_workers(client, info: dict) -> None:
-    """Every worker loads (the machine's first compiles, once) the contact3d kernels before the points go out
-    (wormsim.sweep.warm.WarmKernels; also on workers that join later). info gets "warm_s"."""
-    from wormsim.sweep.warm import WarmKernels
-
-    t0 = time.perf_counter()
-    try:
-        client.register_plugin(WarmKernels())
-    except Exception:  # (a worker that cannot warm compiles or loads in its first point)
-        pass
-    info["warm_s"] = time.perf_counter() - t0
-
-
-class ClusterStart:
-    """open_client in a thread, started before the sweep file is validated (the cluster's start overlaps it);
-    `get()` waits for it (and re-raises its error), `close()` closes what it opened."""
-
-    def __init__(self, scheduler: str | None, workers: int | None, warm: bool = True):
-        import threading
-
-        self._result: tuple | None = None
-        self._error: BaseException | None = None
-        scheduler = scheduler or os.environ.get(SCHEDULER_ENV) or None
-        if scheduler is None:
-            start_fork_server(warm)
-        self._thread = threading.Thread(
-            target=self._run, args=(scheduler, workers), name="wormsim-cluster-start", daemon=True
-        )
-        self._thread.start()
-
-    def _run(self, scheduler, workers) -> None:
-        try:
-            self._result = open_client(scheduler, workers)
-        except BaseException as exc:  # (re-raised by get in the main thread)
-            self._error = exc
-
-    def get(self):
-        self._thread.join()
-        if self._error is not None:
-            raise self._error
-        assert self._result is not None
-        return self._result
-
-    def close(self) -> None:
-        self._thread.join()
-        if self._result is not None:
-            _close(self._result[0], self._result[1])
-
-
-def _close(client, cluster) -> None:
-    try:
-        if client is not None:
-            client.close()
-        if cluster is not None:
-            cluster.close()
-    except Exception:  # (closing a cluster after Ctrl-C may fail; the tables are written)
-        pass
-
-
 def _free_threads(client) -> int:
     """Worker threads the scheduler knows now (at least 1; workers that join later are used from the next point)."""
     ws = client.scheduler_info().get("workers", {})
@@ -508,6 +376,7 @@ def run_sweep(
         if todo:
             if started is None:
                 started = ClusterStart(scheduler, workers, warm=any(p.scenario.model == "contact3d" for p in todo))
+            png.start()  # matplotlib's import while the cluster starts: this process waits for its workers
             client, cluster, cluster_info = started.get()
             started = None
             if any(p.scenario.model == "contact3d" for p in todo):
@@ -533,7 +402,7 @@ def run_sweep(
                     bar.point_done(summary.get("status") != "ok")
                 flush_csv()
 
-            _dispatch(client, todo, keep_runs, cluster_info, png, on_results)
+            _dispatch(client, todo, keep_runs, cluster_info, on_results)
     except KeyboardInterrupt:
         interrupted = True
     finally:
@@ -553,18 +422,22 @@ def run_sweep(
 
 
 def _close_and_plot(client, cluster, png: _PlotImport, sweep: Sweep, ordered: list[dict], out: Path | None) -> None:
-    """The results are safe: the cluster closes in a thread while sweep.png is drawn into out (None: not drawn, an
-    interrupted sweep)."""
+    """The results are safe (sweep.csv and sweep.json final): the cluster closes in a thread while sweep.png is drawn
+    into out (None: not drawn, an interrupted sweep). A figure that fails raises, with no sweep.png left in out."""
     import threading
 
-    closing = threading.Thread(target=_close, args=(client, cluster), name="wormsim-cluster-close", daemon=True)
+    closing = threading.Thread(target=close_cluster, args=(client, cluster), name="wormsim-cluster-close", daemon=True)
     closing.start()
     try:
         png.join()
         if out is not None:
-            from wormsim.sweep.plot import write_sweep_png
+            from wormsim.sweep import plot
 
-            write_sweep_png(ordered, sweep.swept_paths, sweep.spec.plot, out / PNG_NAME, title=sweep.spec.name)
+            try:
+                plot.write_sweep_png(ordered, sweep.swept_paths, sweep.spec.plot, out / PNG_NAME, title=sweep.spec.name)
+            except BaseException:  # the tables stay; an earlier sweep.png would look like theirs
+                (out / PNG_NAME).unlink(missing_ok=True)
+                raise
     finally:
         closing.join()
 
@@ -585,7 +458,7 @@ def _resume(sweep: Sweep, earlier: list[dict]) -> tuple[dict[int, dict], list[Po
     return rows, todo
 
 
-def _dispatch(client, todo: list[Point], keep_runs: bool, cluster_info: dict, png: _PlotImport, on_results) -> None:
+def _dispatch(client, todo: list[Point], keep_runs: bool, cluster_info: dict, on_results) -> None:
     """Run the points of todo on the cluster in chunks (chunk_size; cluster_info gets points_per_task); each finished
     chunk goes to on_results(points, results, submitted, received), a lost worker's chunk as failed results.
     Only as many points in flight as the cluster has threads: a point waits on the scheduler, not in a worker's
@@ -611,7 +484,6 @@ def _dispatch(client, todo: list[Point], keep_runs: bool, cluster_info: dict, pn
         return fut
 
     pending = as_completed([submit_next() for _ in range(min(-(-len(queue) // chunk), threads))])
-    png.start()  # matplotlib's import while the points run (this thread waits on them)
     for fut in pending:
         if queue:
             pending.add(submit_next())
@@ -638,7 +510,8 @@ def _dispatch(client, todo: list[Point], keep_runs: bool, cluster_info: dict, pn
 
 class _PlotImport:
     """matplotlib's import (pyplot on the Agg backend, what sweep.png needs; not the run writers' rerun) in a thread
-    while the points run; a failure is dropped (the plot imports for itself)."""
+    while the cluster starts (the workers' fork server preloads on another core; once the points run, every core
+    is theirs); a failure is dropped (the plot imports for itself)."""
 
     def __init__(self):
         self._thread = None

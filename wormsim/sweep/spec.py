@@ -38,6 +38,7 @@ import yaml
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
 from wormsim.scenario import Scenario, ScenarioError, format_validation_error, scenario_from_dict, set_path, yaml_load
+from wormsim.sweep.cluster import may_run_contact3d
 
 MAX_POINTS = 100_000
 _PATH = r"^[A-Za-z_][A-Za-z0-9_]*(\.[A-Za-z_][A-Za-z0-9_]*)*$"
@@ -345,7 +346,7 @@ def load_sweep(path: str | Path, max_errors: int = 5, on_parsed: Callable[[bool]
     for p, v in spec.set.items():
         set_path(base, p.split("."), v, f"{path.name}: set.{p}")
     if on_parsed is not None:
-        on_parsed(base.get("model", "contact3d") == "contact3d" or "model" in spec.grid or "model" in spec.zip)
+        on_parsed(may_run_contact3d(base.get("model", "contact3d"), [*spec.grid, *spec.zip]))
 
     points, errors = [], []
     for i, values in enumerate(expand(spec)):

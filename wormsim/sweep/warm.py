@@ -4,7 +4,8 @@
 points include contact3d runs) in a thread of the worker, so the worker's event loop keeps answering the scheduler:
 wormsim.runtime.jit_cache.ensure_warm (the machine's first worker compiles, holding the cache's lock; the others wait
 for it
-and load), then one short run (jit_cache.WARM_RUNS' first, WARM_STEPS steps) that loads every compiled function,
+and load), then one short run (jit_cache.WARM_RUNS' first, SAMPLED_STEPS steps: long enough for the samples that
+leave the compiled stretch) and the friction check, which load every compiled function a screw-jack point calls,
 numba's start-up and the imports into the worker process. A worker's first point then costs what its others cost.
 A failure is dropped: the point compiles or loads for itself.
 """
@@ -16,6 +17,10 @@ import os
 
 from distributed.diagnostics.plugin import WorkerPlugin
 
+# the short run's steps: enough for the samples that leave the compiled stretch (the guards' and friction's Python
+# path, the series' columns), which a point reaches in its first milliseconds and WARM_STEPS does not (measured on
+# the screw jack: 40 steps leave 6 functions to the point, 120 none; 200 costs about 0.05 s more than 40)
+SAMPLED_STEPS = 200
 _warm_pid: int | None = None  # the process that ran the short run: this one, or the fork server it was forked from
 
 
@@ -31,12 +36,13 @@ def warm_worker() -> dict:
     global _warm_pid
     if _warm_pid is not None:
         return {"compiled": False, "error": None, "skipped": True}
-    from wormsim.contact3d.runner import warm_runs
+    from wormsim.contact3d.runner import _warm_friction_check, warm_runs
     from wormsim.runtime import jit_cache
 
     try:
         compiled = jit_cache.ensure_warm(warm_runs)
-        warm_runs(jit_cache.WARM_RUNS[:1])
+        warm_runs(jit_cache.WARM_RUNS[:1], steps=SAMPLED_STEPS)
+        _warm_friction_check()  # (the machine's warm-up's own step, due later in a point than the short run)
     except Exception as exc:  # (the points compile or load for themselves)
         return {"compiled": False, "error": f"{exc.__class__.__name__}: {exc}", "skipped": False}
     _warm_pid = os.getpid()
