@@ -43,6 +43,9 @@ def test_key_follows_the_compiled_code_and_not_the_rest(tmp_path, monkeypatch):
         assert jit_cache.cache_key() != k0, rel  # a callee or a constant module of the kernels
         f.write_text(text)
     assert jit_cache.cache_key() == k0
+    # the same code in another folder: numba files each source folder's functions apart, so its own warm-up
+    monkeypatch.setattr(jit_cache, "_ROOT", _copy_tree(tmp_path / "clone"))
+    assert jit_cache.cache_key() != k0
 
 
 def test_the_key_is_remembered_by_the_files_stamps(tmp_path, monkeypatch):
@@ -191,22 +194,30 @@ def _stats_script(name: str, duration_s: float, *overrides: str) -> str:
     )
 
 
+def _setup_warm_command() -> list[str]:
+    """The set-up's warm-up as the Makefile's install recipe runs it (`make install`, `make demo`):
+    jit_cache.main with the contact3d warm-up runs."""
+    line = next(x for x in (ROOT / "Makefile").read_text().splitlines() if "jit_cache" in x and " -c " in x)
+    return [sys.executable, "-c", line.split(" -c ", 1)[1].strip().strip("'")]
+
+
+def test_the_setup_warms_with_the_contact3d_warm_up():
+    cmd = _setup_warm_command()
+    assert "j.main(r.warm_runs)" in cmd[2] and "wormsim.contact3d.runner as r" in cmd[2]
+
+
 @pytest.mark.long
 def test_a_fresh_machine_compiles_once_and_later_processes_compile_nothing(tmp_path):
-    """Two `wormsim run` processes start at once on an empty cache: one compiles (and says so), the other waits and
-    loads; then fresh processes run the demo, the seat motor, shafts and the pieces without compiling anything."""
+    """On an empty cache the set-up's warm-up (the Makefile's, as `make demo` runs it) and a `wormsim run` start at
+    once: one compiles (and says so), the other waits and loads; then fresh processes run the demo, the seat motor,
+    one contact per tooth flank, a table-form (ZK) worm, shafts and the pieces without compiling anything."""
     env = {k: v for k, v in os.environ.items() if k not in ("NUMBA_CACHE_DIR", jit_cache._OURS, "WORMSIM_NO_PROGRESS")}
     env[jit_cache.ENV] = str(tmp_path / "jit")
     cmd = [str(Path(sys.executable).parent / "wormsim"), "run", str(ROOT / "scenarios" / "screw_jack.yaml")]
+    run = [*cmd, "--out", str(tmp_path / "o"), "--set", "simulation.duration_s=0.004"]
     procs = [
-        subprocess.Popen(
-            [*cmd, "--out", str(tmp_path / f"o{i}"), "--set", "simulation.duration_s=0.004"],
-            env=env,
-            stderr=subprocess.PIPE,
-            stdout=subprocess.DEVNULL,
-            text=True,
-        )
-        for i in range(2)
+        subprocess.Popen(c, env=env, stderr=subprocess.PIPE, stdout=subprocess.DEVNULL, text=True, cwd=ROOT)
+        for c in (_setup_warm_command(), run)
     ]
     errs = [p.communicate(timeout=1200)[1] for p in procs]
     assert [p.returncode for p in procs] == [0, 0], errs
@@ -221,6 +232,8 @@ def test_a_fresh_machine_compiles_once_and_later_processes_compile_nothing(tmp_p
     for case in (
         ("seat_motor_demo", 0.003),
         ("seat_motor", 0.003, "model=contact3d"),
+        ("seat_motor", 0.003, "model=contact3d", "contact.flank_contacts=tooth"),
+        ("screw_jack", 0.003, "gear.profile=ZK"),
         ("screw_jack", 0.003, "shafts.worm.bearings_mm=[-40, 40]", "shafts.worm.bending=true"),
         ("involute_41", 0.003, "model=contact3d", "contact.geometry=pieces"),
     ):
