@@ -155,4 +155,5 @@ def test_one_compiled_signature_with_and_without_one_contact_per_tooth_flank():
         sc = load_scenario(JACK, ["simulation.duration_s=0.002", "simulation.resolution=coarse", *extra])
         simulate(sc)
     assert len(FS.run_samples.signatures) == 1, FS.run_samples.signatures
-    assert len(FS.contact_rows.signatures) == 1, FS.contact_rows.signatures
+    # (a callee is typed only where its caller compiles here: none where run_samples came from the cache)
+    assert len(FS.contact_rows.signatures) <= 1, FS.contact_rows.signatures
