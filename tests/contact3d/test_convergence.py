@@ -88,12 +88,12 @@ SLICES_XFAIL = {
 def test_flank_fluctuation_converged_in_slices(name, key):
     """The default slice count (the CI run, medium: flanks.default_slices) against twice it: within 10 % (issue 31:
     F_t p2p and p_H max, wormsim.tooth.hertz (4); and the TE p2p). p_H max: screw jack 318.3 -> 322.2 MPa, involute_41
-    250.4 -> 253.0 MPa, seat motor 661.9 -> 628.9 MPa (+5.2 %; one contact's p_H, the maximum before: 341.9 -> 338.8,
+    250.4 -> 252.9 MPa, seat motor 661.9 -> 628.9 MPa (+5.2 %; one contact's p_H, the maximum before: 341.9 -> 338.8,
     300.7 -> 294.4 and 844.7 -> 856.8 MPa; docs/data/slice_convergence_medium.json, _seat_motor.json). Seat motor
     (32; F_t p2p 0.07 % of its mean): F_t p2p 0.874 -> 0.856 N (-2.1 %), TE p2p 219.9 -> 203.4 urad (-7.5 %); at 16
     slices (the default before) F_t p2p is 1.062 N, -17.7 % to 32: the slices' switching rings the contact mode
-    (F_t above 1 kHz p2p 0.324 / 0.203 N at 16 / 32; all at the default step, 6.4e-6 s). Screw jack (16): F_t p2p 1.636 -> 1.639 N, TE p2p 8.580 ->
-    8.650 urad; its whole-band F_t p2p is the contact mode's ringing and jumps between other counts (24 -> 48: +38 %,
+    (F_t above 1 kHz p2p 0.324 / 0.203 N at 16 / 32; all at the default step, 6.4e-6 s). Screw jack (16): F_t p2p
+    1.636 -> 1.639 N, TE p2p 8.580 -> 8.650 urad; its whole-band F_t p2p is the contact mode's ringing and jumps between other counts (24 -> 48: +38 %,
     32 -> 64: x2.0; docs/contact3d.md, 'Default slice count'), its meshing band below converges."""
     n = DEFAULT_SLICES[name]
     a, b = run(name), run(name, f"contact.slices={2 * n}")
