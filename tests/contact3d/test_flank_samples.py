@@ -145,3 +145,15 @@ def test_guards_stop_the_compiled_samples_with_the_python_paths_error(case, monk
             _run(path, sets, enabled, monkeypatch)
         errs.append((type(exc.value), str(exc.value)))
     assert errs[0] == errs[1]
+
+
+def test_one_compiled_signature_with_and_without_one_contact_per_tooth_flank():
+    """run_samples and contact_rows get the merge's arrays either way (the kernel's merge flag chooses): one compiled
+    specialisation for per-slice and per-tooth-flank runs, not one per tuple and None (issue 33: fewer
+    specialisations; the warm-up then covers both)."""
+    for extra in ([], ["contact.flank_contacts=tooth"]):
+        sc = load_scenario(JACK, ["simulation.duration_s=0.002", "simulation.resolution=coarse", *extra])
+        simulate(sc)
+    assert len(FS.run_samples.signatures) == 1, FS.run_samples.signatures
+    # (a callee is typed only where its caller compiles here: none where run_samples came from the cache)
+    assert len(FS.contact_rows.signatures) <= 1, FS.contact_rows.signatures

@@ -66,11 +66,12 @@ def test_ratio_within_0p1_percent(name):
 # wheel's mesh mode ringing at ~0.8-2.3 kHz leaked into it); at the two-digit default 8.5e-5 s (decision 0043) it passes
 MESH_XFAIL: dict[str, str] = {}
 EFF_XFAIL = {
-    "seat_motor": "efficiency 0.600 against tan(g)/tan(g+rho') = 0.620 at the pitch radius (-3.2 %): the contacts sit "
-    "on the worm above its pitch radius (force-weighted 4.40 mm against r1 4.19 mm; the wheel is 58 % "
-    "undercut), where the local lead angle is smaller; the same formula at each contact's own radius "
-    "gives 0.609 (test below). Finer pieces resolve it further: coarse / medium / fine 0.605 / 0.600 / "
-    "0.592. Not the rattle (driven-machine inertia 1e-4 kg m^2: 0.605) and not back-flank friction "
+    "seat_motor": "efficiency 0.600 against tan(g)/tan(g+rho') = 0.620 at the pitch radius (-3.2 %; its default step "
+    "6.4e-6 s): the contacts sit on the worm above its pitch radius (force-weighted 4.39 mm against r1 4.19 mm; the "
+    "wheel is 58 % undercut), where the local lead angle is smaller; the same formula at each contact's own radius "
+    "gives 0.610 (test below). Finer pieces resolve it further: coarse / medium / fine 0.605 / 0.600 / "
+    "0.592. Not the rattle (driven-machine inertia 1e-4 kg m^2: 0.586, at its default step 4.6e-5 s) and not "
+    "back-flank friction "
     "(back-flank contacts carry 0.0 % of |F_t|)",
 }
 

@@ -43,6 +43,9 @@ def test_key_follows_the_compiled_code_and_not_the_rest(tmp_path, monkeypatch):
         assert jit_cache.cache_key() != k0, rel  # a callee or a constant module of the kernels
         f.write_text(text)
     assert jit_cache.cache_key() == k0
+    # the same code in another folder: numba files each source folder's functions apart, so its own warm-up
+    monkeypatch.setattr(jit_cache, "_ROOT", _copy_tree(tmp_path / "clone"))
+    assert jit_cache.cache_key() != k0
 
 
 def test_the_key_is_remembered_by_the_files_stamps(tmp_path, monkeypatch):
@@ -184,36 +187,54 @@ def test_progress_says_compiling_once_and_leaves_the_compile_out_of_its_estimate
 
 def _stats_script(name: str, duration_s: float, *overrides: str) -> str:
     return (
-        "import json, wormsim; from wormsim import jit_cache; from wormsim.scenario import load_scenario; "
+        "import json, wormsim; from wormsim.runtime import jit_cache; from wormsim.scenario import load_scenario; "
         "from wormsim.run import simulate; "
         f"sc = load_scenario('{ROOT / 'scenarios' / name}.yaml', {list(overrides)!r}); "
         f"sc.simulation.duration_s = {duration_s}; simulate(sc); print(json.dumps(jit_cache.dispatcher_stats()))"
     )
 
 
+def _setup_warm_command() -> list[str]:
+    """The set-up's warm-up as the Makefile's install recipe runs it (`make install`, `make demo`):
+    jit_cache.main with the contact3d warm-up runs."""
+    line = next(x for x in (ROOT / "Makefile").read_text().splitlines() if "jit_cache" in x and " -c " in x)
+    return [sys.executable, "-c", line.split(" -c ", 1)[1].strip().strip("'")]
+
+
+def test_the_setup_warms_with_the_contact3d_warm_up():
+    cmd = _setup_warm_command()
+    assert "j.main(r.warm_runs)" in cmd[2] and "wormsim.contact3d.runner as r" in cmd[2]
+
+
 @pytest.mark.long
 def test_a_fresh_machine_compiles_once_and_later_processes_compile_nothing(tmp_path):
-    """Two `wormsim run` processes start at once on an empty cache: one compiles (and says so), the other waits and
-    loads; then fresh processes run the demo, the seat motor, shafts and the pieces without compiling anything."""
+    """On an empty cache a `wormsim run` compiles and its progress line says so; the set-up's warm-up (the Makefile's,
+    as `make demo` runs it), started while it compiles, says that it waits and loads; then fresh processes run the
+    demo, the seat motor, one contact per tooth flank, a table-form (ZK) worm, shafts and the pieces without compiling
+    anything."""
     env = {k: v for k, v in os.environ.items() if k not in ("NUMBA_CACHE_DIR", jit_cache._OURS, "WORMSIM_NO_PROGRESS")}
     env[jit_cache.ENV] = str(tmp_path / "jit")
     cmd = [str(Path(sys.executable).parent / "wormsim"), "run", str(ROOT / "scenarios" / "screw_jack.yaml")]
-    procs = [
-        subprocess.Popen(
-            [*cmd, "--out", str(tmp_path / f"o{i}"), "--set", "simulation.duration_s=0.004"],
-            env=env,
-            stderr=subprocess.PIPE,
-            stdout=subprocess.DEVNULL,
-            text=True,
-        )
-        for i in range(2)
-    ]
-    errs = [p.communicate(timeout=1200)[1] for p in procs]
-    assert [p.returncode for p in procs] == [0, 0], errs
-    compiled = [e for e in errs if "compiling the contact3d kernels (once per machine" in e]
-    waited = [e for e in errs if jit_cache.WAIT_NOTE in e]
-    assert len(compiled) == 1 and len(waited) == 1, errs
-    assert "min left" not in compiled[0]
+    run = [*cmd, "--out", str(tmp_path / "o"), "--set", "simulation.duration_s=0.004"]
+
+    def start(c):
+        return subprocess.Popen(c, env=env, stderr=subprocess.PIPE, stdout=subprocess.DEVNULL, text=True, cwd=ROOT)
+
+    first, head = start(run), []
+    try:
+        while not head or "compiling the contact3d kernels (once per machine" not in head[-1]:
+            line = first.stderr.readline()
+            assert line, head  # the run ended without saying that it compiles
+            head.append(line)
+    except BaseException:
+        first.kill()
+        raise
+    assert head[-1].startswith("screw_jack (contact3d): compiling the contact3d kernels"), head  # the progress line
+    setup = start(_setup_warm_command())
+    errs = ["".join(head) + first.communicate(timeout=1200)[1], setup.communicate(timeout=1200)[1]]
+    assert [first.returncode, setup.returncode] == [0, 0], errs
+    assert "min left" not in errs[0] and jit_cache.WAIT_NOTE not in errs[0], errs[0]
+    assert jit_cache.WAIT_NOTE in errs[1] and "(once per machine" not in errs[1], errs[1]  # it waited and loaded
     folders = list((tmp_path / "jit").iterdir())
     folders = [f for f in folders if f.is_dir()]
     assert len(folders) == 1 and json.loads((folders[0] / jit_cache.WARM_NAME).read_text())["error"] is None
@@ -221,6 +242,8 @@ def test_a_fresh_machine_compiles_once_and_later_processes_compile_nothing(tmp_p
     for case in (
         ("seat_motor_demo", 0.003),
         ("seat_motor", 0.003, "model=contact3d"),
+        ("seat_motor", 0.003, "model=contact3d", "contact.flank_contacts=tooth"),
+        ("screw_jack", 0.003, "gear.profile=ZK"),
         ("screw_jack", 0.003, "shafts.worm.bearings_mm=[-40, 40]", "shafts.worm.bending=true"),
         ("involute_41", 0.003, "model=contact3d", "contact.geometry=pieces"),
     ):
@@ -255,8 +278,10 @@ def test_watchers_are_told_in_the_compiling_thread():
 
 @pytest.mark.long
 def test_a_two_worker_sweep_on_a_fresh_cache_compiles_once(tmp_path):
-    """`wormsim sweep` of 4 short contact3d points on 2 workers, empty cache: one worker compiles (its plugin), the
-    other waits and loads; the compile seconds summed over the workers are one process's."""
+    """`wormsim sweep` of 4 short contact3d points on 2 workers, empty cache: the kernels are compiled once, in the
+    fork server both workers are forked from (wormsim.sweep.preload_warm), and neither worker compiles anything of its
+    own: each reports the fork server's compile seconds and signatures (a worker's counters start from its parent's),
+    the same on both."""
     sweep = tmp_path / "s.yaml"
     sweep.write_text(
         f"name: fresh\nbase: {ROOT / 'scenarios' / 'screw_jack.yaml'}\n"
@@ -284,13 +309,17 @@ def test_a_two_worker_sweep_on_a_fresh_cache_compiles_once(tmp_path):
     assert out.returncode == 0, out.stderr
     doc = json.loads((tmp_path / "o" / "sweep.json").read_text())
     assert all(p["status"] == "ok" for p in doc["points"])
+    timing = [p["timing"] for p in doc["points"]]
     per_worker: dict[str, dict] = {}
-    for p in doc["points"]:
-        t = p["timing"]
+    for t in timing:
         w = per_worker.setdefault(t["worker"], {"compile_s": 0.0, "misses": 0})
         w["compile_s"] = max(w["compile_s"], t["compile_s"])
         w["misses"] = max(w["misses"], t["jit_misses"])
     assert len(per_worker) == 2, per_worker
-    compiled = sorted(per_worker.values(), key=lambda w: w["compile_s"])
-    assert compiled[0]["misses"] == 0 and compiled[0]["compile_s"] == 0.0, per_worker  # loaded only
-    assert compiled[1]["misses"] > 5 and compiled[1]["compile_s"] > 5.0, per_worker  # compiled once, for both
+    warmed_by = {t["warmed_by_pid"] for t in timing}
+    assert len(warmed_by) == 1 and None not in warmed_by and not warmed_by & {t["pid"] for t in timing}, timing
+    # one compile, in the fork server: both workers carry its counters and added none
+    assert len({w["misses"] for w in per_worker.values()}) == 1, per_worker
+    assert len({w["compile_s"] for w in per_worker.values()}) == 1, per_worker
+    w = next(iter(per_worker.values()))
+    assert w["misses"] > 5 and w["compile_s"] > 5.0, per_worker

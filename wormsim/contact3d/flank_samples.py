@@ -109,17 +109,18 @@ def contact_guard(p, io, t, depth, n, w1, w2, cmd_i):
 
 
 @numba.njit(cache=True)
-def contact_rows(d_addr, off, adr, ncon, n_fc, cone3, frame, pos, nh, mrg):
+def contact_rows(d_addr, off, adr, ncon, n_fc, cone3, frame, pos, nh, merged, mrg):
     """The sample's contacts (ContactRows) read from d at the checked offsets off: d.contact's efc addresses into
-    adr, d.efc_force; with one contact per tooth flank (mrg not None) the merged contacts' forces split over their
-    slices (FlankContacts.slice_rows). Typed as FlankLoop.sample passes them (one compiled signature of
-    sample_table: int64 counts, a non-literal bool)."""
+    adr, d.efc_force; with one contact per tooth flank (merged) the merged contacts' forces split over their slices
+    with mrg's arrays (FlankContacts.slice_rows). Typed as FlankLoop.sample passes them (one compiled signature of
+    sample_table: int64 counts, a non-literal bool); mrg is the same tuple of arrays either way (one compiled
+    signature here and in run_samples, not one per tuple and None)."""
     size, o_adr = off[6], off[7]
     cbase = i64_at(d_addr + off[3])[0]
     for k in range(ncon):
         adr[k] = i32_at(cbase + k * size + o_adr)[0]
     efc = numba.carray(f64_at(i64_at(d_addr + off[4])[0]), (max(i32_at(d_addr + off[2])[0], 0),))
-    if mrg is not None:
+    if merged:
         grp, share, mfric, mwrap, adr_m, efc_m = mrg
         split_forces(adr[:ncon], efc, ncon - min(nh, ncon), cone3, (grp, share, mfric, mwrap), n_fc, (adr_m, efc_m))
         return ContactRows(adr_m[:n_fc], efc_m, frame, pos, n_fc, n_fc, True, True)
@@ -132,10 +133,10 @@ def run_samples(tables, mj, cmds, span, S, p, room, io, mrg, shaft):
     + rec of cmds = (drive, load). tables = flank_loop's run and sample tables (T, Ts); mj = (the model's and the
     data's address); S the series (series.SERIES rows); p the run's SampleParams; room = (the checked mjData offsets
     (native.mjdata_offsets), the kernel's contact frames and points, ADR_CAP work room, the pattern's and the radius
-    log's rows); io: IO_*; mrg: with one contact per tooth flank (merge) the kernel's (grp, share, mfric, mwrap) and
-    the per-slice rows' room (FlankContacts.slice_rows), else None; shaft = (mj_rnePostConstraint's address or 0, the
-    shaft log's raw addresses, its raw rows: wormsim.contact3d.shafts.ShaftLog), the addresses empty without
-    `shafts:`."""
+    log's rows); io: IO_*; mrg: the kernel's (grp, share, mfric, mwrap) and the per-slice rows' room
+    (FlankContacts.slice_rows), used with one contact per tooth flank (the kernel's merge flag, ib[6]); shaft =
+    (mj_rnePostConstraint's address or 0, the shaft log's raw addresses, its raw rows:
+    wormsim.contact3d.shafts.ShaftLog), the addresses empty without `shafts:`."""
     T, Ts = tables
     m_addr, d_addr = mj
     cmd, load = cmds
@@ -143,6 +144,7 @@ def run_samples(tables, mj, cmds, span, S, p, room, io, mrg, shaft):
     off, frame, pos, adr, pat_buf, r_buf = room
     rne, sh_adr, sh_raw = shaft
     acc, state, ib = f1(T, Row.acc), i1(T, Row.state), i1(T, Row.ib)
+    merged = ib[6] != 0  # one contact per tooth flank (the kernel's merge flag, wormsim.tooth.merge)
     qpos, qvel = f1(T, Row.qpos), f1(T, Row.qvel)
     depth = f1(Ts, SampleRow.depth)
     tptr, nptr, bptr = f64_at(d_addr + off[0]), i32_at(d_addr + off[1]), i32_at(d_addr + off[5])
@@ -194,10 +196,10 @@ def run_samples(tables, mj, cmds, span, S, p, room, io, mrg, shaft):
         if ncon > adr.shape[0] or pm + n_fc > pat_buf.shape[0] or rm + n_fc > r_buf.shape[0]:
             io[IO_EVENT] = EV_LOG_FULL
             return
-        if contact_guard(p, io, t, depth, n_fc if mrg is not None else min(n_fc, ncon), w1, w2, cmd_i):
+        if contact_guard(p, io, t, depth, n_fc if merged else min(n_fc, ncon), w1, w2, cmd_i):
             io[IO_EVENT] = EV_GUARD  # Guards.contact raises, or the lock guard acts or keeps state
             return
-        rows = contact_rows(d_addr, off, adr, ncon, n_fc, cone3, frame, pos, ib[7], mrg)
+        rows = contact_rows(d_addr, off, adr, ncon, n_fc, cone3, frame, pos, ib[7], merged, mrg)
         logs = (pat_buf, io[IO_E_STAR], pm, r_buf, rm)
         nteeth, pen2, fr, W, wr, pm, rm = sample_table(Ts, rows, (th2, p.z2, p.a), i, logs)
         if rne != 0:  # ShaftLog.record: the reactions, then the raw values
@@ -277,7 +279,7 @@ class FlankSamples:
         io[IO_STUCK] = float(guards.stuck)
         io[IO_TURN_MAX], io[IO_PM], io[IO_RM] = guards.turn_max, pattern.m, rlog.m
         room = (self.off, fc.frame, fc.pos, self.adr, pattern.buf, rlog.buf)
-        mrg = (k.grp, k.share, k.mfric, k.mwrap, fc.slice_adr, fc.slice_efc) if fc.merge else None
+        mrg = (k.grp, k.share, k.mfric, k.mwrap, fc.slice_adr, fc.slice_efc)  # read only with merge (run_samples)
         mj = (loop.m._address, loop.d._address)
         run_samples(tables, mj, (cmd, load), (i0, i1, o0, self.rec), self.S, self.params, room, io, mrg, self.shaft)
         loop.sync()

@@ -318,6 +318,21 @@ def warm_runs(runs: tuple[tuple[str, tuple[str, ...]], ...] = jit_cache.WARM_RUN
         simulate(sc)
     if runs == jit_cache.WARM_RUNS:  # the friction check, due later in a run than the warm-up's steps
         _warm_friction_check()
+        _warm_helpers()
+
+
+def _warm_helpers() -> None:
+    """The compiled helpers that the screw jack's warm-up runs do not call: H(r)'s table (meshgen.worm_forms.FormTable:
+    ZN / ZK / ZC worms) and mu(Vs) called from Python (friction_coefficient_scalar: the Python samples of a run with a
+    friction group), each with the types of its callers."""
+    import numpy as np
+
+    from meshgen.worm_forms import FormTable
+    from meshgen.worm_forms_jit import N_CHEB
+    from wormsim.physics.friction import GROUP, GROUPS, mu_at
+
+    FormTable(0.0, 1.0, np.zeros(N_CHEB)).evaluate(0.5)
+    mu_at(0.1, GROUP, *(float(x) for x in GROUPS["I"]))
 
 
 def _warm_friction_check() -> None:

@@ -8,9 +8,10 @@ Here every wormsim process points numba at one folder per (code, CPU, numba, Pyt
 
 KEY hashes the text of every module whose code or constants the compiled functions use (every wormsim / meshgen
 module that imports numba, and `SOURCES`: the modules whose constants they read; this module's own text is not part
-of it), the CPU (model name and flags), numba's and Python's
-versions. A NUMBA_CACHE_DIR set by the user wins. numba's own index, inside the folder, still checks each source
-file's time stamp and the CPU.
+of it), the CPU (model name and flags), numba's and Python's versions, and the folder the code is in: numba files
+each source folder's functions apart (a subfolder named by its path), so a second checkout of the same code would
+find the first one's warm.json and compile in every process. A NUMBA_CACHE_DIR set by the user wins. numba's own
+index, inside the folder, still checks each source file's time stamp and the CPU.
 
 The folder is filled once per machine (`ensure_warm`): the first contact3d run, `make install` or a sweep's
 worker plugin runs the short contact3d runs of `WARM_RUNS` (wormsim.contact3d.runner.warm_runs, handed to ensure_warm:
@@ -107,8 +108,10 @@ def _machine() -> str:
 
 
 def cache_key() -> str:
-    """16 hex digits of the SHA-256 of the sources' text (_sources), the CPU, numba's and Python's versions."""
+    """16 hex digits of the SHA-256 of the sources' text (_sources), the CPU, numba's and Python's versions and the
+    code's folder (module docstring)."""
     h = hashlib.sha256(_machine().encode())
+    h.update(str(_ROOT).encode())
     for p in _sources():
         h.update(str(p.relative_to(_ROOT)).encode())
         h.update(p.read_bytes())
