@@ -57,6 +57,7 @@ def level_lines(sc: Scenario) -> list[str]:
         return [f"timestep: {h:.3g} s ({src}), {sc.simulation.duration_s / h:.0f} steps"]
     if sc.model != "contact3d":
         return []
+    from wormsim.contact3d.flank_step import merge_group
     from wormsim.contact3d.mjcf import flank_slices, prepare
     from wormsim.contact3d.timestep import timestep_for
 
@@ -72,7 +73,13 @@ def level_lines(sc: Scenario) -> list[str]:
         out.append(f"worm speed command: {rad_s_to_rpm(abs(p.worm_speed_rad_s)):.5g} rpm")
     if sc.contact.geometry == "flanks":
         src = "contact.slices" if sc.contact.slices else f"default for resolution {sc.simulation.resolution}"
-        out.append(f"flank slices across the face: {flank_slices(sc, p.geometry)} ({src})")
+        slices = flank_slices(sc, p.geometry)
+        out.append(f"flank slices across the face: {slices} ({src})")
+        fc = sc.contact.flank_contacts
+        if fc != "slice":
+            group = merge_group(fc, slices)
+            per = "one per slice" if group == 0 else f"{group} slices each"
+            out.append(f"MuJoCo contacts per tooth flank: {fc} ({per}; contact.flank_contacts)")
     return out
 
 

@@ -29,14 +29,29 @@ from wormsim.tooth.merge import split_forces
 from wormsim.tooth.window import window_centre
 
 
+def merge_group(flank_contacts: str | int, slices: int) -> int:
+    """The slices per MuJoCo contact for contact.flank_contacts (wormsim.tooth.merge): slice 0 (no merge), tooth
+    `slices` (one per tooth flank), N: ceil(slices / N) (N contacts per tooth flank; 0 where that is one slice)."""
+    if flank_contacts == "slice":
+        return 0
+    if flank_contacts == "tooth":
+        return slices
+    group = -(-slices // int(flank_contacts))
+    return group if group > 1 else 0
+
+
 class FlankContacts:
     """The flank contacts of one model: the grid, the window, the template contact and the step."""
 
     def __init__(self, bm, slices: int, merge: bool | None = None):
         """merge: one MuJoCo contact per tooth flank (wormsim.tooth.merge; contact.flank_contacts tooth);
-        None: from the model's scenario (bm.meta's flank_contacts)."""
+        None: from the model's scenario (bm.meta's flank_contacts: slice, tooth or N contacts per tooth flank)."""
         g = bm.geometry
-        self.merge = bm.meta.get("flank_contacts", "slice") == "tooth" if merge is None else bool(merge)
+        if merge is None:
+            self.group = merge_group(bm.meta.get("flank_contacts", "slice"), slices)
+        else:
+            self.group = slices if merge else 0
+        self.merge = self.group > 0
         m = bm.model
         self.bm = bm
         plan_grid = bm.plan.grid if getattr(bm, "plan", None) is not None else None
@@ -105,7 +120,7 @@ class FlankContacts:
         """The kernel's arrays, memo included, in two buffers: one compiled call per step (kernel.find_packed);
         again when self.params was replaced."""
         k = self.kernel = PackedKernel(
-            self.grid, self.params, len(self.depth), len(self.ks), self.bm.geometry.z2, self.merge
+            self.grid, self.params, len(self.depth), len(self.ks), self.bm.geometry.z2, self.group
         )
         k.ks[:] = self.ks
         self.pos, self.nrm, self.depth, self.meta, self.line = k.pos, k.nrm, k.depth, k.meta, k.line

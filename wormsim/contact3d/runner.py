@@ -272,7 +272,7 @@ def _run_summary(S: dict, bm: BuiltModel, rec: int, turn_max: float, collision_g
         "collision_geoms": collision_geoms,
         "contact_geometry": gp.contact.geometry,
         "flank_slices": law.contacts_per_pair if flanks else None,
-        "flank_contacts": bm.meta.get("flank_contacts") if flanks else None,
+        "flank_contacts": str(bm.meta.get("flank_contacts")) if flanks else None,
         "step_wall_us": step_wall_us,
         "piece_error_um": bm.pieces.piece_error_um,
     }

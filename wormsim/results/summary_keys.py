@@ -379,7 +379,7 @@ KEYS: dict[str, Key] = {
     "collision_geoms": Key("-", C, "MuJoCo collision geoms (0 with contact.geometry flanks)"),
     "contact_geometry": Key("text", C, "flanks or pieces"),
     "flank_slices": Key("-", C, "face slices per flank (flanks; null for pieces)"),
-    "flank_contacts": Key("text", C, "slice or tooth (flanks; null for pieces)"),
+    "flank_contacts": Key("text", C, "slice, tooth or N (contacts per tooth flank; flanks; null for pieces)"),
     "step_wall_us": Key("us", C, "wall time per step"),
     "piece_error_um": Key("object", C, "deviation of the convex pieces from the exact flanks (max, rms, ...)"),
     "mass_scaling": Key("-", C, "inertia factor applied (1 = off)"),

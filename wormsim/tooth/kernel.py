@@ -582,7 +582,7 @@ _F_FIELDS += (
     "axes",
 )  # wormsim.tooth.merge
 _I_FIELDS = ("span", "ks", "stamp")
-_I_HEADER = 8  # S, N, cap, len(P), W, z2, merge (one contact per tooth flank), merged contacts
+_I_HEADER = 8  # S, N, cap, len(P), W, z2, merge (slices per merged contact, 0: none), merged contacts
 
 
 @numba.njit(cache=True)
@@ -670,15 +670,16 @@ class PackedKernel:
     numba's dispatch costs ~0.25 us per array argument (the three calls with their 28 arrays and find_contacts' work
     allocation cost ~9 us of Python per step). The fields are numpy views of the buffers (pos, nrm, depth, meta, line,
     weight, frame, P, memo, span, ks: write ks and P in place), cut by `_views` from the one layout `_layout`.
-    merge: also one contact per tooth flank (wormsim.tooth.merge: mpos, mnrm, mdepth, mweight, mframe, mfric, mwrap,
-    their number in ib[7]; grp, share; axes: the hinges, set by the caller)."""
+    merge: the slices per merged contact (wormsim.tooth.merge; 0: none, True or S: one per tooth flank): mpos, mnrm,
+    mdepth, mweight, mframe, mfric, mwrap, their number in ib[7]; grp, share; axes: the hinges, set by the caller)."""
 
-    def __init__(self, grid: FlankGrid, P: np.ndarray, cap: int, W: int, z2: int, merge: bool = False):
+    def __init__(self, grid: FlankGrid, P: np.ndarray, cap: int, W: int, z2: int, merge: int = 0):
         S, N = grid.slices, grid.c.shape[2]
         fs, is_ = _layout(S, N, cap, len(P), W, z2)
         self.fb = np.zeros(_size(fs))
         self.ib = np.zeros(_I_HEADER + _size(is_), dtype=np.int64)
-        self.ib[:7] = (S, N, cap, len(P), W, z2, int(merge))
+        group = S if merge is True else int(merge)
+        self.ib[:7] = (S, N, cap, len(P), W, z2, group)
         views = _cut(self.fb, 0, fs) + _cut(self.ib, _I_HEADER, is_)
         for name, v in zip(_F_FIELDS + _I_FIELDS, views, strict=True):
             setattr(self, name, v)
@@ -715,9 +716,9 @@ def find_packed(fb, ib, theta1, theta2, margin, taper_rad):
     )
     n = slice_weights(meta, line, n, S, pos, nrm, depth, weight)
     contact_frames(nrm, n, frame)
-    if ib[6]:  # one contact per tooth flank (wormsim.tooth.merge)
+    if ib[6]:  # ib[6] slices per merged contact (wormsim.tooth.merge)
         merged = (mpos, mnrm, mdepth, mweight, mfric, mwrap)
-        nm = merge_flanks(meta, n, (pos, nrm, depth, weight), grp, share, merged, axes)
+        nm = merge_flanks(meta, n, (pos, nrm, depth, weight), grp, share, merged, axes, ib[6])
         ib[7] = nm
         contact_frames(mnrm, nm, mframe)
     return n

@@ -1,5 +1,7 @@
-"""One MuJoCo contact per tooth flank (`contact.flank_contacts: tooth`): the slice contacts of one tooth
-flank (same tooth, same side: meta[:, 0:2], contiguous in the kernel's order) handed to MuJoCo as one contact.
+"""Fewer MuJoCo contacts than slices (`contact.flank_contacts: tooth` or N): the slice contacts of one tooth flank
+(same tooth, same side: meta[:, 0:2], contiguous in the kernel's order), or of each run of `group` adjacent slices on
+it (slice index meta[:, 2] // group; N contacts per tooth flank: group = ceil(S / N)), handed to MuJoCo as one
+contact.
 
 The contact law is a linear spring per contact whose stiffness is scaled by the contact's share w_i of its slice
 (wormsim.contact3d.law (1); kernel.slice_weights; flank_handoff.fill_add scales solref by w). With a_i = w_i d_i:
@@ -29,20 +31,21 @@ import numpy as np
 
 
 @numba.njit(cache=True)
-def merge_flanks(meta, n, slices, grp, share, merged, axes):
+def merge_flanks(meta, n, slices, grp, share, merged, axes, group):
     """The merged contacts of the n slice contacts slices = (pos, nrm, depth, weight) (module docstring): merged =
     (mpos, mnrm, mdepth, mweight, mfric (the friction coefficient's factor), mwrap (1 / c_w)) per tooth flank;
     grp[c] the merged contact of slice contact c, share[c] = a_c / sum a (its share of the slices' spring forces);
     axes = (a point on the worm axis, its direction, a point on the wheel axis, its direction, the wheel's speed per
-    worm speed): the hinges for the moment-arm and friction corrections (module docstring). Returns the number of
-    merged contacts."""
+    worm speed): the hinges for the moment-arm and friction corrections (module docstring); group: the slices per
+    merged contact (S or more: one per tooth flank). Returns the number of merged contacts."""
     pos, nrm, depth, weight = slices
     mpos, mnrm, mdepth, mweight, mfric, mwrap = merged
     g = 0
     i = np.int64(0)  # not a literal: _match_arms compiles once (int64), not also for Literal[int](0)
     while i < n:
         e = i + 1
-        while e < n and meta[e, 0] == meta[i, 0] and meta[e, 1] == meta[i, 1]:
+        seg = int(meta[i, 2]) // group
+        while e < n and meta[e, 0] == meta[i, 0] and meta[e, 1] == meta[i, 1] and int(meta[e, 2]) // group == seg:
             e += 1
         W = 0.0
         A = 0.0
