@@ -189,6 +189,34 @@ def flank_speed_table(name: str = "flank_speed") -> str:
     return _table(head, rows) + "\n" + _source(name)
 
 
+def flank_contacts_table(name: str = "flank_contacts") -> str:
+    """MuJoCo contacts per tooth flank (studies/flank_contacts.py): the seat motor's CPU s per simulated second per
+    variant, and the seeds' CI results relative to per slice."""
+    r = load(name)
+    cpu, seeds = r["cpu_s_per_sim_s"], r["seeds"]
+    variants = list(cpu)
+    head = ["contact.flank_contacts", "seat motor, 36 rpm: CPU s per simulated s (rounds)", "ratio to slice"]
+    keys = (
+        ("tangential_force_p2p_n", "F_t p2p"),
+        ("efficiency", "efficiency"),
+        ("transmission_error_p2p_urad", "TE p2p"),
+    )
+    for seed in seeds:
+        head.append(f"{seed}: contacts; " + ", ".join(k[1] for k in keys))
+    rows = []
+    for v in variants:
+        row = [v, " / ".join(f"{x:.1f}" for x in cpu[v]), " / ".join(f"{x:.2f}" for x in r["ratio_to_slice"][v])]
+        for seed, res in seeds.items():
+            b, x = res["slice"], res[v]
+            if v == "slice":
+                cell = f"{x['contacts_mean']:.0f}; " + ", ".join(f"{x[k]:.4g}" for k, _ in keys)
+            else:
+                cell = f"{x['contacts_mean']:.0f}; " + ", ".join(f"{(x[k] / b[k] - 1) * 100:+.2f} %" for k, _ in keys)
+            row.append(cell)
+        rows.append(row)
+    return _table(head, rows) + "\n" + _source(name)
+
+
 def seat_motor_20s_table(name: str = "seat_motor_20s") -> str:
     """The 20 s seat motor run (pieces, unscaled): its summary recomputed with the fixed steady window."""
     r = load(name)
@@ -1228,6 +1256,7 @@ TABLES: dict[str, Callable[[], str]] = {
     "bench_stability": bench_stability_table,
     "bench_flanks_vs_pieces": bench_flanks_vs_pieces_table,
     "flank_speed": flank_speed_table,
+    "flank_contacts": flank_contacts_table,
     "bench_shafts": bench_shafts_table,
     "seat_motor_20s": seat_motor_20s_table,
     "sweep_speedup": sweep_speedup_table,
