@@ -109,12 +109,13 @@ def contact_guard(p, io, t, depth, n, w1, w2, cmd_i):
 
 
 @numba.njit(cache=True)
-def contact_rows(d_addr, off, adr, ncon, n_fc, cone3, frame, pos, nh, merged, mrg):
+def contact_rows(d_addr, off, adr, ncon, n_fc, cone3, pts, nh, merged, mrg):
     """The sample's contacts (ContactRows) read from d at the checked offsets off: d.contact's efc addresses into
-    adr, d.efc_force; with one contact per tooth flank (merged) the merged contacts' forces split over their slices
-    with mrg's arrays (FlankContacts.slice_rows). Typed as FlankLoop.sample passes them (one compiled signature of
-    sample_table: int64 counts, a non-literal bool); mrg is the same tuple of arrays either way (one compiled
-    signature here and in run_samples, not one per tuple and None)."""
+    adr, d.efc_force; pts = (the kernel's contact frames, points); with merged contacts (merged) their forces split
+    over their slices with mrg's arrays (FlankContacts.slice_rows). Typed as FlankLoop.sample passes them (one
+    compiled signature of sample_table: int64 counts, a non-literal bool); mrg is the same tuple of arrays either way
+    (one compiled signature here and in run_samples, not one per tuple and None)."""
+    frame, pos = pts
     size, o_adr = off[6], off[7]
     cbase = i64_at(d_addr + off[3])[0]
     for k in range(ncon):
@@ -199,7 +200,7 @@ def run_samples(tables, mj, cmds, span, S, p, room, io, mrg, shaft):
         if contact_guard(p, io, t, depth, n_fc if merged else min(n_fc, ncon), w1, w2, cmd_i):
             io[IO_EVENT] = EV_GUARD  # Guards.contact raises, or the lock guard acts or keeps state
             return
-        rows = contact_rows(d_addr, off, adr, ncon, n_fc, cone3, frame, pos, ib[7], merged, mrg)
+        rows = contact_rows(d_addr, off, adr, ncon, n_fc, cone3, (frame, pos), ib[7], merged, mrg)
         logs = (pat_buf, io[IO_E_STAR], pm, r_buf, rm)
         nteeth, pen2, fr, W, wr, pm, rm = sample_table(Ts, rows, (th2, p.z2, p.a), i, logs)
         if rne != 0:  # ShaftLog.record: the reactions, then the raw values
