@@ -18,7 +18,9 @@ import pytest
 
 from meshgen import assembly
 from wormsim.contact3d import shafts
+from wormsim.contact3d.mass_scaling import floor_2_digits
 from wormsim.contact3d.mjcf import build_model
+from wormsim.contact3d.timestep import SHAFTS_SOURCE
 from wormsim.physics.geometry import derive
 from wormsim.run import simulate
 from wormsim.scenario import Scenario, ScenarioError, load_scenario
@@ -151,8 +153,23 @@ def test_bad_shafts_input_names_the_field():
             }
         )
     stiff = {"worm": {"bearings_mm": [-60, 60], "radial_stiffness_n_per_um": 1e6}}
+    given = Scenario.model_validate(
+        {**_scenario(stiff).model_dump(), "simulation": {"duration_s": 0.08, "timestep_s": 1e-5}}
+    )
     with pytest.raises(ScenarioError, match="simulation.timestep_s"):
-        build_model(_scenario(stiff))
+        build_model(given)
+
+
+def test_default_step_follows_the_shafts_stiffest_mode():
+    """Without simulation.timestep_s a shaft mode stiffer than the contact lowers the default to 0.4 x its explicit
+    limit, rounded down to two digits (the contact's rule, wormsim.contact3d.timestep); the contact's own default holds
+    otherwise."""
+    stiff = build_model(_scenario({"worm": {"bearings_mm": [-60, 60], "radial_stiffness_n_per_um": 1e6}}))
+    lim = shafts.stable_limit_s(stiff.model)
+    assert stiff.timestep_source == SHAFTS_SOURCE
+    assert stiff.model.opt.timestep == floor_2_digits(0.4 * lim) < 0.4 * stiff.law.stable_limit_s
+    soft = build_model(_scenario({"worm": {"bearings_mm": [-60, 60]}}))
+    assert soft.timestep_source != SHAFTS_SOURCE and soft.model.opt.timestep <= 0.4 * shafts.stable_limit_s(soft.model)
 
 
 @pytest.mark.parametrize("block", [RIGID, json.dumps({"worm": {"bearings_mm": [-60, 60], "bending": True}})])

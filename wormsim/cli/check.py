@@ -65,6 +65,11 @@ def level_lines(sc: Scenario) -> list[str]:
     h, src = timestep_for(
         sc.simulation.timestep_s, p.worm_speed_rad_s, p.law, p.scaling.factor if p.scaling is not None else 1.0
     )
+    if sc.shafts is not None and sc.simulation.timestep_s is None:  # the shafts' modes may lower it: the built model's
+        from wormsim.contact3d.mjcf import build_model
+
+        bm = build_model(sc)
+        h, src = float(bm.model.opt.timestep), bm.timestep_source
     out = [
         f"timestep: {h:.3g} s ({src}), {sc.simulation.duration_s / h:.0f} steps; stable limit "
         f"{p.law.stable_limit_s:.3g} s",

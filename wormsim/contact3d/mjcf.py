@@ -50,8 +50,8 @@ from wormsim.contact3d.law import (
     keep_friction_rows,
     pair_stiffness_n_per_m,
 )
-from wormsim.contact3d.mass_scaling import ScalingCheck
-from wormsim.contact3d.timestep import timestep_for
+from wormsim.contact3d.mass_scaling import ScalingCheck, floor_2_digits
+from wormsim.contact3d.timestep import DEFAULT_FRACTION, SHAFTS_SOURCE, timestep_for
 from wormsim.physics import gear_theory as gt
 from wormsim.physics.friction import mu_law
 from wormsim.physics.geometry import derive, gear_set, solid_set
@@ -446,6 +446,13 @@ def build(
     shift = dev.tooth_angle_shift(geo, np.arange(geo.z2)) if dev is not None and any(dev.tooth_shift) else None
     spec, W, worm_names, slot_names, sups, drive_sign = _spec(p, window_teeth, dev, shift, h)
     model = spec.compile()
+    if sups is not None and timestep_s is None and sim.timestep_s is None:  # a default step: the shafts' modes too
+        lim = shafts.stable_limit_s(model)  # inf where the shafts are rigid
+        h_shafts = floor_2_digits(DEFAULT_FRACTION * lim) if math.isfinite(lim) else h
+        if h_shafts < h:
+            h, h_source = h_shafts, SHAFTS_SOURCE
+            spec, W, worm_names, slot_names, sups, drive_sign = _spec(p, window_teeth, dev, shift, h)
+            model = spec.compile()
     meta = {"flank_contacts": gp.contact.flank_contacts, **backlash_meta}
     # a torque-driven wheel starts on its loaded flank (wormsim.physics.locking.wheel_start_rad): the hinge's
     # initial angle

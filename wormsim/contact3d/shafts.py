@@ -229,9 +229,21 @@ def mesh_margin_rad(supports: dict[str, Support | None], normal_force_n: float, 
 
 
 def check_timestep(model: mujoco.MjModel, timestep_s: float, prefix: str = "") -> float:
+    """The shaft modes' explicit limit (stable_limit_s); raises ScenarioError naming the keys when the timestep
+    exceeds STABLE_SHARE of it. Returns the limit (inf without shaft joints)."""
+    lim = stable_limit_s(model, prefix)
+    if timestep_s > STABLE_SHARE * lim:
+        raise ScenarioError(
+            f"simulation.timestep_s = {timestep_s:.3g} s is too large for the shafts' stiffness: the stiffest shaft "
+            f"mode's explicit limit is {lim:.3g} s; allowed range: simulation.timestep_s <= "
+            f"{STABLE_SHARE * lim:.3g} s, or lower shafts.*.radial_stiffness_n_per_um / axial_stiffness_n_per_um"
+        )
+    return lim
+
+
+def stable_limit_s(model: mujoco.MjModel, prefix: str = "") -> float:
     """The shaft modes' explicit limit min 2 / omega_i (omega_i^2 = K_ii / M_ii over the shaft joints: the joint's
-    own stiffness plus its tendons' k coef^2 against the mass matrix's diagonal at qpos0); raises ScenarioError
-    naming the keys when the timestep exceeds STABLE_SHARE of it. Returns the limit (inf without shaft joints)."""
+    own stiffness plus its tendons' k coef^2 against the mass matrix's diagonal at qpos0); inf without shaft joints."""
     names = ("_radial_", "_tilt_", "_axial", "_bend_")
     dofs = [
         j
@@ -258,12 +270,6 @@ def check_timestep(model: mujoco.MjModel, timestep_s: float, prefix: str = "") -
         v = model.jnt_dofadr[j]
         if K[v] > 0:
             lim = min(lim, 2.0 / math.sqrt(K[v] / M[v, v]))
-    if timestep_s > STABLE_SHARE * lim:
-        raise ScenarioError(
-            f"simulation.timestep_s = {timestep_s:.3g} s is too large for the shafts' stiffness: the stiffest shaft "
-            f"mode's explicit limit is {lim:.3g} s; allowed range: simulation.timestep_s <= "
-            f"{STABLE_SHARE * lim:.3g} s, or lower shafts.*.radial_stiffness_n_per_um / axial_stiffness_n_per_um"
-        )
     return lim
 
 

@@ -24,6 +24,10 @@ MAX_WORM_TURN_PER_STEP_RAD = 0.035  # largest worm rotation per step contact3d r
 # docs/stability_speed.md has the measurements behind it)
 OVERSPEED_GUARD = 1.25  # the running check fires at this multiple of MAX_WORM_TURN_PER_STEP_RAD
 DEFAULT_SOURCE = "default: 0.4 x the stable limit, rounded down to two digits (docs/bench.md, stability map)"
+SHAFTS_SOURCE = (
+    "default: 0.4 x the shafts' stable limit (their stiffest mode, below the contact's), rounded down to two digits "
+    "(wormsim.contact3d.shafts)"
+)
 
 
 def default_timestep(law: ContactLaw, contacts: int | None = None) -> float:
