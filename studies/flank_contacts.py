@@ -15,7 +15,6 @@ from __future__ import annotations
 import argparse
 import os
 import sys
-import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -31,17 +30,6 @@ KEYS = (
 )
 
 
-def _run(name: str, overrides: list[str]) -> tuple[float, dict, float]:
-    from wormsim.contact3d.mjcf import build_model
-    from wormsim.contact3d.runner import run_model
-    from wormsim.scenario import load_scenario
-
-    bm = build_model(load_scenario(ROOT / "scenarios" / f"{name}.yaml", overrides))
-    c0 = time.thread_time()
-    res = run_model(bm)
-    return time.thread_time() - c0, res.summary, res.sim_time_s
-
-
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seconds", type=float, default=0.3)
@@ -49,6 +37,7 @@ def main() -> None:
     ap.add_argument("--record", default="")
     a = ap.parse_args()
     sys.path.insert(0, str(ROOT))
+    from studies.measure_step_levers import run_cpu
     from tests.contact3d.test_seeds_pieces import CI
     from wormsim.results.provenance import provenance, record
 
@@ -56,18 +45,18 @@ def main() -> None:
     speed = ["contact.geometry=flanks", "simulation.mass_scaling=1", f"simulation.duration_s={a.seconds}"]
     speed += ["simulation.record_every=156"]
     for v in VARIANTS:  # warm-up: every variant's compiled path
-        _run("seat_motor", [*speed[:2], "simulation.duration_s=0.002", f"contact.flank_contacts={v}"])
+        run_cpu([*speed[:2], "simulation.duration_s=0.002", f"contact.flank_contacts={v}"])
     cpu: dict[str, list[float]] = {v: [] for v in VARIANTS}
     for r in range(a.rounds):
         for v in VARIANTS:
-            c, _, sim = _run("seat_motor", [*speed, f"contact.flank_contacts={v}"])
+            c, _, sim = run_cpu([*speed, f"contact.flank_contacts={v}"])
             cpu[v].append(c / sim)
             print(f"round {r} {v}: {c / sim:.2f} CPU s per simulated s", flush=True)
     results: dict[str, dict[str, dict]] = {}
     for seed in CI:
         results[seed] = {}
         for v in VARIANTS:
-            _, s, _ = _run(seed, [*CI[seed], "contact.geometry=flanks", f"contact.flank_contacts={v}"])
+            _, s, _ = run_cpu([*CI[seed], "contact.geometry=flanks", f"contact.flank_contacts={v}"], seed)
             results[seed][v] = {k: s[k] for k in KEYS} | {"flank_slices": s["flank_slices"]}
             print(seed, v, results[seed][v], flush=True)
     out = {

@@ -30,7 +30,7 @@ def _kernels(bm, mod, merge):
     from wormsim.contact3d.flank_step import FlankContacts
 
     fc = FlankContacts(bm, bm.law.contacts_per_pair, merge=merge)
-    k = mod.PackedKernel(fc.grid, fc.params, len(fc.depth), len(fc.ks), bm.geometry.z2, merge)
+    k = mod.PackedKernel(fc.grid, fc.params, len(fc.depth), len(fc.ks), bm.geometry.z2, fc.group)
     k.axes[:] = fc.kernel.axes
     return fc, k
 

@@ -17,17 +17,9 @@ import mujoco
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
-WHEEL_DRIVEN = [
-    "drive.on=wheel",
-    "drive.speed_rpm=55",
-    "drive.ramp_s=0.01",
-    "load.on=worm",
-    "load.torque_nm=0.1",
-    "load.ramp_s=0.01",
-    "contact.friction_static=null",
-    "contact.friction_dynamic=null",
-    "simulation.resolution=coarse",
-]
+sys.path.insert(0, str(ROOT))
+
+from tests.contact3d.test_guards import WHEEL_DRIVEN  # noqa: E402  (the screw jack with its wheel speed-driven)
 
 
 def contact_rows(m: mujoco.MjModel, d: mujoco.MjData, worm_dof: int) -> dict:

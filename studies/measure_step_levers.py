@@ -25,12 +25,13 @@ ROOT = Path(__file__).resolve().parents[1]
 KEYS = ("tangential_force_mean_n", "tangential_force_p2p_n", "efficiency", "ratio", "transmission_error_p2p_urad")
 
 
-def _run(overrides: list[str]) -> tuple[float, dict, float]:
+def run_cpu(overrides: list[str], name: str = "seat_motor") -> tuple[float, dict, float]:
+    """The seed's run with the overrides: (CPU s of this thread in the run, its summary, the simulated s)."""
     from wormsim.contact3d.mjcf import build_model
     from wormsim.contact3d.runner import run_model
     from wormsim.scenario import load_scenario
 
-    bm = build_model(load_scenario(ROOT / "scenarios" / "seat_motor.yaml", overrides))
+    bm = build_model(load_scenario(ROOT / "scenarios" / f"{name}.yaml", overrides))
     c0 = time.thread_time()
     res = run_model(bm)
     return time.thread_time() - c0, res.summary, res.sim_time_s
@@ -56,12 +57,12 @@ def main() -> None:
     from tests.contact3d.test_seeds_pieces import CI
 
     print(f"load average {os.getloadavg()}", flush=True)
-    _run([*speed[:2], "simulation.duration_s=0.002"])  # warm-up
+    run_cpu([*speed[:2], "simulation.duration_s=0.002"])  # warm-up
     cpu: dict[str, list[float]] = {v: [] for v in names}
     for r in range(a.rounds):
         for v in names:
             use(v)
-            c, s, sim = _run(speed)
+            c, s, sim = run_cpu(speed)
             cpu[v].append(c / sim)
             print(f"round {r} {v}: {c / sim:.2f} CPU s per simulated s (36 rpm, {sim:.3f} s)", flush=True)
     for v in names:
@@ -73,7 +74,7 @@ def main() -> None:
     base = None
     for v in names:
         use(v)
-        c, s, sim = _run([*CI["seat_motor"], "contact.geometry=flanks"])
+        c, s, sim = run_cpu([*CI["seat_motor"], "contact.geometry=flanks"])
         vals = {k: s[k] for k in KEYS}
         print(f"CI run, {v}: {c / sim:.2f} CPU s per simulated s; " + ", ".join(f"{k} {v!r}" for k, v in vals.items()))
         if base is None:

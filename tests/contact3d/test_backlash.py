@@ -23,6 +23,7 @@ import pytest
 
 from meshgen.geometry import derive
 from tests.conftest import SCENARIOS as SCEN
+from tests.contact3d.test_seeds_pieces import CI
 from wormsim import cli
 from wormsim.contact3d.backlash import UM, flank_clearance_m, min_backlash_m, piece_bulge_m, piece_play
 from wormsim.contact3d.mjcf import build_model
@@ -38,23 +39,6 @@ DEMO = SCEN / "seat_motor_demo.yaml"
 # pieces; the flank contacts are found on the exact flanks and need no such margin
 PIECES = ["contact.geometry=pieces"]
 DEMO_PIECES = ["simulation.resolution=coarse", *PIECES]  # the demo as it was before flanks: coarse pieces
-# the CI configurations of tests/contact3d/test_seeds_pieces.py (kept in step by hand: that module runs its seeds at import)
-CI = {
-    "seat_motor": [
-        "drive.speed_rpm=1800",
-        "drive.ramp_s=0.02",
-        "load.ramp_s=0.02",
-        "simulation.duration_s=0.25",
-        "simulation.resolution=medium",
-    ],
-    "screw_jack": [
-        "drive.ramp_s=0.02",
-        "load.ramp_s=0.02",
-        "simulation.duration_s=0.35",
-        "simulation.resolution=medium",
-    ],
-    "involute_41": ["drive.ramp_s=0.02", "load.ramp_s=0.02", "simulation.duration_s=0.3", "simulation.resolution=fine"],
-}
 
 
 # ----------------------------------------------------------------------------- backlash

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 import wormsim.contact3d.flank_samples as FS
+from tests.contact3d.test_guards import WHEEL_DRIVEN
 from wormsim.contact3d.runner import simulate, warm_runs
 from wormsim.exceptions import SimulationError
 from wormsim.runtime import jit_cache
@@ -96,15 +97,7 @@ def test_compiled_samples_equal_the_python_path(case, monkeypatch):
 HELD = (
     JACK,
     [
-        "drive.on=wheel",
-        "drive.speed_rpm=55",
-        "drive.ramp_s=0.01",
-        "load.on=worm",
-        "load.torque_nm=0.1",
-        "load.ramp_s=0.01",
-        "contact.friction_static=null",
-        "contact.friction_dynamic=null",
-        "simulation.resolution=coarse",
+        *WHEEL_DRIVEN,
         "contact.friction=0.2",
         "simulation.duration_s=0.085",
     ],

@@ -17,6 +17,7 @@ import numpy as np
 import pytest
 
 from meshgen import assembly
+from wormsim.cli.check import level_lines
 from wormsim.contact3d import shafts
 from wormsim.contact3d.mass_scaling import floor_2_digits
 from wormsim.contact3d.mjcf import build_model
@@ -168,6 +169,8 @@ def test_default_step_follows_the_shafts_stiffest_mode():
     lim = shafts.stable_limit_s(stiff.model)
     assert stiff.timestep_source == SHAFTS_SOURCE
     assert stiff.model.opt.timestep == floor_2_digits(0.4 * lim) < 0.4 * stiff.law.stable_limit_s
+    printed = level_lines(_scenario({"worm": {"bearings_mm": [-60, 60], "radial_stiffness_n_per_um": 1e6}}))[0]
+    assert printed.startswith(f"timestep: {stiff.model.opt.timestep:.3g} s ({SHAFTS_SOURCE})")  # wormsim check
     soft = build_model(_scenario({"worm": {"bearings_mm": [-60, 60]}}))
     assert soft.timestep_source != SHAFTS_SOURCE and soft.model.opt.timestep <= 0.4 * shafts.stable_limit_s(soft.model)
 

@@ -167,7 +167,7 @@ def test_merged_te_and_pattern_agree_with_slices():
     strict=True,
     reason="merged F_t p2p +39.9 % of per-slice on the screw jack CI run (1.722 against 1.231 N on 400 N, with law "
     "(5) of wormsim.contact3d.law; before it +12.8 %, 1.845 against 1.636 N, meshing band below 1 kHz 0.96 against "
-    "0.36 N); involute_41 +0.6 % (band +21 %) before (5): the issue's 10 % criterion not met, so "
+    "0.36 N); involute_41 +0.5 %, seat motor +29.6 % (docs/data/flank_contacts.json): the issue's 10 % criterion not met, so "
     "per-slice stays the default; frictionless the two agree (band 0.2517 / 0.2507 N): friction's one direction per "
     "flank (docs/contact3d.md, 'One contact per tooth flank')",
 )

@@ -58,7 +58,7 @@ def level_lines(sc: Scenario) -> list[str]:
     if sc.model != "contact3d":
         return []
     from wormsim.contact3d.flank_step import merge_group
-    from wormsim.contact3d.mjcf import flank_slices, prepare
+    from wormsim.contact3d.mjcf import build, flank_slices, prepare
     from wormsim.contact3d.timestep import timestep_for
 
     p = prepare(sc)
@@ -66,9 +66,7 @@ def level_lines(sc: Scenario) -> list[str]:
         sc.simulation.timestep_s, p.worm_speed_rad_s, p.law, p.scaling.factor if p.scaling is not None else 1.0
     )
     if sc.shafts is not None and sc.simulation.timestep_s is None:  # the shafts' modes may lower it: the built model's
-        from wormsim.contact3d.mjcf import build_model
-
-        bm = build_model(sc)
+        bm = build(p)
         h, src = float(bm.model.opt.timestep), bm.timestep_source
     out = [
         f"timestep: {h:.3g} s ({src}), {sc.simulation.duration_s / h:.0f} steps; stable limit "

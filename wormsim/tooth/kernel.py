@@ -670,7 +670,7 @@ class PackedKernel:
     numba's dispatch costs ~0.25 us per array argument (the three calls with their 28 arrays and find_contacts' work
     allocation cost ~9 us of Python per step). The fields are numpy views of the buffers (pos, nrm, depth, meta, line,
     weight, frame, P, memo, span, ks: write ks and P in place), cut by `_views` from the one layout `_layout`.
-    merge: the slices per merged contact (wormsim.tooth.merge; 0: none, True or S: one per tooth flank): mpos, mnrm,
+    merge: the slices per merged contact (wormsim.tooth.merge; 0: none, S: one per tooth flank): mpos, mnrm,
     mdepth, mweight, mframe, mfric, mwrap, their number in ib[7]; grp, share; axes: the hinges, set by the caller)."""
 
     def __init__(self, grid: FlankGrid, P: np.ndarray, cap: int, W: int, z2: int, merge: int = 0):
@@ -678,8 +678,7 @@ class PackedKernel:
         fs, is_ = _layout(S, N, cap, len(P), W, z2)
         self.fb = np.zeros(_size(fs))
         self.ib = np.zeros(_I_HEADER + _size(is_), dtype=np.int64)
-        group = S if merge is True else int(merge)
-        self.ib[:7] = (S, N, cap, len(P), W, z2, group)
+        self.ib[:7] = (S, N, cap, len(P), W, z2, merge)
         views = _cut(self.fb, 0, fs) + _cut(self.ib, _I_HEADER, is_)
         for name, v in zip(_F_FIELDS + _I_FIELDS, views, strict=True):
             setattr(self, name, v)
