@@ -13,7 +13,15 @@ from pathlib import Path
 import pytest
 
 from wormsim.sweep import load_sweep
-from wormsim.sweep.cluster import may_run_contact3d, peek_contact3d, start_fork_server, stop_fork_server
+from wormsim.sweep.cluster import (
+    LOCAL_DASK_CONFIG,
+    close_cluster,
+    may_run_contact3d,
+    open_client,
+    peek_contact3d,
+    start_fork_server,
+    stop_fork_server,
+)
 
 ROOT = Path(__file__).resolve().parents[2]
 SCREW_JACK = ROOT / "scenarios" / "screw_jack.yaml"  # model: contact3d
@@ -77,6 +85,35 @@ def test_stop_fork_server_ends_its_process():
     assert forkserver._forkserver._forkserver_pid is None
     with pytest.raises(ProcessLookupError):  # reaped: no such process
         os.kill(pid, 0)
+
+
+def _worker_settings() -> dict:
+    import dask
+
+    return {
+        "config": {k: dask.config.get(k) for k in LOCAL_DASK_CONFIG},
+        "env": {k: os.environ.get(k) for k in ("OPENBLAS_THREAD_TIMEOUT", "MUJOCO_GL")},
+    }
+
+
+def test_local_workers_run_with_the_sweeps_dask_settings():
+    """A local cluster's worker (forked from the fork server) has LOCAL_DASK_CONFIG (no profiler, slower monitors),
+    OpenBLAS's threads that do not spin and MuJoCo without GL (wormsim.sweep.preload; a value the user set wins); the
+    scheduler has no work stealing."""
+    start_fork_server(False)
+    client, cluster, info = open_client(None, 1)
+    try:
+        assert info["workers"] == 1
+        (got,) = client.run(_worker_settings).values()
+        stealing = client.run_on_scheduler(lambda dask_scheduler: "stealing" in dask_scheduler.extensions)
+    finally:
+        close_cluster(client, cluster)
+    assert got["config"] == LOCAL_DASK_CONFIG
+    assert got["env"] == {
+        "OPENBLAS_THREAD_TIMEOUT": os.environ.get("OPENBLAS_THREAD_TIMEOUT", "4"),
+        "MUJOCO_GL": os.environ.get("MUJOCO_GL", "disable"),
+    }
+    assert stealing is False
 
 
 # `wormsim sweep` with the cluster's start recorded instead of run: what had been imported when the fork server

@@ -30,6 +30,23 @@ PEEK_MAX_BYTES = 1_000_000  # a sweep file or base scenario larger than this is 
 # death starts by dask's default (spawn).
 LOCAL_START_METHOD = "forkserver"
 
+# dask settings of the local cluster (its scheduler, nannies and workers; the nannies hand them to their workers):
+# what runs beside the points takes less CPU from them. Traced on the 2-core machine (studies/trace_sweep_cpu.py,
+# docs/sweeps.md "Where the CPU goes"): with dask's defaults each worker's event loop took about 5 % of a core
+# during the points, most of it the statistical profiler's 100 samples a second of every thread's stack (a point
+# waits for the GIL meanwhile), and the client's loop (scheduler, nannies, client) another 5 %. The profile feeds
+# only the dashboard, which a sweep does not show; work stealing and the active memory manager have nothing to do
+# (no more tasks in flight than threads, no data kept on the workers); the memory monitors (100 ms) and the event
+# loops' health tick (20 ms) run less often.
+LOCAL_DASK_CONFIG = {
+    "distributed.worker.profile.enabled": False,
+    "distributed.worker.memory.monitor-interval": "1s",
+    "distributed.admin.system-monitor.interval": "1s",
+    "distributed.admin.tick.interval": "500ms",
+    "distributed.scheduler.work-stealing": False,
+    "distributed.scheduler.active-memory-manager.start": False,
+}
+
 
 def default_workers() -> int:
     """One worker per core this process may use."""
@@ -168,7 +185,7 @@ def open_client(scheduler: str | None, workers: int | None):
         # dask's own log lines stay off stderr up to ERROR: on a loaded machine a worker's heartbeat times out and
         # distributed logs it with a traceback, though the worker reconnects and the sweep ends well (a point that
         # fails, or a lost worker, is a row with its message in sweep.csv / sweep.json)
-        with dask.config.set({"distributed.worker.multiprocessing-method": LOCAL_START_METHOD}):
+        with dask.config.set({"distributed.worker.multiprocessing-method": LOCAL_START_METHOD, **LOCAL_DASK_CONFIG}):
             cluster = LocalCluster(
                 n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0", silence_logs=logging.CRITICAL
             )

@@ -7,6 +7,17 @@ contact3d points preloads wormsim.sweep.preload_warm instead, which also loads t
 
 from __future__ import annotations
 
+import os
+
+# before numpy is imported here: OpenBLAS's threads sleep as soon as a call ends instead of spinning for about
+# 2^28 cycles (0.1 s) after it; a point's summary calls a threaded complex dot product (the mesh line's amplitudes)
+# a few dozen times, and each call left a thread spinning on the other core (about 0.13 CPU-s per point, traced with
+# 2 workers on 2 cores). The number of threads, hence every result bit, stays as in `wormsim run` on the machine:
+# dask's nanny sets OPENBLAS_NUM_THREADS=1 only in the workers it spawns, after this server imported numpy.
+os.environ.setdefault("OPENBLAS_THREAD_TIMEOUT", "4")
+# a worker draws nothing with MuJoCo: its import then skips the GLFW probe (which starts a Python subprocess)
+os.environ.setdefault("MUJOCO_GL", "disable")
+
 import distributed.nanny  # noqa: F401  (the worker's own imports, once in the server)
 import distributed.worker  # noqa: F401
 

@@ -57,6 +57,7 @@ def run_point(scenario: dict, keep_files: bool) -> dict:
     """One point, on a worker: simulate (and with keep_files write the result folder into a temporary directory
     and return its files). Never raises for a failed simulation: returns status "failed" and the message."""
     t_start = time.time()
+    cpu_start = time.thread_time()
     from wormsim.sweep.warm import warm_pid
 
     warmed_by = warm_pid()
@@ -117,6 +118,8 @@ def run_point(scenario: dict, keep_files: bool) -> dict:
             "start": t_start,
             "end": time.time(),
             "setup_s": t_setup,
+            # this thread's CPU seconds for the point: against end - start, the time it waited for a core
+            "thread_cpu_s": time.thread_time() - cpu_start,
             # the pid that loaded the kernels before this point: the fork server's for a worker forked warm
             "warmed_by_pid": warmed_by,
             "pid": os.getpid(),
