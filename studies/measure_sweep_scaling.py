@@ -11,6 +11,9 @@ Per command, from its wall time and sweep.json's timing records (worker and clie
   the client's interpreter, imports and validation where they take longer, the workers' start and connection, the
   tables written, sweep.png beside the cluster's close, the process's exit);
 - point_wall_median_s: a point's simulate() on its worker (sweep.csv wall_time_s); step_wall_us: its loop's step;
+- point_cpu_median_s: a point's CPU seconds on its worker's thread (sweep.json thread_cpu_s): against the point's
+  wall time, what it waited for a core (other processes of the command, or of the machine); against the 1-worker
+  run's, whether a point itself runs slower with both cores busy (memory, caches);
 - idle_per_point_s: span_s x workers less the points' task time, per point (hand-back, dispatch, imbalance);
 - first_point_extra_s: each worker's first point less the median of its others;
 - cluster_start_s: sweep.json's cluster start, from the sweep file read (the cluster's thread started) to the
@@ -95,6 +98,9 @@ def measure(out: Path, workers: int) -> dict:
         "after_last_point_s": w1 - max(t["end"] for t in tim.values()),
         "point_wall_median_s": statistics.median(r["wall_time_s"] for r in rows.values()),
         "step_wall_us_median": statistics.median(r["step_wall_us"] for r in rows.values()),
+        "point_cpu_median_s": statistics.median(cpu)
+        if (cpu := [t.get("thread_cpu_s") for t in tim.values()]) and None not in cpu
+        else None,
         "idle_per_point_s": (span * n_w - sum(task)) / len(tim),
         "first_point_extra_s": first_extra,
         "compile_s_per_worker": compile_s,
@@ -162,6 +168,11 @@ def main() -> None:
         "speedup_command": runs["1"]["command_wall_s"] / runs["2"]["command_wall_s"],
         "speedup_span": runs["1"]["span_s"] / runs["2"]["span_s"],
         "step_growth_2": g2,
+        "point_cpu_growth_2": (
+            runs["2"]["point_cpu_median_s"] / runs["1"]["point_cpu_median_s"]
+            if runs["1"].get("point_cpu_median_s") and runs["2"].get("point_cpu_median_s")
+            else None
+        ),
         "model": models(runs, g2),
     }
     Path(args.record).write_text(json.dumps(rec, indent=1) + "\n")

@@ -136,20 +136,19 @@ def main() -> None:
     from wormsim.sweep import load_sweep, run_sweep
 
     sw = load_sweep(out / "scaling.yaml", on_parsed=lambda c: started.append(ClusterStart(None, args.workers, warm=c)))
-    client, _, _ = started[0].get()
-    names = {"client": _thread_names()}
-    names.update(client.run(_thread_names))
-    pids = {"client": os.getpid()}
-    pids.update(client.run(os.getpid))
     from multiprocessing import forkserver
 
-    pids["fork server"] = forkserver._forkserver._forkserver_pid
+    pids = {"client": os.getpid(), "fork server": forkserver._forkserver._forkserver_pid}
+    names = {"client": _thread_names()}
 
-    def late_names():  # the executor's and the profiler's threads start with the first task
+    def late_names():  # once the points run (the executor's threads start with the first task)
+        client = started[0].get()[0]
         time.sleep(6.0)
         try:
+            pids.update(client.run(os.getpid))
             for k, v in client.run(_thread_names).items():
                 names.setdefault(k, {}).update(v)
+            names["client"].update(_thread_names())
         except Exception:
             pass
 

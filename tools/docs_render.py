@@ -293,6 +293,7 @@ def sweep_scaling_table(name: str = "sweep_scaling") -> str:
                 f"{x['cluster_start_s']:.1f}",
                 "-" if x.get("warm_s") is None else f"{x['warm_s']:.1f}",
                 f"{x['point_wall_median_s']:.2f}",
+                "-" if x.get("point_cpu_median_s") is None else f"{x['point_cpu_median_s']:.2f}",
                 f"{x['step_wall_us_median']:.0f}",
                 f"{x['idle_per_point_s']:.2f}",
                 ", ".join(f"{v:.2f}" for v in x["first_point_extra_s"]) or "-",
@@ -309,6 +310,7 @@ def sweep_scaling_table(name: str = "sweep_scaling") -> str:
         "cluster start s",
         "warm-up s",
         "point median s",
+        "point CPU s",
         "step us",
         "idle per point s",
         "first point extra s",
@@ -320,7 +322,9 @@ def sweep_scaling_table(name: str = "sweep_scaling") -> str:
     text += (
         f"\n{r['what']}. Speed-up 1 -> 2 workers: {r['speedup_command']:.2f}x for the whole command, "
         f"{r['speedup_span']:.2f}x over the points' span; the step grows {r['step_growth_2']:.2f}x with 2 busy "
-        f"workers. Load average after: {', '.join(f'{v:.1f}' for v in r['load_average_after'])} "
+        "workers"
+        + (f", a point's CPU seconds {r['point_cpu_growth_2']:.2f}x" if r.get("point_cpu_growth_2") is not None else "")
+        + f". Load average after: {', '.join(f'{v:.1f}' for v in r['load_average_after'])} "
         f"({r['cpu_count']} CPUs)."
         + (
             " Commands (s), in turns: "
