@@ -86,6 +86,19 @@ def _plain_axes(ax, numeric_x: bool) -> None:
         ax.xaxis.set_major_formatter(ScalarFormatter(useOffset=False))
 
 
+def _panels(plt, nrow: int, ncol: int):
+    """(figure, axes grid) of nrow x ncol panels of 5.2 x 3.6 in, margins and gaps MARGIN_IN."""
+    width_in, height_in = 5.2 * ncol, 3.6 * nrow
+    fig, axes = plt.subplots(nrow, ncol, figsize=(width_in, height_in), squeeze=False)
+    m = MARGIN_IN
+    left, right = m["left"] / width_in, 1.0 - m["right"] / width_in
+    bottom, top = m["bottom"] / height_in, 1.0 - m["top"] / height_in
+    ax_w = (width_in * (right - left) - (ncol - 1) * m["wspace"]) / ncol
+    ax_h = (height_in * (top - bottom) - (nrow - 1) * m["hspace"]) / nrow
+    fig.subplots_adjust(left, bottom, right, top, wspace=m["wspace"] / ax_w, hspace=m["hspace"] / ax_h)
+    return fig, axes
+
+
 def write_sweep_png(rows: list[dict], swept: list[str], plot: Plot | None, path: str | Path, title: str = "") -> None:
     import matplotlib
 
@@ -120,14 +133,7 @@ def write_sweep_png(rows: list[dict], swept: list[str], plot: Plot | None, path:
     n = len(keys)
     ncol = 1 if n == 1 else 2 if n <= 4 else 3
     nrow = math.ceil(n / ncol)
-    width_in, height_in = 5.2 * ncol, 3.6 * nrow
-    fig, axes = plt.subplots(nrow, ncol, figsize=(width_in, height_in), squeeze=False)
-    m = MARGIN_IN
-    left, right = m["left"] / width_in, 1.0 - m["right"] / width_in
-    bottom, top = m["bottom"] / height_in, 1.0 - m["top"] / height_in
-    ax_w = (width_in * (right - left) - (ncol - 1) * m["wspace"]) / ncol
-    ax_h = (height_in * (top - bottom) - (nrow - 1) * m["hspace"]) / nrow
-    fig.subplots_adjust(left, bottom, right, top, wspace=m["wspace"] / ax_w, hspace=m["hspace"] / ax_h)
+    fig, axes = _panels(plt, nrow, ncol)
     for ax, key in zip(axes.flat, keys):
         label, theory = MAIN_OUTPUTS.get(key, (LABELS.get(key, key), None))
         if continuous:
