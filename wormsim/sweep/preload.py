@@ -11,7 +11,7 @@ import os
 
 # before numpy is imported here: OpenBLAS's threads sleep as soon as a call ends instead of spinning for about
 # 2^28 cycles (0.1 s) after it; a point's summary calls a threaded complex dot product (the mesh line's amplitudes)
-# a few dozen times, and each call left a thread spinning on the other core (about 0.13 CPU-s per point, traced with
+# several times, and each call left a thread spinning on the other core (about 0.13 CPU-s per point, traced with
 # 2 workers on 2 cores). The number of threads, hence every result bit, stays as in `wormsim run` on the machine:
 # dask's nanny sets OPENBLAS_NUM_THREADS=1 only in the workers it spawns, after this server imported numpy.
 os.environ.setdefault("OPENBLAS_THREAD_TIMEOUT", "4")
