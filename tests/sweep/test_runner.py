@@ -85,6 +85,8 @@ def test_local_workers_start_warm_from_the_fork_server(tmp_path):
     assert len(timing) == 2, timing
     warmed_by = {t["warmed_by_pid"] for t in timing}
     assert len(warmed_by) == 1 and None not in warmed_by and not warmed_by & {t["pid"] for t in timing}, timing
+    # each point's thread CPU seconds: spent, and within its wall time (a thread runs on one core at a time)
+    assert all(0.0 < t["thread_cpu_s"] <= t["end"] - t["start"] + 0.01 for t in timing), timing
 
 
 def test_warm_worker_runs_once_per_process(monkeypatch):
