@@ -33,8 +33,8 @@ LOCAL_START_METHOD = "forkserver"
 # dask settings of the local cluster (its scheduler, nannies and workers; the nannies hand them to their workers):
 # what runs beside the points takes less CPU from them. Traced on the 2-core machine (studies/trace_sweep_cpu.py,
 # docs/sweeps.md "Where the CPU goes"): with dask's defaults each worker's event loop took about 5 % of a core
-# during the points, most of it the statistical profiler's 100 samples a second of every thread's stack (a point
-# waits for the GIL meanwhile), and the client's loop (scheduler, nannies, client) another 5 %. The profile feeds
+# during the points, most of it the statistical profiler's 100 samples a second of every thread's stack, and the
+# client's loop (scheduler, nannies, client) another 5 %: CPU the other busy worker lacks. The profile feeds
 # only the dashboard, which a sweep does not show; work stealing and the active memory manager have nothing to do
 # (no more tasks in flight than threads, no data kept on the workers); the memory monitors (100 ms) and the event
 # loops' health tick (20 ms) run less often.
