@@ -184,7 +184,7 @@ def flank_speed_table(name: str = "flank_speed") -> str:
                 f"{b['speedup_flanks_tooth_vs_pieces']:.1f}x",
             ]
         )
-    head = ["seed", "pieces (medium)", "flanks, per slice (default)", "speed-up", "flanks, per tooth flank"]
+    head = ["seed", "pieces (medium)", "flanks, per slice", "speed-up", "flanks, per tooth flank"]
     head += ["speed-up"]
     return _table(head, rows) + "\n" + _source(name)
 
