@@ -121,6 +121,9 @@ def test_split_gives_each_slice_its_spring_share():
 
 def test_flank_contacts_key_validated(capsys):
     assert load_scenario(MINIMAL).contact.flank_contacts == DEFAULT_FLANK_CONTACTS == 4
+    assert cli.main(["check", str(MINIMAL)]) == 0
+    out = capsys.readouterr().out  # the default (flanks, medium: 16 slices here, 4 per contact) says how it merges
+    assert "MuJoCo contacts per tooth flank: 4 (4 slices each; contact.flank_contacts)" in out, out
     code = cli.main(["check", str(MINIMAL), "--set", "contact.flank_contacts=line"])
     err = capsys.readouterr().err
     assert code == 2
@@ -178,7 +181,7 @@ def test_merged_te_and_pattern_agree_with_slices():
     reason="merged F_t p2p +39.9 % of per-slice on the screw jack CI run (1.722 against 1.231 N on 400 N, with law "
     "(5) of wormsim.contact3d.law; before it +12.8 %, 1.845 against 1.636 N, meshing band below 1 kHz 0.96 against "
     "0.36 N); involute_41 +0.5 %, seat motor +29.6 % (docs/data/flank_contacts.json): the issue's 10 % criterion not met, so "
-    "per-slice stays the default; frictionless the two agree (band 0.2517 / 0.2507 N): friction's one direction per "
+    "tooth is not the default (4 per flank is: F_t p2p within 4.3 %, decision 0049); frictionless the two agree (band 0.2517 / 0.2507 N): friction's one direction per "
     "flank (docs/contact3d.md, 'One contact per tooth flank')",
 )
 def test_merged_ft_p2p_within_10_percent_of_slices():
