@@ -1,9 +1,10 @@
 """Per-step cost of exact-flank contacts against medium convex pieces (issue 13), measured in one process: the CI
 configurations of tests/contact3d/test_seeds_pieces.py shortened to 0.08 s at medium resolution, pieces and flanks
-alternating twice (flanks with one contact per slice, the default, and with one per tooth flank,
-`contact.flank_contacts: tooth`); wall time per step (summary step_wall_us: the step and the runner's per-sample
-work) and the run's CPU time. Writes docs/data/flank_speed.json; README "Speed of exact flanks against the issue's
-targets" quotes the best of two per geometry. Compare ratios from one run only: the machine is shared.
+alternating twice (flanks with one contact per slice, `contact.flank_contacts: slice`, and with one per tooth
+flank, `tooth`; the default, 4 per flank, is in docs/data/flank_contacts.json); wall time per step (summary
+step_wall_us: the step and the runner's per-sample work) and the run's CPU time. Writes docs/data/flank_speed.json;
+README "Speed of exact flanks against the issue's targets" quotes the best of two per geometry. Compare ratios from
+one run only: the machine is shared.
 
     .venv/bin/python studies/measure_flank_speed.py [seat_motor screw_jack involute_41]
 """
@@ -31,7 +32,11 @@ def main(seeds: list[str]) -> dict:
         for rep in range(2):
             for geo in ("pieces", "flanks", "flanks-tooth"):
                 over = [f"contact.geometry={geo.split('-')[0]}"]
-                over += ["contact.flank_contacts=tooth"] if geo.endswith("-tooth") else []
+                over += (
+                    [f"contact.flank_contacts={'tooth' if geo.endswith('-tooth') else 'slice'}"]
+                    if geo != "pieces"
+                    else []
+                )
                 sc = load_scenario(ROOT / "scenarios" / f"{name}.yaml", base + over)
                 c0 = time.process_time()
                 s = simulate(sc).summary

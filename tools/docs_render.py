@@ -184,7 +184,7 @@ def flank_speed_table(name: str = "flank_speed") -> str:
                 f"{b['speedup_flanks_tooth_vs_pieces']:.1f}x",
             ]
         )
-    head = ["seed", "pieces (medium)", "flanks, per slice (default)", "speed-up", "flanks, per tooth flank"]
+    head = ["seed", "pieces (medium)", "flanks, per slice", "speed-up", "flanks, per tooth flank"]
     head += ["speed-up"]
     return _table(head, rows) + "\n" + _source(name)
 
@@ -215,6 +215,46 @@ def flank_contacts_table(name: str = "flank_contacts") -> str:
             row.append(cell)
         rows.append(row)
     return _table(head, rows) + "\n" + _source(name)
+
+
+def flank_contacts_default_table(name: str = "flank_contacts_default") -> str:
+    """N MuJoCo contacts per tooth flank against per slice on the slice-convergence cases (studies/
+    flank_contacts_default.py): N per flank's change at the default slices S, the stepping's CPU per simulated second,
+    and S against 2 S per variant (issue 31's criterion: F_t p2p and p_H max within 10 %)."""
+    r = load(name)
+    n = str(r["n"])
+    keys = (
+        ("tangential_force_mean_n", "F_t mean"),
+        ("tangential_force_p2p_n", "F_t p2p"),
+        ("contact_pressure_max_mpa", "p_H max"),
+        ("transmission_error_p2p_urad", "TE p2p"),
+        ("efficiency", "efficiency"),
+        ("radial_force_mean_n", "F_r"),
+        ("axial_force_mean_n", "F_a"),
+    )
+    head = ["case (S)", *(f"{k[1]}: {n} per flank vs slice" for k in keys), "CPU s per simulated s: slice, " + n]
+    head += [f"S vs 2 S: F_t p2p, p_H max: slice; {n} per flank"]
+
+    def pct(x):
+        return "-" if x is None else f"{100 * x:+.2f} %"
+
+    rows = []
+    within = {"slice": 0, n: 0}
+    for case, c in r["cases"].items():
+        ch, cv = c["change_vs_slice"], c["change_S_vs_2S"]
+        a, b = c["runs"]["slice"][0], c["runs"][n][0]
+        conv = "; ".join(
+            ", ".join(f"{100 * cv[v][k]:+.1f} %" for k in ("tangential_force_p2p_n", "contact_pressure_max_mpa"))
+            for v in ("slice", n)
+        )
+        for v in within:
+            within[v] += all(abs(cv[v][k]) <= 0.10 for k in ("tangential_force_p2p_n", "contact_pressure_max_mpa"))
+        row = [f"{case} ({c['default_slices']})", *(pct(ch[k]) for k, _ in keys)]
+        rows.append([*row, f"{a['cpu_s_per_sim_s']:.1f}, {b['cpu_s_per_sim_s']:.1f}", conv])
+    total = len(r["cases"])
+    foot = f"\nS against 2 S within 10 % (F_t p2p and p_H max): per slice {within['slice']} of {total}, {n} per flank "
+    foot += f"{within[n]} of {total}.\n"
+    return _table(head, rows) + foot + "\n" + _source(name)
 
 
 def seat_motor_20s_table(name: str = "seat_motor_20s") -> str:
@@ -1261,6 +1301,7 @@ TABLES: dict[str, Callable[[], str]] = {
     "bench_flanks_vs_pieces": bench_flanks_vs_pieces_table,
     "flank_speed": flank_speed_table,
     "flank_contacts": flank_contacts_table,
+    "flank_contacts_default": flank_contacts_default_table,
     "bench_shafts": bench_shafts_table,
     "seat_motor_20s": seat_motor_20s_table,
     "sweep_speedup": sweep_speedup_table,

@@ -28,11 +28,11 @@ DURATION_S = 0.05  # 10 000 steps of 5 us; contacts read over the last 40 % (aft
 
 
 def sliding_contacts(rpm: float, impratio: float | None = None) -> tuple[np.ndarray, float, object]:
-    """Seat motor (seed 001 gear, load and contact law; coarse, the default contact.geometry) with the worm at `rpm`:
-    rows (f_n, |f_t|, mu, |v_t|, w) of every loaded contact sampled every 20 steps over the last 40 % of the run, the
-    sliding speed Vs, and the model. w: the contact's share of the law's stiffness and damping (1 for pieces; a flank
-    contact's share of its face slice, wormsim.tooth.kernel.slice_weights). mu(Vs) is set as
-    wormsim.contact3d.runner sets it."""
+    """Seat motor (seed 001 gear, load and contact law; coarse, the default contact.geometry, one MuJoCo contact per
+    slice: contact.flank_contacts slice, the rows the law maps) with the worm at `rpm`: rows (f_n, |f_t|, mu, |v_t|, w)
+    of every loaded contact sampled every 20 steps over the last 40 % of the run, the sliding speed Vs, and the model.
+    w: the contact's share of the law's stiffness and damping (1 for pieces; a flank contact's share of its face
+    slice, wormsim.tooth.kernel.slice_weights). mu(Vs) is set as wormsim.contact3d.runner sets it."""
     sc = load_scenario(
         SCEN / "seat_motor.yaml",
         [
@@ -41,6 +41,7 @@ def sliding_contacts(rpm: float, impratio: float | None = None) -> tuple[np.ndar
             "load.ramp_s=0.01",
             f"simulation.duration_s={DURATION_S}",
             "simulation.resolution=coarse",
+            "contact.flank_contacts=slice",
         ],
     )
     bm = build_model(sc)

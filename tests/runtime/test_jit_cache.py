@@ -243,6 +243,7 @@ def test_a_fresh_machine_compiles_once_and_later_processes_compile_nothing(tmp_p
         ("seat_motor_demo", 0.003),
         ("seat_motor", 0.003, "model=contact3d"),
         ("seat_motor", 0.003, "model=contact3d", "contact.flank_contacts=tooth"),
+        ("seat_motor", 0.003, "model=contact3d", "contact.flank_contacts=slice"),  # the default is 4 per flank
         ("screw_jack", 0.003, "gear.profile=ZK"),
         ("screw_jack", 0.003, "shafts.worm.bearings_mm=[-40, 40]", "shafts.worm.bending=true"),
         ("involute_41", 0.003, "model=contact3d", "contact.geometry=pieces"),

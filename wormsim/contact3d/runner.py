@@ -319,6 +319,7 @@ def warm_runs(runs: tuple[tuple[str, tuple[str, ...]], ...] = jit_cache.WARM_RUN
     if runs == jit_cache.WARM_RUNS:  # the friction check, due later in a run than the warm-up's steps
         _warm_friction_check()
         _warm_helpers()
+        _warm_split_forces()
 
 
 def _warm_helpers() -> None:
@@ -333,6 +334,27 @@ def _warm_helpers() -> None:
 
     FormTable(0.0, 1.0, np.zeros(N_CHEB)).evaluate(0.5)
     mu_at(0.1, GROUP, *(float(x) for x in GROUPS["I"]))
+
+
+def _warm_split_forces() -> None:
+    """merge.split_forces as FlankContacts.slice_rows calls it from Python (the merged contacts' forces split over
+    their slices: the per-sample outputs off the compiled loop, e.g. the contact pattern's rows), with its argument
+    types: d.contact.efc_address (MuJoCo's strided view), d.efc_force, int k0, bool cone3, float64 arrays, int n (a
+    box resting on a plane: 4 contacts, merged into one)."""
+    import mujoco
+    import numpy as np
+
+    from wormsim.tooth.merge import split_forces
+
+    m = mujoco.MjModel.from_xml_string(
+        "<mujoco><worldbody><geom type='plane' size='1 1 .1'/><body pos='0 0 .09'><freejoint/>"
+        "<geom type='box' size='.1 .1 .1'/></body></worldbody></mujoco>"
+    )
+    d = mujoco.MjData(m)
+    mujoco.mj_forward(m, d)
+    n = int(d.ncon)
+    merged = (np.zeros(n), np.full(n, 1.0 / max(n, 1)), np.ones(n), np.ones(n))
+    split_forces(d.contact.efc_address, d.efc_force, 0, True, merged, n, (np.zeros(n, np.int64), np.zeros(3 * n)))
 
 
 def _warm_friction_check() -> None:
