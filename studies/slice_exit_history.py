@@ -5,8 +5,7 @@ kernel's weight), its depth (the line's), line[:, 0] (the covered share the weig
 the line point's excess in slice widths), its profile index and MuJoCo's normal force on it. Per tooth the normal forces
 are summed (the tooth's load); the histories are compared across the counts step by step (the counts share the
 timestep), so that a quantity that does not converge as S grows shows where; the first exit in the steady window is
-summarised (its load over its last steps, and each slice's fall from full weight to gone against the steps between
-consecutive slices' ends).
+summarised (its load over its last steps).
 
     .venv/bin/python studies/slice_exit_history.py [--case involute_41] [--slices 24 48 96] [--duration S]
         [--save DIR] [--record NAME]
@@ -100,41 +99,26 @@ def tooth_loads(r: dict) -> dict[int, np.ndarray]:
     return out
 
 
-def ramps(r: dict, k: int) -> list[tuple[int, int, int]]:
-    """Tooth k's slices through its exit: (slice, the step its weight last is 1, the step it is gone), for each
-    slice that leaves from full weight."""
-    T = r["table"]
-    T = T[T[:, 1] == k]
-    out = []
-    for j in sorted({int(a) for a in T[:, 3]}):
-        R = T[T[:, 3] == j]
-        full = R[R[:, 4] >= 1.0, 0]
-        if len(full):
-            out.append((j, int(full.max()), int(R[:, 0].max()) + 1))
-    return out
-
-
 def exit_summary(r: dict, loads: dict[int, np.ndarray], window) -> dict:
-    """The first tooth that leaves inside the steady window: its exit step, its load over the last steps, and the
-    slices' falls: each slice's fall (steps from its last full weight to gone) over the steps between consecutive
-    slices' ends (1 where the weights follow the line's end across the face)."""
+    """The first tooth to leave inside the steady window: its exit step (its last with load) and its load over its
+    last 20 steps."""
     t = r["t_s"]
+    ends = {}
     for k, f in loads.items():
         on = np.nonzero(f > 0)[0]
         if len(on) and t[on[-1]] > window[0] and on[-1] < len(t) - 1 and on[0] > 0:
-            end = int(on[-1])
-            rs = sorted(ramps(r, k), key=lambda x: x[2])
-            falls = [b - a for _, a, b in rs]
-            gaps = np.diff([b for _, _, b in rs])
-            ratio = [falls[i + 1] / gaps[i] for i in range(len(gaps)) if gaps[i] > 0]
-            return {
-                "tooth": k,
-                "exit_step": end,
-                "exit_t_s": float(t[end]),
-                "load_before_exit_n": [float(f[end - i]) for i in (20, 10, 5, 2, 1, 0)],
-                "slice_fall_over_exit_spacing_median": float(np.median(ratio)) if ratio else None,
-            }
-    return {}
+            ends[k] = int(on[-1])
+    if not ends:
+        return {}
+    k = min(ends, key=ends.get)
+    f, end = loads[k], ends[k]
+    return {
+        "tooth": k,
+        "exit_step": end,
+        "exit_t_s": float(t[end]),
+        "load_steps_before_exit": [20, 10, 5, 2, 1, 0],
+        "load_before_exit_n": [float(f[end - i]) for i in (20, 10, 5, 2, 1, 0)],
+    }
 
 
 def kernel_blob() -> str:
@@ -152,8 +136,9 @@ def main() -> None:
     ap.add_argument("--duration", type=float, help="simulated seconds (default: the case's)")
     ap.add_argument("--save", type=Path)
     ap.add_argument("--record")
+    ap.add_argument("--note", help="a note kept in the record (e.g. which kernel version ran)")
     a = ap.parse_args()
-    out: dict = {"case": a.case, "duration_s": a.duration, "kernel_blob": kernel_blob(), "runs": {}}
+    out: dict = {"case": a.case, "duration_s": a.duration, "kernel_blob": kernel_blob(), "note": a.note, "runs": {}}
     loads: dict[int, dict] = {}
     for S in a.slices:
         r = run(a.case, S, a.duration)
