@@ -15,13 +15,13 @@ continuous in the mesh angle), giving ONE contact per (tooth, flank, slice): dep
 n = grad G / |grad G| in the assembly frame (from the worm into the wheel: the force on the wheel is along +n),
 position = the wheel point moved delta / 2 along n (MuJoCo's midpoint). A tooth pair whose contact line spans the face
 thus gives S contacts of stiffness K / S each (wormsim.contact3d.law, n_ref = S): the slice method of gear dynamics;
-slice_weights scales each by the share of its slice the contact line covers (the line's end interpolated with the
-excess's own slope across the face at the line's point, _face_slope). Where the line's point lies past the wheel's
-active profile, the contact is the profile's end (the wheel's tip edge, or the end at the worm tip's reach) pressed
-into the worm flank, its depth the gap there; its depth fades linearly to zero over the outer TAPER_SHARE of the
-candidate window, so that it leaves at zero load also where the flanks are still pressed together at the window's
-edge (seat motor: 30 um deep, 0.1 pitch past the profile's end). With `merge`, the contacts of one tooth flank are
-also merged into one (wormsim.tooth.merge).
+slice_weights scales each by the share of its slice the contact line covers (the line's ends interpolated with the
+excess along the contact line to the neighbouring slices, _line_share). Where the line's point lies past the wheel's
+active profile, the contact is the profile's end (the wheel's tip edge, or the end at the worm tip's reach) pressed into
+the worm flank, its depth the gap there; its depth fades linearly to zero over the outer TAPER_SHARE of the candidate
+window, so that it leaves at zero load also where the flanks are still pressed together at the window's edge (seat
+motor: 30 um deep, 0.1 pitch past the profile's end). With `merge`, the contacts of one tooth flank are also merged into
+one (wormsim.tooth.merge).
 """
 
 from __future__ import annotations
@@ -44,8 +44,9 @@ MEMO_JITTER_MODULE = 1e-3  # allowance (x m_x) for the slice minimum's change at
 MEMO_AGE_CYCLE = 1.0 / 8  # a memorised slice is evaluated again after this share of a mesh cycle of worm rotation
 MEMO_COLS = 4  # the memo table's columns: gline, TE, theta1, the pose's drift (_pose_drift) when it was evaluated
 MEMO_CONSTS = 4  # rho_max, jitter allowance, age, the largest distance of a grid point from the wheel's origin
-INSIDE_SHARE = 0.5 * (1.0 + 1e-3)  # line points deeper inside than this x the slice width: weight 1 without the face
-# slope (its |change| across a slice is at most the slice width; 1e-3 is far above the slope's round-off)
+INSIDE_SHARE = 0.75 * (1.0 + 1e-3)  # line points deeper inside than this x the distance to the neighbouring slices'
+# line points: weight 1 without their excess (the quadratic through them changes by at most 3/4 of it within the slice;
+# 1e-3 is far above the round-off; _line_share)
 
 
 @numba.njit(cache=True, inline="always")
@@ -67,10 +68,9 @@ def find_contacts(grid, ks, theta1, theta2, margin, P, out, taper_rad=0.0, memo=
     c_range, span, zeta), the flank grid's arrays (wormsim.tooth.grid.FlankGrid), out = (pos, nrm, depth, meta,
     line), the arrays written. Writes per contact
     the assembly position pos (n, 3), unit normal nrm (n, 3) (worm -> wheel), depth (n,) > 0 and meta (n, 4) =
-    (tooth k, flank sigma, slice j, fractional profile index), and line (n, 2) = (excess of the contact line's point
-    in slice widths, e / |de| with de its change across one slice width (_face_slope; e / dz, dz the slice width, where
-    the slice's strip lies wholly inside: slice_weights gives weight 1 either way); its depth: the extended gap's
-    minimum, m) for slice_weights; returns n. A contact is written where the depth at
+    (tooth k, flank sigma, slice j, fractional profile index), and line (n, 2) = (the share of its slice's strip
+    that the contact line covers, _line_share; its depth: the extended gap's minimum, m) for slice_weights; returns
+    n. A contact is written where the depth at
     the worm's edge or the line's depth is positive (depth may then be 0). The candidate window is margin plus the
     transmission error |theta2 - hand z1 / z2 theta1| (wrapped to a pitch), so a wheel pushed far into the
     worm keeps its contacts. Edge contacts fade to zero over the last taper_rad of the margin (default TAPER_SHARE x
@@ -160,7 +160,10 @@ def _find_contacts(grid, ks, theta1, theta2, margin, taper_rad, P, out, work, me
                 i_s = _start_point(c, span, sg, j, target)
                 sid += 1
                 memo_row = (use_memo, mtab, te, drift)
-                n, full = _slice_contact(ev, span, zeta, (sg, j, k), i_s, sid, taper, memo_row, out, n)
+                # the conjugate contact line of this tooth flank at the current pose: conjugate angle target - TE
+                # (the slice weights', _line_share)
+                sc = (span, c, target - te)
+                n, full = _slice_contact(ev, sc, zeta, (sg, j, k), i_s, sid, taper, memo_row, out, n)
                 if full:
                     return n
     return n
@@ -277,11 +280,13 @@ def _g(ev, sg, j, i, zj, sid):
 
 
 @numba.njit(cache=True, inline="always")
-def _slice_contact(ev, span, zeta, slc, i_s, sid, taper, memo_row, out, n):
+def _slice_contact(ev, sc, zeta, slc, i_s, sid, taper, memo_row, out, n):
     """The contact of slc = (flank sg, slice j, tooth k) from the start point i_s (module docstring): the gap's
     minimum along the profile (`_descend`), the parabola through it (`_line_parabola`), the worm's edge where the
     minimum lies past it (`_edge_minimum`); written as contact n (`_write_contact`) where it touches, else the slice
-    memorised where it is open (memo_row = (use_memo, table, TE)). Returns (the contacts written, out full)."""
+    memorised where it is open (memo_row = (use_memo, table, TE)). sc = (span, c, the contact line's conjugate
+    angle), the grid's and _line_share's. Returns (the contacts written, out full)."""
+    span = sc[0]
     sg, j, k = slc
     exc = ev[7]
     zj = zeta[j]
@@ -306,7 +311,7 @@ def _slice_contact(ev, span, zeta, slc, i_s, sid, taper, memo_row, out, n):
         x = x_l  # no edge inside reach: the line's point (only its weight can make it carry)
     if n >= out[2].shape[0]:
         return n, True
-    _write_contact(ev, zeta, slc, (ib, x, x_l, e_x), (gmin, gline, taper), out, n)
+    _write_contact(ev, sc, zeta, slc, (ib, x, x_l, e_x), (gmin, gline, taper), out, n)
     return n + 1, False
 
 
@@ -427,11 +432,11 @@ def _edge_minimum(ev, sg, j, zj, at, parab, sid):
 
 
 @numba.njit(cache=True, inline="always")
-def _write_contact(ev, zeta, slc, at, gap, out, n):
+def _write_contact(ev, sc, zeta, slc, at, gap, out, n):
     """Contact n of slc = (flank sg, slice j, tooth k) at at = (ib, x, x_l, e_x): fractional profile index ib + x,
     the line's point at ib + x_l with its excess e_x; gap = (the edge's gap minimum gmin, the line's gline, the
-    taper): its point and normal linear between the grid points around it, moved half the depth along the normal
-    (find_contacts' fields)."""
+    taper); sc = (span, c, the contact line's conjugate angle) (_line_share): its point and normal linear between the
+    grid points around it, moved half the depth along the normal (find_contacts' fields)."""
     sg, j, k = slc
     ib, x, x_l, e_x = at
     gmin, gline, taper = gap
@@ -463,17 +468,135 @@ def _write_contact(ev, zeta, slc, at, gap, out, n):
     pos[n, 2] = pz + 0.5 * dlt * az
     nrm[n, 0], nrm[n, 1], nrm[n, 2] = ax, ay, az
     depth[n] = max(dlt, 0.0)
-    dz = zeta[1] - zeta[0]
-    zj = zeta[j]
-    if e_x < -INSIDE_SHARE * dz:
-        # the slice's strip lies wholly inside the threaded region: the excess changes by at most the distance moved
-        # (a max of distances), so |sl| <= dz, e / |sl| < -1/2 and the weight is 1 either way (slice_weights); e / dz
-        # is kept instead of the slope's two evaluations
-        line[n, 0] = e_x / dz
-    else:
-        line[n, 0] = _excess_in_slices(e_x, _face_slope(xy, sg, j, ib + x_l, zj, dz, ca, sa, P, tmp))
+    line[n, 0] = _line_share(xy, sc, zeta, sg, j, ib, ca, sa, P, tmp)
     line[n, 1] = -gline * taper
     meta[n, 0], meta[n, 1], meta[n, 2], meta[n, 3] = k, sg, j, f
+
+
+@numba.njit(cache=True, inline="always")
+def _point_at(xy, c, sg, j, f, i0):
+    """(x, y, conjugate angle) of (flank sg, slice j) at fractional profile index f, linear through the grid points
+    i0 and i0 + 1 (extrapolated past them)."""
+    t = f - i0
+    x = xy[sg, j, i0, 0] + t * (xy[sg, j, i0 + 1, 0] - xy[sg, j, i0, 0])
+    y = xy[sg, j, i0, 1] + t * (xy[sg, j, i0 + 1, 1] - xy[sg, j, i0, 1])
+    return x, y, c[sg, j, i0] + t * (c[sg, j, i0 + 1] - c[sg, j, i0])
+
+
+@numba.njit(cache=True, inline="always")
+def _index_at(c, span, sg, j, target, hint):
+    """(f, i0): the fractional profile index f of (flank sg, slice j) whose conjugate angle is target, linear in
+    the segment [i0, i0 + 1] around it, extrapolated along the end segment past the active profile (so f is
+    continuous in target); i0 = -1 where the slice has no active segment there. c is monotone along the active
+    profile: the segment is found by walking from the segment at index hint (the line's point of the slice or its
+    neighbour's: a step or two), by bisection (_start_point) where the walk meets a trimmed point."""
+    a, b = span[sg, j, 0], span[sg, j, 1]
+    if a < 0 or b <= a:
+        return -1.0, -1
+    up = 1.0 if c[sg, j, b] > c[sg, j, a] else -1.0  # c's direction along the profile
+    i0 = min(max(hint, a), b - 1)
+    for _ in range(b - a):
+        c0, c1 = c[sg, j, i0], c[sg, j, i0 + 1]
+        if c0 != c0 or c1 != c1:
+            i0 = -1  # a point trimmed inside the row
+            break
+        if up * (target - c0) < 0.0 and i0 > a:
+            i0 -= 1
+        elif up * (target - c1) > 0.0 and i0 < b - 1:
+            i0 += 1
+        else:
+            break
+    if i0 < 0:
+        i = _start_point(c, span, sg, j, target)
+        if i < 0:
+            return -1.0, -1
+        # the segment on the target's side of the nearest point i
+        i0 = min(max(i if up * (target - c[sg, j, i]) > 0.0 else i - 1, a), b - 1)
+    c0, c1 = c[sg, j, i0], c[sg, j, i0 + 1]
+    if c0 != c0 or c1 != c1 or c1 == c0:
+        return -1.0, -1
+    return i0 + (target - c0) / (c1 - c0), i0
+
+
+@numba.njit(cache=True, inline="always")
+def _covered(e0, b, a):
+    """The measure of {u in [-1/2, 1/2] : e0 + b u + a u^2 < 0} (the share of a slice where the excess along the
+    contact line, quadratic in u, slice widths from the slice centre, is negative: covered). Continuous in (e0, b, a)
+    except where q has a double root at an end of the interval, or vanishes (e0 = b = a = 0); a = 0 is the linear
+    limit (the far root runs off to infinity)."""
+    disc = b * b - 4.0 * a * e0
+    if disc <= 0.0:  # q keeps one sign (a's; e0's where a = b = 0)
+        return 1.0 if (a < 0.0 or (a == 0.0 and e0 < 0.0)) else 0.0
+    q = -0.5 * (b + math.copysign(math.sqrt(disc), b))  # the roots q / a and e0 / q, without cancellation
+    if a == 0.0:  # linear: the root e0 / q = -e0 / b
+        r = e0 / q
+        return min(max(r + 0.5, 0.0), 1.0) if b > 0.0 else min(max(0.5 - r, 0.0), 1.0)
+    r1, r2 = q / a, e0 / q
+    lo, hi = min(r1, r2), max(r1, r2)
+    inside = max(0.0, min(hi, 0.5) - max(lo, -0.5))  # where q lies between its roots
+    return inside if a > 0.0 else 1.0 - inside
+
+
+@numba.njit(cache=True, inline="always")
+def _line_share(xy, sc, zeta, sg, j, hint, ca, sa, P, tmp):
+    """The share of the strip of (flank sg, slice j) that the contact line covers inside the worm's threaded region.
+    The contact line is the conjugate one at the current pose: the flank points of conjugate angle c_line (sc =
+    (span, c, c_line): the tooth flank's target less the transmission error, _find_contacts; it lies within a
+    fraction of a per cent of a pitch of the loaded line's gap minima), in this slice and its two neighbours (c
+    interpolated along the profile, extrapolated along its end segment past the active profile, so the point is
+    continuous where the line runs off the grid); the excess along the line (_excess: < 0 inside the threaded region)
+    e_-, e_0, e_+ there, taken quadratic in between, and the share of the slice where it is negative (_covered);
+    where one neighbour has no active segment (the face's ends) linear through the other, where neither the
+    change across the face at the point (_face_slope).
+
+    The line is oblique on the flank: its point moves along the profile from slice to slice, and its excess changes
+    with it, not as at a fixed profile point (_face_slope: on involute_41's leaving tooth 0.45 x the change along
+    the line, so each slice's weight fell in 0.45 of the time between two slices' exits, a staircase at their exit
+    rate). Where the line shrinks to a point inside the face (it touches the worm's tip cylinder there), its excess
+    has a quadratic minimum and the covered length falls to zero as the square root of the time left, which the
+    quadratic follows within the slice. Where the line leaves the grid (its point past the active profile's end),
+    the extrapolated point keeps the line's excess (the gap's minimum stays at the profile's end). Exact for a
+    straight line end and for a parabolic excess; a property of the pose and the grid, so each slice's weight is
+    continuous in the mesh angle (slice_weights). Where the point lies deeper inside than INSIDE_SHARE x the larger
+    distance to a neighbour's point, the share is 1 without the neighbours' excess (a max of distances, it changes
+    by at most the distance moved, the quadratic by at most 3/4 of it within the slice). hint: the profile index of
+    the slice's line point (_index_at's walk starts there)."""
+    span, c, c_line = sc
+    S = zeta.shape[0]
+    dz = zeta[1] - zeta[0] if S > 1 else 1.0
+    f0, i0 = _index_at(c, span, sg, j, c_line, hint)
+    if i0 < 0:  # no active segment on the line (a trimmed point): the change across the face at the profile's middle
+        a, b = span[sg, j, 0], span[sg, j, 1]
+        i0 = (a + b) // 2
+        x0, y0 = xy[sg, j, i0, 0], xy[sg, j, i0, 1]
+        e0 = _excess(x0, y0, zeta[j], ca, sa, P, tmp)
+        return _covered(e0, _face_slope(xy, sg, j, float(i0), zeta[j], dz, ca, sa, P, tmp), 0.0)
+    x0, y0, _ = _point_at(xy, c, sg, j, f0, i0)
+    e0 = _excess(x0, y0, zeta[j], ca, sa, P, tmp)
+    im = ip = -1
+    xm = ym = xp = yp = fm = fp = 0.0
+    if j > 0:
+        fm, im = _index_at(c, span, sg, j - 1, c_line, i0)
+    if j < S - 1:
+        fp, ip = _index_at(c, span, sg, j + 1, c_line, i0)
+    if im < 0 and ip < 0:
+        return _covered(e0, _face_slope(xy, sg, j, f0, zeta[j], dz, ca, sa, P, tmp), 0.0)
+    reach = 0.0
+    if im >= 0:
+        xm, ym, _ = _point_at(xy, c, sg, j - 1, fm, im)
+        reach = math.sqrt((xm - x0) ** 2 + (ym - y0) ** 2 + dz * dz)
+    if ip >= 0:
+        xp, yp, _ = _point_at(xy, c, sg, j + 1, fp, ip)
+        reach = max(reach, math.sqrt((xp - x0) ** 2 + (yp - y0) ** 2 + dz * dz))
+    if e0 < -INSIDE_SHARE * reach:
+        return 1.0  # |e_+- - e_0| <= reach: covered either way
+    if im < 0:
+        return _covered(e0, _excess(xp, yp, zeta[j + 1], ca, sa, P, tmp) - e0, 0.0)
+    em = _excess(xm, ym, zeta[j - 1], ca, sa, P, tmp)
+    if ip < 0:
+        return _covered(e0, e0 - em, 0.0)
+    ep = _excess(xp, yp, zeta[j + 1], ca, sa, P, tmp)
+    return _covered(e0, 0.5 * (ep - em), 0.5 * (ep + em) - e0)
 
 
 @numba.njit(cache=True, inline="always")
@@ -489,16 +612,6 @@ def _face_slope(xy, sg, j, f, zj, dz, ca, sa, P, tmp):
         x0 += t * (xy[sg, j, i0 + 1, 0] - x0)
         y0 += t * (xy[sg, j, i0 + 1, 1] - y0)
     return _excess(x0, y0, zj + 0.5 * dz, ca, sa, P, tmp) - _excess(x0, y0, zj - 0.5 * dz, ca, sa, P, tmp)
-
-
-@numba.njit(cache=True, inline="always")
-def _excess_in_slices(e, sl):
-    """The line point's excess e in slice widths along the face, e / |sl| (sl: its change across one slice width,
-    _face_slope): how far past the contact line's end the slice centre lies. +-inf where sl is 0 or undefined."""
-    a = abs(sl)
-    if a > 0.0:
-        return e / a
-    return -np.inf if e <= 0.0 else np.inf
 
 
 @numba.njit(cache=True, inline="always")
@@ -521,17 +634,17 @@ def slice_weights(meta, line, n, slices, pos, nrm, depth, weight):
     """Line-end interpolation of the slice method: each contact's share w in [0, 1] of its slice's strip (width b2 / S)
     that the contact line covers, so that the mesh stiffness changes continuously as the line's end (where it runs
     past the worm's tip, root or end face: the line point's excess crosses 0) sweeps across the face, instead of by
-    K / S when the end crosses a slice centre. line[:, 0] is the line point's excess in slice widths, e / |de|
-    (find_contacts: de is the excess's change across one slice width at that point, _face_slope); with the excess
-    linear across the strip, the covered share is w = clip(1/2 - e / |de|, 0, 1) (the trapezoidal rule for the line
-    load with its end interpolated). The slope is the contact's own, not the neighbours' difference: with the
-    neighbours' excess, a neighbour leaving the list (its slice leaving the candidate window, or a slice without
-    one) switched the slope and stepped the weight at full depth (docs/contact3d.md). Keeps the contacts with w > 0
-    (in place: pos, nrm, depth, meta, line), sets depth to the line's depth and weight to w; returns their number.
-    meta and slices are kept in the signature for the callers."""
+    K / S when the end crosses a slice centre. line[:, 0] is that share (find_contacts, _line_share: the excess
+    linear along the contact line on each side of the line's point, its change to the neighbouring slices' line
+    points; the trapezoidal rule for the line load with its ends interpolated). The share is the contact's own,
+    not from the neighbours' contacts: with the neighbours' excess from the list, a neighbour leaving it (its slice
+    leaving the candidate window, or a slice without one) switched the slope and stepped the weight at full depth
+    (docs/contact3d.md). Keeps the contacts with w > 0 (in place: pos, nrm, depth, meta, line), sets depth to the
+    line's depth and weight to w; returns their number. meta and slices are kept in the signature for the
+    callers."""
     m = 0
     for i in range(n):
-        w = min(max(0.5 - line[i, 0], 0.0), 1.0)
+        w = min(max(line[i, 0], 0.0), 1.0)
         if w <= 0.0 or line[i, 1] <= 0.0:
             continue
         if m != i:
