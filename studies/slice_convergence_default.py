@@ -103,6 +103,7 @@ def measure(sc: Scenario, save: Path | None = None, tag: str = "") -> dict:
         )
     return {
         "slices": r["flank_slices"],
+        "flank_contacts": r["flank_contacts"],
         "ft_p2p_n": r["tangential_force_p2p_n"],
         "ft_p2p_band_n": float(p2p_below(t[m], S["tangential_force_n"][m], BAND_HZ)),
         "ph_max_mpa": r.get("contact_pressure_max_mpa"),

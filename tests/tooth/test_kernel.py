@@ -104,7 +104,8 @@ def _settle(bm, d, torque_nm: float, steps: int, fc):
 
 @pytest.fixture(scope="module")
 def static_flanks():
-    """Worm held at 0 rpm by its servo, frictionless, wheel torques 21 and 24 N m (tests/contact3d/test_law.py)."""
+    """Worm held at 0 rpm by its servo, frictionless, wheel torques 21 and 24 N m (tests/contact3d/test_law.py), one
+    MuJoCo contact per slice (the per-contact law; the default merges 4 per flank)."""
     from wormsim.contact3d.flank_step import FlankContacts
     from wormsim.contact3d.native import split_forward
 
@@ -115,6 +116,7 @@ def static_flanks():
             "drive.ramp_s=0",
             "load.ramp_s=0",
             "contact.geometry=flanks",
+            "contact.flank_contacts=slice",
             "contact.friction=0",
             "contact.friction_static=null",
             "contact.friction_dynamic=null",
