@@ -104,7 +104,11 @@ def locked_error(t: float, w_drive: float, w_cmd: float, bm: BuiltModel) -> Simu
 
 
 def penetration_error(t: float, pen: float, pen_lim: float, dt: float, bm: BuiltModel) -> SimulationError:
-    """Penetration beyond gear_theory.penetration_limit_m (0.4 m_x): the teeth are about to skip."""
+    """Penetration beyond gear_theory.penetration_limit_m (0.4 m_x): the teeth are about to skip. Above the stable
+    timestep this is the integration running away, reported as divergence with the timestep's cure (as jump_error):
+    which guard sees the run-away first depends on the contacts' count and weights, not on its cause."""
+    if dt > bm.law.stable_limit_s:
+        return diverged_error(t, dt, bm, f"penetration {pen * 1e6:.1f} um beyond the tolerance {pen_lim * 1e6:.1f} um")
     return PenetrationError(
         f"penetration {pen * 1e6:.1f} um at t = {t:.4g} s exceeds the tolerance {pen_lim * 1e6:.1f} um "
         f"(0.4 m_x): contact too soft for the load or timestep {dt:.3g} s too large (stable limit "
