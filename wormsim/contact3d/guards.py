@@ -48,6 +48,9 @@ def state_event(th1, th2, w1, w2, badqacc, dt, turn_lim, direction, ratio, jump_
     return 0, te, turn
 
 
+HELD_FOLLOW_FRACTION = 0.1  # a back-driven worm turning slower than this share of the kinematic speed is held
+
+
 @numba.njit(cache=True, inline="always")
 def contact_event(t, pen, pen_lim, w_drive, cmd, speed_driven, lock_start, lock_fraction):
     """The contact checks of a sample, in order: PENETRATED (the largest penetration pen beyond pen_lim), then for a
@@ -105,10 +108,15 @@ class Guards:
         self.friction.check(d, t, w1, w2)
         return te
 
-    def _creeping(self, w_worm: float) -> bool:
-        """The worm's sliding speed below 10 transition velocities (the static friction's reach)."""
+    def _creeping(self, w_worm: float, w_wheel: float) -> bool:
+        """The worm holds: its sliding speed below 10 transition velocities (the static friction's reach), or it follows
+        the wheel at under HELD_FOLLOW_FRACTION of the ratio (the wheel's servo crushes the held mesh instead of turning
+        the worm: the screw jack at mu 0.2, worm at 0.66 % of z2 / z1 times the wheel's speed when the penetration
+        guard trips)."""
         geo = self.bm.geometry
-        return abs(w_worm) * geo.r_m1 / math.cos(geo.gamma_m) < 10 * self.bm.plan.transition_velocity_m_s
+        if abs(w_worm) * geo.r_m1 / math.cos(geo.gamma_m) < 10 * self.bm.plan.transition_velocity_m_s:
+            return True
+        return abs(w_worm) < HELD_FOLLOW_FRACTION * geo.ratio * abs(w_wheel)
 
     def contact(self, t: float, pen: float, w_drive: float, cmd: float, w_worm: float = 0.0) -> None:
         """Penetration beyond the limit; a speed-driven drive stuck below half its command (locked) for lock_hold.
@@ -119,7 +127,7 @@ class Guards:
             t, pen, self.pen_lim, w_drive, cmd, self.speed_driven, self.lock_start, gt.LOCK_SPEED_FRACTION
         )
         if code == PENETRATED:
-            if self.self_locking_backdrive and self._creeping(w_worm):  # the stalled wheel's servo pushed on
+            if self.self_locking_backdrive and self._creeping(w_worm, w_drive):  # the stalled wheel's servo pushed on
                 raise Held(t, self.locked_since)
             raise penetration_error(t, pen, self.pen_lim, self.dt, self.bm)
         if code == STUCK:

@@ -4,7 +4,8 @@ A speed-driven wheel that back-drives a pair that self-locks at standstill, rho'
 >= gamma (DIN 3975-2: back-driving efficiency tan(gamma - rho') / tan(gamma) <= 0), cannot turn the worm: the
 wheel stalls and the mesh holds. That is the answer the run was asked for, not a failure. At torsional and contact3d
 the lock guard (gear_theory.drive_stuck held for LOCK_HOLD_S after the ramps) and, at contact3d, the penetration
-guard while the worm creeps (the stalled wheel's speed servo pushing the held mesh into the contact) end such a run
+guard while the worm creeps or follows the wheel at under a tenth of the ratio (the stalled wheel's speed servo
+pushing the held mesh into the contact; wormsim.contact3d.guards.HELD_FOLLOW_FRACTION) end such a run
 at that moment with status ok; the summary is taken over the run up to there and says
 
 - `locked`: true;
