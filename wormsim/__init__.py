@@ -23,6 +23,7 @@ from wormsim.runtime import jit_cache as _jit_cache
 _jit_cache.configure()  # numba's cache: this machine's folder for this code, before any compiled function exists
 
 from wormsim.exceptions import ScenarioError, SimulationError  # noqa: E402
+from wormsim.runtime.lazy import lazy_getattr  # noqa: E402
 
 if TYPE_CHECKING:
     from wormsim.pair import WormPair, step
@@ -58,15 +59,7 @@ _LAZY = {
 }
 
 
-def __getattr__(name: str):
-    module = _LAZY.get(name)
-    if module is None:
-        raise AttributeError(f"module 'wormsim' has no attribute {name!r}")
-    import importlib
-
-    value = getattr(importlib.import_module(module), name)
-    globals()[name] = value
-    return value
+__getattr__ = lazy_getattr(__name__, _LAZY)
 
 
 def __dir__() -> list[str]:

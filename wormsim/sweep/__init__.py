@@ -8,6 +8,8 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+from wormsim.runtime.lazy import lazy_getattr
+
 if TYPE_CHECKING:
     from wormsim.sweep.runner import run_sweep
     from wormsim.sweep.spec import Point, Sweep, SweepFile, load_sweep
@@ -19,12 +21,4 @@ _LAZY = {
 }
 
 
-def __getattr__(name: str):
-    module = _LAZY.get(name)
-    if module is None:
-        raise AttributeError(f"module 'wormsim.sweep' has no attribute {name!r}")
-    import importlib
-
-    value = getattr(importlib.import_module(module), name)
-    globals()[name] = value
-    return value
+__getattr__ = lazy_getattr(__name__, _LAZY)
