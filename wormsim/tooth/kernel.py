@@ -311,7 +311,7 @@ def _slice_contact(ev, sc, zeta, slc, i_s, sid, taper, memo_row, out, n):
         x = x_l  # no edge inside reach: the line's point (only its weight can make it carry)
     if n >= out[2].shape[0]:
         return n, True
-    _write_contact(ev, sc, zeta, slc, (ib, x, x_l, e_x), (gmin, gline, taper), out, n)
+    _write_contact(ev, sc, zeta, slc, (ib, x), (gmin, gline, taper), out, n)
     return n + 1, False
 
 
@@ -433,12 +433,12 @@ def _edge_minimum(ev, sg, j, zj, at, parab, sid):
 
 @numba.njit(cache=True, inline="always")
 def _write_contact(ev, sc, zeta, slc, at, gap, out, n):
-    """Contact n of slc = (flank sg, slice j, tooth k) at at = (ib, x, x_l, e_x): fractional profile index ib + x,
-    the line's point at ib + x_l with its excess e_x; gap = (the edge's gap minimum gmin, the line's gline, the
-    taper); sc = (span, c, the contact line's conjugate angle) (_line_share): its point and normal linear between the
-    grid points around it, moved half the depth along the normal (find_contacts' fields)."""
+    """Contact n of slc = (flank sg, slice j, tooth k) at at = (ib, x): fractional profile index ib + x; gap = (the
+    edge's gap minimum gmin, the line's gline, the taper); sc = (span, c, the contact line's conjugate angle)
+    (_line_share): its point and normal linear between the grid points around it, moved half the depth along the
+    normal (find_contacts' fields)."""
     sg, j, k = slc
-    ib, x, x_l, e_x = at
+    ib, x = at
     gmin, gline, taper = gap
     xy, ca, sa, P, tmp, pts, nrs = ev[0], ev[1], ev[2], ev[4], ev[5], ev[8], ev[9]
     pos, nrm, depth, meta, line = out
@@ -474,13 +474,13 @@ def _write_contact(ev, sc, zeta, slc, at, gap, out, n):
 
 
 @numba.njit(cache=True, inline="always")
-def _point_at(xy, c, sg, j, f, i0):
-    """(x, y, conjugate angle) of (flank sg, slice j) at fractional profile index f, linear through the grid points
-    i0 and i0 + 1 (extrapolated past them)."""
+def _point_at(xy, sg, j, f, i0):
+    """(x, y) of (flank sg, slice j) at fractional profile index f, linear through the grid points i0 and i0 + 1
+    (extrapolated past them)."""
     t = f - i0
     x = xy[sg, j, i0, 0] + t * (xy[sg, j, i0 + 1, 0] - xy[sg, j, i0, 0])
     y = xy[sg, j, i0, 1] + t * (xy[sg, j, i0 + 1, 1] - xy[sg, j, i0, 1])
-    return x, y, c[sg, j, i0] + t * (c[sg, j, i0 + 1] - c[sg, j, i0])
+    return x, y
 
 
 @numba.njit(cache=True, inline="always")
@@ -571,7 +571,7 @@ def _line_share(xy, sc, zeta, sg, j, hint, ca, sa, P, tmp):
         x0, y0 = xy[sg, j, i0, 0], xy[sg, j, i0, 1]
         e0 = _excess(x0, y0, zeta[j], ca, sa, P, tmp)
         return _covered(e0, _face_slope(xy, sg, j, float(i0), zeta[j], dz, ca, sa, P, tmp), 0.0)
-    x0, y0, _ = _point_at(xy, c, sg, j, f0, i0)
+    x0, y0 = _point_at(xy, sg, j, f0, i0)
     e0 = _excess(x0, y0, zeta[j], ca, sa, P, tmp)
     im = ip = -1
     xm = ym = xp = yp = fm = fp = 0.0
@@ -583,10 +583,10 @@ def _line_share(xy, sc, zeta, sg, j, hint, ca, sa, P, tmp):
         return _covered(e0, _face_slope(xy, sg, j, f0, zeta[j], dz, ca, sa, P, tmp), 0.0)
     reach = 0.0
     if im >= 0:
-        xm, ym, _ = _point_at(xy, c, sg, j - 1, fm, im)
+        xm, ym = _point_at(xy, sg, j - 1, fm, im)
         reach = math.sqrt((xm - x0) ** 2 + (ym - y0) ** 2 + dz * dz)
     if ip >= 0:
-        xp, yp, _ = _point_at(xy, c, sg, j + 1, fp, ip)
+        xp, yp = _point_at(xy, sg, j + 1, fp, ip)
         reach = max(reach, math.sqrt((xp - x0) ** 2 + (yp - y0) ** 2 + dz * dz))
     if e0 < -INSIDE_SHARE * reach:
         return 1.0  # |e_+- - e_0| <= reach: covered either way
