@@ -336,15 +336,9 @@ def _warm_helpers() -> None:
     mu_at(0.1, GROUP, *(float(x) for x in GROUPS["I"]))
 
 
-def _warm_split_forces() -> None:
-    """merge.split_forces as FlankContacts.slice_rows calls it from Python (the merged contacts' forces split over
-    their slices: the per-sample outputs off the compiled loop, e.g. the contact pattern's rows), with its argument
-    types: d.contact.efc_address (MuJoCo's strided view), d.efc_force, int k0, bool cone3, float64 arrays, int n (a
-    box resting on a plane: 4 contacts, merged into one)."""
+def _box_on_plane():
+    """MuJoCo's data of a box resting on a plane after mj_forward (4 contacts): the warm-ups' contact arrays."""
     import mujoco
-    import numpy as np
-
-    from wormsim.tooth.merge import split_forces
 
     m = mujoco.MjModel.from_xml_string(
         "<mujoco><worldbody><geom type='plane' size='1 1 .1'/><body pos='0 0 .09'><freejoint/>"
@@ -352,6 +346,19 @@ def _warm_split_forces() -> None:
     )
     d = mujoco.MjData(m)
     mujoco.mj_forward(m, d)
+    return d
+
+
+def _warm_split_forces() -> None:
+    """merge.split_forces as FlankContacts.slice_rows calls it from Python (the merged contacts' forces split over
+    their slices: the per-sample outputs off the compiled loop, e.g. the contact pattern's rows), with its argument
+    types: d.contact.efc_address (MuJoCo's strided view), d.efc_force, int k0, bool cone3, float64 arrays, int n (a
+    box resting on a plane: 4 contacts, merged into one)."""
+    import numpy as np
+
+    from wormsim.tooth.merge import split_forces
+
+    d = _box_on_plane()
     n = int(d.ncon)
     merged = (np.zeros(n), np.full(n, 1.0 / max(n, 1)), np.ones(n), np.ones(n))
     split_forces(d.contact.efc_address, d.efc_force, 0, True, merged, n, (np.zeros(n, np.int64), np.zeros(3 * n)))
@@ -359,14 +366,7 @@ def _warm_split_forces() -> None:
 
 def _warm_friction_check() -> None:
     """friction_guard.friction_alignment on MuJoCo's contact arrays (a box resting on a plane: 4 contacts)."""
-    import mujoco
-
     from wormsim.contact3d.friction_guard import friction_alignment
 
-    m = mujoco.MjModel.from_xml_string(
-        "<mujoco><worldbody><geom type='plane' size='1 1 .1'/><body pos='0 0 .09'><freejoint/>"
-        "<geom type='box' size='.1 .1 .1'/></body></worldbody></mujoco>"
-    )
-    d = mujoco.MjData(m)
-    mujoco.mj_forward(m, d)
+    d = _box_on_plane()
     friction_alignment(d, 1e-3)
