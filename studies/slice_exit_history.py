@@ -121,6 +121,57 @@ def exit_summary(r: dict, loads: dict[int, np.ndarray], window) -> dict:
     }
 
 
+def line_history(r: dict, k: int, steps: list[int]) -> list[dict]:
+    """Tooth k's loaded contacts at the given steps: how many, their slices' range, their weights' sum x b2 / S (the
+    covered length in slice widths), the smallest weight and its slice, their profile indices' range (against the
+    grid's active span of that slice: where the line ends, tip, root or a face end) and the tooth's load."""
+    T = r["table"]
+    out = []
+    for i in steps:
+        m = (T[:, 0] == i) & (T[:, 1] == k)
+        if not m.any():
+            out.append({"step": int(i), "contacts": 0})
+            continue
+        R = T[m]
+        j = int(np.argmin(R[:, 4]))
+        out.append(
+            {
+                "step": int(i),
+                "contacts": int(m.sum()),
+                "slices": [int(R[:, 3].min()), int(R[:, 3].max())],
+                "covered_slices": float(R[:, 4].sum()),
+                "min_weight": float(R[j, 4]),
+                "min_weight_slice": int(R[j, 3]),
+                "profile_index": [float(R[:, 7].min()), float(R[:, 7].max())],
+                "depth_um": [float(R[:, 5].min() * 1e6), float(R[:, 5].max() * 1e6)],
+                "load_n": float(np.nansum(R[:, 8])),
+            }
+        )
+    return out
+
+
+def enter_summary(r: dict, loads: dict[int, np.ndarray], window) -> dict:
+    """The first tooth to enter inside the steady window: its entry step (its first with load) and its load over
+    its first 20 steps."""
+    t = r["t_s"]
+    starts = {}
+    for k, f in loads.items():
+        on = np.nonzero(f > 0)[0]
+        if len(on) and t[on[0]] > window[0] and on[0] > 0:
+            starts[k] = int(on[0])
+    if not starts:
+        return {}
+    k = min(starts, key=starts.get)
+    f, s0 = loads[k], starts[k]
+    return {
+        "tooth": k,
+        "entry_step": s0,
+        "entry_t_s": float(t[s0]),
+        "load_steps_after_entry": [0, 1, 2, 5, 10, 20],
+        "load_after_entry_n": [float(f[min(s0 + i, len(f) - 1)]) for i in (0, 1, 2, 5, 10, 20)],
+    }
+
+
 def kernel_blob() -> str:
     """The git blob hash of wormsim/tooth/kernel.py as it is on disk (which kernel measured the record)."""
     import subprocess
@@ -156,8 +207,17 @@ def main() -> None:
                 th2=r["theta2"] if r["theta2"] is not None else np.zeros(0),
             )
         loads[S] = tooth_loads(r)
+        ex = exit_summary(r, loads[S], s["steady_window_s"])
+        en = enter_summary(r, loads[S], s["steady_window_s"])
+        if ex:
+            e = ex["exit_step"]
+            ex["line"] = line_history(r, ex["tooth"], [e - i for i in (40, 20, 10, 5, 2, 1, 0)])
+        if en:
+            e = en["entry_step"]
+            en["line"] = line_history(r, en["tooth"], [e + i for i in (0, 1, 2, 5, 10, 20, 40)])
         out["runs"][str(S)] = {
-            "exit": exit_summary(r, loads[S], s["steady_window_s"]),
+            "exit": ex,
+            "entry": en,
             "ft_p2p_n": s["tangential_force_p2p_n"],
             "ft_mean_n": s["tangential_force_mean_n"],
             "steady_window_s": s["steady_window_s"],
