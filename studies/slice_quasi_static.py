@@ -2,7 +2,7 @@
 "Default slice count"): a case of studies/slice_convergence_default.py, the rigid conjugate pose held back by the
 backlash angle and a small approach, swept over one mesh cycle; per sample each window tooth's load per unit of the
 tooth pair's stiffness K (sum of w delta / S over its loaded flank's contacts: kernel.find_packed's weights and depths,
-as tests/tooth/test_kernel.py's exit sweep) and the mesh's k(theta) / K (their sum over the approach). From k(theta)
+tests/tooth/test_kernel.py's mesh_sweep) and the mesh's k(theta) / K (their sum over the approach). From k(theta)
 the contact mode's response to it (the dynamic mesh force of a one-degree-of-freedom mesh, F0 kappa / k_mean
 r^2 / (1 - r^2 + 2 i zeta r), r = f / f_n, f_n = sqrt(k_mean / m_eff) / 2 pi; decision 0045's hand estimate): its p2p
 at S and 2 S.
@@ -25,41 +25,10 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from studies.slice_convergence_default import scenario  # noqa: E402
+from tests.tooth.test_kernel import APPROACH_M  # noqa: E402
+from tests.tooth.test_kernel import mesh_sweep as sweep  # noqa: E402
 from wormsim.contact3d.mjcf import flank_slices, prepare  # noqa: E402
 from wormsim.results.provenance import record  # noqa: E402
-from wormsim.tooth import grid, kernel  # noqa: E402
-from wormsim.tooth.window import window_size, window_teeth_at  # noqa: E402
-
-APPROACH_M = 1e-6  # the approach beyond the backlash (the depth of a conjugate contact)
-
-
-def sweep(g, slices: int, samples: int, approach_m: float = APPROACH_M) -> dict:
-    """One mesh cycle of worm rotation at `samples` points: per window tooth (its index relative to the cycle's
-    first window) its loaded flank's sum of w delta / S / approach (its share of K), and per sample the contact line's
-    last slice on each tooth."""
-    from meshgen import wheel
-
-    W = window_size(g)
-    pitch = 2 * math.pi / g.z2
-    tooth0 = wheel.tooth_angle(g, 0)
-    bl = g.backlash / (2 * g.r2)
-    arm = g.r2 * math.cos(g.alpha_n) * math.cos(g.gamma)
-    lag = bl + approach_m / arm
-    margin = kernel.MARGIN_PITCH * pitch + bl
-    fg = grid.flank_grid(g, slices)
-    pk = kernel.PackedKernel(fg, fg.params, 2 * W * slices, W, g.z2)
-    th1s = np.arange(samples) / samples * 2 * math.pi / g.z1
-    loads: dict[int, np.ndarray] = {}
-    for i, th1 in enumerate(th1s):
-        th2 = g.hand * (th1 * g.z1 / g.z2 - lag)  # flank A loaded
-        pk.ks[:] = window_teeth_at(th2, g.z2, W, tooth0)
-        n = kernel.find_packed(pk.fb, pk.ib, th1, th2, margin, kernel.TAPER_SHARE * margin)
-        wd = pk.weight[:n] * pk.depth[:n]
-        for k in set(pk.meta[:n, 0].astype(int)):
-            m = pk.meta[:n, 0] == k
-            loads.setdefault(k, np.zeros(samples))[i] = np.sum(wd[m]) / slices / approach_m
-    k_mesh = np.sum(list(loads.values()), axis=0)
-    return {"th1": th1s, "loads": loads, "k_mesh": k_mesh}
 
 
 def mode_response(kappa: np.ndarray, f_mesh_hz: float, f_n_hz: float, zeta: float) -> np.ndarray:
