@@ -438,9 +438,16 @@ def _edge_minimum(ev, sg, j, zj, at, parab, sid):
 @numba.njit(cache=True, inline="always")
 def _write_contact(ev, sc, zeta, slc, at, gap, out, n):
     """Contact n of slc = (flank sg, slice j, tooth k) at at = (ib, x): fractional profile index ib + x; gap = (the
-    edge's gap minimum gmin, the line's gline, the taper); sc = (span, c, the contact line's conjugate angle)
-    (_line_share): its point and normal linear between the grid points around it, moved half the depth along the
-    normal (find_contacts' fields)."""
+    edge's gap minimum gmin, the line's gline, the taper, the gap's parabola (best, qa, qb, ib) of _line_parabola);
+    sc = (span, c, the contact line's conjugate angle) (_line_share): its point and normal linear between the grid
+    points around it, moved half the depth along the normal (find_contacts' fields). The depth for slice_weights
+    (line[n, 1]) is the line's gline, except where the line leaves the active profile (decision 0052): where the line
+    crosses the wheel's tip edge in the slice, the depth averaged across the slice (_tip_depth: the line's inside the
+    edge, the tip edge's parabola past it); where the line's point lies past the profile's lower end (the worm tip's
+    reach, where the share w is the worm's), the line's own depth, the parabola at the line's point. With the
+    profile end's gap instead (the clamped parabola) each slice took its centre's depth across its width, which
+    falls from the line's to zero within a small share of a slice past an end: on the screw jack at 16 slices the
+    mesh stiffness over a mesh cycle 3.8 % of its mean off 64 slices' (1.7 % with these depths)."""
     sg, j, k = slc
     ib, x = at
     gmin, gline, taper, parab = gap
@@ -475,7 +482,13 @@ def _write_contact(ev, sc, zeta, slc, at, gap, out, n):
     w, tip = _line_share(xy, sc, zeta, sg, j, ib, ca, sa, P, tmp)
     line[n, 0] = w
     best, qa, qb, il = parab
-    if tip[3] or qb <= 0.0:  # the line inside the wheel's tip edge across the slice
+    if qb > 0.0 and tip[5] < sc[0][sg, j, 0]:
+        # the line's point lies past the profile's lower end (the worm tip's reach): the covered share w is the
+        # worm's (its excess along the line), the covered part's depth the line's, the gap's parabola at the line's
+        # point (at least the clamped line's), not the profile end's gap
+        xl = tip[5] - il
+        line[n, 1] = max(-(best + qa * xl + qb * xl * xl), -gline) * taper
+    elif tip[3] or qb <= 0.0:  # the line inside the wheel's tip edge across the slice
         line[n, 1] = -gline * taper
     else:
         # the line crosses the tip edge in the slice (or lies past it): its depth averaged across the slice, the
@@ -576,13 +589,11 @@ def _line_share(xy, sc, zeta, sg, j, hint, ca, sa, P, tmp):
     by at most the distance moved, the quadratic by at most 3/4 of it within the slice). hint: the profile index of
     the slice's line point (_index_at's walk starts there).
 
-    Returns (w, w_in): w that share, w_in the share where the line lies inside the wheel's active profile as well
-    (_tip_past: the line's point past the tip edge, quadratic across the slice in the same way; w where the line
-    lies inside it across the whole slice). Where the line crosses the wheel's tip edge inside a slice, the slice's
-    depth is the line's over w_in and the tip edge's over the rest (_write_contact): the tip edge's gap grows
-    quadratically with the distance past the line, so the depth fell from the line's to zero within a small share
-    of a slice, and a slice carried its centre's depth across its width (on the screw jack's entering tooth at 16
-    slices the tooth's quasi-static load 5.1 % below 64 slices'; docs/decisions/0052)."""
+    Returns (w, tip): w that share; tip = (t0, tb, ta, inside, seg, f0) for the slice's depth (_write_contact): how
+    far the line lies past the wheel's tip edge (the active profile's last point, _tip_past, m), quadratic across the
+    slice from the line's points as the excess (t0 + tb u + ta u^2), whether it stays inside the tip edge across the
+    slice (by INSIDE_SHARE x its change to the neighbours, as the excess), the end segment's length, and the line
+    point's fractional profile index f0 (past the profile's lower end where f0 < its first active point)."""
     span, c, c_line = sc
     S = zeta.shape[0]
     dz = zeta[1] - zeta[0] if S > 1 else 1.0
@@ -592,7 +603,14 @@ def _line_share(xy, sc, zeta, sg, j, hint, ca, sa, P, tmp):
         i0 = (a + b) // 2
         x0, y0 = xy[sg, j, i0, 0], xy[sg, j, i0, 1]
         e0 = _excess(x0, y0, zeta[j], ca, sa, P, tmp)
-        return _covered(e0, _face_slope(xy, sg, j, float(i0), zeta[j], dz, ca, sa, P, tmp), 0.0), (0.0, 0.0, 0.0, True, 1.0)
+        return _covered(e0, _face_slope(xy, sg, j, float(i0), zeta[j], dz, ca, sa, P, tmp), 0.0), (
+            0.0,
+            0.0,
+            0.0,
+            True,
+            1.0,
+            1e9,
+        )
     x0, y0 = _point_at(xy, sg, j, f0, i0)
     e0 = _excess(x0, y0, zeta[j], ca, sa, P, tmp)
     im = ip = -1
@@ -602,7 +620,14 @@ def _line_share(xy, sc, zeta, sg, j, hint, ca, sa, P, tmp):
     if j < S - 1:
         fp, ip = _index_at(c, span, sg, j + 1, c_line, i0)
     if im < 0 and ip < 0:
-        return _covered(e0, _face_slope(xy, sg, j, f0, zeta[j], dz, ca, sa, P, tmp), 0.0), (0.0, 0.0, 0.0, True, 1.0)
+        return _covered(e0, _face_slope(xy, sg, j, f0, zeta[j], dz, ca, sa, P, tmp), 0.0), (
+            0.0,
+            0.0,
+            0.0,
+            True,
+            1.0,
+            1e9,
+        )
     t0, seg = _tip_past(xy, span, sg, j, f0)
     tm = _tip_past(xy, span, sg, j - 1, fm)[0] if im >= 0 else 0.0
     tp = _tip_past(xy, span, sg, j + 1, fp)[0] if ip >= 0 else 0.0
@@ -624,7 +649,7 @@ def _line_share(xy, sc, zeta, sg, j, hint, ca, sa, P, tmp):
         reach = max(reach, math.sqrt((xp - x0) ** 2 + (yp - y0) ** 2 + dz * dz))
     if e0 < -INSIDE_SHARE * reach:
         # |e_+- - e_0| <= reach: covered either way
-        return 1.0, (t0, tb, ta, inside, seg)
+        return 1.0, (t0, tb, ta, inside, seg, f0)
     if im < 0:
         eb, ea = _excess(xp, yp, zeta[j + 1], ca, sa, P, tmp) - e0, 0.0
     elif ip < 0:
@@ -633,7 +658,7 @@ def _line_share(xy, sc, zeta, sg, j, hint, ca, sa, P, tmp):
         em = _excess(xm, ym, zeta[j - 1], ca, sa, P, tmp)
         ep = _excess(xp, yp, zeta[j + 1], ca, sa, P, tmp)
         eb, ea = 0.5 * (ep - em), 0.5 * (ep + em) - e0
-    return _covered(e0, eb, ea), (t0, tb, ta, inside, seg)
+    return _covered(e0, eb, ea), (t0, tb, ta, inside, seg, f0)
 
 
 @numba.njit(cache=True, inline="always")
