@@ -5,7 +5,8 @@ module of contact line) and, for comparison, the largest p_H of one contact (her
 2 S. Each case at the default contact stiffness, the teeth's compliance (the variety gears' test asset pins Hertz's:
 the sweep sets contact.stiffness_model=teeth); Hertz's where the teeth's compliance fails on the gear (gmsh; the
 record says so, `hertz_fallback`). The cases: the variety gears (tests/contact3d/test_variety.py FLANK_GEARS), three
-random gears (tests/contact3d/test_random_forces.py) and the seeds' CI runs with flanks
+random gears (tests/contact3d/test_random_forces.py; --cases random4 .. further draws of its generator, and steep,
+its STEEP gear) and the seeds' CI runs with flanks
 (tests/contact3d/test_seeds_pieces.py CI; the seat motor and the screw jack set their own
 contact.stiffness_n_per_m). Writes docs/data/RECORD.json after each case (a long sweep can be cut).
 
@@ -32,7 +33,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from tests.conftest import SCENARIOS  # noqa: E402
-from tests.contact3d.test_random_forces import GEARS, _scenario  # noqa: E402
+from tests.contact3d.test_random_forces import GEARS, STEEP, _draw, _scenario  # noqa: E402
 from tests.contact3d.test_seeds_pieces import CI  # noqa: E402
 from tests.contact3d.test_variety import FAST, FLANK_GEARS, GEAR  # noqa: E402
 from wormsim.contact3d.mjcf import flank_slices  # noqa: E402
@@ -54,8 +55,17 @@ def scenario(name: str, slices: int | None, medium: bool = False, hertz: bool = 
         return load_scenario(
             SCENARIOS / f"{name}.yaml", [*CI[name], "contact.geometry=flanks", *extra, *([stiffness] if hertz else [])]
         )
-    if name.startswith("random"):
-        d = _scenario(GEARS[int(name[6:])]).model_dump()
+    if name.startswith("random") or name == "steep":
+        # random{i}: tests/contact3d/test_random_forces.py's i-th draw (beyond its GEARS: further draws of the same
+        # generator, cases no setting was tuned on; the 4th, random3, is refused as undercut); steep: its STEEP
+        gear = (
+            STEEP
+            if name == "steep"
+            else GEARS[int(name[6:])]
+            if int(name[6:]) < len(GEARS)
+            else _draw(int(name[6:]) + 1)[-1]
+        )
+        d = _scenario(gear).model_dump()
         if medium:
             d["simulation"]["resolution"] = "medium"
         if slices is not None:
