@@ -297,3 +297,17 @@ def test_entering_tooth_load_converges_in_slices():
     its largest of 64 slices' (the leaving tooth's exit on involute_41: test_leaving_tooth_load_converges_in_slices)."""
     _, tooth_dev = _sweep_dev("screw_jack", 16, 512)
     assert tooth_dev < 0.01, tooth_dev
+
+
+def test_depths_finite_where_a_trimmed_point_ends_the_profile():
+    """The steep random gear (tests/contact3d/test_random_forces.py STEEP, gamma 33.7 deg, alpha_n 10 deg) at its
+    medium count (40): each tooth's quasi-static share of K over a mesh cycle is finite and at most 1 (+2 %). Its
+    grid has trimmed points next to the active profile's last point, where the end segment's length is not finite:
+    the slice's depth then stays the line's (kernel._write_contact); without that guard the tip-edge depth was NaN
+    and MuJoCo diverged at the first step."""
+    from tests.contact3d.test_random_forces import STEEP, _scenario
+
+    g = derive(_scenario(STEEP).gear)
+    r = mesh_sweep(g, 40, 256)
+    assert np.all(np.isfinite(r["k_mesh"]))
+    assert max(float(v.max()) for v in r["loads"].values()) < 1.02

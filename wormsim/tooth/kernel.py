@@ -487,16 +487,19 @@ def _write_contact(ev, sc, zeta, slc, at, gap, out, n):
         # worm's (its excess along the line), the covered part's depth the line's, the gap's parabola at the line's
         # point (at least the clamped line's), not the profile end's gap
         xl = tip[5] - il
-        line[n, 1] = max(-(best + qa * xl + qb * xl * xl), -gline) * taper
+        dl = max(-(best + qa * xl + qb * xl * xl), -gline)
     elif tip[3] or qb <= 0.0:  # the line inside the wheel's tip edge across the slice
-        line[n, 1] = -gline * taper
+        dl = -gline
     else:
         # the line crosses the tip edge in the slice (or lies past it): its depth averaged across the slice, the
         # line's depth the gap's parabola (_line_parabola, profile index offsets from il) at the line's point (at
         # tip[0] past the last point b along the end segment of length tip[4]), at least the clamped line's
         xl = sc[0][sg, j, 1] - il + tip[0] / tip[4]
         delta = max(-(best + qa * xl + qb * xl * xl), -gline)
-        line[n, 1] = _tip_depth(delta, qb / (tip[4] * tip[4]), tip[0], tip[1], tip[2]) * taper
+        dl = _tip_depth(delta, qb / (tip[4] * tip[4]), tip[0], tip[1], tip[2])
+    if dl - dl != 0.0:  # not finite (a trimmed point next to the profile's end: no end segment): the line's gline
+        dl = -gline
+    line[n, 1] = dl * taper
     meta[n, 0], meta[n, 1], meta[n, 2], meta[n, 3] = k, sg, j, f
 
 
