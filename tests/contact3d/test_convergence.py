@@ -80,7 +80,8 @@ DEFAULT_SLICES = {
 SLICES_XFAIL = {
     ("screw_jack", "tangential_force_p2p_n"): "whole-band F_t p2p 8.351 N at 16 slices against 6.712 N at 32 (+24.4 "
     "%; 2 % of its 400 N mean; 32 against 64: 6.712 / 6.549 N, +2.5 %; +29.2 % before decision 0052): the entering "
-    "tooth's line appears as a point on the wheel's tip edge inside the face and grows; its quasi-static load at 16 "
+    "tooth's line appears on the wheel's tip edge at its corners (the throat meets the outside diameter, 4.8 mm "
+    "either side of the mid-plane), where how far the line lies past the edge has a kink across the face; its quasi-static load at 16 "
     "slices is 2.5 % of its largest off 64 slices' (5.1 % before decision 0052) and rings the contact mode. The "
     "meshing band below 1 kHz converges (0.321 -> 0.336 N) and p_H max does (322.0 -> 324.2 MPa) "
     "(studies/slice_convergence_default.py --medium; docs/decisions/0052-slice-depth-where-the-line-leaves-the-profile.md)",

@@ -288,8 +288,10 @@ def test_mesh_stiffness_converges_where_the_line_leaves_the_profile():
     strict=True,
     reason="the screw jack's entering tooth at its default 16 slices: its quasi-static load 2.50 % of its "
     "largest off 64 slices' (5.1 % before decision 0052, which averages the depth across a slice where the line "
-    "runs off the wheel's tip edge): its line appears as a point on the tip edge inside the face and grows, which "
-    "the quadratic across a coarse slice does not follow (docs/decisions/0052-slice-depth-where-the-line-leaves-"
+    "runs off the wheel's tip edge): its line appears on the tip edge at the edge's corners (the throat meets the "
+    "outside diameter, 4.8 mm either side of the mid-plane), where how far the line lies past the edge has a kink "
+    "across the face (96 -> 154 -> 359 um over three of 64 slices), which the quadratic across a coarse slice does "
+    "not follow (docs/decisions/0052-slice-depth-where-the-line-leaves-"
     "the-profile.md)",
 )
 def test_entering_tooth_load_converges_in_slices():
