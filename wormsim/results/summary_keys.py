@@ -406,6 +406,13 @@ KEYS: dict[str, Key] = {
     "inertia_source": Key("text", T, "how the inertias are estimated"),
     "mesh_natural_frequency_hz": Key("Hz", T, "natural frequency of the mesh mode"),
     "drive_kv_nm_s": Key("N m s", T, "speed servo gain of a speed-driven shaft (null for a torque drive)"),
+    "drive_peak_torque_nm": Key(
+        "N m",
+        GEAR,
+        "a speed drive's peak torque: 3 x its rated torque, the expected torque at the full load plus the start-up "
+        "ramp's acceleration torque (wormsim.physics.gear_theory.servo_peak_torque_nm); the servo pushes no harder. "
+        "Null for a torque drive or a step command (drive.ramp_s 0)",
+    ),
     "backlash_angle_rad": Key("rad", T, "wheel-angle play of the mesh"),
     "mesh_stiffness_samples": Key("-", T, "k(theta) samples per mesh cycle"),
     "mesh_stiffness_source": Key(

@@ -435,12 +435,21 @@ class _Setup:
         self.kv = plan.servo_gain_nm_s if self.speed_driven else 0.0
         self.worm_drive = drv.on == "worm"
         self.drive_f, self.load_f = cmds.drive, cmds.load
+        # the speed drive's peak torque (gear_theory.servo_peak_torque_nm), None for a torque drive or a step command
+        j_drive = gt.drive_inertia_kg_m2(drv.on, g.ratio, self.I1, self.I2)
+        self.peak = (
+            gt.servo_peak_torque_nm(plan.drive_torque_nm, j_drive, cmds.drive_target, drv.ramp_s)
+            if self.speed_driven
+            else None
+        )
         w_full = abs(cmds.drive_target) if self.speed_driven else 2 * math.pi
         self.w1_full = w_full * (g.ratio if (self.speed_driven and not self.worm_drive) else 1.0)
 
     def shaft_torques(self, t, w1, w2):
         cmd = self.drive_f(t)
         td = self.kv * (cmd - (w1 if self.worm_drive else w2)) if self.speed_driven else cmd
+        if self.peak is not None:  # the servo under its peak torque
+            td = gt.servo_limited_torque_nm(td, self.peak)
         tl = self.load_f(t)
         return (td, tl) if self.worm_drive else (tl, td)
 
@@ -550,6 +559,7 @@ def _summary(plan: GearPlan, su: _Setup, S: dict, held: Held | None, solver_keys
         "contact_damping_used_n_s_per_m": mesh.c_lin,
         "contact_damping_ratio": mesh.c_lin / mesh.c_crit,
         "drive_kv_nm_s": su.kv if su.speed_driven else None,
+        "drive_peak_torque_nm": su.peak,
         "backlash_angle_rad": 2 * mesh.gap,
         "friction": plan.friction_mode,
         **ms.summary(),
