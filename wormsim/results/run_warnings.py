@@ -252,8 +252,8 @@ def drive_peak_warning(result: Result, scenario) -> str | None:
         f"the speed drive reached its peak torque: {float(T.max()):.4g} N m on the {on} against its peak "
         f"{peak:.4g} N m ({gt.SERVO_PEAK_FACTOR:g} x the rated torque: the expected torque at the full load plus the "
         f"ramp's acceleration torque) between t = {float(t_hit[0]):.3g} s and {float(t_hit[-1]):.3g} s; there the "
-        f"{on} follows the limit, slower than commanded: lengthen drive.ramp_s, or the load or the pair asks more than the drive's "
-        "rating"
+        f"{on} follows the limit, slower than commanded: lengthen drive.ramp_s, or the load or the pair asks more "
+        "than the drive's rating"
     )
 
 
