@@ -374,10 +374,11 @@ def _prepare(gp: GearPlan, gs: GearSet, slabs: int) -> Prepared:
         segments_per_turn=0 if flanks else gs.resolution.worm_segments_per_turn or 0,
     )
     S = scaling.factor
-    # a speed drive's peak torque, its ramp's share with the inertias the model has (x S)
+    # a stalling speed drive's peak torque (gear_theory.servo_peak_applies), its ramp's share with the inertias the
+    # model has (x S)
     drv = gp.duty.drive
     peak = None
-    if gp.duty.speed_driven:
+    if gt.servo_peak_applies(gp.duty.speed_driven, gp.backdrive_self_locks):
         j_drive = gt.drive_inertia_kg_m2(drv.on, geo.ratio, S * I1, S * I2)
         peak = gt.servo_peak_torque_nm(t_drive, j_drive, gp.duty.commands.drive_target, drv.ramp_s)
     held = gp.backdrive_self_locks

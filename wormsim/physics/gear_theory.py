@@ -350,6 +350,16 @@ def servo_peak_torque_nm(
     return SERVO_PEAK_FACTOR * rated
 
 
+def servo_peak_applies(speed_driven: bool, backdrive_self_locks: bool) -> bool:
+    """Where a speed drive's peak torque (servo_peak_torque_nm) is enforced: a drive that stalls by design, the wheel
+    back-driving a pair that self-locks at rest (wormsim.physics.locking.backdrive_self_locks). Every other speed
+    drive stays unlimited, a motion drive as in the seeds' ADAMS models: its servo also stands in for the motor's
+    rotor inertia, which the model lacks and which carries a real drive through impacts. Limited at 3 x, the other
+    gear's start-up impact (5.3 x its rating, 1.5 ms) and the convex pieces' facet impacts (up to 4.9 x, throughout
+    a 0.04 s run) bound, and the pieces variant's ratio moved by 0.13 % (docs/decisions/0053-servo-peak-torque.md)."""
+    return speed_driven and backdrive_self_locks
+
+
 def drive_inertia_kg_m2(drive_on: str, ratio: float, worm_kg_m2: float, wheel_kg_m2: float) -> float:
     """The inertia a drive accelerates, reduced to its shaft: I1 + I2 / i^2 on the worm, I2 + I1 i^2 on the
     wheel (each with its driven-machine inertia)."""

@@ -450,11 +450,11 @@ class _Setup:
         self.kv = plan.servo_gain_nm_s if self.speed_driven else 0.0
         self.worm_drive = drv.on == "worm"
         self.drive_f, self.load_f = cmds.drive, cmds.load
-        # the speed drive's peak torque (gear_theory.servo_peak_torque_nm), None for a torque drive or a step command
+        # a stalling speed drive's peak torque (gear_theory.servo_peak_applies), None elsewhere or for a step command
         j_drive = gt.drive_inertia_kg_m2(drv.on, g.ratio, self.I1, self.I2)
         self.peak = (
             gt.servo_peak_torque_nm(plan.drive_torque_nm, j_drive, cmds.drive_target, drv.ramp_s)
-            if self.speed_driven
+            if gt.servo_peak_applies(self.speed_driven, plan.backdrive_self_locks)
             else None
         )
         self.on = False  # the limit applied (integrate_backward_euler's limit; the series: always, binds)
