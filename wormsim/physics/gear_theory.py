@@ -342,8 +342,8 @@ def servo_peak_torque_nm(
     measured value. The run's servo (servo_gain_of) droops SPEED_DROOP at the expected torque, so unlimited it would
     push a stalled shaft with T_expected / SPEED_DROOP (1000 x): a wheel back-driving a self-locking pair crushed the
     held mesh (the screw jack at mu 0.2: 21 kN m against the 12 N m load, 1 mm penetration, the worm creeping at
-    0.7 %);
-    held at this limit it stands (docs/decisions/0053-servo-peak-torque.md)."""
+    0.7 %); held at this limit it stands (0.002 %, docs/decisions/0053-servo-peak-torque.md). Where it applies:
+    servo_peak_applies."""
     if ramp_s <= 0.0:
         return None
     rated = expected_torque_nm + drive_inertia_kg_m2 * STEP_PEAK_SLOPE * abs(command_rad_s) / ramp_s
@@ -371,8 +371,8 @@ def drive_inertia_kg_m2(drive_on: str, ratio: float, worm_kg_m2: float, wheel_kg
 def servo_limited_torque_nm(torque_nm: float, peak_nm: float | None) -> float:
     """The torsional servo's torque under its peak (servo_peak_torque_nm), solved within the implicit step: the
     linear law up to SERVO_KNEE x peak, above it peak - d exp(-(|T| - knee) / d) with d = peak - knee (continuous in
-    value and slope: with a hard clip the step's Newton iteration cycled and did not converge, the screw jack's held
-    back-drive at 3 x at t = 3 ms). None: the linear law."""
+    value and slope: with a hard clip the step's Newton iteration cycled and did not converge where the bend did, the
+    screw jack's held back-drive at 3 x at t = 3 ms). None: the linear law."""
     if peak_nm is None:
         return torque_nm
     knee = SERVO_KNEE * peak_nm
