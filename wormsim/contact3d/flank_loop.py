@@ -197,7 +197,7 @@ def views(T):
 
 
 # the speed servo's command under its peak torque (wormsim.physics.gear_theory.servo_command), compiled into run_table
-servo_command = numba.njit(inline="always")(gt.servo_command)
+servo_command = numba.njit(cache=True, inline="always")(gt.servo_command)
 
 
 @numba.njit(cache=True, nogil=True)
