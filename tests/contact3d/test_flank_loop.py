@@ -22,11 +22,15 @@ BASE = ["contact.geometry=flanks", "simulation.resolution=coarse", "drive.ramp_s
 
 def _python_sums(m, d, fc, bm, cmd, load, a1, a2, s0):
     """The runner's former per-step loop (wormsim.contact3d.runner.run_model before flank_loop), the step from Python
-    (native.split_step with FlankContacts.add)."""
+    (native.split_step with FlankContacts.add); the drive's command under its peak torque
+    (wormsim.physics.gear_theory.servo_command; the screw jack's worm drives)."""
+    from wormsim.physics import gear_theory as gt
+
     sd, act, qv, ctrl = d.sensordata, d.actuator_force, d.qvel, d.ctrl
+    band = bm.plan.servo_band_rad_s
     t1 = t2 = p1 = p2 = nc = fx = fy = fz = mz = fpk = 0.0
     for j in range(len(cmd)):
-        ctrl[bm.drive_actuator] = cmd[j]
+        ctrl[bm.drive_actuator] = gt.servo_command(float(cmd[j]), float(qv[bm.worm_dof]), band)
         ctrl[bm.load_actuator] = load[j]
         w1j, w2j = qv[bm.worm_dof], qv[bm.wheel_dof]
         split_step(m, d, fc.add)

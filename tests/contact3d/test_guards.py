@@ -73,42 +73,22 @@ def _held_through_the_cli(tmp_path, capsys, geometry: str) -> dict:
 
 
 def test_self_locking_pair_with_speed_driven_wheel_ends_held_with_flanks(tmp_path, capsys):
-    """The default geometry's held back-drive ends as a result (exit 0, locked, no contact message), whatever its creep
-    (the creep's own check is the strict xfail below): the wheel's servo crushes the held mesh to the penetration
-    limit while the worm turns at 0.66 % of z2 / z1 times the wheel's speed (guards.HELD_FOLLOW_FRACTION)."""
+    """The default geometry's held back-drive ends as a result (exit 0, locked, no contact message): the wheel's
+    servo stalls at its peak torque (gear_theory.servo_peak_torque_nm) and the mesh holds it; the summary says what
+    the servo pushed with (its peak, to 1e-9) and that the penetration stayed far inside its guard."""
     s = _held_through_the_cli(tmp_path, capsys, "flanks")
-    assert s["holding_torque_nm"] > 0 and s["creep_speed_rpm"] is not None
+    assert s["holding_torque_nm"] == pytest.approx(s["drive_peak_torque_nm"], rel=1e-9)
+    # the unlimited servo crushed the mesh to the penetration guard (1 mm, 0.4 m_x); held at the peak: 22 um
+    assert s["max_penetration_um"] < 0.1 * 0.4 * 2.5e3, s["max_penetration_um"]
 
 
-@pytest.mark.parametrize(
-    "geometry",
-    [
-        pytest.param(
-            "flanks",
-            marks=pytest.mark.xfail(
-                strict=True,
-                reason=(
-                    "exit 0 and locked, but the worm creeps at 9.31 rpm (0.71 % of 55 rpm x 24; sliding speed "
-                    "12 mm/s, 12 x contact.transition_velocity_m_s) while the stalled servo winds the held mesh up "
-                    "to 21 kN m (T_expected / SPEED_DROOP; 9.68 rpm, 24 kN m before decision 0051): the flank contacts slide in the held mesh where the "
-                    "pieces hold (under 0.1 %); the seat motor demo gear's flanks hold (0.079 rpm at 1 N m, "
-                    "tests/physics/test_locking.py); the friction rows' damping at c_c (no sliding speed) and impratio "
-                    "1.2e6 did not change it, nor did 20 noslip iterations (opt.noslip_iterations; 9.68 rpm). The wheel "
-                    "still turns into the worm at up to 40 rpm (27 rpm at the end, penetration up to 1 mm) and the worm "
-                    "moves with it at 1-16 rpm: the stall torque overruns the contact; constant mu, so the friction "
-                    "law's stick state (decision 0039) does not apply. Not resolved (issue 31 item 4)"
-                ),
-            ),
-        ),
-        "pieces",
-    ],
-)
+@pytest.mark.parametrize("geometry", ["flanks", "pieces"])
 def test_self_locking_pair_with_speed_driven_wheel_is_held_through_the_cli(tmp_path, capsys, geometry):
     """mu = 0.2: rho' = 12.0 deg > gamma = 5.71 deg, the wheel cannot turn the worm. That is the run's result
-    (wormsim.physics.locking), not a failure: exit 0, status ok, `locked` true, the holding torque the stalled servo pushed
-    with (wormsim.physics.locking.stall_torque_nm) and a creeping worm; no message about the contact. For each
-    contact.geometry. Before: exit 3, "the drive locked" (and with flanks the friction guard: at the worm load's
-    normal force the flank contacts' friction rows were sized for 1e-4 of the held force)."""
+    (wormsim.physics.locking), not a failure: exit 0, status ok, `locked` true, the holding torque the stalled servo
+    pushed with (its peak torque, wormsim.physics.locking.stall_torque_nm) and a creeping worm; no message about the
+    contact. For each contact.geometry. Before the servo's peak torque (decision 0053) the flanks crept at 0.71 %:
+    the unlimited servo (1000 x its expected torque, 21 kN m) crushed the held mesh to 1 mm."""
     # gamma = atan(z1 / q) = atan(1 / 10) = 5.71 deg for the screw jack (scenarios/screw_jack.yaml)
     assert _rho_deg(0.2, 20.0) > 5.71
     summary = _held_through_the_cli(tmp_path, capsys, geometry)

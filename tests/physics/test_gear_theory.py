@@ -182,3 +182,46 @@ def test_effective_modulus_steel_on_nylon():
     )
     # 1 / E* = (1 - 0.09) / 210e9 + (1 - 0.1521) / 3.1e9 -> E* = 3.5991 GPa
     assert gt.effective_modulus_pa(m) / 1e9 == pytest.approx(3.5991, abs=1e-4)
+
+
+def test_servo_peak_torque_is_three_times_the_rated_torque_with_the_ramp():
+    """servo_peak_torque_nm: 3 x (T_expected + J_eff 1.5 omega / ramp); 1.5 = the ADAMS STEP's steepest slope
+    (6 x (1 - x) at x = 1/2); no limit for a step command. J_eff: I1 + I2 / i^2 on the worm, I2 + I1 i^2 on the
+    wheel."""
+    assert gt.servo_peak_torque_nm(2.0, 1e-3, 100.0, 0.05) == pytest.approx(3 * (2.0 + 1e-3 * 1.5 * 100.0 / 0.05))
+    assert gt.servo_peak_torque_nm(2.0, 1e-3, -100.0, 0.05) == gt.servo_peak_torque_nm(2.0, 1e-3, 100.0, 0.05)
+    assert gt.servo_peak_torque_nm(2.0, 1e-3, 100.0, 0.0) is None
+    assert gt.drive_inertia_kg_m2("worm", 40.0, 1e-5, 0.16) == pytest.approx(1e-5 + 0.16 / 1600)
+    assert gt.drive_inertia_kg_m2("wheel", 40.0, 1e-5, 0.16) == pytest.approx(0.16 + 1e-5 * 1600)
+    # the STEP's steepest slope, by finite differences of the drive's own STEP
+    x = np.linspace(0.0, 1.0, 100001)
+    slope = np.max(np.diff(x**2 * (3 - 2 * x)) / np.diff(x))
+    assert slope == pytest.approx(gt.STEP_PEAK_SLOPE, rel=1e-6)
+
+
+def test_servo_command_leaves_the_linear_law_bit_for_bit_and_holds_the_peak():
+    """servo_command: inside band = peak / kv of the speed the command is the command itself (the same float: a run
+    whose drive never reaches its peak does not move); beyond it the servo's torque kv (command - w) is +-peak."""
+    kv, peak = 8333.0, 150.0
+    band = peak / kv
+    for cmd, w in ((5.76, 5.76), (5.76, 5.76 - 0.9 * band), (-3.0, -3.0 + 0.99 * band), (0.1234567, 0.1234)):
+        assert gt.servo_command(cmd, w, band) == cmd
+    assert kv * (gt.servo_command(5.76, 0.0, band) - 0.0) == pytest.approx(peak, rel=1e-12)  # a stall
+    assert kv * (gt.servo_command(5.76, 9.0, band) - 9.0) == pytest.approx(-peak, rel=1e-12)  # an overrun
+    assert gt.servo_command(5.76, 0.0, 0.0) == 5.76  # band 0: no limit
+
+
+def test_torsional_servo_law_bends_to_its_peak_and_is_linear_below_the_knee():
+    """servo_limited_torque_nm: the linear law up to 0.9 x peak, then continuous in value and slope, rising, below
+    the peak, and at the peak for a stalled servo's 1000 x."""
+    peak = 10.0
+    for t in (0.0, 3.0, -8.9999, 9.0):
+        assert gt.servo_limited_torque_nm(t, peak) == t
+    ts = np.linspace(0.0, 40.0, 4001)
+    ys = np.array([gt.servo_limited_torque_nm(float(t), peak) for t in ts])
+    assert np.all(np.diff(ys) >= 0) and ys.max() < peak
+    dy = np.diff(ys) / np.diff(ts)
+    assert abs(dy[899] - 1.0) < 1e-2 and abs(dy[900] - 1.0) < 1e-2  # the slope at the knee (t = 9)
+    assert gt.servo_limited_torque_nm(1000.0 * peak, peak) == pytest.approx(peak)
+    assert gt.servo_limited_torque_nm(-1000.0 * peak, peak) == pytest.approx(-peak)
+    assert gt.servo_limited_torque_nm(123.0, None) == 123.0

@@ -7,7 +7,8 @@ flank_pose.set_pose, kernel.find_packed (find_contacts with its memo, slice_weig
 flank_handoff.fill_add). It does what `FlankContacts.step` (wormsim.contact3d.flank_step) does from Python, in the
 same order and with the same floating-point operations, so the results are bit-identical
 (tests/contact3d/test_flank_loop.py).
-`run_table` steps an interval: per step the drive and load commands into d.ctrl, the shaft speeds read, flank_step,
+`run_table` steps an interval: per step the drive (under its peak torque, gear_theory.servo_command) and load commands
+into d.ctrl, the shaft speeds read, flank_step,
 then the runner's per-step sums (actuator torques, shaft powers T w, the contact sensor's count, force and moment,
 the peak |F_x|).
 
@@ -42,6 +43,7 @@ from wormsim.contact3d.contact_sums import contact_forces, radial_and_radius, ra
 from wormsim.contact3d.flank_handoff import Handed, Handoff, fill_add
 from wormsim.contact3d.native import N_BEFORE, call_stage, f1, f2, f3, f32x3, f64_at, i1, stage_addresses
 from wormsim.contact3d.series import N_SUMS, add_step
+from wormsim.physics import gear_theory as gt
 from wormsim.tooth.hertz import pattern_rows
 from wormsim.tooth.kernel import find_packed
 from wormsim.tooth.pose import set_pose
@@ -72,7 +74,7 @@ IV = enum.IntEnum(
     ),
     start=0,
 )
-FV = enum.IntEnum("FV", ("tooth0", "pitch", "margin", "taper", "mu"), start=0)
+FV = enum.IntEnum("FV", ("tooth0", "pitch", "margin", "taper", "mu", "servo_band"), start=0)
 STAGE_ADDRESSES = stage_addresses()  # native.STEP by address, mj_addContact last
 
 
@@ -194,6 +196,10 @@ def views(T):
     )  # fmt: skip
 
 
+# the speed servo's command under its peak torque (wormsim.physics.gear_theory.servo_command), compiled into run_table
+servo_command = numba.njit(cache=True, inline="always")(gt.servo_command)
+
+
 @numba.njit(cache=True, nogil=True)
 def run_table(T, m_addr, d_addr, cmd, load, j0, j1):
     """Steps j0..j1-1 of the command arrays cmd (drive) and load (module docstring), their arrays given by address
@@ -206,10 +212,12 @@ def run_table(T, m_addr, d_addr, cmd, load, j0, j1):
     iv = v.iv
     ia_drv, ia_load, dof1, dof2 = iv[IV.drive_actuator], iv[IV.load_actuator], iv[IV.worm_dof], iv[IV.wheel_dof]
     a1, a2, s0 = iv[IV.worm_actuator], iv[IV.wheel_actuator], iv[IV.sensor]
+    band = f1(T, Row.fv)[FV.servo_band]  # the drive's peak torque / kv (servo_command; 0: none)
+    dof_drv = dof2 if ia_drv == a2 else dof1
     sums = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
     dropped = 0
     for j in range(j0, j1):
-        ctrl[ia_drv] = cmd[j]
+        ctrl[ia_drv] = servo_command(cmd[j], qvel[dof_drv], band)
         ctrl[ia_load] = load[j]
         w1j, w2j = qvel[dof1], qvel[dof2]
         dropped += flank_step(v, m_addr, d_addr)
@@ -345,6 +353,7 @@ class FlankLoop:
         }
         self.iv = np.array([iv[k] for k in IV], dtype=np.int64)
         fv = {FV.tooth0: float(bm.tooth0_angle_rad), FV.pitch: fc.pitch, FV.margin: fc.margin0, FV.taper: fc.taper_rad}
+        fv[FV.servo_band] = bm.plan.servo_band_rad_s if runner else 0.0
         self.fv = np.array([fv.get(k, 0.0) for k in FV])  # mu: `prepare`
         self.state = np.array([NO_WINDOW if fc.centre is None else fc.centre, fc.n], dtype=np.int64)
         self.acc = np.zeros(N_SUMS)

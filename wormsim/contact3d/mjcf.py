@@ -140,6 +140,7 @@ class Prepared:
     timestep_s: float = 0.0  # the model's timestep (build_model: timestep_for's or the one given)
     window_teeth: int = 0  # the wheel tooth slots with collision (build_model)
     wheel_torque_nm: float = 0.0  # T2 the friction rows are sized for: the working one, a held stall's when larger
+    servo_peak_torque_nm: float | None = None  # a speed drive's peak torque (gear_theory.servo_peak_torque_nm)
     supports: dict = field(default_factory=dict)  # part -> its Support (wormsim.contact3d.shafts.support) or None
 
     @property
@@ -166,6 +167,13 @@ class Prepared:
     def servo_gain_nm_s(self) -> float | None:
         """A speed drive's kv (gear_theory.servo_gain_of); None for a torque drive."""
         return self.gear.servo_gain_nm_s
+
+    @property
+    def servo_band_rad_s(self) -> float:
+        """The speed servo's band peak / kv (wormsim.contact3d.flank_loop.servo_command); 0: no limit (a torque
+        drive, a step command)."""
+        kv, peak = self.servo_gain_nm_s, self.servo_peak_torque_nm
+        return peak / kv if kv and peak is not None else 0.0
 
     @property
     def stick_velocity_m_s(self) -> float:
@@ -347,15 +355,7 @@ def _prepare(gp: GearPlan, gs: GearSet, slabs: int) -> Prepared:
     # the drive and load, once (wormsim.physics.plan): their commands, the worm's speed, the working and the
     # drive's torques
     w1, t_drive, t2 = gp.worm_speed_rad_s, gp.drive_torque_nm, gp.working_wheel_torque_nm
-    held = gp.backdrive_self_locks
-    if (
-        held
-    ):  # the mesh holds the stalled wheel servo's torque (wormsim.physics.locking): the friction rows' hardness for it
-        t2 = max(t2, stall_torque_nm(t_drive))
     arm1, arm2 = gt.mesh_arms_m(geo.r_m1, geo.r2, geo.alpha_n, geo.gamma_m)
-    f_n, v_s = nominal_normal_force_n(t2, geo), nominal_sliding_speed_m_s(w1, geo)
-    if held:  # the worm stands: no sliding speed to size the friction rows' damping by (law (4): c_f = c_c)
-        v_s = 0.0
     # driven-machine inertia J on the loaded shaft (joint armature) belongs to that shaft's effective mass
     I1 = ine.worm_inertia_kg_m2 + ine.worm_load_inertia_kg_m2
     I2 = ine.wheel_inertia_kg_m2 + ine.wheel_load_inertia_kg_m2
@@ -374,6 +374,19 @@ def _prepare(gp: GearPlan, gs: GearSet, slabs: int) -> Prepared:
         segments_per_turn=0 if flanks else gs.resolution.worm_segments_per_turn or 0,
     )
     S = scaling.factor
+    # a stalling speed drive's peak torque (gear_theory.servo_peak_applies), its ramp's share with the inertias the
+    # model has (x S)
+    drv = gp.duty.drive
+    peak = None
+    if gt.servo_peak_applies(gp.duty.speed_driven, gp.backdrive_self_locks):
+        j_drive = gt.drive_inertia_kg_m2(drv.on, geo.ratio, S * I1, S * I2)
+        peak = gt.servo_peak_torque_nm(t_drive, j_drive, gp.duty.commands.drive_target, drv.ramp_s)
+    held = gp.backdrive_self_locks
+    if held:  # the mesh holds the stalled wheel servo's torque (wormsim.physics.locking): the friction rows' hardness
+        t2 = max(t2, stall_torque_nm(t_drive, peak))
+    f_n, v_s = nominal_normal_force_n(t2, geo), nominal_sliding_speed_m_s(w1, geo)
+    if held:  # the worm stands: no sliding speed to size the friction rows' damping by (law (4): c_f = c_c)
+        v_s = 0.0
     a1, a2 = arm1**2 / (S * I1), arm2**2 / (S * I2)
     if S != 1:  # the scaled inertias
         ine = Inertias(*(S * v for v in astuple(ine)))
@@ -404,6 +417,7 @@ def _prepare(gp: GearPlan, gs: GearSet, slabs: int) -> Prepared:
         mu_law=mu_law(contact),
         e_star_pa=gt.effective_modulus_pa(mats),
         wheel_torque_nm=t2,
+        servo_peak_torque_nm=peak,
         supports=supports,
     )
 

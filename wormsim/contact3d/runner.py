@@ -108,6 +108,7 @@ def run_model(bm: BuiltModel, progress=None) -> Result:
         if held is None
         else held_keys(S["t_s"], S["worm_speed_rpm"], S["wheel_torque_nm"], held.stuck_since_s or held.t_s)
     )
+    lock["drive_peak_torque_nm"] = plan.servo_peak_torque_nm  # the speed drive's limit (gear_theory)
     st_keys, ms, lt = _stiffness_outputs(bm)  # the tooth pair's stiffness and load sharing (torsional's)
     step_wall_us = 1e6 * wall / max(n_rec * rec, 1)
     summary = level_summary(

@@ -24,6 +24,7 @@ import numpy as np
 from wormsim.contact3d.mjcf import BuiltModel
 from wormsim.contact3d.series import ZERO_SUMS, add_step
 from wormsim.contact3d.slots import repose_window
+from wormsim.physics import gear_theory as gt
 
 _ROWS3 = np.arange(3)  # the normal and two tangent rows of an elliptic-cone contact
 
@@ -54,8 +55,10 @@ class PieceSource:
         sd, act, qv, ctrl = d.sensordata, d.actuator_force, d.qvel, d.ctrl
         dof1, dof2 = bm.worm_dof, bm.wheel_dof
         sums = ZERO_SUMS
+        band, dof_drv = bm.plan.servo_band_rad_s, dof1 if bm.plan.drive_on == "worm" else dof2
         for j in range(o, o + rec):
-            ctrl[ia_drv] = cmd_blk[j]
+            # the drive's peak torque (gear_theory.servo_command; band 0: none)
+            ctrl[ia_drv] = gt.servo_command(cmd_blk[j], float(qv[dof_drv]), band) if band else cmd_blk[j]
             ctrl[ia_load] = load_blk[j]
             w1j, w2j = float(qv[dof1]), float(qv[dof2])
             mujoco.mj_step(m, d)

@@ -321,6 +321,87 @@ def servo_gain_of(drv: Drive, expected_torque_nm: float) -> float:
     return expected_torque_nm / (SPEED_DROOP * max(w_cmd, 1e-3))
 
 
+SERVO_PEAK_FACTOR = 3.0  # a speed drive's peak torque: this many times its rated torque (servo_peak_torque_nm)
+SERVO_KNEE = 0.9  # the torsional servo's limit bends off the linear law above this share of the peak
+STEP_PEAK_SLOPE = 1.5  # ADAMS STEP's steepest slope, x (h1 - h0) / ramp: d/dx x^2 (3 - 2 x) = 6 x (1 - x) at x = 1/2
+
+
+def servo_peak_torque_nm(
+    expected_torque_nm: float, drive_inertia_kg_m2: float, command_rad_s: float, ramp_s: float
+) -> float | None:
+    """The peak torque (N m) of a speed drive: SERVO_PEAK_FACTOR x its rated torque, the rated torque being what the
+    run asks of it, the expected torque at the full load (expected_drive_torque_of) plus the start-up ramp's
+    acceleration torque J_eff STEP_PEAK_SLOPE omega_cmd / ramp_s (J_eff: the inertia the drive accelerates, reduced
+    to its shaft, drive_inertia_kg_m2). None (no limit) for a step command (ramp_s 0), whose acceleration no finite
+    torque follows.
+
+    A speed servo (a motor with its amplifier's speed loop) is sized for its duty's rated torque (the load plus the
+    acceleration, servo-sizing practice) and delivers a peak torque of a few times that for short spells: the
+    intermittent zone of a servo motor's torque-speed curve reaches about three times its continuous rating, and the
+    amplifier's current limit holds the torque there. SERVO_PEAK_FACTOR = 3 is that modelling choice, not a
+    measured value. The run's servo (servo_gain_of) droops SPEED_DROOP at the expected torque, so unlimited it would
+    push a stalled shaft with T_expected / SPEED_DROOP (1000 x): a wheel back-driving a self-locking pair crushed the
+    held mesh (the screw jack at mu 0.2: 21 kN m against the 12 N m load, 1 mm penetration, the worm creeping at
+    0.7 %); held at this limit it stands (0.002 %, docs/decisions/0053-servo-peak-torque.md). Where it applies:
+    servo_peak_applies."""
+    if ramp_s <= 0.0:
+        return None
+    rated = expected_torque_nm + drive_inertia_kg_m2 * STEP_PEAK_SLOPE * abs(command_rad_s) / ramp_s
+    return SERVO_PEAK_FACTOR * rated
+
+
+def servo_peak_applies(speed_driven: bool, backdrive_self_locks: bool) -> bool:
+    """Where a speed drive's peak torque (servo_peak_torque_nm) is enforced: a drive that stalls by design, the wheel
+    back-driving a pair that self-locks at rest (wormsim.physics.locking.backdrive_self_locks). Every other speed
+    drive stays unlimited, a motion drive as in the seeds' ADAMS models: its servo also stands in for the motor's
+    rotor inertia, which the model lacks and which carries a real drive through impacts. Limited at 3 x, the other
+    gear's start-up impact (5.3 x its rating, 1.5 ms) and the convex pieces' facet impacts (up to 4.9 x, throughout
+    a 0.04 s run) bound, and the pieces variant's ratio moved by 0.13 % (docs/decisions/0053-servo-peak-torque.md)."""
+    return speed_driven and backdrive_self_locks
+
+
+def drive_inertia_kg_m2(drive_on: str, ratio: float, worm_kg_m2: float, wheel_kg_m2: float) -> float:
+    """The inertia a drive accelerates, reduced to its shaft: I1 + I2 / i^2 on the worm, I2 + I1 i^2 on the
+    wheel (each with its driven-machine inertia)."""
+    if drive_on == "worm":
+        return worm_kg_m2 + wheel_kg_m2 / ratio**2
+    return wheel_kg_m2 + worm_kg_m2 * ratio**2
+
+
+def servo_limited_torque_nm(torque_nm: float, peak_nm: float | None) -> float:
+    """The torsional servo's torque under its peak (servo_peak_torque_nm), solved within the implicit step: the
+    linear law up to SERVO_KNEE x peak, above it peak - d exp(-(|T| - knee) / d) with d = peak - knee (continuous in
+    value and slope: with a hard clip the step's Newton iteration cycled and did not converge where the bend did, the
+    screw jack's held back-drive at 3 x at t = 3 ms). None: the linear law."""
+    if peak_nm is None:
+        return torque_nm
+    knee = SERVO_KNEE * peak_nm
+    x = abs(torque_nm)
+    if x <= knee:
+        return torque_nm
+    d = peak_nm - knee
+    return math.copysign(peak_nm - d * math.exp(-(x - knee) / d), torque_nm)
+
+
+def servo_command(cmd: float, w: float, band: float) -> float:
+    """The speed servo's command under its peak torque (servo_peak_torque_nm), for a step that starts at speed w:
+    cmd, or, where w is more than band = peak / kv from it, w + band towards it. The servo's torque kv (command -
+    w') at the step's end speed w' is then peak - kv (w' - w): the peak at a stall, the linear law wherever the
+    limit does not bind (the command unchanged, bit for bit), and implicit in w' as the unlimited servo (a hard
+    clip of kv (cmd - w) is explicit where it binds: with kv h / I of 400 it chattered between +peak and -peak
+    step by step with MuJoCo's forcerange; docs/decisions/0053-servo-peak-torque.md). contact3d's drive
+    (wormsim.contact3d.flank_loop.run_table); the torsional level's implicit step solves the limited law itself
+    (servo_limited_torque_nm). Where it binds while the shaft is free to accelerate, the damping
+    kv (w' - w) slows the acceleration to I / (I + kv h) of the peak's: such a run is warned about
+    (wormsim.results.run_warnings.drive_peak_warning). band 0: no limit."""
+    if band > 0.0:
+        if cmd - w > band:
+            return w + band
+        if w - cmd > band:
+            return w - band
+    return cmd
+
+
 # ----------------------------------------------------------------------------- guards
 
 PENETRATION_LIMIT_AXIAL_MODULES = 0.4  # beyond 0.4 m_x of penetration (mesh deflection) teeth are about to skip

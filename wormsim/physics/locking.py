@@ -70,12 +70,15 @@ def run_keys(
     return {"locked": True, "holding_torque_nm": abs(float(drv.torque_nm)), "creep_speed_rpm": creep}
 
 
-def stall_torque_nm(expected_drive_torque_nm: float) -> float:
-    """The torque a stalled speed servo pushes with: kv omega_cmd = T_expected / SPEED_DROOP
-    (gear_theory.servo_gain_of). contact3d takes it as the held mesh's working torque for the friction rows' hardness
-    (wormsim.contact3d.law (3)) when backdrive_self_locks: with the worm load alone (often 0) impratio fell to 1 and
-    the held pair crept back through the soft cone's viscous branch (measured: 65 rpm of the worm, 6 % of the wheel
-    command times the ratio, on the seat motor demo gear at mu 0.1)."""
+def stall_torque_nm(expected_drive_torque_nm: float, peak_torque_nm: float | None) -> float:
+    """The torque a stalled speed servo pushes with: its peak torque (gear_theory.servo_peak_torque_nm), or without
+    one (a step command) kv omega_cmd = T_expected / SPEED_DROOP (gear_theory.servo_gain_of). contact3d takes it as
+    the held mesh's working torque for the friction rows' hardness (wormsim.contact3d.law (3)) when
+    backdrive_self_locks: with the worm load alone (often 0) impratio fell to 1 and the held pair crept back through
+    the soft cone's viscous branch (measured: 65 rpm of the worm, 6 % of the wheel command times the ratio, on the
+    seat motor demo gear at mu 0.1)."""
+    if peak_torque_nm is not None:
+        return peak_torque_nm
     return expected_drive_torque_nm / gt.SPEED_DROOP
 
 

@@ -17,7 +17,8 @@ that are computed correctly but that a user should not read as the gear's steady
   materials.wheel); a runaway (the driven shaft above RUNAWAY_FACTOR x its speed command, or, for a torque drive,
   RUNAWAY_FACTOR x its speed at half the run at the end: still accelerating); power
   flowing from the wheel into a worm-driven pair (an overhauling load); a pair that does not turn (no ratio and no
-  efficiency). The root stress above its limit is the rating's warning (wormsim.rating.fe_root).
+  efficiency); a speed drive at its peak torque outside a held back-drive (the shaft follows the limit, not its
+  command). The root stress above its limit is the rating's warning (wormsim.rating.fe_root).
 """
 
 from __future__ import annotations
@@ -228,12 +229,45 @@ def power_flow_warning(summary: dict, scenario) -> str | None:
     return None
 
 
+def drive_peak_warning(result: Result, scenario) -> str | None:
+    """A speed drive at its peak torque (summary `drive_peak_torque_nm`, wormsim.physics.gear_theory
+    .servo_peak_torque_nm) in a run that did not end held: its |torque| at or above SERVO_KNEE of the peak, where the
+    limit bends the servo's law (torsional) or binds (contact3d), so the shaft follows the limit, not its command.
+    A held back-drive (`locked`) stalls at the peak by design and is not warned about."""
+    from wormsim.physics import gear_theory as gt
+
+    peak = _num(result.summary, "drive_peak_torque_nm")
+    if peak is None or scenario is None or scenario.drive is None or result.summary.get("locked") is True:
+        return None
+    on = scenario.drive.on
+    S = result.series
+    if f"{on}_torque_nm" not in S or "t_s" not in S or not len(S["t_s"]):
+        return None
+    t, T = np.asarray(S["t_s"]), np.abs(np.asarray(S[f"{on}_torque_nm"]))
+    hit = T >= gt.SERVO_KNEE * peak
+    if not hit.any():
+        return None
+    t_hit = t[hit]
+    return (
+        f"the speed drive reached its peak torque: {float(T.max()):.4g} N m on the {on} against its peak "
+        f"{peak:.4g} N m ({gt.SERVO_PEAK_FACTOR:g} x the rated torque: the expected torque at the full load plus the "
+        f"ramp's acceleration torque) between t = {float(t_hit[0]):.3g} s and {float(t_hit[-1]):.3g} s; there the "
+        f"{on} follows the limit, slower than commanded: lengthen drive.ramp_s, or the load or the pair asks more "
+        "than the drive's rating"
+    )
+
+
 def plausibility_warnings(result: Result, scenario) -> list[str]:
     """The results that contradict a physical limit or the run's premise (see the module docstring)."""
     s = result.summary
     return [
         w
-        for w in (pressure_warning(s, scenario), runaway_warning(result, scenario), power_flow_warning(s, scenario))
+        for w in (
+            pressure_warning(s, scenario),
+            runaway_warning(result, scenario),
+            power_flow_warning(s, scenario),
+            drive_peak_warning(result, scenario),
+        )
         if w
     ]
 

@@ -292,7 +292,7 @@ def default_timestep(g: GearGeometry, ms: MeshStiffness, w1_full_rad_s: float, d
     return max(gt.round_down_125(min(h, duration_s / 50)), duration_s / MAX_SAMPLES)
 
 
-def integrate_backward_euler(acc, duration: float, h: float, max_iter: int = 30):
+def integrate_backward_euler(acc, duration: float, h: float, max_iter: int = 30, limit=None):
     """Fixed-step backward (implicit) Euler, L-stable (Hairer & Wanner, Solving ODEs II, IV.3), for
     theta_i' = omega_i, omega_i' = a_i(t, theta1, omega1, theta2, omega2):
 
@@ -304,7 +304,10 @@ def integrate_backward_euler(acc, duration: float, h: float, max_iter: int = 30)
     system is reduced to 2x2 in the speed updates (d theta_i = r_theta_i + h d omega_i) and solved by Cramer's
     rule, all in floats. Converged when every update is below TOL + 1e-10 |y|. A step whose iteration does not
     converge is split in two (recursively, down to h / 1024). It steps over the mesh and servo modes (kHz) and
-    damps them: it follows the motion and the quasi-static mesh force.
+    damps them: it follows the motion and the quasi-static mesh force. limit (the speed servo's peak torque,
+    _Setup): each step is solved with the limit as it was in the step before (limit.on) and solved again with it
+    switched when the solution says otherwise (limit.binds(t, y)) or the solve fails, so that a run whose servo
+    never reaches its knee takes the unlimited law's iterations, bit for bit.
     Returns (t, Y (4, n + 1), evaluations of acc)."""
     n = int(math.floor(duration / h + 1e-9))
     t = np.arange(n + 1) * h
@@ -364,10 +367,22 @@ def integrate_backward_euler(acc, duration: float, h: float, max_iter: int = 30)
         ym = solve_step(y0, y0, t1 - hh / 2, hh / 2, depth + 1)
         return solve_step(ym, ym, t1, hh / 2, depth + 1)
 
+    def limited_step(y0, yp, t1):
+        """solve_step with the servo's limit switched where the solution (or a failed solve) asks for it."""
+        try:
+            y1 = solve_step(y0, yp, t1, h, 0)
+            if limit.binds(t1, y1) == limit.on:
+                return y1
+        except SimulationError:
+            pass
+        limit.on = not limit.on
+        return solve_step(y0, yp, t1, h, 0)
+
     y_prev = y = (0.0, 0.0, 0.0, 0.0)
     for i in range(n):
         pred = tuple(2 * a - b for a, b in zip(y, y_prev))
-        y_prev, y = y, solve_step(y, pred, t[i + 1], h, 0)
+        y_new = solve_step(y, pred, t[i + 1], h, 0) if limit is None else limited_step(y, pred, t[i + 1])
+        y_prev, y = y, y_new
         Y[:, i + 1] = y
     return t, Y, nfev
 
@@ -435,12 +450,27 @@ class _Setup:
         self.kv = plan.servo_gain_nm_s if self.speed_driven else 0.0
         self.worm_drive = drv.on == "worm"
         self.drive_f, self.load_f = cmds.drive, cmds.load
+        # a stalling speed drive's peak torque (gear_theory.servo_peak_applies), None elsewhere or for a step command
+        j_drive = gt.drive_inertia_kg_m2(drv.on, g.ratio, self.I1, self.I2)
+        self.peak = (
+            gt.servo_peak_torque_nm(plan.drive_torque_nm, j_drive, cmds.drive_target, drv.ramp_s)
+            if gt.servo_peak_applies(self.speed_driven, plan.backdrive_self_locks)
+            else None
+        )
+        self.on = False  # the limit applied (integrate_backward_euler's limit; the series: always, binds)
         w_full = abs(cmds.drive_target) if self.speed_driven else 2 * math.pi
         self.w1_full = w_full * (g.ratio if (self.speed_driven and not self.worm_drive) else 1.0)
+
+    def binds(self, t: float, y) -> bool:
+        """The servo's unlimited law beyond the knee of its peak (gear_theory.servo_limited_torque_nm) at state y."""
+        w = y[1] if self.worm_drive else y[3]
+        return abs(self.kv * (self.drive_f(t) - w)) > gt.SERVO_KNEE * self.peak
 
     def shaft_torques(self, t, w1, w2):
         cmd = self.drive_f(t)
         td = self.kv * (cmd - (w1 if self.worm_drive else w2)) if self.speed_driven else cmd
+        if self.on:  # the servo under its peak torque
+            td = gt.servo_limited_torque_nm(td, self.peak)
         tl = self.load_f(t)
         return (td, tl) if self.worm_drive else (tl, td)
 
@@ -464,10 +494,12 @@ def run_plan(plan: GearPlan, progress=None, scipy_method: str | None = None) -> 
     h = plan.simulation.timestep_s or default_timestep(g, ms, su.w1_full, duration)
     t_wall = time.perf_counter()
     if scipy_method is not None:
+        su.on = su.peak is not None  # scipy's solvers: the limited law throughout
         t, Y, nfev = _integrate_scipy(rhs, duration, h, ms, su.w1_full, scipy_method)
         solver = f"scipy {scipy_method} rtol {RTOL}"
     else:
-        t, Y, nfev = integrate_backward_euler(acc, duration, h)
+        limit = su if su.peak is not None else None
+        t, Y, nfev = integrate_backward_euler(acc, duration, h, limit=limit)
         solver = "backward Euler (fixed step, Newton)"
     wall = time.perf_counter() - t_wall
     if progress is not None:
@@ -500,6 +532,7 @@ def _series(plan: GearPlan, su: _Setup, t: np.ndarray, Y: np.ndarray) -> tuple[d
         n = int(np.searchsorted(t, held.t_s, side="right"))
         t, th1, w1, th2, w2, cmd = t[:n], th1[:n], w1[:n], th2[:n], w2[:n], cmd[:n]
         out = {k: v[:n] for k, v in out.items()}
+    su.on = su.peak is not None  # the limited law is the unlimited one below its knee (servo_limited_torque_nm)
     tq = np.array([su.shaft_torques(ti, a, b) for ti, a, b in zip(t, w1, w2)])
     S = {
         "t_s": t,
@@ -550,6 +583,7 @@ def _summary(plan: GearPlan, su: _Setup, S: dict, held: Held | None, solver_keys
         "contact_damping_used_n_s_per_m": mesh.c_lin,
         "contact_damping_ratio": mesh.c_lin / mesh.c_crit,
         "drive_kv_nm_s": su.kv if su.speed_driven else None,
+        "drive_peak_torque_nm": su.peak,
         "backlash_angle_rad": 2 * mesh.gap,
         "friction": plan.friction_mode,
         **ms.summary(),
