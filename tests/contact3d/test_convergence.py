@@ -71,67 +71,34 @@ def _per_step(name: str, half: bool = False) -> dict:
 
 
 DEFAULT_SLICES = {
-    "screw_jack": 16,
+    "screw_jack": 32,
     "seat_motor": 32,
-    "involute_41": 24,
+    "involute_41": 32,
 }  # wormsim.tooth.grid.default_slices at medium (the CI runs' resolution)
 
 
-SLICES_XFAIL = {
-    ("screw_jack", "tangential_force_p2p_n"): "whole-band F_t p2p 8.351 N at 16 slices against 6.712 N at 32 (+24.4 "
-    "%; 2 % of its 400 N mean; 32 against 64: 6.712 / 6.549 N, +2.5 %; +29.2 % before decision 0052): the entering "
-    "tooth's line appears on the wheel's tip edge at its corners (the throat meets the outside diameter, 4.8 mm "
-    "either side of the mid-plane), where how far the line lies past the edge has a kink across the face; its quasi-static load at 16 "
-    "slices is 2.5 % of its largest off 64 slices' (5.1 % before decision 0052) and rings the contact mode. The "
-    "meshing band below 1 kHz converges (0.321 -> 0.336 N) and p_H max does (322.0 -> 324.2 MPa) "
-    "(studies/slice_convergence_default.py --medium; docs/decisions/0052-slice-depth-where-the-line-leaves-the-profile.md)",
-}
-
-
-@pytest.mark.parametrize(
-    "name,key",
-    [
-        pytest.param(n, k, marks=pytest.mark.xfail(reason=SLICES_XFAIL[(n, k)], strict=True))
-        if (n, k) in SLICES_XFAIL
-        else (n, k)
-        for n in DEFAULT_SLICES
-        for k in SLICE_KEYS
-    ],
-)
+@pytest.mark.parametrize("name,key", [(n, k) for n in DEFAULT_SLICES for k in SLICE_KEYS])
 def test_flank_fluctuation_converged_in_slices(name, key):
     """The default slice count (the CI run, medium: flanks.default_slices) against twice it: within 10 % (issue 31:
     F_t p2p and p_H max, wormsim.tooth.hertz (4); and the TE p2p). With the slice weights along the contact line
     (decision 0051), the slice's depth where the line leaves the profile (decision 0052) and 4 contacts per flank
-    (decision 0049): involute_41 F_t p2p 701.9 -> 690.0 N (+1.7 %; 583.6 -> 271.7 N before decision 0051), p_H max
-    253.9 -> 254.0 MPa; screw jack p_H max 322.0 -> 324.2 MPa; seat motor (32; F_t p2p 0.07 % of its mean): F_t p2p
-    0.881 -> 0.885 N, p_H max 662.7 -> 629.4 MPa (+5.3 %) (studies/slice_convergence_default.py --medium; law (5) of
-    wormsim.contact3d.law)."""
+    (decision 0049), at least 32 slices (decision 0054): involute_41 F_t p2p 688.2 -> 701.2 N (-1.8 %; 701.9 -> 690.0
+    N at 24, 583.6 -> 271.7 N before decision 0051), p_H max 253.8 -> 253.9 MPa; screw jack F_t p2p 6.712 -> 6.549 N
+    (+2.5 %; 8.351 -> 6.712 N, +24.4 %, at 16 slices), p_H max 324.2 -> 324.4 MPa; seat motor (F_t p2p 0.07 % of its
+    mean): F_t p2p 0.881 -> 0.885 N, p_H max 662.7 -> 629.4 MPa (+5.3 %) (studies/slice_convergence_default.py
+    --medium; law (5) of wormsim.contact3d.law)."""
     n = DEFAULT_SLICES[name]
     a, b = run(name), run(name, f"contact.slices={2 * n}")
     assert a["flank_slices"] == n and b["flank_slices"] == 2 * n
     assert b[key] == pytest.approx(a[key], rel=0.10), (key, a[key], b[key])
 
 
-MESH_BAND_XFAIL = {
-    "involute_41": "meshing band below 1 kHz: F_t p2p 454.0 N at 24 slices against 402.8 N at 48 (+12.7 %; 453.6 / "
-    "399.9 N before decision 0052, 392.4 / 248.0 N per slice before decision 0051): with the teeth's compliance (its "
-    "default; 1.01e9 N/m per tooth pair against Hertz's 5.41e9) the contact mode is at 941 Hz, inside the band, where "
-    "each leaving tooth's load rings it; per slice 48 against 96 slices (before decision 0052): 411.5 against 460.0 N "
-    "(-10.5 %) (studies/slice_convergence_default.py --medium, --factor 2)",
-}
-
-
-@pytest.mark.parametrize(
-    "name",
-    [
-        pytest.param(n, marks=pytest.mark.xfail(reason=MESH_BAND_XFAIL[n], strict=True)) if n in MESH_BAND_XFAIL else n
-        for n in DEFAULT_SLICES
-    ],
-)
+@pytest.mark.parametrize("name", list(DEFAULT_SLICES))
 def test_flank_mesh_band_converged_in_slices(name):
     """F_t's meshing band (below 1 kHz, under the contact modes) at the default against twice the slices, within 10 %:
-    screw jack 0.321 -> 0.336 N (16 -> 32), seat motor 0.828 -> 0.871 N (32 -> 64; studies/slice_convergence_default.py
-    --medium; decisions 0051, 0052)."""
+    screw jack 0.336 -> 0.324 N, involute_41 413.4 -> 428.2 N (-3.5 %; +12.7 % at 24 slices, where its 941 Hz contact
+    mode inside the band rang differently at each count), seat motor 0.828 -> 0.871 N (32 -> 64;
+    studies/slice_convergence_default.py --medium; decisions 0051, 0052, 0054)."""
     n = DEFAULT_SLICES[name]
     a, b = mesh_band_p2p(name), mesh_band_p2p(name, f"contact.slices={2 * n}")
     assert b == pytest.approx(a, rel=0.10), (a, b)

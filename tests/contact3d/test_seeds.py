@@ -1,5 +1,5 @@
 """The seed validation of tests/contact3d/test_seeds_pieces.py with `contact.geometry: flanks` (issue 13): same CI
-configurations (slices by flanks.default_slices: seat_motor 32, screw_jack 16, involute_41 24), same criteria: ratio
+configurations (slices by flanks.default_slices: 32 each), same criteria: ratio
 0.1 %, meshing frequency, torque balance 2 %, efficiency within 3 % of the wedge model at the pitch radius and at the
 contact radius, DIN 3975 radial force 3 %. Measured numbers of the expected failures in docs/contact3d.md."""
 

@@ -233,7 +233,7 @@ def test_scenario_md_has_every_block():
 def test_check_prints_the_derived_sizes_timestep_and_slices(template, capsys):
     """The user's gear: d1 = q m_x = 40 mm, d2 = z2 m_x = 160 mm, a = 100 mm, b2 = 0.75 d_a1 = 36 mm; at contact3d
     the step and slices of the model its run builds (measured: 3.6e-05 s with the teeth's compliance, 0.4 x the stable
-    limit 9.07e-05 s rounded down to two digits; 24 slices at medium)."""
+    limit 9.07e-05 s rounded down to two digits; 32 slices at medium)."""
     from wormsim.cli import main
 
     assert (

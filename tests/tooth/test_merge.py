@@ -122,8 +122,8 @@ def test_split_gives_each_slice_its_spring_share():
 def test_flank_contacts_key_validated(capsys):
     assert load_scenario(MINIMAL).contact.flank_contacts == DEFAULT_FLANK_CONTACTS == 4
     assert cli.main(["check", str(MINIMAL)]) == 0
-    out = capsys.readouterr().out  # the default (flanks, medium: 16 slices here, 4 per contact) says how it merges
-    assert "MuJoCo contacts per tooth flank: 4 (4 slices each; contact.flank_contacts)" in out, out
+    out = capsys.readouterr().out  # the default (flanks, medium: 32 slices here, 8 per contact) says how it merges
+    assert "MuJoCo contacts per tooth flank: 4 (8 slices each; contact.flank_contacts)" in out, out
     code = cli.main(["check", str(MINIMAL), "--set", "contact.flank_contacts=line"])
     err = capsys.readouterr().err
     assert code == 2

@@ -198,8 +198,8 @@ class Contact(_Strict):
         le=256,
         description=(
             "flanks: slices across the face width (default: coarse 8, a quick look; medium from the gear, a slice's "
-            "stiffness at most 1/5 of the mesh stiffness's fluctuation, a multiple of 8: seat motor 32, screw jack 16, "
-            "involute_41 24; fine twice medium's; at most 16 with simulation.mass_scaling, which keeps means only; "
+            "stiffness at most 1/5 of the mesh stiffness's fluctuation, a multiple of 8, at least 32: seat motor, "
+            "screw jack and involute_41 32; fine twice medium's; at most 16 with simulation.mass_scaling, which keeps means only; "
             "docs/contact3d.md)"
         ),
     )

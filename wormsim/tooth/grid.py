@@ -34,6 +34,7 @@ SLICES_COARSE = 8  # simulation.resolution coarse: a quick look (not converged; 
 SLICES_FINE_FACTOR = 2  # fine: this many times medium's count (the count medium's convergence is measured against)
 SLICE_SHARE = 0.2  # medium: a slice's stiffness K / S at most this share of the mesh stiffness's p2p
 SLICES_STEP = 8  # the count rounded up to a multiple of this
+SLICES_MIN = 32  # medium: at least this many (a line end's kink inside a slice; docs/decisions/0054)
 SLICES_TCA_SAMPLES = 128  # worm angles per mesh cycle of the TCA that gives the fluctuation
 # Default slices of a mass-scaled run, at most: mass scaling keeps the means and loses the fluctuation
 # (docs/contact3d.md, "Mass scaling"), which default_slices sizes the slices for; the means converge from 16 (seat
@@ -45,19 +46,22 @@ SLICES_MASS_SCALED = 16
 def default_slices(g: GearGeometry, resolution: str) -> int:
     """Slices across the face when contact.slices is not given. Each slice switches a stiffness of up to K / S as the
     contact line's end crosses it, and rings the contact mode; the slicing resolves the mesh stiffness's own change
-    over a mesh cycle once K / S is small against it:
+    over a mesh cycle once K / S is small against it, and the kinks of a line's ends inside a slice (where the line
+    runs off the wheel's tip edge, decision 0052) once the slices are at least SLICES_MIN:
 
-        S = SLICES_STEP ceil(k_mean / (SLICE_SHARE k_p2p) / SLICES_STEP),
+        S = max(SLICES_MIN, SLICES_STEP ceil(k_mean / (SLICE_SHARE k_p2p) / SLICES_STEP)),
 
     k_p2p / k_mean the fluctuation of the zero-load TCA's k(theta) (wormsim.tooth.mesh_stiffness, both flank
-    sides, the smaller). Measured (docs/contact3d.md, "Default slice count"): seat motor 0.177 -> 32 slices (16 were
-    not converged), screw jack 0.376 -> 16, involute_41 0.267 -> 24. That is medium's count; fine takes
-    SLICES_FINE_FACTOR times it (the count medium's convergence is measured against), coarse SLICES_COARSE."""
+    sides, the smaller). Measured (docs/contact3d.md, "Default slice count"; docs/decisions/0054): the fluctuation
+    alone gives seat motor 0.177 -> 32 slices (16 were not converged), screw jack 0.376 -> 16 and involute_41
+    0.267 -> 24, where the screw jack's F_t p2p was 24 % (16) and 14 % (24) off twice the count's and 2.5 % at 32.
+    That is medium's count; fine takes SLICES_FINE_FACTOR times it (the count medium's convergence is measured
+    against), coarse SLICES_COARSE."""
     if resolution == "coarse":
         return SLICES_COARSE
     ms = mesh_stiffness(g, 1.0, "slices", SLICES_TCA_SAMPLES)
     share = min(float(np.ptp(k) / np.mean(k)) for k in (ms.k_mesh_fwd_n_per_m, ms.k_mesh_rev_n_per_m))
-    medium = int(SLICES_STEP * math.ceil(1.0 / (SLICE_SHARE * max(share, 1e-3)) / SLICES_STEP))
+    medium = max(SLICES_MIN, int(SLICES_STEP * math.ceil(1.0 / (SLICE_SHARE * max(share, 1e-3)) / SLICES_STEP)))
     return medium * SLICES_FINE_FACTOR if resolution == "fine" else medium
 
 
