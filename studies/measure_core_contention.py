@@ -14,9 +14,13 @@ Workloads (each child process sets up once, then runs the work on "go"; its thre
 - stream: a 64 MB NumPy copy (memory bandwidth: beyond the core's caches);
 - point: wormsim's simulate() of the screw jack at contact3d (0.15 s simulated, twice, the kernels loaded by one
   warm-up run in the child).
-Modes: alone (child 0 pinned to core 0, nothing of ours on core 1) and pair (children 0 and 1 pinned to cores 0 and
-1, started at once). The modes take turns (alone, pair, pair, alone, ...) for every workload in every repeat. The
-growth of a workload is median CPU(pair) / median CPU(alone) per unit of work. The machine's other work is read from
+Modes: alone (child 0 pinned to core 0, nothing of ours on core 1), pair (children 0 and 1 pinned to cores 0 and
+1, started at once), beside_python and beside_stream (child 0, and on core 1 a neighbour that runs until it is
+stopped: a pure-Python loop, or a 64 MB copy). The modes take turns (in order, then reversed) for every workload in
+every repeat. The growth of a workload is median CPU(mode) / median CPU(alone) per unit of work: a growth beside any
+busy neighbour (the pure-Python loop touches no memory) is the machine's (the two virtual CPUs share a physical
+core, or its clock); a growth only beside a twin or the copy is the work's own traffic in the shared caches and
+memory. The machine's other work is read from
 /proc/stat (busy jiffies of both cores less ours during the measurement, and the hypervisor's steal).
 """
 
@@ -165,16 +169,34 @@ class Child:
         self.p.wait(30)
 
 
-def run_mode(children: list[Child], pair: bool) -> dict:
-    used = children if pair else children[:1]
+# a neighbour on core 1 that runs until it is stopped: a pure-Python loop (no memory traffic) or a 64 MB copy
+SPINNERS = {
+    "python": "import os\nos.sched_setaffinity(0, {1})\ns = 0\nwhile True:\n    for i in range(100000):\n"
+    "        s += i * i % 7\n",
+    "stream": "import os\nos.sched_setaffinity(0, {1})\nimport numpy as np\na = np.ones(8_000_000)\n"
+    "b = np.empty_like(a)\nwhile True:\n    np.copyto(b, a)\n",
+}
+
+
+def run_mode(children: list[Child], mode: str) -> dict:
+    """mode: alone (child 0), pair (children 0 and 1), beside_python / beside_stream (child 0, a SPINNERS
+    neighbour on core 1)."""
+    used = children if mode == "pair" else children[:1]
+    spinner = None
+    if mode.startswith("beside_"):
+        spinner = subprocess.Popen([sys.executable, "-c", SPINNERS[mode.removeprefix("beside_")]])
+        time.sleep(0.3)  # (its start-up)
     hz = os.sysconf("SC_CLK_TCK")
     j0, t0 = _cpu_jiffies(), time.perf_counter()
     for c in used:
         c.go()
     res = [c.result() for c in used]
     j1, t1 = _cpu_jiffies(), time.perf_counter()
+    if spinner is not None:
+        spinner.kill()
+        spinner.wait()
     wall = t1 - t0
-    ours = sum(r["cpu_s"] for r in res)
+    ours = sum(r["cpu_s"] for r in res) + (wall if spinner is not None else 0.0)  # (the spinner: about a core)
     return {
         "cpu_s": [r["cpu_s"] for r in res],
         "wall_s": [r["wall_s"] for r in res],
@@ -203,12 +225,12 @@ def main() -> None:
     for cs in children.values():
         for c in cs:
             c.ready()
-    runs: dict[str, dict[str, list]] = {k: {"alone": [], "pair": []} for k in kinds}
+    modes = ("alone", "pair", "beside_python", "beside_stream")
+    runs: dict[str, dict[str, list]] = {k: {m: [] for m in modes} for k in kinds}
     for rep in range(args.repeats):
         for k in kinds:
-            order = ("alone", "pair") if rep % 2 == 0 else ("pair", "alone")
-            for mode in order:
-                runs[k][mode].append(run_mode(children[k], mode == "pair"))
+            for mode in modes if rep % 2 == 0 else modes[::-1]:
+                runs[k][mode].append(run_mode(children[k], mode))
     for cs in children.values():
         for c in cs:
             c.stop()
@@ -221,6 +243,10 @@ def main() -> None:
             "cpu_pair_median_s": statistics.median(pair),
             "growth": statistics.median(pair) / statistics.median(alone),
             "growth_best": min(pair) / min(alone),
+            **{
+                f"growth_{m}": statistics.median(r["cpu_s"][0] for r in runs[k][m]) / statistics.median(alone)
+                for m in ("beside_python", "beside_stream")
+            },
             "others_cores_alone_median": statistics.median(r["others_cores"] for r in runs[k]["alone"]),
             "others_cores_pair_median": statistics.median(r["others_cores"] for r in runs[k]["pair"]),
             "steal_cores_median": statistics.median(r["steal_cores"] for mode in runs[k].values() for r in mode),
