@@ -5,10 +5,11 @@ one run, the commands taking turns. Writes docs/data/sweep_fixed_cost.json; docs
 
 BASE_DIR holds the other source tree (e.g. `git archive 5c5cb29 | tar -x -C BASE_DIR`); its code runs with this
 virtual environment through PYTHONPATH (its kernels' cache is its own: warm it first with `make`'s warm-up command
-under the same PYTHONPATH). Per turn, for each tree:
+under the same PYTHONPATH). The trees take turns (in order, then reversed), first --preload-repeats times:
 - preload: the CPU seconds (user + system) of a process that imports wormsim.sweep.preload_warm, the local cluster's
   fork server's work before it forks the first worker (the workers' imports, numba's start-up, the kernels loaded,
   the short run): the path before a sweep's first point on a machine with a core free beside the client;
+then --repeats times:
 - command: a sweep of --points screw-jack points of --duration s at contact3d on --workers workers, its wall time,
   the time before its first point and after its last (sweep.json's timing), fixed = command less the points' span.
 Each tree's medians, and the ratio this / other of the medians (CPU seconds hold on a shared machine; wall times
@@ -80,7 +81,8 @@ def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--compare", required=True, help="the other source tree")
     ap.add_argument("--label-compare", default="compare")
-    ap.add_argument("--repeats", type=int, default=6)
+    ap.add_argument("--repeats", type=int, default=6, help="commands per tree")
+    ap.add_argument("--preload-repeats", type=int, default=10, help="preload processes per tree")
     ap.add_argument("--points", type=int, default=4)
     ap.add_argument("--duration", type=float, default=0.05)
     ap.add_argument("--workers", type=int, default=2)
@@ -96,26 +98,33 @@ def main() -> None:
     trees = {"this": ROOT, args.label_compare: Path(args.compare).resolve()}
     load_before = list(os.getloadavg())
     runs: dict[str, list[dict]] = {k: [] for k in trees}
+    preload: dict[str, list[float]] = {k: [] for k in trees}
+    for rep in range(args.preload_repeats):
+        for name in trees if rep % 2 == 0 else list(trees)[::-1]:
+            preload[name].append(preload_cpu(trees[name]))
     for rep in range(args.repeats):
         for name in trees if rep % 2 == 0 else list(trees)[::-1]:
-            r = {"preload_cpu_s": preload_cpu(trees[name])}
-            r.update(command(trees[name], sweep, out / name, args.workers))
-            runs[name].append(r)
-    keys = ("preload_cpu_s", "command_s", "before_first_point_s", "after_last_point_s", "fixed_s")
-    med = {n: {k: statistics.median(r[k] for r in rs) for k in keys} for n, rs in runs.items()}
+            runs[name].append(command(trees[name], sweep, out / name, args.workers))
+    keys = ("command_s", "before_first_point_s", "after_last_point_s", "fixed_s")
+    med = {
+        n: {"preload_cpu_s": statistics.median(preload[n]), **{k: statistics.median(r[k] for r in rs) for k in keys}}
+        for n, rs in runs.items()
+    }
+    keys = ("preload_cpu_s", *keys)
     rec = {
         "provenance": provenance(
             f"python studies/measure_sweep_fixed.py --compare TREE_OF_{args.label_compare} "
-            f"--label-compare {args.label_compare} --repeats {args.repeats}"
+            f"--label-compare {args.label_compare} --repeats {args.repeats} --preload-repeats {args.preload_repeats}"
         ),
         "what": f"`wormsim sweep` of {args.points} contact3d screw-jack points ({args.duration} s) on {args.workers} "
-        f"workers and the fork server's preload, this checkout against {args.label_compare}, taking turns, "
-        f"{args.repeats} times each",
+        f"workers ({args.repeats} each) and the fork server's preload ({args.preload_repeats} each), this checkout "
+        f"against {args.label_compare}, taking turns",
         "cpu_count": os.cpu_count(),
         "load_average_before": load_before,
         "load_average_after": list(os.getloadavg()),
         "medians": med,
         "ratio_this_over_compare": {k: med["this"][k] / med[args.label_compare][k] for k in keys},
+        "preload_cpu_s": preload,
         "runs": runs,
     }
     Path(args.record).write_text(json.dumps(rec, indent=1) + "\n")
