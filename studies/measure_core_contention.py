@@ -258,8 +258,9 @@ def main() -> None:
             + (f" --repeats {args.repeats}" if args.repeats != 5 else "")
             + (f" --kinds {args.kinds}" if args.kinds != ",".join(KINDS) else "")
         ),
-        "what": "the same work by one process alone and by two at once (one per core, pinned), modes taking turns; "
-        "CPU seconds of the working thread",
+        "what": "the same work by one process alone, by two at once and beside a neighbour on the other core (a "
+        "pure-Python loop, a 64 MB copy), each pinned to its core, modes taking turns; CPU seconds of the working "
+        "thread",
         "cpu_count": os.cpu_count(),
         "load_average_before": load_before,
         "load_average_after": list(os.getloadavg()),

@@ -396,6 +396,9 @@ CONTENTION_LABELS = {
 }
 
 
+QUIET_OTHERS_CORES = 0.2  # the other processes' cores below which an "alone" run was alone
+
+
 def core_contention_table(name: str = "core_contention") -> str:
     """The same work alone and two at once, one process per core (studies/measure_core_contention.py)."""
     r = load(name)
@@ -425,13 +428,20 @@ def core_contention_table(name: str = "core_contention") -> str:
     ]
     text = _table(head, rows)
     text += (
-        f"\n{r['what']}; {r['repeats']} turns. Load average before / after: "
+        "\nThe same work alone, two at once, and beside a neighbour on the other core (each process pinned to its "
+        f"core; CPU seconds of the working thread, medians of {r['repeats']} turns). Load average before / after: "
         f"{', '.join(f'{v:.1f}' for v in r['load_average_before'])} / "
         f"{', '.join(f'{v:.1f}' for v in r['load_average_after'])} ({r['cpu_count']} CPUs). "
-        "'others' cores': what the machine's other processes used meanwhile (/proc/stat less ours)."
+        "Others' cores: what the machine's other processes used meanwhile (/proc/stat less ours)."
     )
-    if r.get("span_speedup_bound_2") is not None:
+    point = r["summary"].get("point")
+    if point is not None and point["others_cores_alone_median"] <= QUIET_OTHERS_CORES:
         text += f" Bound on a CPU-bound 2-worker span from the point's growth: {r['span_speedup_bound_2']:.2f}x."
+    elif point is not None:
+        text += (
+            f" The machine was not quiet (others' cores above {QUIET_OTHERS_CORES}): no growth or bound is read "
+            "from this record."
+        )
     return text + "\n\n" + _source(name)
 
 
