@@ -386,6 +386,90 @@ def sweep_scaling_table(name: str = "sweep_scaling") -> str:
     return text + "\n" + _source(name)
 
 
+CONTENTION_LABELS = {
+    "python": "pure-Python integer loop",
+    "numpy_small": "NumPy on 64-element arrays",
+    "mujoco": "mj_step of MuJoCo's sample model from Python",
+    "mujoco_rollout": "mujoco.rollout of the same model",
+    "stream": "64 MB NumPy copy (memory bandwidth)",
+    "point": "screw-jack point at contact3d (ours)",
+}
+
+
+QUIET_OTHERS_CORES = 0.2  # the other processes' cores below which an "alone" run was alone
+
+
+def core_contention_table(name: str = "core_contention") -> str:
+    """The same work alone and two at once, one process per core (studies/measure_core_contention.py)."""
+    r = load(name)
+    rows = []
+    for k, x in r["summary"].items():
+        rows.append(
+            [
+                CONTENTION_LABELS.get(k, k),
+                f"{x['cpu_alone_median_s']:.3f}",
+                f"{x['cpu_pair_median_s']:.3f}",
+                f"{x['growth']:.2f}",
+                f"{x['growth_best']:.2f}",
+                f"{x['growth_beside_python']:.2f}",
+                f"{x['growth_beside_stream']:.2f}",
+                f"{x['others_cores_alone_median']:.2f} / {x['others_cores_pair_median']:.2f}",
+            ]
+        )
+    head = [
+        "work",
+        "CPU s alone",
+        "CPU s two at once",
+        "growth two at once",
+        "same, fastest",
+        "growth beside a Python loop",
+        "growth beside a 64 MB copy",
+        "others' cores alone / two",
+    ]
+    text = _table(head, rows)
+    text += (
+        "\nThe same work alone, two at once, and beside a neighbour on the other core (each process pinned to its "
+        f"core; CPU seconds of the working thread, medians of {r['repeats']} turns). Load average before / after: "
+        f"{', '.join(f'{v:.1f}' for v in r['load_average_before'])} / "
+        f"{', '.join(f'{v:.1f}' for v in r['load_average_after'])} ({r['cpu_count']} CPUs). "
+        "Others' cores: what the machine's other processes used meanwhile (/proc/stat less ours)."
+    )
+    point = r["summary"].get("point")
+    if point is not None and point["others_cores_alone_median"] <= QUIET_OTHERS_CORES:
+        text += f" Bound on a CPU-bound 2-worker span from the point's growth: {r['span_speedup_bound_2']:.2f}x."
+    elif point is not None:
+        text += (
+            f" The machine was not quiet (others' cores above {QUIET_OTHERS_CORES}): no growth or bound is read "
+            "from this record."
+        )
+    return text + "\n\n" + _source(name)
+
+
+def sweep_fixed_cost_table(name: str = "sweep_fixed_cost") -> str:
+    """A sweep command's fixed cost, this commit against an earlier one, taking turns
+    (studies/measure_sweep_fixed.py)."""
+    r = load(name)
+    keys = [
+        ("preload_cpu_s", "fork server's preload, CPU s"),
+        ("before_first_point_s", "before the first point s"),
+        ("after_last_point_s", "after the last point s"),
+        ("fixed_s", "fixed s"),
+        ("command_s", "command s"),
+    ]
+    names = list(r["medians"])
+    rows = [
+        [label, *(f"{r['medians'][n][k]:.2f}" for n in names), f"{r['ratio_this_over_compare'][k]:.2f}"]
+        for k, label in keys
+    ]
+    head = ["median", *(("this commit" if n == "this" else n) for n in names), "ratio"]
+    text = _table(head, rows)
+    text += (
+        f"\n{r['what']}. Load average before / after: {', '.join(f'{v:.1f}' for v in r['load_average_before'])} / "
+        f"{', '.join(f'{v:.1f}' for v in r['load_average_after'])} ({r['cpu_count']} CPUs).\n"
+    )
+    return text + "\n" + _source(name)
+
+
 def _study_value(v) -> str:
     """The error's value: a number, or the pitch deviations of every other tooth as one phrase."""
     if v in (None, ""):
@@ -1306,6 +1390,8 @@ TABLES: dict[str, Callable[[], str]] = {
     "seat_motor_20s": seat_motor_20s_table,
     "sweep_speedup": sweep_speedup_table,
     "sweep_scaling": sweep_scaling_table,
+    "sweep_fixed_cost": sweep_fixed_cost_table,
+    "core_contention": core_contention_table,
     "errors_study": errors_study_table,
     "wedge_seed000": wedge_seed000_table,
     "mass_scaling": mass_scaling_table,

@@ -24,7 +24,8 @@ The scenario's `contact:` friction keys select mu(Vs) (friction_coefficient, sha
   none given: mu = 0.05 (lubricated steel/bronze, DEFAULT_FRICTION).
 
 The law is written once, compiled (`mu_at`, on the four numbers of `mu_law`; `rho_group_rad` the group's rho(Vs)):
-the compiled contact3d samples call it, friction_coefficient and rho_rad are its numpy forms (numba.vectorize),
+the compiled contact3d samples call it, friction_coefficient and rho_rad are its numpy forms (numba.vectorize, built
+on the first array; one speed calls the compiled function),
 friction_coefficient_scalar a float wrapper (the torsional ODE, contact3d's Python samples, wormsim.pair).
 Group I against a handbook curve (Mechanical Engineer's Data Handbook, p. 111, hard steel on phosphor bronze:
 mu 0.06 / 0.05 / 0.035 / 0.023 / 0.017 / 0.014 at 0.5 / 1 / 2 / 5 / 10 / 20 m/s): within 25 %
@@ -145,6 +146,8 @@ def rho_rad(vs_m_s, group: str | None = None, friction: float | None = None):
             a, b, c = GROUPS[group]
         except KeyError:
             raise ValueError(f"friction group {group!r}: allowed I, II, III") from None
+        if vs.ndim == 0:  # one speed: the compiled law itself (friction_coefficient)
+            return float(rho_group_rad(float(vs), a, b, c))
         out = _ufuncs()[1](vs, a, b, c)
     return float(out) if np.ndim(out) == 0 else out
 
@@ -175,8 +178,11 @@ def friction_mode(contact: Contact) -> str:
 def friction_coefficient(contact: Contact, sliding_speed_m_s) -> float | np.ndarray:
     """mu(Vs): see the module docstring (mu_at). Vectorised over Vs."""
     vs = np.abs(np.asarray(sliding_speed_m_s, dtype=float))
-    out = _ufuncs()[0](vs, *mu_law(contact))
-    return float(out) if np.ndim(out) == 0 else out
+    if vs.ndim == 0:  # one speed (gear_plan's mu, the wedge's): the compiled law itself, the same bits as the ufunc
+        # (tests/physics/test_friction.py); it loads one cached function where the ufuncs load two (about 0.1 s of
+        # CPU in a process's first run, on a sweep's fork server's path before the first point)
+        return float(mu_at(float(vs), *mu_law(contact)))
+    return _ufuncs()[0](vs, *mu_law(contact))
 
 
 def friction_coefficient_scalar(contact: Contact):
