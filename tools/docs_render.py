@@ -219,6 +219,27 @@ def seat_motor_profile_table(name: str = "seat_motor_profile") -> str:
     return text + "\n" + _source(name)
 
 
+def seat_motor_levers_table(name: str = "seat_motor_levers") -> str:
+    """The unscaled seat motor's result-moving levers (studies/seat_motor_levers.py): CPU s per simulated s and the
+    ratio to the default per round, the CI run's results relative to the default."""
+    r = load(name)
+    rows = []
+    for k, c in r["cpu_s_per_sim_s"].items():
+        rel = r["ci_relative_pct"][k]
+        rows.append(
+            [
+                k,
+                " / ".join(f"{x:.1f}" for x in c),
+                " / ".join(f"{x:.2f}" for x in r["ratio_to_default"][k]),
+                ", ".join(f"{rel[x]:+.3f} %" for x in ("tangential_force_mean_n", "tangential_force_p2p_n")),
+                ", ".join(f"{rel[x]:+.3f} %" for x in ("efficiency", "transmission_error_p2p_urad")),
+            ]
+        )
+    head = ["lever", "CPU s per simulated s (rounds)", "ratio to default", "CI run: F_t mean, p2p"]
+    head += ["CI run: efficiency, TE p2p"]
+    return _table(head, rows) + "\n" + _source(name)
+
+
 def flank_contacts_table(name: str = "flank_contacts") -> str:
     """MuJoCo contacts per tooth flank (studies/flank_contacts.py): the seat motor's CPU s per simulated second per
     variant, and the seeds' CI results relative to per slice."""
@@ -1331,6 +1352,7 @@ TABLES: dict[str, Callable[[], str]] = {
     "bench_flanks_vs_pieces": bench_flanks_vs_pieces_table,
     "flank_speed": flank_speed_table,
     "seat_motor_profile": seat_motor_profile_table,
+    "seat_motor_levers": seat_motor_levers_table,
     "flank_contacts": flank_contacts_table,
     "flank_contacts_default": flank_contacts_default_table,
     "bench_shafts": bench_shafts_table,
