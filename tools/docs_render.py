@@ -189,6 +189,57 @@ def flank_speed_table(name: str = "flank_speed") -> str:
     return _table(head, rows) + "\n" + _source(name)
 
 
+def seat_motor_profile_table(name: str = "seat_motor_profile") -> str:
+    """The unscaled seat motor's CPU at its defaults, split (studies/profile_seat_motor.py): the compiled step's
+    stages, the loop outside them, the whole run."""
+    r = load(name)
+    run, st = r["run"], r["step"]
+    total = st["sum_of_parts_us"]
+    rows = [[g, f"{us:.1f}", f"{100 * us / total:.0f} %"] for g, us in st["groups_us"].items()]
+    rows.append(["the compiled step (the stages' sum)", f"{total:.1f}", "100 %"])
+    rows.append(
+        [
+            "the stepping loop outside the compiled steps (samples, Python, numba's dispatch)",
+            f"{r['samples_and_python_us_per_step']:.1f}",
+            "-",
+        ]
+    )
+    text = _table(["part", "us per step", "share of the step"], rows)
+    text += (
+        f"\nThe step from t = {st['from_s']} s ({st['steps']} steps, median of {st['rounds']} rounds): "
+        f"{st['mujoco_contacts']} MuJoCo contacts ({st['slice_contacts']} slice contacts merged), "
+        f"{st['constraint_rows']} constraint rows, {st['solver_iterations']:.2f} solver iterations and "
+        f"{st['line_search_evaluations']:.2f} line-search evaluations per step. The whole run over "
+        f"{r['seconds']} s from rest: {run['cpu_s_per_sim_s']:.1f} CPU s per simulated s (rounds: "
+        + " / ".join(f"{x:.1f}" for x in run["rounds_cpu_s_per_sim_s"])
+        + f"), its stepping loop {run['loop_us_per_step']:.1f} us per step, the compiled steps alone over the same "
+        f"window {r['run_table_whole_window_us_per_step']:.1f} us per step (load average "
+        f"{r['load_average_at_start'][0]:.1f} at the start, {r['load_average_after'][0]:.1f} after).\n"
+    )
+    return text + "\n" + _source(name)
+
+
+def seat_motor_levers_table(name: str = "seat_motor_levers") -> str:
+    """The unscaled seat motor's result-moving levers (studies/seat_motor_levers.py): CPU s per simulated s and the
+    ratio to the default per round, the CI run's results relative to the default."""
+    r = load(name)
+    rows = []
+    for k, c in r["cpu_s_per_sim_s"].items():
+        rel = r["ci_relative_pct"][k]
+        rows.append(
+            [
+                k,
+                " / ".join(f"{x:.1f}" for x in c),
+                " / ".join(f"{x:.2f}" for x in r["ratio_to_default"][k]),
+                ", ".join(f"{rel[x]:+.3f} %" for x in ("tangential_force_mean_n", "tangential_force_p2p_n")),
+                ", ".join(f"{rel[x]:+.3f} %" for x in ("efficiency", "transmission_error_p2p_urad")),
+            ]
+        )
+    head = ["lever", "CPU s per simulated s (rounds)", "ratio to default", "CI run: F_t mean, p2p"]
+    head += ["CI run: efficiency, TE p2p"]
+    return _table(head, rows) + "\n" + _source(name)
+
+
 def flank_contacts_table(name: str = "flank_contacts") -> str:
     """MuJoCo contacts per tooth flank (studies/flank_contacts.py): the seat motor's CPU s per simulated second per
     variant, and the seeds' CI results relative to per slice."""
@@ -1384,6 +1435,8 @@ TABLES: dict[str, Callable[[], str]] = {
     "bench_stability": bench_stability_table,
     "bench_flanks_vs_pieces": bench_flanks_vs_pieces_table,
     "flank_speed": flank_speed_table,
+    "seat_motor_profile": seat_motor_profile_table,
+    "seat_motor_levers": seat_motor_levers_table,
     "flank_contacts": flank_contacts_table,
     "flank_contacts_default": flank_contacts_default_table,
     "bench_shafts": bench_shafts_table,

@@ -155,3 +155,33 @@ def test_memo_with_displaced_poses_gives_the_same_contacts():
             assert np.array_equal(u, v)
     assert np.count_nonzero(memo[0][..., 0] > 0) > 10
     assert memo[0][..., 3].max() > 1e-6  # the slices were memorised with the poses' drift
+
+
+def test_merging_kernel_leaves_slice_frames_to_the_samples():
+    """find_packed merging 4 slices per contact gives the slice contacts of the unmerged call bit for bit, and leaves
+    their frames out (MuJoCo gets the merged ones); contact_frames on its normals, as the samples compute them
+    (FlankContacts.slice_rows, flank_samples.contact_rows), are the unmerged call's frames."""
+    g = derive(load_scenario(SCENARIOS / "screw_jack.yaml").gear)
+    S = 16
+    fg = grid.flank_grid(g, S)
+    W = window_size(g)
+    tooth0 = -math.pi / 2 + math.pi / g.z2
+    margin = kernel.MARGIN_PITCH * 2 * math.pi / g.z2 + g.backlash / (2 * g.r2)
+    cap = 2 * W * S
+    plain = kernel.PackedKernel(fg, fg.params, cap, W, g.z2)
+    merged = kernel.PackedKernel(fg, fg.params, cap, W, g.z2, merge=4)
+    frames = np.zeros((cap, 9))
+    loaded = 0
+    for th1, th2 in _states(g, 200):
+        ks = window_teeth_at(th2, g.z2, W, tooth0).astype(np.int64)
+        plain.ks[:] = merged.ks[:] = ks
+        merged.frame[:] = 0.0
+        n = kernel.find_packed(plain.fb, plain.ib, th1, th2, margin, 0.0)
+        assert kernel.find_packed(merged.fb, merged.ib, th1, th2, margin, 0.0) == n
+        for f in ("pos", "nrm", "depth", "weight", "meta"):
+            assert np.array_equal(getattr(plain, f)[:n], getattr(merged, f)[:n])
+        assert not merged.frame[:n].any()  # left out
+        kernel.contact_frames(merged.nrm, n, frames)
+        assert np.array_equal(frames[:n], plain.frame[:n])
+        loaded += n > 0
+    assert loaded > 50

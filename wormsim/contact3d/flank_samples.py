@@ -40,6 +40,7 @@ from wormsim.contact3d.native import address, call_stage, f1, f64_at, i1, i32_at
 from wormsim.contact3d.series import column
 from wormsim.contact3d.shafts import gather
 from wormsim.physics.friction import MuLaw, mu_at, stuck_after
+from wormsim.tooth.kernel import contact_frames
 from wormsim.tooth.merge import split_forces
 
 ENABLED = True  # the runner's switch (tests compare against the per-sample path)
@@ -111,17 +112,19 @@ def contact_guard(p, io, t, depth, n, w1, w2, cmd_i):
 @numba.njit(cache=True)
 def contact_rows(d_addr, off, adr, ncon, n_fc, cone3, pts, nh, merged, mrg):
     """The sample's contacts (ContactRows) read from d at the checked offsets off: d.contact's efc addresses into
-    adr, d.efc_force; pts = (the kernel's contact frames, points); with merged contacts (merged) their forces split
+    adr, d.efc_force; pts = (the kernel's contact frames, points, normals); with merged contacts (merged) their
+    frames from the normals (kernel.find_packed leaves them out) and their forces split
     over their slices with mrg's arrays (FlankContacts.slice_rows). Typed as FlankLoop.sample passes them (one
     compiled signature of sample_table: int64 counts, a non-literal bool); mrg is the same tuple of arrays either way
     (one compiled signature here and in run_samples, not one per tuple and None)."""
-    frame, pos = pts
+    frame, pos, nrm = pts
     size, o_adr = off[6], off[7]
     cbase = i64_at(d_addr + off[3])[0]
     for k in range(ncon):
         adr[k] = i32_at(cbase + k * size + o_adr)[0]
     efc = numba.carray(f64_at(i64_at(d_addr + off[4])[0]), (max(i32_at(d_addr + off[2])[0], 0),))
     if merged:
+        contact_frames(nrm, n_fc, frame)  # the slices' frames: find_packed leaves them out where it merges
         grp, share, mfric, mwrap, adr_m, efc_m = mrg
         split_forces(adr[:ncon], efc, ncon - min(nh, ncon), cone3, (grp, share, mfric, mwrap), n_fc, (adr_m, efc_m))
         return ContactRows(adr_m[:n_fc], efc_m, frame, pos, n_fc, n_fc, True, True)
@@ -133,8 +136,8 @@ def run_samples(tables, mj, cmds, span, S, p, room, io, mrg, shaft):
     """Samples i0..i1-1 of span = (i0, i1, o0, rec) (module docstring); sample i's steps are o0 + (i - i0) rec ..
     + rec of cmds = (drive, load). tables = flank_loop's run and sample tables (T, Ts); mj = (the model's and the
     data's address); S the series (series.SERIES rows); p the run's SampleParams; room = (the checked mjData offsets
-    (native.mjdata_offsets), the kernel's contact frames and points, ADR_CAP work room, the pattern's and the radius
-    log's rows); io: IO_*; mrg: the kernel's (grp, share, mfric, mwrap) and the per-slice rows' room
+    (native.mjdata_offsets), the kernel's contact frames, points and normals, ADR_CAP work room, the pattern's and
+    the radius log's rows); io: IO_*; mrg: the kernel's (grp, share, mfric, mwrap) and the per-slice rows' room
     (FlankContacts.slice_rows), used with one contact per tooth flank (the kernel's merge flag, ib[6]); shaft =
     (mj_rnePostConstraint's address or 0, the shaft log's raw addresses, its raw rows:
     wormsim.contact3d.shafts.ShaftLog), the addresses empty without `shafts:`."""
@@ -142,7 +145,7 @@ def run_samples(tables, mj, cmds, span, S, p, room, io, mrg, shaft):
     m_addr, d_addr = mj
     cmd, load = cmds
     i0, i1_, o0, rec = span
-    off, frame, pos, adr, pat_buf, r_buf = room
+    off, frame, pos, nrm, adr, pat_buf, r_buf = room
     rne, sh_adr, sh_raw = shaft
     acc, state, ib = f1(T, Row.acc), i1(T, Row.state), i1(T, Row.ib)
     merged = ib[6] != 0  # one contact per tooth flank (the kernel's merge flag, wormsim.tooth.merge)
@@ -200,7 +203,7 @@ def run_samples(tables, mj, cmds, span, S, p, room, io, mrg, shaft):
         if contact_guard(p, io, t, depth, n_fc if merged else min(n_fc, ncon), w1, w2, cmd_i):
             io[IO_EVENT] = EV_GUARD  # Guards.contact raises, or the lock guard acts or keeps state
             return
-        rows = contact_rows(d_addr, off, adr, ncon, n_fc, cone3, (frame, pos), ib[7], merged, mrg)
+        rows = contact_rows(d_addr, off, adr, ncon, n_fc, cone3, (frame, pos, nrm), ib[7], merged, mrg)
         logs = (pat_buf, io[IO_E_STAR], pm, r_buf, rm)
         nteeth, pen2, fr, W, wr, pm, rm = sample_table(Ts, rows, (th2, p.z2, p.a), i, logs)
         if rne != 0:  # ShaftLog.record: the reactions, then the raw values
@@ -279,7 +282,7 @@ class FlankSamples:
         io[IO_LOCKED] = float(guards.locked_since is not None)
         io[IO_STUCK] = float(guards.stuck)
         io[IO_TURN_MAX], io[IO_PM], io[IO_RM] = guards.turn_max, pattern.m, rlog.m
-        room = (self.off, fc.frame, fc.pos, self.adr, pattern.buf, rlog.buf)
+        room = (self.off, fc.frame, fc.pos, fc.nrm, self.adr, pattern.buf, rlog.buf)
         mrg = (k.grp, k.share, k.mfric, k.mwrap, fc.slice_adr, fc.slice_efc)  # read only with merge (run_samples)
         mj = (loop.m._address, loop.d._address)
         run_samples(tables, mj, (cmd, load), (i0, i1, o0, self.rec), self.S, self.params, room, io, mrg, self.shaft)

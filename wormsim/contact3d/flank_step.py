@@ -24,7 +24,7 @@ from wormsim.contact3d.contact_sums import contact_forces
 from wormsim.contact3d.flank_handoff import ContactBuffer, Handed, fill_add
 from wormsim.contact3d.native import MJ_ADD_CONTACT
 from wormsim.tooth.grid import flank_grid
-from wormsim.tooth.kernel import MARGIN_PITCH, TAPER_SHARE, PackedKernel, find_packed
+from wormsim.tooth.kernel import MARGIN_PITCH, TAPER_SHARE, PackedKernel, contact_frames, find_packed
 from wormsim.tooth.merge import split_forces
 from wormsim.tooth.window import window_centre
 
@@ -165,6 +165,7 @@ class FlankContacts:
         adr, efc, k0 = self.slice_adr, self.slice_efc, d.ncon - nh
         merged = (k.grp, k.share, k.mfric, k.mwrap)
         split_forces(d.contact.efc_address, d.efc_force, k0, dim3, merged, n, (adr, efc))
+        contact_frames(self.nrm, n, self.frame)  # find_packed leaves the slices' frames out where it merges
         return self.slice_adr[:n], self.slice_efc, self.frame[:n], self.pos[:n], True
 
     def set_friction(self, mu: float) -> None:

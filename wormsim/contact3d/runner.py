@@ -351,18 +351,20 @@ def _box_on_plane():
 
 
 def _warm_split_forces() -> None:
-    """merge.split_forces as FlankContacts.slice_rows calls it from Python (the merged contacts' forces split over
-    their slices: the per-sample outputs off the compiled loop, e.g. the contact pattern's rows), with its argument
-    types: d.contact.efc_address (MuJoCo's strided view), d.efc_force, int k0, bool cone3, float64 arrays, int n (a
-    box resting on a plane: 4 contacts, merged into one)."""
+    """merge.split_forces and kernel.contact_frames as FlankContacts.slice_rows calls them from Python (the merged
+    contacts' forces split over their slices and their frames: the per-sample outputs off the compiled loop, e.g. the
+    contact pattern's rows), with their argument types: d.contact.efc_address (MuJoCo's strided view), d.efc_force,
+    int k0, bool cone3, float64 arrays, int n (a box resting on a plane: 4 contacts, merged into one)."""
     import numpy as np
 
+    from wormsim.tooth.kernel import contact_frames
     from wormsim.tooth.merge import split_forces
 
     d = _box_on_plane()
     n = int(d.ncon)
     merged = (np.zeros(n), np.full(n, 1.0 / max(n, 1)), np.ones(n), np.ones(n))
     split_forces(d.contact.efc_address, d.efc_force, 0, True, merged, n, (np.zeros(n, np.int64), np.zeros(3 * n)))
+    contact_frames(np.zeros((n, 3)), n, np.zeros((n, 9)))  # the slices' frames after it (FlankContacts.slice_rows)
 
 
 def _warm_friction_check() -> None:

@@ -894,7 +894,10 @@ class PackedKernel:
 def find_packed(fb, ib, theta1, theta2, margin, taper_rad):
     """find_contacts (with its memo), slice_weights and contact_frames on a PackedKernel's buffers at worm angle
     theta1, wheel angle theta2 for the window teeth in its ks; returns the number of contacts (their fields in
-    pos, nrm, depth, weight, frame, meta, line; with ib[6], the merged contacts as well, PackedKernel)."""
+    pos, nrm, depth, weight, frame, meta, line; with ib[6], the merged contacts as well, PackedKernel). With ib[6]
+    the slice contacts' frames are not computed here (MuJoCo gets the merged contacts' frames, mframe): the samples,
+    which alone read them, call contact_frames on nrm (FlankContacts.slice_rows, flank_samples.contact_rows); the
+    same values, once per sample instead of once per step."""
     S = ib[0]
     floats, ints = _views(fb, ib)
     xy, c, c_range, zeta, P, pos, nrm, depth, meta, line, weight, frame = floats[:12]
@@ -916,8 +919,9 @@ def find_packed(fb, ib, theta1, theta2, margin, taper_rad):
         (mtab, mc),
     )
     n = slice_weights(meta, line, n, S, pos, nrm, depth, weight)
-    contact_frames(nrm, n, frame)
-    if ib[6]:  # ib[6] slices per merged contact (wormsim.tooth.merge)
+    if not ib[6]:
+        contact_frames(nrm, n, frame)
+    else:  # ib[6] slices per merged contact (wormsim.tooth.merge); the slices' frames where a sample reads them
         merged = (mpos, mnrm, mdepth, mweight, mfric, mwrap)
         nm = merge_flanks(meta, n, (pos, nrm, depth, weight), grp, share, merged, axes, ib[6])
         ib[7] = nm
