@@ -162,8 +162,9 @@ def _find_contacts(grid, ks, theta1, theta2, margin, taper_rad, P, out, work, me
                 sid += 1
                 memo_row = (use_memo, mtab, te, drift)
                 # the conjugate contact line of this tooth flank at the current pose: conjugate angle target - TE
-                # (the slice weights', _line_share)
-                sc = (span, c, target - te)
+                # (the slice weights', _line_share), the tooth's own TE te + dk (a tooth with pitch deviation dk
+                # meshes as the tooth turned by dk: its line is the undisplaced tooth's at the worm angle)
+                sc = (span, c, target - te - dk)
                 n, full = _slice_contact(ev, sc, zeta, (sg, j, k), i_s, sid, taper, memo_row, out, n)
                 if full:
                     return n
@@ -571,7 +572,7 @@ def _covered(e0, b, a):
 def _line_share(xy, sc, zeta, sg, j, hint, ca, sa, P, tmp):
     """The share of the strip of (flank sg, slice j) that the contact line covers inside the worm's threaded region.
     The contact line is the conjugate one at the current pose: the flank points of conjugate angle c_line (sc =
-    (span, c, c_line): the tooth flank's target less the transmission error, _find_contacts; it lies within a
+    (span, c, c_line): the tooth flank's target less the tooth's transmission error, _find_contacts; it lies within a
     fraction of a per cent of a pitch of the loaded line's gap minima), in this slice and its two neighbours (c
     interpolated along the profile, extrapolated along its end segment past the active profile, so the point is
     continuous where the line runs off the grid); the excess along the line (_excess: < 0 inside the threaded region)
