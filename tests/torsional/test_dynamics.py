@@ -303,3 +303,21 @@ def test_driven_machine_inertia_adds_to_the_loaded_shaft():
     )
     k1, k2 = inertias(on_worm.materials, on_worm.load, g)
     assert k2 == i2 and abs(k1 - i1 - 2e-4) < 1e-15
+
+
+def test_backward_euler_globalised_newton_lands_in_a_steep_friction_band():
+    """A worm speed braked by a tanh friction direction (a1 = B - A tanh(omega1 / v), A h >> v: the band |omega1| < v
+    is crossed in one Newton update): entering the band at 0.05 rad/s, the plain Newton iteration cycles between the
+    two saturated sides (their Jacobian is flat) at every timestep down to h / 1024 (the screw jack's held back-drive,
+    tests/physics/test_locking.py); the backtracking fallback lands on the quasi-static creep v atanh(B / A)."""
+    big, held, band = 1e5, 5e4, 1e-3
+
+    def acc(t, th1, w1, th2, w2):
+        if t <= 0.0025 + 1e-12:
+            return 20.0, -w2
+        return held - big * math.tanh(w1 / band), -w2
+
+    t, Y, _ = torsional.integrate_backward_euler(acc, 0.01, 1e-3)
+    assert Y[1, 2] == pytest.approx(0.04, rel=1e-12)  # the plain steps before the band, unchanged
+    creep = band * math.atanh(held / big)
+    assert np.allclose(Y[1, 4:], creep, rtol=1e-6, atol=0.0)

@@ -94,6 +94,7 @@ from wormsim.tooth.mesh_stiffness import MeshStiffness
 from wormsim.tooth.stiffness import mesh_stiffness_table, stiffness_outputs
 
 CHORD_ITER = 4  # backward Euler: Newton iterations that reuse the first Jacobian of a step
+LINE_SEARCH_HALVINGS = 30  # backward Euler's globalised Newton: the most halvings of a step's update
 MAX_SAMPLES = 20000
 SAMPLES_PER_MESH_PERIOD = 64
 RTOL, ATOL_ANGLE = 1e-7, 1e-10
@@ -303,7 +304,15 @@ def integrate_backward_euler(acc, duration: float, h: float, max_iter: int = 30,
     (the mesh force is piecewise smooth: backlash, contact onset); the 4x4 Newton
     system is reduced to 2x2 in the speed updates (d theta_i = r_theta_i + h d omega_i) and solved by Cramer's
     rule, all in floats. Converged when every update is below TOL + 1e-10 |y|. A step whose iteration does not
-    converge is split in two (recursively, down to h / 1024). It steps over the mesh and servo modes (kHz) and
+    converge is split in two (recursively, down to h / 1024). Where that fails too, the step is solved again with
+    the globalised Newton method (Nocedal & Wright, Numerical Optimization, ch. 11): the Jacobian each
+    iteration and a backtracking line search on the residual (Armijo, halving the update up to
+    LINE_SEARCH_HALVINGS times), the same splitting and convergence test. The plain iteration cycles where the
+    solution lies inside the friction direction's band |Vs| < v_s (tanh, _Mesh._with_friction) and an update
+    crosses it: the Jacobian at the saturated sides is flat in omega1, so each update jumps to the other side (a
+    held back-drive, the worm stopped inside the band under the mesh torque: the screw jack at t = 2.8 ms, at
+    every split down to 4.9e-7 s; docs/decisions/0055-backward-euler-line-search.md); the line search lands in
+    the band. Every step the plain iteration solves keeps its bits. It steps over the mesh and servo modes (kHz) and
     damps them: it follows the motion and the quasi-static mesh force. limit (the speed servo's peak torque,
     _Setup): each step is solved with the limit as it was in the step before (limit.on) and solved again with it
     switched when the solution says otherwise (limit.binds(t, y)) or the solve fails, so that a run whose servo
@@ -316,27 +325,45 @@ def integrate_backward_euler(acc, duration: float, h: float, max_iter: int = 30,
     TOL_TH, TOL_W = 1e-13, 1e-10
     nfev = 0
 
-    def solve_step(y0, yp, t1, hh, depth):
+    def jacobian(t1, x1, u1, x2, u2, a1, a2):
+        """Forward differences of (a1, a2) in (theta1, omega1, theta2, omega2)."""
+        nonlocal nfev
+        d = FD_TH + 1e-9 * abs(x1)
+        b1, b2 = acc(t1, x1 + d, u1, x2, u2)
+        j10, j30 = (b1 - a1) / d, (b2 - a2) / d
+        d = FD_W + 1e-9 * abs(u1)
+        b1, b2 = acc(t1, x1, u1 + d, x2, u2)
+        j11, j31 = (b1 - a1) / d, (b2 - a2) / d
+        d = FD_TH + 1e-9 * abs(x2)
+        b1, b2 = acc(t1, x1, u1, x2 + d, u2)
+        j12, j32 = (b1 - a1) / d, (b2 - a2) / d
+        d = FD_W + 1e-9 * abs(u2)
+        b1, b2 = acc(t1, x1, u1, x2, u2 + d)
+        j13, j33 = (b1 - a1) / d, (b2 - a2) / d
+        nfev += 4
+        return j10, j11, j12, j13, j30, j31, j32, j33
+
+    def residual_norm(y0, t1, hh, x1, u1, x2, u2):
+        """The step's residual in speed units, |(r_theta1 / h, r_omega1, r_theta2 / h, r_omega2)|, and the
+        accelerations there."""
+        nonlocal nfev
+        a1, a2 = acc(t1, x1, u1, x2, u2)
+        nfev += 1
+        p1, v1, p2, v2 = y0
+        r = math.hypot((p1 - x1) / hh + u1, v1 + hh * a1 - u1, (p2 - x2) / hh + u2, v2 + hh * a2 - u2)
+        return r, a1, a2
+
+    def solve_step(y0, yp, t1, hh, depth, damped=False):
         nonlocal nfev
         p1, v1, p2, v2 = y0
         x1, u1, x2, u2 = yp
-        for it in range(max_iter):
-            a1, a2 = acc(t1, x1, u1, x2, u2)
-            nfev += 1
-            if it == 0 or it >= CHORD_ITER:  # chord (simplified) Newton first, full Newton if it stalls
-                d = FD_TH + 1e-9 * abs(x1)
-                b1, b2 = acc(t1, x1 + d, u1, x2, u2)
-                j10, j30 = (b1 - a1) / d, (b2 - a2) / d
-                d = FD_W + 1e-9 * abs(u1)
-                b1, b2 = acc(t1, x1, u1 + d, x2, u2)
-                j11, j31 = (b1 - a1) / d, (b2 - a2) / d
-                d = FD_TH + 1e-9 * abs(x2)
-                b1, b2 = acc(t1, x1, u1, x2 + d, u2)
-                j12, j32 = (b1 - a1) / d, (b2 - a2) / d
-                d = FD_W + 1e-9 * abs(u2)
-                b1, b2 = acc(t1, x1, u1, x2, u2 + d)
-                j13, j33 = (b1 - a1) / d, (b2 - a2) / d
-                nfev += 4
+        a1 = a2 = None
+        for it in range(max_iter * (2 if damped else 1)):
+            if a1 is None or not damped:
+                a1, a2 = acc(t1, x1, u1, x2, u2)
+                nfev += 1
+            if damped or it == 0 or it >= CHORD_ITER:  # chord (simplified) Newton first, full Newton if it stalls
+                j10, j11, j12, j13, j30, j31, j32, j33 = jacobian(t1, x1, u1, x2, u2, a1, a2)
             r0, r1 = p1 + hh * u1 - x1, v1 + hh * a1 - u1
             r2, r3 = p2 + hh * u2 - x2, v2 + hh * a2 - u2
             # (I - hJ) d = r with d_theta_i = r_theta_i + h d_omega_i  ->  2x2 in (d_omega1, d_omega2)
@@ -350,38 +377,60 @@ def integrate_backward_euler(acc, duration: float, h: float, max_iter: int = 30,
             dw1 = (q0 * m11 - m01 * q1) / det
             dw2 = (m00 * q1 - m10 * q0) / det
             dp1, dp2 = r0 + hh * dw1, r2 + hh * dw2
+            converged = (
+                abs(dp1) <= TOL_TH + 1e-10 * abs(x1 + dp1)
+                and abs(dp2) <= TOL_TH + 1e-10 * abs(x2 + dp2)
+                and abs(dw1) <= TOL_W + 1e-10 * abs(u1 + dw1)
+                and abs(dw2) <= TOL_W + 1e-10 * abs(u2 + dw2)
+            )
+            if damped and not converged:  # backtracking on the residual (Armijo), the globalised Newton
+                r_now = math.hypot(r0 / hh, r1, r2 / hh, r3)
+                lam = 1.0
+                for k in range(LINE_SEARCH_HALVINGS + 1):
+                    r_new, b1, b2 = residual_norm(
+                        y0, t1, hh, x1 + lam * dp1, u1 + lam * dw1, x2 + lam * dp2, u2 + lam * dw2
+                    )
+                    if r_new <= (1.0 - 1e-4 * lam) * r_now or k == LINE_SEARCH_HALVINGS:
+                        break
+                    lam *= 0.5
+                a1, a2 = b1, b2
+                dp1, dw1, dp2, dw2 = lam * dp1, lam * dw1, lam * dp2, lam * dw2
             x1, u1, x2, u2 = x1 + dp1, u1 + dw1, x2 + dp2, u2 + dw2
             if not math.isfinite(x1 + u1 + x2 + u2):
                 break
-            if (
-                abs(dp1) <= TOL_TH + 1e-10 * abs(x1)
-                and abs(dp2) <= TOL_TH + 1e-10 * abs(x2)
-                and abs(dw1) <= TOL_W + 1e-10 * abs(u1)
-                and abs(dw2) <= TOL_W + 1e-10 * abs(u2)
-            ):
+            if converged:
                 return (x1, u1, x2, u2)
         if depth >= 10:
             raise SimulationError(
                 f"torsional: implicit step did not converge at t = {t1:.4g} s even at timestep {hh:.3g} s"
             )
-        ym = solve_step(y0, y0, t1 - hh / 2, hh / 2, depth + 1)
-        return solve_step(ym, ym, t1, hh / 2, depth + 1)
+        ym = solve_step(y0, y0, t1 - hh / 2, hh / 2, depth + 1, damped)
+        return solve_step(ym, ym, t1, hh / 2, depth + 1, damped)
 
-    def limited_step(y0, yp, t1):
+    def limited_step(y0, yp, t1, damped):
         """solve_step with the servo's limit switched where the solution (or a failed solve) asks for it."""
         try:
-            y1 = solve_step(y0, yp, t1, h, 0)
+            y1 = solve_step(y0, yp, t1, h, 0, damped)
             if limit.binds(t1, y1) == limit.on:
                 return y1
         except SimulationError:
             pass
         limit.on = not limit.on
-        return solve_step(y0, yp, t1, h, 0)
+        return solve_step(y0, yp, t1, h, 0, damped)
+
+    def step_of(y0, yp, t1, damped):
+        return solve_step(y0, yp, t1, h, 0, damped) if limit is None else limited_step(y0, yp, t1, damped)
 
     y_prev = y = (0.0, 0.0, 0.0, 0.0)
     for i in range(n):
         pred = tuple(2 * a - b for a, b in zip(y, y_prev))
-        y_new = solve_step(y, pred, t[i + 1], h, 0) if limit is None else limited_step(y, pred, t[i + 1])
+        on = limit.on if limit is not None else None
+        try:
+            y_new = step_of(y, pred, t[i + 1], False)
+        except SimulationError:  # the plain iteration cycles: the globalised one (docstring)
+            if limit is not None:
+                limit.on = on
+            y_new = step_of(y, pred, t[i + 1], True)
         y_prev, y = y, y_new
         Y[:, i + 1] = y
     return t, Y, nfev
