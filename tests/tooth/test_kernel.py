@@ -314,3 +314,34 @@ def test_depths_finite_where_a_trimmed_point_ends_the_profile():
     r = mesh_sweep(g, 40, 256)
     assert np.all(np.isfinite(r["k_mesh"]))
     assert max(float(v.max()) for v in r["loads"].values()) < 1.02
+
+
+def test_weights_finite_where_the_line_runs_past_a_trimmed_profile_end():
+    """left-q6-4start (tests/contact3d/test_variety.py) at 128 slices, flank 1 of its tooth 1: slice 68's contact
+    line runs past its active profile's last point (index 60; point 61 is trimmed, NaN) and neither neighbour has an
+    active segment there, so its share comes from the change across the face at the line's point (_face_slope). That
+    point is the line's, extrapolated along the end segment; read at the grid points around its fractional index
+    (60 and the trimmed 61) the share was NaN and MuJoCo diverged at t = 5.9 ms. Every output is finite at the
+    poses where that slice carries."""
+    from meshgen import wheel
+    from tests.contact3d.test_variety import FLANK_GEARS
+    from tests.contact3d.test_variety import GEAR as OTHER
+
+    g = derive(load_scenario(OTHER, FLANK_GEARS["left-q6-4start"]).gear)
+    S = 128
+    W = window_size(g)
+    bl = g.backlash / (2 * g.r2)
+    margin = kernel.MARGIN_PITCH * 2 * math.pi / g.z2 + bl
+    lag = bl + 1e-6 / (g.r2 * math.cos(g.alpha_n) * math.cos(g.gamma))
+    fg = grid.flank_grid(g, S)
+    pk = kernel.PackedKernel(fg, fg.params, 2 * W * S, W, g.z2, S // 4)
+    carried = 0
+    for th1 in np.linspace(0.5553, 0.5600, 4):
+        th2 = g.hand * (th1 * g.z1 / g.z2 - lag)
+        pk.ks[:] = window_teeth_at(th2, g.z2, W, wheel.tooth_angle(g, 0))
+        n = kernel.find_packed(pk.fb, pk.ib, th1, th2, margin, kernel.TAPER_SHARE * margin)
+        nm = int(pk.ib[7])
+        for a in (pk.pos[:n], pk.nrm[:n], pk.depth[:n], pk.weight[:n], pk.line[:n], pk.mdepth[:nm], pk.mweight[:nm]):
+            assert np.all(np.isfinite(a))
+        carried += int(np.any((pk.meta[:n, 1] == 1) & (pk.meta[:n, 2] == 68)))
+    assert carried == 4

@@ -607,7 +607,7 @@ def _line_share(xy, sc, zeta, sg, j, hint, ca, sa, P, tmp):
         i0 = (a + b) // 2
         x0, y0 = xy[sg, j, i0, 0], xy[sg, j, i0, 1]
         e0 = _excess(x0, y0, zeta[j], ca, sa, P, tmp)
-        return _covered(e0, _face_slope(xy, sg, j, float(i0), zeta[j], dz, ca, sa, P, tmp), 0.0), (
+        return _covered(e0, _face_slope(x0, y0, zeta[j], dz, ca, sa, P, tmp), 0.0), (
             0.0,
             0.0,
             0.0,
@@ -624,7 +624,7 @@ def _line_share(xy, sc, zeta, sg, j, hint, ca, sa, P, tmp):
     if j < S - 1:
         fp, ip = _index_at(c, span, sg, j + 1, c_line, i0)
     if im < 0 and ip < 0:
-        return _covered(e0, _face_slope(xy, sg, j, f0, zeta[j], dz, ca, sa, P, tmp), 0.0), (
+        return _covered(e0, _face_slope(x0, y0, zeta[j], dz, ca, sa, P, tmp), 0.0), (
             0.0,
             0.0,
             0.0,
@@ -690,17 +690,11 @@ def _tip_depth(delta, kappa, t0, tb, ta):
 
 
 @numba.njit(cache=True, inline="always")
-def _face_slope(xy, sg, j, f, zj, dz, ca, sa, P, tmp):
-    """Change of the excess (worm_gap_ext) across one slice width at the line's point: the wheel point at fractional
-    profile index f of (flank sg, slice j), its (x, y) linear between the grid points, moved by -dz/2 and +dz/2
-    along the wheel axis. A property of the point alone, so each slice's weight is continuous in the mesh angle
-    (slice_weights)."""
-    i0 = int(math.floor(f))
-    t = f - i0
-    x0, y0 = xy[sg, j, i0, 0], xy[sg, j, i0, 1]
-    if t > 0.0:
-        x0 += t * (xy[sg, j, i0 + 1, 0] - x0)
-        y0 += t * (xy[sg, j, i0 + 1, 1] - y0)
+def _face_slope(x0, y0, zj, dz, ca, sa, P, tmp):
+    """Change of the excess (worm_gap_ext) across one slice width at the line's point: the wheel point (x0, y0) of
+    the slice at zj (_line_share's, extrapolated along the end segment past the active profile: the grid points
+    past its ends may be trimmed, NaN) moved by -dz/2 and +dz/2 along the wheel axis. A property of the point alone,
+    so each slice's weight is continuous in the mesh angle (slice_weights)."""
     return _excess(x0, y0, zj + 0.5 * dz, ca, sa, P, tmp) - _excess(x0, y0, zj - 0.5 * dz, ca, sa, P, tmp)
 
 
