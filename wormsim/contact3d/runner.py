@@ -364,7 +364,8 @@ def _warm_split_forces() -> None:
     n = int(d.ncon)
     merged = (np.zeros(n), np.full(n, 1.0 / max(n, 1)), np.ones(n), np.ones(n))
     split_forces(d.contact.efc_address, d.efc_force, 0, True, merged, n, (np.zeros(n, np.int64), np.zeros(3 * n)))
-    contact_frames(np.zeros((n, 3)), n, np.zeros((n, 9)))  # the slices' frames after it (FlankContacts.slice_rows)
+    normals = np.tile(np.array([0.0, 0.0, 1.0]), (n, 1))  # unit normals (a zero one divides by zero)
+    contact_frames(normals, n, np.zeros((n, 9)))  # the slices' frames after it (FlankContacts.slice_rows)
 
 
 def _warm_friction_check() -> None:

@@ -293,6 +293,56 @@ def default_timestep(g: GearGeometry, ms: MeshStiffness, w1_full_rad_s: float, d
     return max(gt.round_down_125(min(h, duration_s / 50)), duration_s / MAX_SAMPLES)
 
 
+FD_TH, FD_W = 1e-10, 1e-7  # integrate_backward_euler's forward-difference steps (angle, speed)
+TOL_TH, TOL_W = 1e-13, 1e-10  # and its absolute update tolerances (angle, speed)
+
+
+def _converged(x, dx) -> bool:
+    """Every Newton update below TOL + 1e-10 |x + dx| (integrate_backward_euler)."""
+    x1, u1, x2, u2 = x
+    dp1, dw1, dp2, dw2 = dx
+    return (
+        abs(dp1) <= TOL_TH + 1e-10 * abs(x1 + dp1)
+        and abs(dp2) <= TOL_TH + 1e-10 * abs(x2 + dp2)
+        and abs(dw1) <= TOL_W + 1e-10 * abs(u1 + dw1)
+        and abs(dw2) <= TOL_W + 1e-10 * abs(u2 + dw2)
+    )
+
+
+def _jacobian(acc, t1, x1, u1, x2, u2, a1, a2):
+    """Forward differences of (a1, a2) in (theta1, omega1, theta2, omega2) (integrate_backward_euler; 4 evaluations
+    of acc)."""
+    d = FD_TH + 1e-9 * abs(x1)
+    b1, b2 = acc(t1, x1 + d, u1, x2, u2)
+    j10, j30 = (b1 - a1) / d, (b2 - a2) / d
+    d = FD_W + 1e-9 * abs(u1)
+    b1, b2 = acc(t1, x1, u1 + d, x2, u2)
+    j11, j31 = (b1 - a1) / d, (b2 - a2) / d
+    d = FD_TH + 1e-9 * abs(x2)
+    b1, b2 = acc(t1, x1, u1, x2 + d, u2)
+    j12, j32 = (b1 - a1) / d, (b2 - a2) / d
+    d = FD_W + 1e-9 * abs(u2)
+    b1, b2 = acc(t1, x1, u1, x2, u2 + d)
+    j13, j33 = (b1 - a1) / d, (b2 - a2) / d
+    return j10, j11, j12, j13, j30, j31, j32, j33
+
+
+def _backtrack(acc, y0, t1, hh, x, dx, r_now):
+    """integrate_backward_euler's line search (Armijo): the update dx from x halved until the step's residual in
+    speed units, |(r_theta1 / h, r_omega1, r_theta2 / h, r_omega2)|, falls below (1 - 1e-4 lam) r_now, at most
+    LINE_SEARCH_HALVINGS times; returns (lam, the accelerations at x + lam dx, the evaluations of acc)."""
+    p1, v1, p2, v2 = y0
+    lam = 1.0
+    for k in range(LINE_SEARCH_HALVINGS + 1):
+        x1, u1, x2, u2 = (xi + lam * di for xi, di in zip(x, dx))
+        a1, a2 = acc(t1, x1, u1, x2, u2)
+        r_new = math.hypot((p1 - x1) / hh + u1, v1 + hh * a1 - u1, (p2 - x2) / hh + u2, v2 + hh * a2 - u2)
+        if r_new <= (1.0 - 1e-4 * lam) * r_now or k == LINE_SEARCH_HALVINGS:
+            break
+        lam *= 0.5
+    return lam, a1, a2, k + 1
+
+
 def integrate_backward_euler(acc, duration: float, h: float, max_iter: int = 30, limit=None):
     """Fixed-step backward (implicit) Euler, L-stable (Hairer & Wanner, Solving ODEs II, IV.3), for
     theta_i' = omega_i, omega_i' = a_i(t, theta1, omega1, theta2, omega2):
@@ -307,12 +357,9 @@ def integrate_backward_euler(acc, duration: float, h: float, max_iter: int = 30,
     converge is split in two (recursively, down to h / 1024). Where that fails too, the step is solved again with
     the globalised Newton method (Nocedal & Wright, Numerical Optimization, ch. 11): the Jacobian each
     iteration and a backtracking line search on the residual (Armijo, halving the update up to
-    LINE_SEARCH_HALVINGS times), the same splitting and convergence test. The plain iteration cycles where the
-    solution lies inside the friction direction's band |Vs| < v_s (tanh, _Mesh._with_friction) and an update
-    crosses it: the Jacobian at the saturated sides is flat in omega1, so each update jumps to the other side (a
-    held back-drive, the worm stopped inside the band under the mesh torque: the screw jack at t = 2.8 ms, at
-    every split down to 4.9e-7 s; docs/decisions/0055-backward-euler-line-search.md); the line search lands in
-    the band. Every step the plain iteration solves keeps its bits. It steps over the mesh and servo modes (kHz) and
+    LINE_SEARCH_HALVINGS times, _backtrack), the same splitting and convergence test: the plain iteration cycles
+    across the friction direction's tanh band where the solution lies inside it (a held back-drive; decision
+    0055). Every step the plain iteration solves keeps its bits. It steps over the mesh and servo modes (kHz) and
     damps them: it follows the motion and the quasi-static mesh force. limit (the speed servo's peak torque,
     _Setup): each step is solved with the limit as it was in the step before (limit.on) and solved again with it
     switched when the solution says otherwise (limit.binds(t, y)) or the solve fails, so that a run whose servo
@@ -321,37 +368,7 @@ def integrate_backward_euler(acc, duration: float, h: float, max_iter: int = 30,
     n = int(math.floor(duration / h + 1e-9))
     t = np.arange(n + 1) * h
     Y = np.zeros((4, n + 1))
-    FD_TH, FD_W = 1e-10, 1e-7
-    TOL_TH, TOL_W = 1e-13, 1e-10
     nfev = 0
-
-    def jacobian(t1, x1, u1, x2, u2, a1, a2):
-        """Forward differences of (a1, a2) in (theta1, omega1, theta2, omega2)."""
-        nonlocal nfev
-        d = FD_TH + 1e-9 * abs(x1)
-        b1, b2 = acc(t1, x1 + d, u1, x2, u2)
-        j10, j30 = (b1 - a1) / d, (b2 - a2) / d
-        d = FD_W + 1e-9 * abs(u1)
-        b1, b2 = acc(t1, x1, u1 + d, x2, u2)
-        j11, j31 = (b1 - a1) / d, (b2 - a2) / d
-        d = FD_TH + 1e-9 * abs(x2)
-        b1, b2 = acc(t1, x1, u1, x2 + d, u2)
-        j12, j32 = (b1 - a1) / d, (b2 - a2) / d
-        d = FD_W + 1e-9 * abs(u2)
-        b1, b2 = acc(t1, x1, u1, x2, u2 + d)
-        j13, j33 = (b1 - a1) / d, (b2 - a2) / d
-        nfev += 4
-        return j10, j11, j12, j13, j30, j31, j32, j33
-
-    def residual_norm(y0, t1, hh, x1, u1, x2, u2):
-        """The step's residual in speed units, |(r_theta1 / h, r_omega1, r_theta2 / h, r_omega2)|, and the
-        accelerations there."""
-        nonlocal nfev
-        a1, a2 = acc(t1, x1, u1, x2, u2)
-        nfev += 1
-        p1, v1, p2, v2 = y0
-        r = math.hypot((p1 - x1) / hh + u1, v1 + hh * a1 - u1, (p2 - x2) / hh + u2, v2 + hh * a2 - u2)
-        return r, a1, a2
 
     def solve_step(y0, yp, t1, hh, depth, damped=False):
         nonlocal nfev
@@ -363,7 +380,8 @@ def integrate_backward_euler(acc, duration: float, h: float, max_iter: int = 30,
                 a1, a2 = acc(t1, x1, u1, x2, u2)
                 nfev += 1
             if damped or it == 0 or it >= CHORD_ITER:  # chord (simplified) Newton first, full Newton if it stalls
-                j10, j11, j12, j13, j30, j31, j32, j33 = jacobian(t1, x1, u1, x2, u2, a1, a2)
+                j10, j11, j12, j13, j30, j31, j32, j33 = _jacobian(acc, t1, x1, u1, x2, u2, a1, a2)
+                nfev += 4
             r0, r1 = p1 + hh * u1 - x1, v1 + hh * a1 - u1
             r2, r3 = p2 + hh * u2 - x2, v2 + hh * a2 - u2
             # (I - hJ) d = r with d_theta_i = r_theta_i + h d_omega_i  ->  2x2 in (d_omega1, d_omega2)
@@ -377,23 +395,11 @@ def integrate_backward_euler(acc, duration: float, h: float, max_iter: int = 30,
             dw1 = (q0 * m11 - m01 * q1) / det
             dw2 = (m00 * q1 - m10 * q0) / det
             dp1, dp2 = r0 + hh * dw1, r2 + hh * dw2
-            converged = (
-                abs(dp1) <= TOL_TH + 1e-10 * abs(x1 + dp1)
-                and abs(dp2) <= TOL_TH + 1e-10 * abs(x2 + dp2)
-                and abs(dw1) <= TOL_W + 1e-10 * abs(u1 + dw1)
-                and abs(dw2) <= TOL_W + 1e-10 * abs(u2 + dw2)
-            )
+            converged = _converged((x1, u1, x2, u2), (dp1, dw1, dp2, dw2))
             if damped and not converged:  # backtracking on the residual (Armijo), the globalised Newton
                 r_now = math.hypot(r0 / hh, r1, r2 / hh, r3)
-                lam = 1.0
-                for k in range(LINE_SEARCH_HALVINGS + 1):
-                    r_new, b1, b2 = residual_norm(
-                        y0, t1, hh, x1 + lam * dp1, u1 + lam * dw1, x2 + lam * dp2, u2 + lam * dw2
-                    )
-                    if r_new <= (1.0 - 1e-4 * lam) * r_now or k == LINE_SEARCH_HALVINGS:
-                        break
-                    lam *= 0.5
-                a1, a2 = b1, b2
+                lam, a1, a2, k = _backtrack(acc, y0, t1, hh, (x1, u1, x2, u2), (dp1, dw1, dp2, dw2), r_now)
+                nfev += k
                 dp1, dw1, dp2, dw2 = lam * dp1, lam * dw1, lam * dp2, lam * dw2
             x1, u1, x2, u2 = x1 + dp1, u1 + dw1, x2 + dp2, u2 + dw2
             if not math.isfinite(x1 + u1 + x2 + u2):
