@@ -14,6 +14,7 @@ import pytest
 
 from meshgen.geometry import derive
 from tests.conftest import SCENARIOS
+from tests.contact3d.test_guards import LOCK_DURATION, WHEEL_DRIVEN
 from wormsim import cli
 from wormsim.contact3d.mjcf import prepare
 from wormsim.physics import gear_theory as gt
@@ -149,20 +150,9 @@ def test_torsional_torque_driven_wheel_held_from_rest_is_locked():
 
 
 JACK = SCENARIOS / "screw_jack.yaml"
-JACK_RPM = 55.0
-JACK_BACKDRIVE = [
-    "model=torsional",
-    "drive.on=wheel",
-    f"drive.speed_rpm={JACK_RPM}",
-    "drive.ramp_s=0.01",
-    "load.on=worm",
-    "load.torque_nm=0.1",
-    "load.ramp_s=0.01",
-    "contact.friction_static=null",
-    "contact.friction_dynamic=null",
-    "contact.friction=0.2",
-    "simulation.duration_s=0.085",
-]
+JACK_RPM = 55.0  # the wheel's command in tests/contact3d/test_guards.py's WHEEL_DRIVEN
+# the held back-drive of tests/contact3d/test_guards.py (its contact3d runs) at torsional
+JACK_BACKDRIVE = ["model=torsional", *WHEEL_DRIVEN, "contact.friction=0.2", LOCK_DURATION]
 
 
 def test_torsional_backdrive_of_the_screw_jack_is_held_exit_0(tmp_path, capsys):
