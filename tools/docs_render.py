@@ -487,7 +487,8 @@ def core_contention_table(name: str = "core_contention") -> str:
     )
     point = r["summary"].get("point")
     if point is not None and point["others_cores_alone_median"] <= QUIET_OTHERS_CORES:
-        text += f" Bound on a CPU-bound 2-worker span from the point's growth: {r['span_speedup_bound_2']:.2f}x."
+        bound = min(2.0, r["span_speedup_bound_2"])  # a growth below 1 is noise, not a faster core
+        text += f" Bound on a CPU-bound 2-worker span from the point's growth: {bound:.2f}x."
     elif point is not None:
         text += (
             f" The machine was not quiet (others' cores above {QUIET_OTHERS_CORES}): no growth or bound is read "
