@@ -205,6 +205,36 @@ def test_bad_qacc_at_a_stable_timestep_names_the_command_step_and_its_cure():
     assert res.sim_time_s == pytest.approx(0.004, abs=1e-5)
 
 
+@pytest.mark.parametrize("field", ["qvel", "qacc"])
+def test_a_state_mujoco_resets_mid_run_fails_at_the_time_it_happened(monkeypatch, field):
+    """MuJoCo resets the state and d.time to the start on a non-finite or huge qpos, qvel or qacc and steps on: a run
+    must not go on from rest as if nothing happened, and the divergence must be dated by the run's clock, not the
+    reset one. A NaN velocity (MuJoCo's bad-qvel) or a huge applied force (bad-qacc) is planted after the first
+    sample past 5 ms of a screw-jack run on the compiled flank path."""
+    import numpy as np
+
+    from wormsim.contact3d import runner
+
+    real, planted = runner._sample, []
+
+    def plant(lp, i, cmd, sums):
+        real(lp, i, cmd, sums)
+        if not planted and lp.d.time > 0.005:
+            planted.append(float(lp.d.time))
+            if field == "qvel":
+                lp.d.qvel[:] = np.nan
+            else:
+                lp.d.qfrc_applied[:] = 1e30
+
+    monkeypatch.setattr(runner, "_sample", plant)
+    with pytest.raises(SimulationError) as exc:
+        simulate(load_scenario(JACK, ["simulation.duration_s=0.02", "simulation.resolution=coarse"]))
+    msg = str(exc.value)
+    assert classify_failure(exc.value) == "diverged" and f"bad-{field}" in msg, msg
+    t = float(re.search(r"diverged at t = ([0-9.e+-]+) s", msg).group(1))
+    assert planted[0] < t < planted[0] + 0.002, (planted, msg)
+
+
 def test_classify_failure_names_each_guard_by_its_exception_type():
     for exc_type, klass in FAILURE_CLASSES:
         assert issubclass(exc_type, SimulationError)

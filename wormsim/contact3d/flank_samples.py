@@ -152,6 +152,7 @@ def run_samples(tables, mj, cmds, span, S, p, room, io, mrg, shaft):
     qpos, qvel = f1(T, Row.qpos), f1(T, Row.qvel)
     depth = f1(Ts, SampleRow.depth)
     tptr, nptr, bptr = f64_at(d_addr + off[0]), i32_at(d_addr + off[1]), i32_at(d_addr + off[5])
+    ws = off[8] // 4  # one mjWarningStat in int32s (native.FIELDS: BADQPOS, BADQVEL, BADQACC follow each other)
     mu_now = io[IO_MU]
     cone3 = mu_now > 0.0
     turn_max = io[IO_TURN_MAX]
@@ -174,7 +175,16 @@ def run_samples(tables, mj, cmds, span, S, p, room, io, mrg, shaft):
         w1, w2 = qvel[p.dof1], qvel[p.dof2]
         t = tptr[0]
         event, te, turn = state_event(
-            th1, th2, w1, w2, bptr[0], p.dt, p.overspeed_turn, p.direction, p.ratio, p.jump_rad
+            th1,
+            th2,
+            w1,
+            w2,
+            bptr[0] + bptr[ws] + bptr[2 * ws],
+            p.dt,
+            p.overspeed_turn,
+            p.direction,
+            p.ratio,
+            p.jump_rad,
         )
         if event != 0:  # Guards.state raises: the Python path
             io[IO_EVENT] = EV_GUARD

@@ -32,12 +32,12 @@ PENETRATED, STUCK, RUNNING = 4, 5, 6  # contact_event's codes (0: none)
 
 
 @numba.njit(cache=True, inline="always")
-def state_event(th1, th2, w1, w2, badqacc, dt, turn_lim, direction, ratio, jump_rad):
-    """The state checks of a sample, in order: DIVERGED (non-finite state or MuJoCo's bad-qacc warning count
-    badqacc), OVERSPEED (the worm's turn per step |w1| dt beyond turn_lim), JUMPED (the transmission error
-    th2 - direction th1 / ratio beyond jump_rad), 0 when none fires; with (the TE, the turn). Guards.state and the
-    compiled samples (wormsim.contact3d.flank_samples) both decide by it."""
-    if not math.isfinite(th1 + th2 + w1 + w2) or badqacc != 0:
+def state_event(th1, th2, w1, w2, bad, dt, turn_lim, direction, ratio, jump_rad):
+    """The state checks of a sample, in order: DIVERGED (non-finite state, or MuJoCo's bad-qpos, -qvel or -qacc
+    warnings' count bad: MuJoCo then reset the state and the time), OVERSPEED (the worm's turn per step |w1| dt beyond
+    turn_lim), JUMPED (the transmission error th2 - direction th1 / ratio beyond jump_rad), 0 when none fires; with
+    (the TE, the turn). Guards.state and the compiled samples (wormsim.contact3d.flank_samples) both decide by it."""
+    if not math.isfinite(th1 + th2 + w1 + w2) or bad != 0:
         return DIVERGED, 0.0, 0.0
     turn = abs(w1) * dt
     if turn > turn_lim:
@@ -66,6 +66,14 @@ def contact_event(t, pen, pen_lim, w_drive, cmd, speed_driven, lock_start, lock_
     return 0
 
 
+def bad_state_warnings(d: mujoco.MjData) -> list[str]:
+    """Which of MuJoCo's bad-state warnings (qpos, qvel, qacc) fired: on each MuJoCo resets the state and d.time to
+    the start and steps on (mj_checkPos / mj_checkVel / mj_checkAcc)."""
+    return [
+        w for w in ("qpos", "qvel", "qacc") if d.warning[getattr(mujoco.mjtWarning, f"mjWARN_BAD{w.upper()}")].number
+    ]
+
+
 class Guards:
     """The checks after every record interval (module docstring); each raises its SimulationError subclass. What they
     check against comes from the run's plan (bm.plan: the timestep, the drive's kind, the guards' times, the working
@@ -92,12 +100,14 @@ class Guards:
     def state(self, d: mujoco.MjData, t: float, th1: float, th2: float, w1: float, w2: float) -> float:
         """Divergence, overspeed, teeth jumped, friction against the slip; returns the transmission error (rad)."""
         bm, dt = self.bm, self.dt
-        badqacc = d.warning[mujoco.mjtWarning.mjWARN_BADQACC].number
+        bad = bad_state_warnings(d)
         code, te, turn = state_event(
-            th1, th2, w1, w2, badqacc, dt, self.turn_lim, float(bm.direction), bm.geometry.ratio, self.jump_rad
+            th1, th2, w1, w2, len(bad), dt, self.turn_lim, float(bm.direction), bm.geometry.ratio, self.jump_rad
         )
         if code == DIVERGED:
-            raise diverged_error(t, dt, bm, "non-finite state or huge acceleration (MuJoCo's bad-qacc warning)")
+            what = "huge acceleration" if "qacc" in bad else "huge velocity or position"
+            why = f" (MuJoCo's bad-{' / bad-'.join(bad)} warning)" if bad else ""
+            raise diverged_error(t, dt, bm, f"non-finite state or {what}{why}")
         self.turn_max = max(self.turn_max, turn)
         if code == OVERSPEED:
             if dt > bm.law.stable_limit_s:

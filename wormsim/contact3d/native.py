@@ -214,7 +214,11 @@ _SCALARS = {
     "char": ctypes.c_char,
 }
 # the layout vector, in this order (flank_samples.run_samples reads it so)
-FIELDS = ("time", "ncon", "nefc", "contact", "efc_force", "badqacc_number", "contact_size", "contact_efc_address")
+# badq_number: the count of mjWARN_BADQPOS, whose mjWarningStat is followed by BADQVEL's and BADQACC's (warning_size
+# apart): MuJoCo resets the state and the time on each (mj_checkPos / mj_checkVel / mj_checkAcc)
+FIELDS = ("time", "ncon", "nefc", "contact", "efc_force", "badq_number", "contact_size", "contact_efc_address")
+FIELDS += ("warning_size",)
+BAD_STATE_WARNINGS = ("mjWARN_BADQPOS", "mjWARN_BADQVEL", "mjWARN_BADQACC")
 
 
 class MjDataLayoutError(RuntimeError):
@@ -252,7 +256,10 @@ def _struct(name: str) -> type[ctypes.Structure]:
 def declared_offsets() -> np.ndarray:
     """The offsets of FIELDS from the declared structs (no check)."""
     D, C, W = _struct("mjData"), _struct("mjContact"), _struct("mjWarningStat")
-    badqacc = D.warning.offset + ctypes.sizeof(W) * int(mujoco.mjtWarning.mjWARN_BADQACC) + W.number.offset
+    bad = [int(getattr(mujoco.mjtWarning, w)) for w in BAD_STATE_WARNINGS]
+    if bad != list(range(bad[0], bad[0] + len(bad))):
+        raise KeyError(f"{BAD_STATE_WARNINGS} are not consecutive in mjtWarning ({bad})")
+    badq = D.warning.offset + ctypes.sizeof(W) * bad[0] + W.number.offset
     return np.array(
         [
             D.time.offset,
@@ -260,9 +267,10 @@ def declared_offsets() -> np.ndarray:
             D.nefc.offset,
             D.contact.offset,
             D.efc_force.offset,
-            badqacc,
+            badq,
             ctypes.sizeof(C),
             C.efc_address.offset,
+            ctypes.sizeof(W),
         ],
         dtype=np.int64,
     )
@@ -278,7 +286,8 @@ def check(off: np.ndarray) -> list[str]:
     d = mujoco.MjData(m)
     d.time = 0.25
     mujoco.mj_step(m, d)
-    d.warning[mujoco.mjtWarning.mjWARN_BADQACC].number = 7
+    for k, w in enumerate(BAD_STATE_WARNINGS):
+        d.warning[getattr(mujoco.mjtWarning, w)].number = 7 + k
     a = d._address
     o = [int(x) for x in off]
     con = np.asarray(d.contact.dist).ctypes.data  # dist is mjContact's first field
@@ -288,7 +297,10 @@ def check(off: np.ndarray) -> list[str]:
         "nefc": (ctypes.c_int.from_address(a + o[2]).value, d.nefc),
         "contact": (ctypes.c_int64.from_address(a + o[3]).value, con),
         "efc_force": (ctypes.c_int64.from_address(a + o[4]).value, np.asarray(d.efc_force).ctypes.data),
-        "badqacc_number": (ctypes.c_int.from_address(a + o[5]).value, 7),
+        "badq_number": (
+            [ctypes.c_int.from_address(a + o[5] + k * o[8]).value for k in range(len(BAD_STATE_WARNINGS))],
+            [7 + k for k in range(len(BAD_STATE_WARNINGS))],
+        ),
         "contact_size": (o[6], np.asarray(d.contact.dist).strides[0]),
     }
     if d.ncon >= 1:
@@ -296,7 +308,8 @@ def check(off: np.ndarray) -> list[str]:
         got["contact_efc_address"] = (last, int(d.contact.efc_address[d.ncon - 1]))
     else:
         got["contact_efc_address"] = (0, 1)
-    d.warning[mujoco.mjtWarning.mjWARN_BADQACC].number = 0
+    for w in BAD_STATE_WARNINGS:
+        d.warning[getattr(mujoco.mjtWarning, w)].number = 0
     return [k for k, (x, y) in got.items() if x != y]
 
 

@@ -32,7 +32,7 @@ import numpy as np
 from wormsim.contact3d import jit_warmup, mass_scaling
 from wormsim.contact3d.contact_sums import RadiusLog
 from wormsim.contact3d.diagnosis import diverged_error
-from wormsim.contact3d.guards import Guards
+from wormsim.contact3d.guards import Guards, bad_state_warnings
 from wormsim.contact3d.metrics import contact3d_summary
 from wormsim.contact3d.mjcf import BuiltModel, build_model
 from wormsim.contact3d.ringing_check import ringing
@@ -182,7 +182,7 @@ def _sample(lp: _Loop, i: int, cmd: float, sums) -> None:
     th1 = float(qp[m.jnt_qposadr[m.dof_jntid[bm.worm_dof]]])
     th2 = float(qp[m.jnt_qposadr[m.dof_jntid[bm.wheel_dof]]])
     w1, w2 = float(qv[bm.worm_dof]), float(qv[bm.wheel_dof])
-    t = float(d.time)
+    t = float(d.time) if not bad_state_warnings(d) else (i + 1) * lp.rec * bm.timestep_s  # (MuJoCo reset d.time)
     te = guards.state(d, t, th1, th2, w1, w2)
     vs = abs(w1) * geo.r_m1 / math.cos(geo.gamma_m)  # the sliding speed Vs
     guards.stuck = stuck_after(guards.stuck, vs, bm.plan.stick_velocity_m_s)
