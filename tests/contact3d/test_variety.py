@@ -233,9 +233,10 @@ def test_flanks_no_friction_driven_rattle(monkeypatch):
 
 
 def test_flanks_no_grid_point_is_cut_by_the_worm():
-    """wormsim.tooth.trim: at gamma 33.7 deg (z1 4, q 6) meshgen's envelope folds near the wheel tip and 7
-    points per flank lay 1-29 um inside the thread at other worm positions; the kernel took them as flank (76 um
-    contacts against the conjugate 47 um, 14 um penetration under load). Trimmed, the wheel turned two backlash
+    """At gamma 33.7 deg (z1 4, q 6) meshgen's envelope iteration stopped short of the maximum near the wheel tip
+    before it was safeguarded (docs/decisions/0056-envelope-maximum-safeguarded-newton.md): 7 points per flank lay
+    1-29 um inside the thread at other worm positions, and the kernel took them as flank (76 um contacts against the
+    conjugate 47 um, 14 um penetration under load) until wormsim.tooth.trim cut them. The wheel turned two backlash
     angles behind the conjugate angle meets the worm at the conjugate depth within 2 % over a whole mesh cycle."""
     import math
 
