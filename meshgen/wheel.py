@@ -69,6 +69,49 @@ def _F(g: GearGeometry, rho, zeta, beta, side):
     return g.r2 * beta - rho * np.cos(beta) - g.p * phis + side * worm.half_thickness(g, rs)
 
 
+NEWTON_DROP_M = 1e-12  # a Newton step that lowers sgn F by more than this is taken back (_newton_max)
+NEWTON_RETRIES = 24  # further steps for the points where one was taken back
+
+
+def _newton_max(g: GearGeometry, rho, zeta, beta, side, box, n_newton: int):
+    """Newton on dF/dbeta = 0 (central differences) from the grid's best beta, each step at most one grid step
+    (box = (lo, hi, that step)), kept in [lo, hi]; returns beta. Safeguarded: a step that lowers sgn F by more than
+    NEWTON_DROP_M is taken back and the point's later steps are halved, and such a point gets NEWTON_RETRIES more
+    steps. Near the envelope's limit line (high lead angles: z1 4, q 6, gamma 33.7 deg, near the wheel tip) the
+    maximum is flat and lopsided (F'' small, F''' not): the plain iteration overshot by a grid step, the next step
+    came back, and it ended on the worse of the two, up to 29 um below the maximum (the point then lies inside the
+    thread and wormsim.tooth.trim cut it away, a hole in the flank grid). Where no step is taken back the iteration
+    is the plain one, bit for bit."""
+    lo, hi, dmax = (np.broadcast_to(a, np.shape(beta)) for a in box)
+    rho, zeta = np.broadcast_to(rho, np.shape(beta)), np.broadcast_to(zeta, np.shape(beta))
+    sgn = float(side)
+    h = 1e-5
+    out = beta
+    sub = np.arange(np.size(beta))
+    lam = np.ones(np.shape(beta))
+    for it in range(n_newton + NEWTON_RETRIES):
+        if it == n_newton:  # the retries: only the points where a step was taken back
+            out = beta.copy()
+            keep = np.nonzero(lam < 1.0)[0]
+            if not len(keep):
+                return out
+            sub, beta, lam = sub[keep], beta[keep], lam[keep]
+            rho, zeta, lo, hi, dmax = rho[keep], zeta[keep], lo[keep], hi[keep], dmax[keep]
+        f0 = sgn * _F(g, rho, zeta, beta, side)
+        fp = sgn * _F(g, rho, zeta, beta + h, side)
+        fm = sgn * _F(g, rho, zeta, beta - h, side)
+        d1 = (fp - fm) / (2 * h)
+        d2 = (fp - 2 * f0 + fm) / (h * h)
+        step = np.where(d2 < 0, -d1 / np.where(d2 < 0, d2, -1.0), 0.0)
+        step = lam * np.clip(step, -dmax, dmax)
+        cand = np.clip(beta + step, lo, hi)
+        drop = sgn * _F(g, rho, zeta, cand, side) < f0 - NEWTON_DROP_M
+        beta = np.where(drop, beta, cand)
+        lam = np.where(drop, 0.5 * lam, lam)
+    out[sub] = beta
+    return out
+
+
 def _beta_range(g: GearGeometry, rho, zeta):
     """Half-width delta of the beta interval -pi/2 +- delta where r_s(beta) <= R_r (hob reach)."""
     R = hob_radius(g)
@@ -87,7 +130,7 @@ def space_flank(g: GearGeometry, rho, zeta, side: int, n_grid: int = 48, n_newto
     """psi_side(rho, zeta) of tooth space 0 by equation (3); side +1 -> psi_+, -1 -> psi_-.
 
     Vectorised: a grid search over beta in the reach interval, then Newton on dF/dbeta = 0 with
-    central differences, kept inside the interval; the endpoints compete as candidates.
+    central differences (safeguarded: _newton_max), kept inside the interval; the endpoints compete as candidates.
     """
     rho, zeta = np.broadcast_arrays(np.asarray(rho, float), np.asarray(zeta, float))
     shape = rho.shape
@@ -101,16 +144,7 @@ def space_flank(g: GearGeometry, rho, zeta, side: int, n_grid: int = 48, n_newto
     k = np.argmax(V, axis=1)
     idx = np.arange(len(rho))
     beta = B[idx, k]
-    h = 1e-5
-    for _ in range(n_newton):
-        f0 = sgn * _F(g, rho, zeta, beta, side)
-        fp = sgn * _F(g, rho, zeta, beta + h, side)
-        fm = sgn * _F(g, rho, zeta, beta - h, side)
-        d1 = (fp - fm) / (2 * h)
-        d2 = (fp - 2 * f0 + fm) / (h * h)
-        step = np.where(d2 < 0, -d1 / np.where(d2 < 0, d2, -1.0), 0.0)
-        step = np.clip(step, -(hi - lo) / n_grid, (hi - lo) / n_grid)
-        beta = np.clip(beta + step, lo, hi)
+    beta = _newton_max(g, rho, zeta, beta, side, (lo, hi, (hi - lo) / n_grid), n_newton)
     vb = sgn * _F(g, rho, zeta, beta, side)
     vlo = sgn * _F(g, rho, zeta, lo, side)
     vhi = sgn * _F(g, rho, zeta, hi, side)

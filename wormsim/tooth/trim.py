@@ -2,13 +2,15 @@
 cut into are not on the generated wheel flank.
 
 meshgen.wheel.space_flank takes each flank point as the envelope maximum over the hob positions found by a grid
-search in its reach interval. Where the envelope folds (high lead angles: measured on z1 4, q 6, gamma 33.7 deg,
-near the wheel tip of flank B) some points lie up to 29 um inside the thread at other worm positions: the hob would
-have removed them, yet the kernel took them as flank and met them as a 76 um deep contact against the 47 um of the
-conjugate pose (docs/contact3d.md, "Variety"). Checked here directly: each backlash-free grid point is turned with
-the wheel through the whole mesh window at the conjugate worm angle (theta1 = theta2 z2 / (hand z1)) and its signed
-distance from the thread (wormsim.tooth.gap.worm_gap) is taken at every position; a point whose least distance
-is below -TRIM_TOL_M is cut away (nan), like the hob-tip-cut root points.
+search in its reach interval and a Newton iteration. A point short of the maximum lies inside the thread at another
+worm position: the hob would have removed it. Before that iteration was safeguarded (docs/decisions/0056-envelope-
+maximum-safeguarded-newton.md) it stopped up to 36 um short near the wheel tip at high lead angles (z1 4, q 6, gamma
+33.7 deg), and the kernel took such points as flank (a 76 um deep contact against the 47 um of the conjugate pose;
+docs/contact3d.md, "Variety"); this trim cut them away, and remains the check. Checked here directly: each
+backlash-free grid point is turned with the wheel through the whole mesh window at the conjugate worm angle
+(theta1 = theta2 z2 / (hand z1)) and its signed distance from the thread (wormsim.tooth.gap.worm_gap) is taken at
+every position; a point whose least distance is below -TRIM_TOL_M is cut away (nan), like the hob-tip-cut root
+points.
 """
 
 from __future__ import annotations
