@@ -268,7 +268,7 @@ KEYS: dict[str, Key] = {
     ),
     "power_flow": Key(
         "text",
-        GEAR,
+        GW,
         '"worm to wheel", "wheel to worm" (back-driving, or an overhauling load) or "none" (a shaft slower than '
         "0.01 rpm at the worm: ratio, efficiency and efficiency_theory are null, and the run warns)",
     ),
