@@ -134,6 +134,33 @@ def test_overhauling_load_reports_the_reverse_flow_efficiency(template):
     assert any("power flows from the wheel to the worm" in w for w in s["warnings"]), s["warnings"]
 
 
+def test_contact3d_overhauling_load_takes_the_reverse_flow_theory(template):
+    """contact3d, the same overhauling load (coarse, 0.12 s, Hertz stiffness: the FE compliance of a new gear apart):
+    the theory keys that depend on the friction's direction follow the power flow, not the drive's shaft: the
+    efficiency at the contacts' radius is tan(gamma_r - rho') / tan(gamma_r) and DIN's F_r2 takes cos(gamma - rho')
+    (measured on the user's gear at 0.5 s, teeth: efficiency 0.5612 against 0.5611, F_r2 683.08 against 683.01 N;
+    before, the worm-driving forms 0.6938 and 688.85 N)."""
+    from wormsim.physics.geometry import derive
+
+    s, sc = user_run(
+        template,
+        "model=contact3d",
+        "contact.stiffness_model=hertz",
+        "simulation.resolution=coarse",
+        "simulation.duration_s=0.12",
+        "drive.ramp_s=0.02",
+        "load.ramp_s=0.02",
+        "load.torque_nm=-150",
+    )
+    assert s["power_flow"] == "wheel to worm"
+    assert s["efficiency_theory_at_contact_radius"] == pytest.approx(s["efficiency"], rel=0.01)
+    g = derive(sc.gear)
+    rho = math.atan(s["friction_coefficient_mean"] / math.cos(g.alpha_n))
+    back = math.tan(g.alpha_n) * math.cos(rho) / math.cos(g.gamma - rho)
+    assert s["radial_force_theory_n"] == pytest.approx(s["tangential_force_mean_n"] * back, rel=1e-9)
+    assert s["radial_force_mean_n"] == pytest.approx(s["radial_force_theory_n"], rel=0.01)
+
+
 def test_speed_zero_reports_no_ratio_and_no_efficiency(template):
     s, _ = user_run(template, "drive.speed_rpm=0")
     assert s["power_flow"] == "none"
@@ -148,6 +175,42 @@ def test_runaway_torque_drive_warns(template):
     without bound (measured 1.08e5 rpm at 0.5 s)."""
     s, _ = user_run(template, "simulation.duration_s=0.3", "drive.speed_rpm=null", "drive.torque_nm=10")
     assert any(w.startswith("runaway: the torque-driven worm still accelerates") for w in s["warnings"]), s["warnings"]
+
+
+def test_contact3d_runaway_torque_drive_names_the_runaway(template):
+    """contact3d stops a runaway worm at its overspeed guard (exit 3; measured on the user's gear with 10 N m: 11 609
+    rpm at 0.084 s): the message says first that the torque drive exceeds what the load takes (T2 / (i eta) = 150 /
+    (40 x 0.698) = 5.37 N m), not only that the timestep is too coarse for the speed."""
+    from types import SimpleNamespace
+
+    from wormsim.contact3d.diagnosis import overspeed_error
+    from wormsim.physics.plan import gear_plan
+
+    def message(torque_nm: float) -> str:
+        sc = load_scenario(template, [*USER_GEAR, "drive.speed_rpm=null", f"drive.torque_nm={torque_nm}"])
+        bm = SimpleNamespace(plan=SimpleNamespace(gear=gear_plan(sc)))
+        return str(overspeed_error(0.084, 1216.0, 3.6e-5, bm))  # type: ignore[arg-type]
+
+    runaway = message(10.0)
+    assert runaway.startswith("runaway: the torque drive 10 N m on the worm exceeds the 5.37 N m the load takes")
+    assert "worm overspeed at t = 0.084 s" in runaway
+    assert message(5.0).startswith("worm overspeed")  # below the load's torque: a timestep matter only
+
+
+def test_held_pair_has_no_meshing_window_warning():
+    """A held self-locking pair (`locked`) creeps at a few thousandths of a mesh period over its window: no meshing line
+    to resolve, so no "run N s longer" (measured on the user's gear at mu 0.12, wheel at 20 rpm, torsional: "run at
+    least 6e+03 s longer")."""
+    summary = {
+        "steady_window_mesh_cycles": 5.4e-5,
+        "mesh_frequency_theory_hz": 8.4e-4,
+        "mesh_frequency_hz": None,
+        "mesh_frequency_resolution_hz": 15.6,
+        "steady_window_s": [0.018, 0.081],
+        "power_flow": "wheel to worm",
+    }
+    assert "fewer than 5" in W.mesh_window_warnings(summary)[0]
+    assert W.mesh_window_warnings({**summary, "locked": True}) == []
 
 
 def _result(summary, series=None):

@@ -1,4 +1,4 @@
-"""`wormsim` console script (INTERFACE.md): run, mesh, model, bench, sweep, rate, schema, check, init.
+"""`wormsim` console script (docs/cli.md): run, mesh, model, bench, sweep, rate, schema, check, init.
 
 Exit codes: 0 ok, 2 invalid input or an output path that cannot be written (the message names the field or
 the path), 3 the simulation failed (with a diagnosis), 130 / 143 interrupted by SIGINT (Ctrl-C) / SIGTERM

@@ -11,7 +11,8 @@ that are computed correctly but that a user should not read as the gear's steady
   modules. Such contacts are tip, edge or root contacts, which the meshing forces' theory does not describe.
 - Meshing line: a steady window of fewer than wormsim.results.metrics.MIN_MESH_CYCLES mesh periods (its spectrum's lines
   overlap, and the p2p and the harmonics describe a few periods only), no peak near z1 n1 / 60, or a line more
-  than MESH_FREQUENCY_REL from it.
+  than MESH_FREQUENCY_REL from it; not for a pair that does not turn or that is held (`locked`: it creeps, and a
+  longer run would not resolve a meshing line).
 - Plausibility: the largest contact pressure above the wheel material's pitting strength sigma_HlimT (the rating's
   table, wormsim.rating.materials; the material of rating.wheel_material, else the rating's default for
   materials.wheel); a runaway (the driven shaft above RUNAWAY_FACTOR x its speed command, or, for a torque drive,
@@ -103,6 +104,8 @@ def mesh_window_warnings(summary: dict) -> list[str]:
         _num(summary, k) for k in ("steady_window_mesh_cycles", "mesh_frequency_hz", "mesh_frequency_theory_hz")
     )
     if cycles is None or f0 is None or f0 <= 0 or summary.get("power_flow") == "none":  # standstill: its own warning
+        return []
+    if summary.get("locked") is True:  # a held self-locking pair creeps: no meshing to resolve, whatever the window
         return []
     df = _num(summary, "mesh_frequency_resolution_hz")
     if cycles < MIN_MESH_CYCLES:
