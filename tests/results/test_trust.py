@@ -213,6 +213,20 @@ def test_held_pair_has_no_meshing_window_warning():
     assert W.mesh_window_warnings({**summary, "locked": True}) == []
 
 
+def test_a_held_back_drive_whose_worm_creeps_warns(template):
+    """The user's gear at mu 0.12 (self-locking), the wheel at 20 rpm, a 3 N m load on the worm, contact3d: the
+    wheel's drive stalls at its peak (7531 N m) and the run ends held, but the worm crept at 35.8 rpm (measured),
+    4.5 % of the wheel command times the ratio (800 rpm): `locked` alone would read as held, so the run warns; with
+    no worm load it crept at 1.7e-5 rpm (measured) and does not."""
+    back = ["drive.on=wheel", "drive.speed_rpm=20", "load.on=worm", "load.torque_nm=3", "contact.friction=0.12"]
+    sc = load_scenario(template, [*USER_GEAR, *back])
+    held = {"locked": True, "ratio_theory": 40.0, "holding_torque_nm": 7531.0}
+    w = W.creep_warning({**held, "creep_speed_rpm": 35.8}, sc)
+    assert w is not None and "crept at 35.8 rpm, 4.5 % of the wheel command times the ratio (800 rpm)" in w
+    assert W.creep_warning({**held, "creep_speed_rpm": 1.7e-5}, sc) is None
+    assert W.creep_warning({**held, "creep_speed_rpm": 35.8, "locked": False}, sc) is None
+
+
 def _result(summary, series=None):
     return Result("contact3d", summary, series or {}, 0, 0.0)
 

@@ -19,7 +19,8 @@ that are computed correctly but that a user should not read as the gear's steady
   RUNAWAY_FACTOR x its speed at half the run at the end: still accelerating); power
   flowing from the wheel into a worm-driven pair (an overhauling load); a pair that does not turn (no ratio and no
   efficiency); a speed drive at its peak torque outside a held back-drive (the shaft follows the limit, not its
-  command). The root stress above its limit is the rating's warning (wormsim.rating.fe_root).
+  command); a held back-drive whose worm creeps above HOLD_CREEP_SHARE of its free speed (the mesh slipped under the
+stalled drive's torque). The root stress above its limit is the rating's warning (wormsim.rating.fe_root).
 """
 
 from __future__ import annotations
@@ -260,6 +261,33 @@ def drive_peak_warning(result: Result, scenario) -> str | None:
     )
 
 
+HOLD_CREEP_SHARE = 1e-3  # a held pair creeps at most this share of its free speed (issue 31's holding criterion)
+
+
+def creep_warning(summary: dict, scenario) -> str | None:
+    """A held back-drive (`locked`) whose worm creeps faster than HOLD_CREEP_SHARE of its free speed, the wheel's
+    speed command times the ratio: the mesh did not hold the torque it was given (a stalled drive's peak torque), it
+    slipped through; `locked` then says that the drive stalled, not that the pair held."""
+    creep = _num(summary, "creep_speed_rpm")
+    ratio = _num(summary, "ratio_theory")
+    if summary.get("locked") is not True or creep is None or ratio is None or scenario is None:
+        return None
+    drv = scenario.drive
+    if drv is None or drv.on != "wheel" or drv.speed_rpm is None:
+        return None
+    free = abs(drv.speed_rpm) * ratio
+    if creep <= HOLD_CREEP_SHARE * free:
+        return None
+    held = _num(summary, "holding_torque_nm")
+    return (
+        f"the back-driven pair stalled the wheel's drive but did not hold: the worm crept at {creep:.3g} rpm, "
+        f"{100 * creep / free:.2g} % of the wheel command times the ratio ({free:.4g} rpm), above "
+        f"{100 * HOLD_CREEP_SHARE:g} %, under the holding torque {held or float('nan'):.4g} N m (the drive's peak, "
+        "drive_peak_torque_nm); the contact slips at that torque: a lower load on the worm or a torque drive "
+        "(drive.torque_nm) gives a holding run at a chosen torque"
+    )
+
+
 def plausibility_warnings(result: Result, scenario) -> list[str]:
     """The results that contradict a physical limit or the run's premise (see the module docstring)."""
     s = result.summary
@@ -270,6 +298,7 @@ def plausibility_warnings(result: Result, scenario) -> list[str]:
             runaway_warning(result, scenario),
             power_flow_warning(s, scenario),
             drive_peak_warning(result, scenario),
+            creep_warning(s, scenario),
         )
         if w
     ]
