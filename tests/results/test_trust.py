@@ -251,6 +251,23 @@ def test_contact_pressure_above_the_wheel_material_warns(template):
     assert W.pressure_warning({"contact_pressure_max_mpa": 600.0}, al) is None  # sigma_HlimT 660 MPa
 
 
+def test_torsional_and_wedge_warn_of_a_load_above_the_wheel_materials_strength(template):
+    """Load 20 000 N m on the user's gear at torsional and wedge, which compute no contact pressure: the rating's mean
+    contact stress sigma_Hm (ISO/TS 14521 method B) 2320 MPa (measured) is above bronze's sigma_HlimT 520 MPa, and
+    the run says so; at 150 N m (sigma_Hm 201 MPa) it does not (test_user_gear_torsional_meshing_line_within_half_a
+    _percent: no warning)."""
+    from wormsim.rating.rate import rate
+
+    s, sc = user_run(template, "simulation.duration_s=0.1", "load.torque_nm=20000")
+    sigma = rate(sc)["contact_stress_mean_iso_mpa"]
+    assert sigma > 520.0
+    (w,) = [w for w in s["warnings"] if w.startswith("the mean contact stress sigma_Hm")]
+    assert f"{sigma:.4g} MPa" in w and "520 MPa (CuSn12Ni2)" in w
+    wedge, _ = user_run(template, "model=wedge", "load.torque_nm=20000")
+    assert any(w.startswith("the mean contact stress sigma_Hm") for w in wedge["warnings"]), wedge["warnings"]
+    assert W.iso_pressure_warning({}, load_scenario(template, USER_GEAR)) is None  # 150 N m
+
+
 # ----------------------------------------------------------------------------- 6. force keys
 
 

@@ -15,7 +15,8 @@ that are computed correctly but that a user should not read as the gear's steady
   longer run would not resolve a meshing line).
 - Plausibility: the largest contact pressure above the wheel material's pitting strength sigma_HlimT (the rating's
   table, wormsim.rating.materials; the material of rating.wheel_material, else the rating's default for
-  materials.wheel); a runaway (the driven shaft above RUNAWAY_FACTOR x its speed command, or, for a torque drive,
+  materials.wheel), at wedge and torsional (no contact pressure) the rating's mean contact stress sigma_Hm;
+  a runaway (the driven shaft above RUNAWAY_FACTOR x its speed command, or, for a torque drive,
   RUNAWAY_FACTOR x its speed at half the run at the end: still accelerating); power
   flowing from the wheel into a worm-driven pair (an overhauling load); a pair that does not turn (no ratio and no
   efficiency); a speed drive at its peak torque outside a held back-drive (the shaft follows the limit, not its
@@ -166,6 +167,30 @@ def pressure_warning(summary: dict, scenario) -> str | None:
     )
 
 
+def iso_pressure_warning(summary: dict, scenario) -> str | None:
+    """Wedge and torsional (no contact pressure of their own): the rating's mean contact stress sigma_Hm (ISO/TS 14521
+    method B at the scenario's load and speed, wormsim.rating.rate) above the wheel material's pitting strength
+    sigma_HlimT, the limit pressure_warning takes for contact3d's p_H max. A gear the rating cannot rate gives none."""
+    if scenario is None or scenario.model == "contact3d" or scenario.gear is None:
+        return None
+    from wormsim.exceptions import ScenarioError, SimulationError
+    from wormsim.rating.rate import rate
+
+    lim = wheel_pressure_limit(scenario)
+    try:
+        sigma = _num(rate(scenario), "contact_stress_mean_iso_mpa")
+    except (ScenarioError, SimulationError, ValueError, ArithmeticError):  # outside the rating's range: no check
+        return None
+    if lim is None or sigma is None or sigma <= lim[0]:
+        return None
+    return (
+        f"the mean contact stress sigma_Hm {sigma:.4g} MPa at this load (ISO/TS 14521 method B, wormsim rate) is "
+        f"above the wheel material's pitting strength sigma_HlimT {lim[0]:.4g} MPa ({lim[1]}): the flanks pit or "
+        f"yield at this load, which model {scenario.model} does not see (contact3d reports the contact pressure); "
+        "lower the load or enlarge the gear"
+    )
+
+
 def runaway_warning(result: Result, scenario) -> str | None:
     """The driven shaft above RUNAWAY_FACTOR x its speed command over the steady window, or, for a torque drive (no
     command, and a constant torque has no free speed), at the end RUNAWAY_FACTOR x its speed at half the run."""
@@ -295,6 +320,7 @@ def plausibility_warnings(result: Result, scenario) -> list[str]:
         w
         for w in (
             pressure_warning(s, scenario),
+            iso_pressure_warning(s, scenario),
             runaway_warning(result, scenario),
             power_flow_warning(s, scenario),
             drive_peak_warning(result, scenario),
