@@ -170,6 +170,15 @@ def test_speed_zero_reports_no_ratio_and_no_efficiency(template):
     assert not [w for w in s["warnings"] if "runaway" in w or "mesh periods" in w], s["warnings"]
 
 
+def test_no_power_flow_while_turning_is_not_called_standing_still():
+    """power_flow none while both shafts move (the held back-drive with a worm load: worm 25.8 rpm, wheel 0.102 rpm,
+    measured): the warning says no power flows, not that the pair does not turn."""
+    s = {"power_flow": "none", "worm_speed_mean_rpm": 25.8, "wheel_speed_mean_rpm": 0.102, "ratio_theory": 40.0}
+    assert W.power_flow_warning(s, None).startswith("no power flows through the mesh")
+    still = {**s, "worm_speed_mean_rpm": 1.7e-5, "wheel_speed_mean_rpm": 7e-7}
+    assert W.power_flow_warning(still, None).startswith("the pair does not turn")
+
+
 def test_runaway_torque_drive_warns(template):
     """A torque drive of 10 N m against the 150 N m load (T2 / (i eta) = 5.4 N m holds it): the worm accelerates
     without bound (measured 1.08e5 rpm at 0.5 s)."""

@@ -234,7 +234,15 @@ def power_flow_warning(summary: dict, scenario) -> str | None:
     worm into a wheel-driven one), or a pair that does not turn."""
     flow = summary.get("power_flow")
     if flow == "none":
+        from wormsim.results.metrics import STANDSTILL_RPM
+
         n1, n2 = (_num(summary, k) or 0.0 for k in ("worm_speed_mean_rpm", "wheel_speed_mean_rpm"))
+        ratio = _num(summary, "ratio_theory") or 1.0
+        if n1 >= STANDSTILL_RPM and n2 >= STANDSTILL_RPM / ratio:  # both turn (vibrate), neither puts power in
+            return (
+                f"no power flows through the mesh over the steady window (worm {n1:.3g} rpm, wheel {n2:.3g} rpm, "
+                "neither shaft puts power in on average): ratio and efficiency are not defined and reported as null"
+            )
         return (
             f"the pair does not turn over the steady window (worm {n1:.3g} rpm, wheel {n2:.3g} rpm): ratio and "
             "efficiency are not defined and reported as null"
