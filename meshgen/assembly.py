@@ -1,4 +1,4 @@
-"""Frames and kinematics of the worm gear pair (INTERFACE.md, "Geometry files").
+"""Frames and kinematics of the worm gear pair (docs/geometry.md).
 
 Assembly frame: wheel axis = z through the origin; worm axis parallel to x at y = -a, z = 0.
 
@@ -11,7 +11,7 @@ assembly (at theta1 = 0) as
 
     worm_to_assembly(theta1) = Trans(0, -a, 0) @ R0 @ Rz(theta1),   R0 = [[0, 0, -1], [1, 0, 0], [0, -1, 0]]
 
-Why -x: INTERFACE.md requires that positive worm rotation (right-hand rule about the worm's own axis +z)
+Why -x: docs/geometry.md requires that positive worm rotation (right-hand rule about the worm's own axis +z)
 drives the wheel in the positive sense (about +z) for a right-hand worm. Turning a right-hand helicoid
 z = p phi + c (p > 0) by +theta1 about its +z moves its thread pattern by -p theta1 along worm z; the
 wheel's teeth in mesh sit at y = -r2 (between the wheel centre and the worm), and a positive wheel rotation

@@ -1,4 +1,4 @@
-"""The geometry files' content (INTERFACE.md, `wormsim mesh`): assembly.json's data for a gear set.
+"""The geometry files' content (docs/geometry.md, `wormsim mesh`): assembly.json's data for a gear set.
 
 worm.stl in the worm frame, wheel.stl in the wheel frame (metres); assembly.json holds center_distance_m,
 the 4x4 transforms of both parts into the assembly frame at theta1 = theta2 = 0 (meshgen.assembly), the

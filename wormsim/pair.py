@@ -10,8 +10,8 @@
         pair.step(model, data)                  # one MuJoCo step with the exact-flank contacts
     ft, fr, fa = pair.mesh_forces(data)         # forces on the wheel [N]
 
-What `attach` adds under the parent body, placed in the parent's frame as the geometry contract (INTERFACE.md,
-"Geometry files") places them in the assembly frame (wheel axis z through the origin, worm axis parallel to x at
+What `attach` adds under the parent body, placed in the parent's frame as the geometry contract (docs/geometry.md)
+places them in the assembly frame (wheel axis z through the origin, worm axis parallel to x at
 y = -a; `pos`/`quat` move that frame within the parent): a wheel body and a worm body, one hinge each about their
 own z axis (named `<prefix>wheel_hinge`, `<prefix>worm_hinge`), their masses and axial moments from the solid meshes
 and the materials' densities (wormsim.contact3d.mjcf's inertias), and one visual mesh geom each

@@ -127,7 +127,9 @@ def test_a_torque_driven_worm_running_away_stops_at_the_overspeed_guard():
     """2 N m on the worm against 12 N m on the wheel (0.77 N m needed at efficiency 0.65): the worm accelerates
     without bound. At the default 1e-5 s the overspeed guard stops it when it turns 1.25 x 0.035 rad per step
     (measured t = 0.063 s, 41800 rpm), before its pieces tunnel through the wheel (the penetration guard fired at
-    0.21 rad per step on the plain run); the message names simulation.timestep_s and the limit at that speed."""
+    0.21 rad per step on the plain run); the message names the runaway first (the drive torque above the 0.77 N m
+    the load takes: a smaller step only lets it run further), then simulation.timestep_s and the limit at that
+    speed."""
     sc = load_scenario(
         JACK,
         COARSE
@@ -142,7 +144,8 @@ def test_a_torque_driven_worm_running_away_stops_at_the_overspeed_guard():
     with pytest.raises(SimulationError) as exc:
         simulate(sc)
     msg = str(exc.value)
-    assert msg.startswith("worm overspeed at t = "), msg
+    assert msg.startswith("runaway: the torque drive 2 N m on the worm exceeds the 0.77 N m the load takes"), msg
+    assert "worm overspeed at t = " in msg, msg
     rpm = float(re.search(r"the worm turns ([0-9.]+) rpm", msg).group(1))
     turn = float(re.search(r"rpm, ([0-9.]+) rad per step of 1e-05 s", msg).group(1))
     assert turn == pytest.approx(rpm * RPM * 1e-5, rel=2e-3)

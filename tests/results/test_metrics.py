@@ -43,3 +43,14 @@ def test_efficiency_theory_wedge_values():
     assert efficiency_theory(g, a, 0.05) == pytest.approx(math.tan(g) / math.tan(g + rho))
     assert efficiency_theory(g, a, 0.0) == pytest.approx(1.0)
     assert efficiency_theory(g, a, 0.1, backdriving=True) == 0.0  # rho' 5.8 deg > gamma 4.79 deg
+
+
+def test_power_source_is_the_flows_source_else_the_drive():
+    """The shaft that puts power in: an overhauling load's wheel in a worm-driven pair (the friction, and with it the
+    wedge formulas' sign, follows it: DIN 3975-2), the drive's shaft when no power flows."""
+    from wormsim.results.metrics import power_source
+
+    assert power_source("worm to wheel", "worm") == "worm"
+    assert power_source("wheel to worm", "worm") == "wheel"
+    assert power_source("worm to wheel", "wheel") == "worm"
+    assert power_source("none", "wheel") == "wheel" and power_source("none", "worm") == "worm"

@@ -194,6 +194,22 @@ def test_a_sweep_whose_every_point_fails_exits_3_with_the_first_message(tmp_path
     assert [r["status"] for r in _rows(out)] == ["failed", "failed"]  # the table is still written
 
 
+def test_a_sweep_whose_every_point_is_invalid_input_exits_2_naming_the_field(tmp_path, capsys):
+    """Every point refused by the scenario checks (a face width past the root torus's limit on every point; the random
+    gears' test found 21 of 66 such sweeps exiting 3, "simulation failed"): the input is at fault, exit 2 with the
+    first point's field."""
+    f = _write(
+        tmp_path / "all_invalid.yaml",
+        f"name: all_invalid\nbase: {SCREW_JACK}\nset: {{model: torsional, simulation.duration_s: 0.05}}\n"
+        "grid: {gear.face_width_mm: [200, 300]}\n",
+    )
+    out = tmp_path / "out"
+    assert cli.main(["sweep", str(f), "--out", str(out), "--workers", "1", "--no-progress"]) == 2
+    err = capsys.readouterr().err
+    assert "error: every point of sweep all_invalid is invalid input (the first: gear.face_width_mm" in err, err
+    assert [r["status"] for r in _rows(out)] == ["failed", "failed"]
+
+
 def _start(args: list[str], log: Path) -> subprocess.Popen:
     fh = log.open("w")
     return subprocess.Popen(args, stdout=fh, stderr=subprocess.STDOUT, start_new_session=True)

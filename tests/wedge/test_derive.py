@@ -31,6 +31,7 @@ def test_derived_wedge_writes_the_common_keys_at_the_gear_theory(derived):
     assert s["worm_speed_mean_rpm"] == pytest.approx(1800.0, rel=1e-3)
     # output / input power of a rigid wedge is tan(gamma) / tan(gamma + rho') (DIN 3975-2)
     assert s["efficiency"] == pytest.approx(s["efficiency_theory"], rel=1e-4)
+    assert s["power_flow"] == "worm to wheel" and s["warnings"] == []
     assert s["self_locking"] is False and 0 < s["efficiency_backdrive"] < s["efficiency"]
     assert s["wedge_source"].startswith("derived")
 
@@ -89,6 +90,12 @@ def test_an_assisting_load_is_held_at_the_drive_speed_by_a_braking_motor():
     # the worm brakes with F_t1 = F_t2 tan(gamma - rho') (DIN 3975-2, back-driving), rho' = atan(0.05 / cos 10 deg)
     g, rho = math.radians(s["lead_angle_deg"]), math.radians(s["friction_angle_dynamic_deg"])
     assert s["S1_steady_n"] == pytest.approx(-s["tangential_force_mean_n"] * math.tan(g - rho), rel=1e-4)
+    # the load overhauls the drive (issue 31): power flows from the wheel, the efficiency is the worm's power out
+    # over the wheel's in, tan(gamma - rho') / tan(gamma) (DIN 3975-2) for a rigid wedge, not null; the run warns
+    assert s["power_flow"] == "wheel to worm"
+    assert s["efficiency"] == pytest.approx(math.tan(g - rho) / math.tan(g), rel=1e-4)
+    assert s["efficiency_theory"] == pytest.approx(math.tan(g - rho) / math.tan(g), rel=1e-9)
+    assert any(w.startswith("power flows from the wheel to the worm") for w in s["warnings"]), s["warnings"]
 
 
 @pytest.mark.parametrize(

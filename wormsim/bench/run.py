@@ -1,4 +1,4 @@
-"""`wormsim bench`: speed against accuracy of the fidelity levels (INTERFACE.md, bench.json).
+"""`wormsim bench`: speed against accuracy of the fidelity levels (docs/bench.md, bench.json).
 
 For each seed scenario, each fidelity level runs across its resolutions and timesteps. Per run:
 

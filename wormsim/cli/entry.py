@@ -1,4 +1,4 @@
-"""`wormsim` console script (INTERFACE.md): run, mesh, model, bench, sweep, rate, schema, check, init.
+"""`wormsim` console script (docs/cli.md): run, mesh, model, bench, sweep, rate, schema, check, init.
 
 Exit codes: 0 ok, 2 invalid input or an output path that cannot be written (the message names the field or
 the path), 3 the simulation failed (with a diagnosis), 130 / 143 interrupted by SIGINT (Ctrl-C) / SIGTERM
@@ -262,7 +262,15 @@ def _cmd_sweep(args) -> int:
         import csv
 
         with (out / "sweep.csv").open(newline="") as fh:
-            first = next((r for r in csv.DictReader(fh) if r["status"] != "ok"), {})
+            failed = [r for r in csv.DictReader(fh) if r["status"] != "ok"]
+        first = failed[0] if failed else {}
+        if failed and all(r.get("message", "").startswith("invalid input: ") for r in failed):  # the input's fault
+            print(
+                f"error: every point of sweep {sw.spec.name} is invalid input (the first: "
+                f"{first['message'].removeprefix('invalid input: ')})",
+                file=sys.stderr,
+            )
+            return EXIT_INPUT
         print(
             f"simulation failed: every point of sweep {sw.spec.name} failed (the first: {first.get('message', '?')})",
             file=sys.stderr,

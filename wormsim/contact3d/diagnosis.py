@@ -65,16 +65,28 @@ def jump_error(t: float, te_pitch: float, dt: float, bm: BuiltModel) -> Simulati
     )
 
 
-def overspeed_error(t: float, w1: float, dt: float) -> SimulationError:
+def overspeed_error(t: float, w1: float, dt: float, bm: BuiltModel | None = None) -> SimulationError:
     """The worm turns more than OVERSPEED_GUARD x MAX_WORM_TURN_PER_STEP_RAD per step (a torque drive running away,
-    or a timestep set past the speed check): its pieces would pass through the wheel's between steps."""
+    or a timestep set past the speed check): its pieces would pass through the wheel's between steps. A torque drive
+    above the torque the load takes (the plan's expected drive torque, gear_theory.expected_drive_torque_of: T2 /
+    (i eta) on the worm) runs away, and the message says so first: a smaller timestep only lets it run further."""
     lim = speed_timestep_limit_s(abs(w1))
+    runaway = ""
+    gp = bm.plan.gear if bm is not None else None
+    drv = gp.duty.drive if gp is not None else None
+    if gp is not None and drv is not None and drv.torque_nm is not None and abs(drv.torque_nm) > gp.drive_torque_nm:
+        runaway = (
+            f"runaway: the torque drive {abs(drv.torque_nm):.4g} N m on the {drv.on} exceeds the "
+            f"{gp.drive_torque_nm:.3g} N m the load takes at full load (T_load and the wedge efficiency, DIN 3975-2), "
+            "so the pair accelerates without bound; lower drive.torque_nm or use a speed drive (drive.speed_rpm). "
+        )
     return OverspeedError(
-        f"worm overspeed at t = {t:.4g} s: the worm turns {rad_s_to_rpm(abs(w1)):.0f} rpm, {abs(w1) * dt:.3g} rad per "
-        f"step of {dt:.3g} s, beyond the {MAX_WORM_TURN_PER_STEP_RAD} rad contact3d resolves (the thread passes "
-        f"through the wheel's teeth between steps); set simulation.timestep_s <= {lim:.3g} s (or leave it unset for "
-        f"a speed-driven worm), or lower the drive (drive.speed_rpm / drive.torque_nm); simulation.speculative does "
-        f"not prevent it (measured: it tunnels sooner, docs/stability_speed.md)"
+        f"{runaway}worm overspeed at t = {t:.4g} s: the worm turns {rad_s_to_rpm(abs(w1)):.0f} rpm, "
+        f"{abs(w1) * dt:.3g} rad per step of {dt:.3g} s, beyond the {MAX_WORM_TURN_PER_STEP_RAD} rad contact3d "
+        "resolves (the thread passes through the wheel's teeth between steps); set simulation.timestep_s <= "
+        f"{lim:.3g} s (or leave it unset for a speed-driven worm), or lower the drive (drive.speed_rpm / "
+        "drive.torque_nm); simulation.speculative does not prevent it (measured: it tunnels sooner, "
+        "docs/stability_speed.md)"
     )
 
 

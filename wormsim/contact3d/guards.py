@@ -112,7 +112,7 @@ class Guards:
         if code == OVERSPEED:
             if dt > bm.law.stable_limit_s:
                 raise diverged_error(t, dt, bm, f"the worm ran away to {rad_s_to_rpm(abs(w1)):.0f} rpm")
-            raise overspeed_error(t, w1, dt)
+            raise overspeed_error(t, w1, dt, bm)
         if code == JUMPED:
             raise jump_error(t, te / self.pitch_angle, dt, bm)
         self.friction.check(d, t, w1, w2)

@@ -13,6 +13,7 @@ from wormsim.results.metrics import (
     mean_speeds_rpm,
     mesh_line,
     mesh_line_keys,
+    power_source,
     window_after,
 )
 
@@ -40,7 +41,7 @@ def contact3d_summary(S: dict, bm) -> dict:
         "contacts_mean": float(np.mean(S["contacts"][sl])),
         "teeth_in_contact_mean": float(np.mean(S["teeth_in_contact"][sl])),
         "max_penetration_um": float(np.max(S["max_penetration_m"][sl]) * 1e6),
-        **din_forces(S, duty.drive.on, geo, sl, drive["worm_torque_mean_nm"]),
+        **din_forces(S, power_source(drive["power_flow"], duty.drive.on), geo, sl, drive["worm_torque_mean_nm"]),
         **contact_radius_check(S, sl),
         **startup_peak(S, i0, i1),
     }
@@ -63,12 +64,13 @@ def contact_radius_check(S: dict, sl: slice) -> dict:
     }
 
 
-def din_forces(S: dict, drive_on: str, geo, sl: slice, worm_torque_mean_nm: float) -> dict:
+def din_forces(S: dict, source: str, geo, sl: slice, worm_torque_mean_nm: float) -> dict:
     """The headline radial and axial forces as DIN 3975-2 defines them, with the resultant's components as their own
     keys (docs/outputs.md, "Force keys").
 
-    DIN 3975's F_r2 = F_t2 tan(alpha_n) cos(rho') / cos(gamma + s rho') (s = +1 worm driving, -1 back-driving, rho' =
-    atan(mu / cos alpha_n)) and F_a2 = F_t1 = 2 T1 / d1 assume one contact at the pitch point on the line of centres.
+    DIN 3975's F_r2 = F_t2 tan(alpha_n) cos(rho') / cos(gamma + s rho') (s = +1 power from the worm, -1 from the wheel:
+    back-driving or an overhauling load, `source`; rho' = atan(mu / cos alpha_n)) and F_a2 = F_t1 = 2 T1 / d1 assume
+    one contact at the pitch point on the line of centres.
     The 3D contacts sit around the worm at angles phi (about its axis, from the line of centres), which turn their
     radial components partly into the wheel's axial direction, and at worm radii r_c above r1, where the lead angle is
     smaller: the resultant's radial component is below DIN's F_r2 by about <cos phi> (measured: screw jack, medium:
@@ -81,7 +83,7 @@ def din_forces(S: dict, drive_on: str, geo, sl: slice, worm_torque_mean_nm: floa
         return {}
     mu = float(np.mean(S["friction_coefficient"][sl]))
     rho = gt.virtual_friction_angle_rad(mu, geo.alpha_n)
-    s = -1.0 if drive_on == "wheel" else 1.0
+    s = -1.0 if source == "wheel" else 1.0  # the shaft that puts power in (wormsim.results.metrics.power_source)
     ft = abs(float(np.mean(S["tangential_force_n"][sl])))
     out = {
         "radial_force_resultant_mean_n": abs(float(np.mean(S["radial_force_n"][sl]))),

@@ -2,7 +2,7 @@
 
 Built with mujoco.MjSpec from the template `models/worm_pair.xml` (see models/README.md):
 
-- bodies in the assembly frame of INTERFACE.md (wheel axis z through the origin, worm axis parallel
+- bodies in the assembly frame of docs/geometry.md (wheel axis z through the origin, worm axis parallel
   to x at y = -a), placed by meshgen.assembly; one hinge each, no gear or equality constraint;
 - collision geoms: meshgen's convex pieces (meshgen.pieces). All worm pieces; for the wheel only an
   ACTIVE WINDOW of `window_teeth` tooth slots around the line of centres, which wormsim.contact3d.runner
@@ -288,7 +288,7 @@ def nominal_sliding_speed_m_s(worm_speed_rad_s: float | None, geo: GearGeometry)
 
 
 def expected_direction(geo: GearGeometry) -> int:
-    """+1/-1: sign of the driven shaft's speed per sign of the drive command. INTERFACE.md: a positive
+    """+1/-1: sign of the driven shaft's speed per sign of the drive command (docs/outputs.md, Force signs): a positive
     worm rotation drives the wheel positive for a right-hand worm (and back-driving the same way)."""
     return geo.hand
 

@@ -33,7 +33,7 @@ from wormsim.contact3d import jit_warmup, mass_scaling
 from wormsim.contact3d.contact_sums import RadiusLog
 from wormsim.contact3d.diagnosis import diverged_error
 from wormsim.contact3d.guards import Guards, bad_state_warnings
-from wormsim.contact3d.metrics import contact3d_summary
+from wormsim.contact3d.metrics import contact3d_summary, contact_radius_check
 from wormsim.contact3d.mjcf import BuiltModel, build_model
 from wormsim.contact3d.ringing_check import ringing
 from wormsim.contact3d.series import SERIES, column
@@ -42,6 +42,7 @@ from wormsim.contact3d.sources import FlankSource, PieceSource
 from wormsim.physics.friction import mu_of, stuck_after
 from wormsim.physics.locking import Held, held_keys, run_keys
 from wormsim.physics.units import RPM
+from wormsim.results.metrics import power_source
 from wormsim.results.result import Result
 from wormsim.results.summary_keys import level_summary
 from wormsim.runtime import jit_cache, prewarm
@@ -114,6 +115,7 @@ def run_model(bm: BuiltModel, progress=None) -> Result:
     summary = level_summary(
         "contact3d", _run_summary(S, bm, rec, guards.turn_max, len(src.coll), step_wall_us), lock, st_keys
     )
+    _overhauled_contact_radius(S, summary, rlog, bm)
     extra = {"points_tooth0": store[0], "points_world": store[2], "forces_world": store[1], "built": bm}
     extra.update({"mesh_stiffness": ms, "ltca": lt})
     src.finish(S, summary, extra)  # the source's own keys (the flanks' contact pattern and pressure)
@@ -242,6 +244,20 @@ def _stiffness_outputs(bm: BuiltModel) -> tuple[dict, object, object | None]:
         errors=gp.displaced is not None,
     )
     return keys, ms, lt
+
+
+def _overhauled_contact_radius(S: dict, summary: dict, rlog: RadiusLog, bm: BuiltModel) -> None:
+    """An overhauling load (power from the load's shaft, wormsim.results.metrics.power_source): the friction acts
+    the other way, so the efficiency at the contacts' radius is the other direction's (the series and its summary
+    key, in place); nothing otherwise."""
+    drive_on = bm.plan.drive_on
+    if power_source(summary["power_flow"], drive_on) == drive_on:
+        return
+    S["efficiency_theory_at_contact_radius"][:] = rlog.efficiency(
+        S["friction_coefficient"], bm.geometry, drive_on != "worm"
+    )
+    w0, w1 = summary["steady_window_s"]
+    summary.update(contact_radius_check(S, (S["t_s"] >= w0) & (S["t_s"] <= w1)))
 
 
 def _run_summary(S: dict, bm: BuiltModel, rec: int, turn_max: float, collision_geoms: int, step_wall_us: float) -> dict:

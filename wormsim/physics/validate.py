@@ -9,8 +9,10 @@ from wormsim.scenario import Scenario
 
 def validate_geometry(scenario: Scenario) -> GearGeometry | None:
     """Derive the gear geometry and check worm and wheel teeth (meshgen.geometry.derive, meshgen.worm.check_worm,
-    meshgen.wheel.check_wheel); returns the GearGeometry, or None for a wedge scenario (no gear used)."""
-    if scenario.model == "wedge" or scenario.gear is None:
+    meshgen.wheel.check_wheel); returns the GearGeometry, or None where no gear is used (no gear: block, or model
+    wedge with its own wedge: block). The wedge derived from gear: takes the gear's lead angle, radii and inertias,
+    so a gear that cannot be made is refused there too."""
+    if scenario.gear is None or (scenario.model == "wedge" and scenario.wedge is not None):
         return None
     from meshgen import wheel, worm
     from wormsim.physics.geometry import derive, geometry_errors

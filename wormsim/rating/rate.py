@@ -23,7 +23,7 @@ from wormsim.scenario import Rating, Scenario, ScenarioError
 
 MM_PER_M = 1e3
 
-# the rating keys of INTERFACE.md (rating.json; the contact3d summary when `rating:` is given)
+# the rating keys of docs/rating.md (rating.json; the contact3d summary when `rating:` is given)
 RATING_KEYS = (
     "contact_stress_mean_iso_mpa",
     "friction_iso",

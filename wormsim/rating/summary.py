@@ -1,4 +1,4 @@
-"""The rating keys of a simulation's summary (INTERFACE.md: the contact3d summary when `rating:` is given): the
+"""The rating keys of a simulation's summary (docs/rating.md: the contact3d summary when `rating:` is given): the
 method-B / AGMA keys of wormsim.rating.rate, and beside them the simulation-based safety factors (method C):
 safety_pitting_sim from the simulated mean Hertz pressure, safety_root_sim from the FE root stress
 (rating.root_stress: fe)."""

@@ -1,4 +1,4 @@
-"""Summary metrics shared by the gear-level models (torsional, contact3d; INTERFACE.md keys), from the time series.
+"""Summary metrics shared by the gear-level models (torsional, contact3d; docs/outputs.md keys), from the time series.
 
 - steady window: starts after the last ramp (drive.ramp_s, load.start_s + load.ramp_s) plus settling,
   the first time from which a one-mesh-period moving mean of the driven shaft's speed (from its angle increments,
@@ -229,7 +229,7 @@ def drive_summary(
     n2: float,
     shaft_powers_w: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> dict:
-    """The summary keys every gear-level model shares (INTERFACE.md contact3d list, less the meshing
+    """The summary keys every gear-level model shares (docs/outputs.md, less the meshing
     frequency, which each model takes from its own signal): ratio, forces, torques, speeds, efficiency
     (output / input power over the window) and its theory tan(g) / tan(g + rho') (or back-driving).
     shaft_powers_w: (worm, wheel) power series where the level has better ones than the samples' T w (contact3d:
@@ -299,6 +299,17 @@ def power_flow(n1_rpm: float, n2_rpm: float, ratio: float, p1_w: float, p2_w: fl
     if p2_w > 0:
         return "wheel to worm"
     return "none"
+
+
+def power_source(flow: str, drive_on: str) -> str:
+    """The shaft that puts power into the mesh, "worm" or "wheel": the power flow's source (an overhauling load on
+    the wheel of a worm-driven pair: the wheel), else the drive's shaft (no power flows). The friction acts against
+    that shaft's motion: the wedge formulas' sign (DIN 3975-2, s = +1 worm driving, -1 wheel driving) follows it."""
+    if flow == "worm to wheel":
+        return "worm"
+    if flow == "wheel to worm":
+        return "wheel"
+    return drive_on
 
 
 def flow_efficiency(flow: str, p1_w: float, p2_w: float) -> float:

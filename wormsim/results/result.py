@@ -23,7 +23,7 @@ class Result:
     """
 
     model: str
-    summary: dict  # model-specific summary.json keys (INTERFACE.md)
+    summary: dict  # model-specific summary.json keys (docs/outputs.md)
     series: dict[str, np.ndarray]  # time series, all sampled on series["t_s"]
     steps: int  # integrator steps taken
     sim_time_s: float

@@ -11,14 +11,17 @@ that are computed correctly but that a user should not read as the gear's steady
   modules. Such contacts are tip, edge or root contacts, which the meshing forces' theory does not describe.
 - Meshing line: a steady window of fewer than wormsim.results.metrics.MIN_MESH_CYCLES mesh periods (its spectrum's lines
   overlap, and the p2p and the harmonics describe a few periods only), no peak near z1 n1 / 60, or a line more
-  than MESH_FREQUENCY_REL from it.
+  than MESH_FREQUENCY_REL from it; not for a pair that does not turn or that is held (`locked`: it creeps, and a
+  longer run would not resolve a meshing line).
 - Plausibility: the largest contact pressure above the wheel material's pitting strength sigma_HlimT (the rating's
   table, wormsim.rating.materials; the material of rating.wheel_material, else the rating's default for
-  materials.wheel); a runaway (the driven shaft above RUNAWAY_FACTOR x its speed command, or, for a torque drive,
+  materials.wheel), at wedge and torsional (no contact pressure) the rating's mean contact stress sigma_Hm;
+  a runaway (the driven shaft above RUNAWAY_FACTOR x its speed command, or, for a torque drive,
   RUNAWAY_FACTOR x its speed at half the run at the end: still accelerating); power
   flowing from the wheel into a worm-driven pair (an overhauling load); a pair that does not turn (no ratio and no
   efficiency); a speed drive at its peak torque outside a held back-drive (the shaft follows the limit, not its
-  command). The root stress above its limit is the rating's warning (wormsim.rating.fe_root).
+  command); a held back-drive whose worm creeps above HOLD_CREEP_SHARE of its free speed (the mesh slipped under the
+stalled drive's torque). The root stress above its limit is the rating's warning (wormsim.rating.fe_root).
 """
 
 from __future__ import annotations
@@ -104,6 +107,8 @@ def mesh_window_warnings(summary: dict) -> list[str]:
     )
     if cycles is None or f0 is None or f0 <= 0 or summary.get("power_flow") == "none":  # standstill: its own warning
         return []
+    if summary.get("locked") is True:  # a held self-locking pair creeps: no meshing to resolve, whatever the window
+        return []
     df = _num(summary, "mesh_frequency_resolution_hz")
     if cycles < MIN_MESH_CYCLES:
         w0, w1 = summary.get("steady_window_s") or (float("nan"), float("nan"))
@@ -162,6 +167,30 @@ def pressure_warning(summary: dict, scenario) -> str | None:
     )
 
 
+def iso_pressure_warning(summary: dict, scenario) -> str | None:
+    """Wedge and torsional (no contact pressure of their own): the rating's mean contact stress sigma_Hm (ISO/TS 14521
+    method B at the scenario's load and speed, wormsim.rating.rate) above the wheel material's pitting strength
+    sigma_HlimT, the limit pressure_warning takes for contact3d's p_H max. A gear the rating cannot rate gives none."""
+    if scenario is None or scenario.model == "contact3d" or scenario.gear is None:
+        return None
+    from wormsim.exceptions import ScenarioError, SimulationError
+    from wormsim.rating.rate import rate
+
+    lim = wheel_pressure_limit(scenario)
+    try:
+        sigma = _num(rate(scenario), "contact_stress_mean_iso_mpa")
+    except (ScenarioError, SimulationError, ValueError, ArithmeticError):  # outside the rating's range: no check
+        return None
+    if lim is None or sigma is None or sigma <= lim[0]:
+        return None
+    return (
+        f"the mean contact stress sigma_Hm {sigma:.4g} MPa at this load (ISO/TS 14521 method B, wormsim rate) is "
+        f"above the wheel material's pitting strength sigma_HlimT {lim[0]:.4g} MPa ({lim[1]}): the flanks pit or "
+        f"yield at this load, which model {scenario.model} does not see (contact3d reports the contact pressure); "
+        "lower the load or enlarge the gear"
+    )
+
+
 def runaway_warning(result: Result, scenario) -> str | None:
     """The driven shaft above RUNAWAY_FACTOR x its speed command over the steady window, or, for a torque drive (no
     command, and a constant torque has no free speed), at the end RUNAWAY_FACTOR x its speed at half the run."""
@@ -205,7 +234,15 @@ def power_flow_warning(summary: dict, scenario) -> str | None:
     worm into a wheel-driven one), or a pair that does not turn."""
     flow = summary.get("power_flow")
     if flow == "none":
+        from wormsim.results.metrics import STANDSTILL_RPM
+
         n1, n2 = (_num(summary, k) or 0.0 for k in ("worm_speed_mean_rpm", "wheel_speed_mean_rpm"))
+        ratio = _num(summary, "ratio_theory") or 1.0
+        if n1 >= STANDSTILL_RPM and n2 >= STANDSTILL_RPM / ratio:  # both turn (vibrate), neither puts power in
+            return (
+                f"no power flows through the mesh over the steady window (worm {n1:.3g} rpm, wheel {n2:.3g} rpm, "
+                "neither shaft puts power in on average): ratio and efficiency are not defined and reported as null"
+            )
         return (
             f"the pair does not turn over the steady window (worm {n1:.3g} rpm, wheel {n2:.3g} rpm): ratio and "
             "efficiency are not defined and reported as null"
@@ -257,6 +294,33 @@ def drive_peak_warning(result: Result, scenario) -> str | None:
     )
 
 
+HOLD_CREEP_SHARE = 1e-3  # a held pair creeps at most this share of its free speed (issue 31's holding criterion)
+
+
+def creep_warning(summary: dict, scenario) -> str | None:
+    """A held back-drive (`locked`) whose worm creeps faster than HOLD_CREEP_SHARE of its free speed, the wheel's
+    speed command times the ratio: the mesh did not hold the torque it was given (a stalled drive's peak torque), it
+    slipped through; `locked` then says that the drive stalled, not that the pair held."""
+    creep = _num(summary, "creep_speed_rpm")
+    ratio = _num(summary, "ratio_theory")
+    if summary.get("locked") is not True or creep is None or ratio is None or scenario is None:
+        return None
+    drv = scenario.drive
+    if drv is None or drv.on != "wheel" or drv.speed_rpm is None:
+        return None
+    free = abs(drv.speed_rpm) * ratio
+    if creep <= HOLD_CREEP_SHARE * free:
+        return None
+    held = _num(summary, "holding_torque_nm")
+    return (
+        f"the back-driven pair stalled the wheel's drive but did not hold: the worm crept at {creep:.3g} rpm, "
+        f"{100 * creep / free:.2g} % of the wheel command times the ratio ({free:.4g} rpm), above "
+        f"{100 * HOLD_CREEP_SHARE:g} %, under the holding torque {held or float('nan'):.4g} N m (the drive's peak, "
+        "drive_peak_torque_nm); the contact slips at that torque: a lower load on the worm or a torque drive "
+        "(drive.torque_nm) gives a holding run at a chosen torque"
+    )
+
+
 def plausibility_warnings(result: Result, scenario) -> list[str]:
     """The results that contradict a physical limit or the run's premise (see the module docstring)."""
     s = result.summary
@@ -264,9 +328,11 @@ def plausibility_warnings(result: Result, scenario) -> list[str]:
         w
         for w in (
             pressure_warning(s, scenario),
+            iso_pressure_warning(s, scenario),
             runaway_warning(result, scenario),
             power_flow_warning(s, scenario),
             drive_peak_warning(result, scenario),
+            creep_warning(s, scenario),
         )
         if w
     ]

@@ -74,8 +74,10 @@ KEYS: dict[str, Key] = {
         "wormsim.results.run_warnings): a tangential-force fluctuation above half its mean, contact force outside the "
         "wheel flanks, a steady window "
         "of fewer than 5 mesh periods or no meshing line near z1 n1 / 60, a contact pressure above the wheel "
-        "material's pitting strength, a runaway (1.5 x the speed command, or a torque drive still accelerating), "
-        "power flowing from the wheel into a worm-driven pair (overhauling), a pair that does not turn; with "
+        "material's pitting strength (wedge, torsional: the rating's mean contact stress sigma_Hm), a runaway "
+        "(1.5 x the speed command, or a torque drive still accelerating), "
+        "power flowing from the wheel into a worm-driven pair (overhauling), a pair that does not turn, a held "
+        "back-drive whose worm creeps above 0.1 % of its free speed; with "
         "`rating:`, the rating's warnings follow (a root stress above its limit among them); empty when none",
     ),
     "ignored_inputs": Key(
@@ -268,7 +270,7 @@ KEYS: dict[str, Key] = {
     ),
     "power_flow": Key(
         "text",
-        GEAR,
+        GW,
         '"worm to wheel", "wheel to worm" (back-driving, or an overhauling load) or "none" (a shaft slower than '
         "0.01 rpm at the worm: ratio, efficiency and efficiency_theory are null, and the run warns)",
     ),

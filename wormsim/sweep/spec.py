@@ -1,4 +1,4 @@
-"""Sweep files (INTERFACE.md, "Sweep file"): the pydantic schema and the expansion into validated points.
+"""Sweep files (docs/sweeps.md, "The sweep file"): the pydantic schema and the expansion into validated points.
 
     name: screw_jack_stiffness
     base: ../scenarios/screw_jack.yaml        # relative to the sweep file

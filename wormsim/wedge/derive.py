@@ -17,8 +17,9 @@ From gear:, materials:, contact:, drive:, load: (docs/wedge.md, "Derived from ge
   the synchronous speed. The speed servo of the gear levels becomes this stiff speed-force curve: the steady speed
   lands on drive.speed_rpm at the steady friction. drive.ramp_s is not used (the run says so).
 
-The summary adds the gear levels' common keys (ratio, forces on the wheel, torques, speeds, efficiency and its
-theory) from the wedge's forces and speeds, in the force signs of docs/outputs.md: F_t2 = -S2, F_a2 = F_t1 = S1,
+The summary adds the gear levels' common keys (ratio, forces on the wheel, torques, speeds, the power flow,
+efficiency and its theory in the direction of the power flow) from the wedge's forces and speeds, in the force signs
+of docs/outputs.md: F_t2 = -S2, F_a2 = F_t1 = S1,
 F_r2 = |F_t2| tan(alpha_n) cos(rho') / cos(gamma + s rho') (DIN 3975-2; the wedge has no radial direction).
 """
 
@@ -33,6 +34,7 @@ from wormsim.physics import gear_theory as gt
 from wormsim.physics.friction import friction_coefficient, friction_mode
 from wormsim.physics.geometry import derive
 from wormsim.physics.units import DEG, rad_s_to_rpm, rpm_to_rad_s
+from wormsim.results.metrics import flow_efficiency, power_flow
 from wormsim.results.result import Result
 from wormsim.results.summary_keys import level_summary
 from wormsim.wedge.dynamics import STEADY_FRACTION, WedgeParams, simulate_params
@@ -142,14 +144,19 @@ def run_derived(plan: DerivedPlan, progress=None) -> Result:
         return float(np.trapezoid(x[sl], t[sl]) / (t[sl][-1] - t[sl][0])) if np.ptp(t[sl]) > 0 else float(x[-1])
 
     n1, n2 = mean(S["worm_speed_rpm"]), mean(S["wheel_speed_rpm"])
-    p_in, p_out = mean(S["F1_n"] * S["v1_m_s"]), mean(-S["F2_n"] * S["v2_m_s"])
+    # the power each shaft puts into the pair; an assisting load drives the wheel (the motor brakes): power flows
+    # from the wheel to the worm, and the efficiency is the worm's power out over the wheel's in (as at the gear
+    # levels, wormsim.results.metrics.power_flow)
+    p1, p2 = mean(S["F1_n"] * S["v1_m_s"]), mean(S["F2_n"] * S["v2_m_s"])
+    flow = power_flow(n1, n2, g.ratio, p1, p2)
     mu = mean(S["friction_coefficient"])
     T_load = plan.load_torque_nm
     res.summary = level_summary(
         "wedge",
         res.summary,
         {
-            "ratio": n1 / n2 if n2 > 0 else float("inf"),
+            "ratio": n1 / n2 if flow != "none" else float("nan"),
+            "power_flow": flow,
             "ratio_theory": g.ratio,
             "mesh_frequency_theory_hz": g.z1 * n1 / 60.0,
             "tangential_force_mean_n": abs(mean(ft)),
@@ -161,8 +168,10 @@ def run_derived(plan: DerivedPlan, progress=None) -> Result:
             "wheel_torque_mean_nm": abs(mean(S["F2_n"])) * g.r2,
             "worm_speed_mean_rpm": n1,
             "wheel_speed_mean_rpm": n2,
-            "efficiency": p_out / p_in if p_in > 0 else float("nan"),
-            "efficiency_theory": gt.efficiency_theory(g.gamma_m, g.alpha_n, mu),
+            "efficiency": flow_efficiency(flow, p1, p2),
+            "efficiency_theory": gt.efficiency_theory(g.gamma_m, g.alpha_n, mu, backdriving=flow == "wheel to worm")
+            if flow != "none"
+            else float("nan"),
             "friction_coefficient_mean": mu,
             "friction": plan.friction,
             **d,

@@ -205,7 +205,7 @@ def efficiencies(gamma: float, rho: float) -> dict:
 
 
 def _summary_efficiencies(gamma: float, rho_sliding: float, rho_static: float) -> dict:
-    """summary.json efficiencies (INTERFACE.md). efficiency_backward is 0 when the pair self-locks at
+    """summary.json efficiencies (docs/outputs.md). efficiency_backward is 0 when the pair self-locks at
     standstill (rho(0) > gamma: it cannot be back-driven from rest); the back-driving efficiency of a
     pair that is already sliding at the steady speed is efficiency_backward_sliding."""
     e = efficiencies(gamma, rho_sliding)
