@@ -83,7 +83,7 @@ DOUBLE = {
             "                if use_memo and (_memo_skips(mtab, mc, k, sg, j, theta1, te, drift) or skip2):\n",
         )
     ],
-    "slice_weights, merge, frames": [
+    "slice_weights + merge + frames": [
         (
             "    n = slice_weights(meta, line, n, S, pos, nrm, depth, weight)\n",
             "    n0 = n\n"
