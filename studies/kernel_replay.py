@@ -276,7 +276,11 @@ def main() -> None:
     ap.add_argument("--rounds", type=int, default=5)
     ap.add_argument("--base", default="", help="commit whose kernel.py's parts are measured (default: this one)")
     ap.add_argument("--other", default="", help="another kernel.py (a file) replayed against the base")
-    ap.add_argument("--only", default="", help="comma-separated part names to double (default: all; none: no part)")
+    ap.add_argument(
+        "--only",
+        default="",
+        help="comma-separated part names to double, count: the counts (default: all; none: no part)",
+    )
     ap.add_argument("--record", default="")
     a = ap.parse_args()
     sys.path.insert(0, str(ROOT))
@@ -295,18 +299,22 @@ def main() -> None:
     for i, (name, subs) in enumerate(DOUBLE.items()):
         if not a.only or name in a.only.split(","):
             mods[f"x2 {name}"] = load_module(f"double{i}", _rewrite(src, subs))
-    mods["count"] = load_module("count", _rewrite(src, COUNT))
+    counting = not a.only or "count" in a.only.split(",")
+    if counting:
+        mods["count"] = load_module("count", _rewrite(src, COUNT))
     rec = record(a.warm_s, a.steps)
     print(f"recorded {len(rec['t1'])} steps", flush=True)
     reps = {name: Replay(mod, rec) for name, mod in mods.items()}
     for name, r in reps.items():  # compile
         r.run()
         print(f"compiled {name}", flush=True)
-    cnt = reps.pop("count")
-    cnt.run()
     steps = len(rec["t1"])
-    counts = {c: float(cnt.k.tmp[C0 + i]) / steps for i, c in enumerate(COUNTERS)}
-    print("per call:", {k: round(v, 2) for k, v in counts.items()}, flush=True)
+    counts = {}
+    if counting:
+        cnt = reps.pop("count")
+        cnt.run()
+        counts = {c: float(cnt.k.tmp[C0 + i]) / steps for i, c in enumerate(COUNTERS)}
+        print("per call:", {k: round(v, 2) for k, v in counts.items()}, flush=True)
     cpu: dict[str, list[float]] = {k: [] for k in reps}
     for rd in range(a.rounds):
         items = list(reps.items())
