@@ -137,6 +137,7 @@ def _rewrite(src: str, subs) -> str:
 def load_module(name: str, src: str):
     """kernel.py's text `src` as a module of its own (its own numba cache next to it)."""
     VARIANT_DIR.mkdir(exist_ok=True)
+    src = src.replace("cache=True", "cache=False")  # numba's cache cannot reload a module loaded from a path
     f = VARIANT_DIR / f"{name}.py"
     if not f.exists() or f.read_text() != src:
         f.write_text(src)
