@@ -252,7 +252,7 @@ def kernel_replay_table(name: str = "kernel_replay") -> str:
     text += (
         f"\nPer call ({r['steps']} steps of {r['timestep_s'] * 1e6:.1f} us from t = {r['warm_s']} s, median of "
         f"{r['rounds']} interleaved rounds, load average {r['load_average_at_start'][0]:.1f} at the start): "
-        + ", ".join(f"{v:.1f} {k}" for k, v in c.items())
+        + (", ".join(f"{v:.1f} {k}" for k, v in c.items()) if c else "the parts above")
         + ".\n"
     )
     if r.get("other"):
