@@ -240,6 +240,33 @@ def seat_motor_levers_table(name: str = "seat_motor_levers") -> str:
     return _table(head, rows) + "\n" + _source(name)
 
 
+def kernel_replay_table(name: str = "kernel_replay") -> str:
+    """The flank kernel's parts on a recorded replay of the seat motor (studies/kernel_replay.py): each part's cost
+    (what doing it twice adds), the counts per call, and another kernel against the base."""
+    r = load(name)
+    base = r["us_per_call"]["plain"]
+    rows = [["the whole kernel call (find_packed)", f"{base:.1f}", "100 %"]]
+    rows += [[k, f"{v:.1f}", f"{100 * v / base:.0f} %"] for k, v in r["part_us"].items()]
+    text = _table(["part (base kernel)", "us per call", "share of the call"], rows)
+    c = r["counts_per_call"]
+    text += (
+        f"\nPer call ({r['steps']} steps of {r['timestep_s'] * 1e6:.1f} us from t = {r['warm_s']} s, median of "
+        f"{r['rounds']} interleaved rounds, load average {r['load_average_at_start'][0]:.1f} at the start): "
+        + (", ".join(f"{v:.1f} {k}" for k, v in c.items()) if c else "the parts above")
+        + ".\n"
+    )
+    if r.get("other"):
+        chk = r["contacts_check"]["other"]
+        text += (
+            f"\n`{r['other']}` against the base ({r['base']}): {r['us_per_call']['other']:.1f} against {base:.1f} us "
+            f"per call, ratio {r['other_over_base']:.2f} (rounds "
+            + " / ".join(f"{x:.2f}" for x in r["other_over_base_rounds"])
+            + f"); contacts per step equal: {'yes' if chk['contacts_equal'] else 'no'}, the last step's merged "
+            f"contacts' largest difference {chk['last_step_max_abs_diff']:.1e}.\n"
+        )
+    return text + "\n" + _source(name)
+
+
 def flank_contacts_table(name: str = "flank_contacts") -> str:
     """MuJoCo contacts per tooth flank (studies/flank_contacts.py): the seat motor's CPU s per simulated second per
     variant, and the seeds' CI results relative to per slice."""
@@ -1438,6 +1465,7 @@ TABLES: dict[str, Callable[[], str]] = {
     "flank_speed": flank_speed_table,
     "seat_motor_profile": seat_motor_profile_table,
     "seat_motor_levers": seat_motor_levers_table,
+    "kernel_replay": kernel_replay_table,
     "flank_contacts": flank_contacts_table,
     "flank_contacts_default": flank_contacts_default_table,
     "bench_shafts": bench_shafts_table,

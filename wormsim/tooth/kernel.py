@@ -3,7 +3,8 @@ slice), their slice weights and contact frames, packed in one compiled call (`fi
 
 For every wheel tooth k of the mesh window and both flanks, and for every slice of the flank grid
 (wormsim.tooth.grid) whose conjugate angles come within `margin` of the current wheel angle, `find_contacts` starts at
-the profile point whose conjugate angle is nearest (bisection) and descends along the profile to the worm gap's
+the profile point whose conjugate angle is nearest (walking from the slice's start point at its last evaluation, by
+bisection the first time) and descends along the profile to the worm gap's
 minimum (wormsim.tooth.gap), so a step costs about three points per slice. A point of tooth k at wheel angle theta2
 sits in the assembly at (rho cos b, rho sin b, zeta), b = psi + theta2 + 2 pi k / z2; with assembly errors it goes
 through the body poses (wormsim.tooth.pose). Where the gap's minimum lies past the worm's tip, root or end faces, the
@@ -42,8 +43,10 @@ MARGIN_PITCH = 0.10  # candidate points: conjugate angle within this fraction of
 MEMO_GAP_SHARE = 0.5  # a memorised open slice is skipped while its bound keeps this share of the gap it had
 MEMO_JITTER_MODULE = 1e-3  # allowance (x m_x) for the slice minimum's change at constant TE (measured <= 1.5e-5)
 MEMO_AGE_CYCLE = 1.0 / 8  # a memorised slice is evaluated again after this share of a mesh cycle of worm rotation
-MEMO_COLS = 4  # the memo table's columns: gline, TE, theta1, the pose's drift (_pose_drift) when it was evaluated
+MEMO_COLS = 5  # the memo table's columns: gline, TE, theta1, the pose's drift (_pose_drift) when it was evaluated;
+# the slice's start point + 1 at its last evaluation (0: none; _start_near's hint, kept when the rest is forgotten)
 MEMO_CONSTS = 4  # rho_max, jitter allowance, age, the largest distance of a grid point from the wheel's origin
+LINE_COLS = 7  # _line_point's cache per slice: f, i0, x, y, the tip's distance and its segment, the excess
 TIP_SUBSTEPS = 32  # points across a slice where the contact line crosses the wheel's tip edge (_tip_depth)
 INSIDE_SHARE = 0.75 * (1.0 + 1e-3)  # line points deeper inside than this x the distance to the neighbouring slices'
 # line points: weight 1 without their excess (the quadratic through them changes by at most 3/4 of it within the slice;
@@ -81,7 +84,10 @@ def find_contacts(grid, ks, theta1, theta2, margin, P, out, taper_rad=0.0, memo=
     N = grid[1].shape[2]
     if taper_rad <= 0.0:
         taper_rad = TAPER_SHARE * margin
+    S = grid[1].shape[1]
+    line = (np.empty((S, LINE_COLS)), np.empty((S, 2), dtype=np.int64))  # _line_point's cache
     work = (np.empty(6), np.empty(N), np.empty(N), np.empty((N, 3)), np.empty((N, 3)), np.empty(N, dtype=np.int64))
+    work = (work[0], work[1], work[2], work[3], work[4], work[5], line[0], line[1])
     if memo is None:
         memo = (np.zeros((0, 2, 1, MEMO_COLS)), np.zeros(MEMO_CONSTS))
     return _find_contacts(grid, ks, theta1, theta2, margin, taper_rad, P, out, work, memo)
@@ -105,8 +111,8 @@ def _find_contacts(grid, ks, theta1, theta2, margin, taper_rad, P, out, work, me
     """find_contacts with its work arrays passed in, compiled without numba's reference counting (_nrt=False): the
     inlined helpers take arrays, and with it every helper call cost an atomic incref/decref pair per array (about
     60 % of the kernel's time; docs/contact3d.md, "Exact flanks: cost"). Per window tooth, flank and slice in the
-    candidate window: the memo's check (`_memo_skips`), the start point (`_start_point`), the slice's contact
-    (`_slice_contact`).
+    candidate window: the memo's check (`_memo_skips`), the start point (`_start_near` from the memo table's last
+    start point of the slice, `_start_point` without a memo), the slice's contact (`_slice_contact`).
 
     The open-slice memo (memo = flank_memo(...); an empty table turns it off): a slice whose flanks were apart at its
     last evaluation, with the gap's minimum gline_e > 0 inside the profile (not at its ends, the parabola through
@@ -122,7 +128,7 @@ def _find_contacts(grid, ks, theta1, theta2, margin, taper_rad, P, out, work, me
     skipped slice gives no contact, as its evaluation would: tests/tooth/test_kernel_memo.py compares with and without
     over mesh cycles, nominal and with moving poses."""
     xy, c, c_range, span, zeta = grid
-    tmp, gaps, exc, pts, nrs, stamp = work
+    tmp, gaps, exc, pts, nrs, stamp, lcache, lstamp = work
     mtab, mc = memo
     use_memo = mtab.shape[0] > 0
     S = c.shape[1]
@@ -132,6 +138,7 @@ def _find_contacts(grid, ks, theta1, theta2, margin, taper_rad, P, out, work, me
     taper_end = margin  # edge contacts fade to zero at this distance past the profile's conjugate range
     margin = margin + abs(te)
     stamp[:] = -1
+    lstamp[:] = -1
     sid = 0
     n = 0
     for kk in range(ks.shape[0]):
@@ -158,13 +165,18 @@ def _find_contacts(grid, ks, theta1, theta2, margin, taper_rad, P, out, work, me
                     continue
                 if span[sg, j, 0] < 0:
                     continue
-                i_s = _start_point(c, span, sg, j, target)
+                if use_memo:  # from the slice's start point at its last evaluation: a step or none
+                    km = k % mtab.shape[0]
+                    i_s = _start_near(c, span, sg, j, target, int(mtab[km, sg, j, 4]) - 1)
+                    mtab[km, sg, j, 4] = i_s + 1.0
+                else:
+                    i_s = _start_point(c, span, sg, j, target)
                 sid += 1
                 memo_row = (use_memo, mtab, te, drift)
                 # the conjugate contact line of this tooth flank at the current pose: conjugate angle target - TE
                 # (the slice weights', _line_share), the tooth's own TE te + dk (a tooth with pitch deviation dk
                 # meshes as the tooth turned by dk: its line is the undisplaced tooth's at the worm angle)
-                sc = (span, c, target - te - dk)
+                sc = (span, c, target - te - dk, lcache, lstamp, 2 * kk + sg)
                 n, full = _slice_contact(ev, sc, zeta, (sg, j, k), i_s, sid, taper, memo_row, out, n)
                 if full:
                     return n
@@ -249,6 +261,31 @@ def _start_point(c, span, sg, j, target):
 
 
 @numba.njit(cache=True, inline="always")
+def _start_near(c, span, sg, j, target, hint):
+    """_start_point's point, found by walking from the point hint (the slice's start point at its last evaluation:
+    the seat motor's wheel turns a small fraction of a profile point's conjugate angle per step) instead of by
+    bisection: the segment [i, i + 1] of the row whose conjugate angles bracket the target as the bisection's does,
+    then its nearer end, ties to i (the bisection's rule, so the point is the same); the bisection where hint is
+    not a point of the active row or the walk meets a trimmed point."""
+    a, b = span[sg, j, 0], span[sg, j, 1]
+    if hint < a or hint > b or b - a < 1:
+        return _start_point(c, span, sg, j, target)
+    inc = c[sg, j, b] > c[sg, j, a]
+    i = min(hint, b - 1)
+    for _ in range(b - a):
+        c0, c1 = c[sg, j, i], c[sg, j, i + 1]
+        if c0 != c0 or c1 != c1:
+            return _start_point(c, span, sg, j, target)
+        if i > a and (c0 < target) != inc:
+            i -= 1
+        elif i < b - 1 and (c1 < target) == inc:
+            i += 1
+        else:
+            break
+    return i if abs(c[sg, j, i] - target) <= abs(c[sg, j, i + 1] - target) else i + 1
+
+
+@numba.njit(cache=True, inline="always")
 def _g(ev, sg, j, i, zj, sid):
     """Extended gap (worm_gap_ext) of profile point i of (flank sg, slice j) at the face position zj, with the tooth's
     evaluation context ev = (xy, ca, sa, theta1, P, tmp, gaps, exc, pts, nrs, stamp): evaluated once per slice
@@ -287,7 +324,7 @@ def _slice_contact(ev, sc, zeta, slc, i_s, sid, taper, memo_row, out, n):
     minimum along the profile (`_descend`), the parabola through it (`_line_parabola`), the worm's edge where the
     minimum lies past it (`_edge_minimum`); written as contact n (`_write_contact`) where it touches, else the slice
     memorised where it is open (memo_row = (use_memo, table, TE)). sc = (span, c, the contact line's conjugate
-    angle), the grid's and _line_share's. Returns (the contacts written, out full)."""
+    angle, _line_point's cache), the grid's and _line_share's. Returns (the contacts written, out full)."""
     span = sc[0]
     sg, j, k = slc
     exc = ev[7]
@@ -440,7 +477,7 @@ def _edge_minimum(ev, sg, j, zj, at, parab, sid):
 def _write_contact(ev, sc, zeta, slc, at, gap, out, n):
     """Contact n of slc = (flank sg, slice j, tooth k) at at = (ib, x): fractional profile index ib + x; gap = (the
     edge's gap minimum gmin, the line's gline, the taper, the gap's parabola (best, qa, qb, ib) of _line_parabola);
-    sc = (span, c, the contact line's conjugate angle) (_line_share): its point and normal linear between the grid
+    sc = (span, c, the contact line's conjugate angle, ...) (_line_share): its point and normal linear between the grid
     points around it, moved half the depth along the normal (find_contacts' fields). The depth for slice_weights
     (line[n, 1]) is the line's gline, except where the line leaves the active profile (decision 0052): where the line
     crosses the wheel's tip edge in the slice, the depth averaged across the slice (_tip_depth: the line's inside the
@@ -591,17 +628,24 @@ def _line_share(xy, sc, zeta, sg, j, hint, ca, sa, P, tmp):
     continuous in the mesh angle (slice_weights). Where the point lies deeper inside than INSIDE_SHARE x the larger
     distance to a neighbour's point, the share is 1 without the neighbours' excess (a max of distances, it changes
     by at most the distance moved, the quadratic by at most 3/4 of it within the slice). hint: the profile index of
-    the slice's line point (_index_at's walk starts there).
+    the slice's line point (_index_at's walk starts there). The line's points, their tip distances and excesses are
+    computed once per tooth flank and slice (_line_point, _line_excess: sc = (span, c, c_line, lcache, lstamp,
+    fid)) and shared with the neighbouring slices' calls.
 
     Returns (w, tip): w that share; tip = (t0, tb, ta, inside, seg, f0) for the slice's depth (_write_contact): how
     far the line lies past the wheel's tip edge (the active profile's last point, _tip_past, m), quadratic across the
     slice from the line's points as the excess (t0 + tb u + ta u^2), whether it stays inside the tip edge across the
     slice (by INSIDE_SHARE x its change to the neighbours, as the excess), the end segment's length, and the line
     point's fractional profile index f0 (past the profile's lower end where f0 < its first active point)."""
-    span, c, c_line = sc
+    span, c, c_line, lcache, lstamp, fid = sc
     S = zeta.shape[0]
     dz = zeta[1] - zeta[0] if S > 1 else 1.0
-    f0, i0 = _index_at(c, span, sg, j, c_line, hint)
+    # the line's points of this slice and its neighbours (_line_point: once per tooth flank and slice)
+    for q in range(3):
+        jq = j if q == 0 else j - 1 if q == 1 else j + 1
+        if 0 <= jq < S:
+            _line_point(xy, sc, sg, jq, hint if q == 0 else int(lcache[j, 1]))
+    f0, i0 = lcache[j, 0], int(lcache[j, 1])
     if i0 < 0:  # no active segment on the line (a trimmed point): the change across the face at the profile's middle
         a, b = span[sg, j, 0], span[sg, j, 1]
         i0 = (a + b) // 2
@@ -615,14 +659,10 @@ def _line_share(xy, sc, zeta, sg, j, hint, ca, sa, P, tmp):
             1.0,
             1e9,
         )
-    x0, y0 = _point_at(xy, sg, j, f0, i0)
-    e0 = _excess(x0, y0, zeta[j], ca, sa, P, tmp)
-    im = ip = -1
-    xm = ym = xp = yp = fm = fp = 0.0
-    if j > 0:
-        fm, im = _index_at(c, span, sg, j - 1, c_line, i0)
-    if j < S - 1:
-        fp, ip = _index_at(c, span, sg, j + 1, c_line, i0)
+    x0, y0 = lcache[j, 2], lcache[j, 3]
+    e0 = _line_excess(sc, j, zeta, ca, sa, P, tmp)
+    im = int(lcache[j - 1, 1]) if j > 0 else -1
+    ip = int(lcache[j + 1, 1]) if j < S - 1 else -1
     if im < 0 and ip < 0:
         return _covered(e0, _face_slope(x0, y0, zeta[j], dz, ca, sa, P, tmp), 0.0), (
             0.0,
@@ -632,9 +672,9 @@ def _line_share(xy, sc, zeta, sg, j, hint, ca, sa, P, tmp):
             1.0,
             1e9,
         )
-    t0, seg = _tip_past(xy, span, sg, j, f0)
-    tm = _tip_past(xy, span, sg, j - 1, fm)[0] if im >= 0 else 0.0
-    tp = _tip_past(xy, span, sg, j + 1, fp)[0] if ip >= 0 else 0.0
+    t0, seg = lcache[j, 4], lcache[j, 5]
+    tm = lcache[j - 1, 4] if im >= 0 else 0.0
+    tp = lcache[j + 1, 4] if ip >= 0 else 0.0
     # the tip's quadratic across the slice (as the excess's below), and whether it stays negative across the slice
     # (|t_+- - t_0| bounds its change within the slice as for the excess): then w_in = w
     if im < 0:
@@ -646,23 +686,54 @@ def _line_share(xy, sc, zeta, sg, j, hint, ca, sa, P, tmp):
     inside = t0 < -INSIDE_SHARE * max(abs(tp - t0) if ip >= 0 else 0.0, abs(tm - t0) if im >= 0 else 0.0)
     reach = 0.0
     if im >= 0:
-        xm, ym = _point_at(xy, sg, j - 1, fm, im)
+        xm, ym = lcache[j - 1, 2], lcache[j - 1, 3]
         reach = math.sqrt((xm - x0) ** 2 + (ym - y0) ** 2 + dz * dz)
     if ip >= 0:
-        xp, yp = _point_at(xy, sg, j + 1, fp, ip)
+        xp, yp = lcache[j + 1, 2], lcache[j + 1, 3]
         reach = max(reach, math.sqrt((xp - x0) ** 2 + (yp - y0) ** 2 + dz * dz))
     if e0 < -INSIDE_SHARE * reach:
         # |e_+- - e_0| <= reach: covered either way
         return 1.0, (t0, tb, ta, inside, seg, f0)
     if im < 0:
-        eb, ea = _excess(xp, yp, zeta[j + 1], ca, sa, P, tmp) - e0, 0.0
+        eb, ea = _line_excess(sc, j + 1, zeta, ca, sa, P, tmp) - e0, 0.0
     elif ip < 0:
-        eb, ea = e0 - _excess(xm, ym, zeta[j - 1], ca, sa, P, tmp), 0.0
+        eb, ea = e0 - _line_excess(sc, j - 1, zeta, ca, sa, P, tmp), 0.0
     else:
-        em = _excess(xm, ym, zeta[j - 1], ca, sa, P, tmp)
-        ep = _excess(xp, yp, zeta[j + 1], ca, sa, P, tmp)
+        em = _line_excess(sc, j - 1, zeta, ca, sa, P, tmp)
+        ep = _line_excess(sc, j + 1, zeta, ca, sa, P, tmp)
         eb, ea = 0.5 * (ep - em), 0.5 * (ep + em) - e0
     return _covered(e0, eb, ea), (t0, tb, ta, inside, seg, f0)
+
+
+@numba.njit(cache=True, inline="always")
+def _line_point(xy, sc, sg, j, hint):
+    """The contact line's point of (flank sg, slice j) for _line_share, once per tooth flank and slice (sc = (span, c,
+    c_line, lcache, lstamp, fid): the slices of a tooth flank share their neighbours' points): its fractional profile
+    index f and segment i0 (_index_at from the profile index hint; i0 = -1 where the slice has no active segment
+    there), its (x, y) (_point_at) and how far it lies past the tip edge with the end segment's length (_tip_past),
+    in lcache[j] (f, i0, x, y, t, seg; the excess in column 6, _line_excess); lstamp[j, 0] = fid once done. The
+    segment found does not depend on the walk's start (c is monotone along the active profile), so the values are the
+    ones _line_share computed per call."""
+    span, c, c_line, lcache, lstamp, fid = sc
+    if lstamp[j, 0] == fid:
+        return
+    lstamp[j, 0] = fid
+    f, i0 = _index_at(c, span, sg, j, c_line, hint)
+    lcache[j, 0], lcache[j, 1] = f, i0
+    if i0 >= 0:
+        lcache[j, 2], lcache[j, 3] = _point_at(xy, sg, j, f, i0)
+        lcache[j, 4], lcache[j, 5] = _tip_past(xy, span, sg, j, f)
+
+
+@numba.njit(cache=True, inline="always")
+def _line_excess(sc, j, zeta, ca, sa, P, tmp):
+    """The excess (_excess) at the line's point of slice j (_line_point's, computed before), once per tooth flank and
+    slice (lstamp[j, 1] = fid once done)."""
+    lcache, lstamp, fid = sc[3], sc[4], sc[5]
+    if lstamp[j, 1] != fid:
+        lstamp[j, 1] = fid
+        lcache[j, 6] = _excess(lcache[j, 2], lcache[j, 3], zeta[j], ca, sa, P, tmp)
+    return lcache[j, 6]
 
 
 @numba.njit(cache=True, inline="always")
@@ -778,7 +849,8 @@ _F_FIELDS += (
     "mwrap",
     "axes",
 )  # wormsim.tooth.merge
-_I_FIELDS = ("span", "ks", "stamp")
+_F_FIELDS += ("lcache",)  # _line_point's cache
+_I_FIELDS = ("span", "ks", "stamp", "lstamp")
 _I_HEADER = 8  # S, N, cap, len(P), W, z2, merge (slices per merged contact, 0: none), merged contacts
 
 
@@ -788,8 +860,8 @@ def _layout(S, N, cap, nP, W, z2):
     the int buffer's after its header (_I_FIELDS order). PackedKernel sizes the buffers by it; `_views` cuts them."""
     f = ((2, S, N, 2), (2, S, N), (2, S, 2), (S,), (nP,), (cap, 3), (cap, 3), (cap,), (cap, 4), (cap, 2), (cap,))
     f2 = ((cap, 9), (z2, 2, S, MEMO_COLS), (MEMO_CONSTS,), (6,), (N,), (N,), (N, 3), (N, 3))
-    f3 = ((cap, 3), (cap, 3), (cap,), (cap,), (cap, 9), (cap,), (cap,), (cap,), (cap,), (13,))
-    return f + f2 + f3, ((2, S, 2), (W,), (N,))
+    f3 = ((cap, 3), (cap, 3), (cap,), (cap,), (cap, 9), (cap,), (cap,), (cap,), (cap,), (13,), (S, LINE_COLS))
+    return f + f2 + f3, ((2, S, 2), (W,), (N,), (S, 2))
 
 
 @numba.njit(cache=True, inline="always")
@@ -837,13 +909,15 @@ def _views(fb, ib):
     mfric, o = _take(fb, o, f[26])
     mwrap, o = _take(fb, o, f[27])
     axes, o = _take(fb, o, f[28])
+    lcache, o = _take(fb, o, f[29])
     o = _I_HEADER
     span, o = _take(ib, o, i[0])
     ks, o = _take(ib, o, i[1])
     stamp, o = _take(ib, o, i[2])
+    lstamp, o = _take(ib, o, i[3])
     floats = (xy, c, c_range, zeta, P, pos, nrm, depth, meta, line, weight, frame, mtab, mc, tmp, gaps, exc, pts, nrs)
-    floats2 = (mpos, mnrm, mdepth, mweight, mframe, grp, share, mfric, mwrap, axes)
-    return floats + floats2, (span, ks, stamp)
+    floats2 = (mpos, mnrm, mdepth, mweight, mframe, grp, share, mfric, mwrap, axes, lcache)
+    return floats + floats2, (span, ks, stamp, lstamp)
 
 
 def _size(shapes) -> int:
@@ -897,8 +971,8 @@ def find_packed(fb, ib, theta1, theta2, margin, taper_rad):
     floats, ints = _views(fb, ib)
     xy, c, c_range, zeta, P, pos, nrm, depth, meta, line, weight, frame = floats[:12]
     mtab, mc, tmp, gaps, exc, pts, nrs = floats[12:19]
-    mpos, mnrm, mdepth, mweight, mframe, grp, share, mfric, mwrap, axes = floats[19:]
-    span, ks, stamp = ints
+    mpos, mnrm, mdepth, mweight, mframe, grp, share, mfric, mwrap, axes, lcache = floats[19:]
+    span, ks, stamp, lstamp = ints
     if taper_rad <= 0.0:
         taper_rad = TAPER_SHARE * margin
     n = _find_contacts(
@@ -910,7 +984,7 @@ def find_packed(fb, ib, theta1, theta2, margin, taper_rad):
         taper_rad,
         P,
         (pos, nrm, depth, meta, line),
-        (tmp, gaps, exc, pts, nrs, stamp),
+        (tmp, gaps, exc, pts, nrs, stamp, lcache, lstamp),
         (mtab, mc),
     )
     n = slice_weights(meta, line, n, S, pos, nrm, depth, weight)
