@@ -294,7 +294,7 @@ def drive_peak_warning(result: Result, scenario) -> str | None:
     )
 
 
-HOLD_CREEP_SHARE = 1e-3  # a held pair creeps at most this share of its free speed (issue 31's holding criterion)
+HOLD_CREEP_SHARE = 1e-3  # a held pair creeps at most this share of its free speed (docs/outputs.md)
 
 
 def creep_warning(summary: dict, scenario) -> str | None:

@@ -52,11 +52,9 @@ def default_slices(g: GearGeometry, resolution: str) -> int:
         S = max(SLICES_MIN, SLICES_STEP ceil(k_mean / (SLICE_SHARE k_p2p) / SLICES_STEP)),
 
     k_p2p / k_mean the fluctuation of the zero-load TCA's k(theta) (wormsim.tooth.mesh_stiffness, both flank
-    sides, the smaller). Measured (docs/contact3d.md, "Default slice count"; docs/decisions/0054): the fluctuation
-    alone gives seat motor 0.177 -> 32 slices (16 were not converged), screw jack 0.376 -> 16 and involute_41
-    0.267 -> 24, where the screw jack's F_t p2p was 24 % (16) and 14 % (24) off twice the count's and 2.5 % at 32.
-    That is medium's count; fine takes SLICES_FINE_FACTOR times it (the count medium's convergence is measured
-    against), coarse SLICES_COARSE."""
+    sides, the smaller); the measurements behind the rule and the floor: docs/contact3d.md, "Default slice count",
+    and docs/decisions/0054-at-least-32-slices.md. That is medium's count; fine takes SLICES_FINE_FACTOR times it
+    (the count medium's convergence is measured against), coarse SLICES_COARSE."""
     if resolution == "coarse":
         return SLICES_COARSE
     ms = mesh_stiffness(g, 1.0, "slices", SLICES_TCA_SAMPLES)
