@@ -95,9 +95,8 @@ def whole_run(seconds: float) -> dict:
     }
 
 
-def table_run(seconds: float) -> float:
-    """us per step of the compiled steps alone (FlankLoop.run: run_table with its per-step sums, no samples) over the
-    whole run's window, 0..seconds from rest, in one call."""
+def _compiled_loop():
+    """(bm, model, data, FlankContacts, FlankLoop) of the seat motor at SPEED, its contacts at mu 0.05, from rest."""
     import mujoco
 
     from wormsim.contact3d import native
@@ -114,6 +113,13 @@ def table_run(seconds: float) -> float:
     s0 = int(m.sensor_adr[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SENSOR, "mesh_force")])
     loop = FlankLoop(fc, d, bm.drive_actuator, bm.load_actuator, 0, 1, s0)
     fc.set_friction(0.05)
+    return bm, m, d, fc, loop
+
+
+def table_run(seconds: float) -> float:
+    """us per step of the compiled steps alone (FlankLoop.run: run_table with its per-step sums, no samples) over the
+    whole run's window, 0..seconds from rest, in one call."""
+    bm, m, d, _, loop = _compiled_loop()
     n = int(round(seconds / m.opt.timestep))
     t = (np.arange(n) + 0.5) * m.opt.timestep
     cmd, load = bm.plan.commands.drive(t), bm.plan.commands.load(t)
@@ -132,19 +138,8 @@ def step_split(warm_s: float, steps: int, rounds: int) -> dict:
     from profile_flank_step import CLOCK, PARTS, STEP2, calibrate, profile
 
     from wormsim.contact3d import native
-    from wormsim.contact3d.flank_loop import FlankLoop
-    from wormsim.contact3d.flank_step import FlankContacts
-    from wormsim.contact3d.mjcf import build_model
-    from wormsim.scenario import load_scenario
 
-    bm = build_model(load_scenario(ROOT / "scenarios" / "seat_motor.yaml", SPEED))
-    m = bm.model
-    d = mujoco.MjData(m)
-    fc = FlankContacts(bm, bm.law.contacts_per_pair)
-    native.split_forward(m, d, fc.add)
-    s0 = int(m.sensor_adr[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SENSOR, "mesh_force")])
-    loop = FlankLoop(fc, d, bm.drive_actuator, bm.load_actuator, 0, 1, s0)
-    fc.set_friction(0.05)
+    bm, m, d, fc, loop = _compiled_loop()
     dt = m.opt.timestep
     nw = int(round(warm_s / dt))
     t = (np.arange(nw + steps + 400) + 0.5) * dt

@@ -17,6 +17,15 @@ from wormsim.tooth import grid, kernel
 from wormsim.tooth.window import window_size, window_teeth_at
 
 
+def _setup(name: str, S: int = 16):
+    """The seed's gear, S, its flank grid at S slices, the window's teeth W, the first tooth's angle, the kernel's
+    margin and the contact buffers' capacity."""
+    g = derive(load_scenario(SCENARIOS / f"{name}.yaml").gear)
+    W = window_size(g)
+    margin = kernel.MARGIN_PITCH * 2 * math.pi / g.z2 + g.backlash / (2 * g.r2)
+    return g, S, grid.flank_grid(g, S), W, -math.pi / 2 + math.pi / g.z2, margin, 2 * W * S
+
+
 def _states(g, steps: int) -> np.ndarray:
     """(theta1, theta2) over one mesh cycle: the wheel turned from the conjugate angle by s backlash angles j / (2 r2),
     s = 1.3 +- 0.2 (flank A loaded, the TE varying), then 0 (mid-backlash, open), then jumps between them."""
@@ -32,14 +41,7 @@ def _states(g, steps: int) -> np.ndarray:
 def test_memo_gives_the_same_contacts(name):
     """find_contacts with and without its memo, and find_packed (memo, slice_weights and frames in one call on
     PackedKernel's buffers) against find_contacts without memo + slice_weights + contact_frames."""
-    g = derive(load_scenario(SCENARIOS / f"{name}.yaml").gear)
-    S = 16
-    fg = grid.flank_grid(g, S)
-    W = window_size(g)
-    tooth0 = -math.pi / 2 + math.pi / g.z2
-    pitch = 2 * math.pi / g.z2
-    margin = kernel.MARGIN_PITCH * pitch + g.backlash / (2 * g.r2)
-    cap = 2 * W * S
+    g, S, fg, W, tooth0, margin, cap = _setup(name)
     memo = kernel.flank_memo(fg, g.z2)
     pk = kernel.PackedKernel(fg, fg.params, cap, W, g.z2)
     runs: dict = {"memo": [], "none": [], "packed": []}
@@ -102,13 +104,7 @@ def test_memo_with_displaced_poses_gives_the_same_contacts():
     for the nominal poses and bounds the displacement of every wheel grid point, and the memo still skips."""
     from wormsim.tooth import pose
 
-    g = derive(load_scenario(SCENARIOS / "screw_jack.yaml").gear)
-    S = 16
-    fg = grid.flank_grid(g, S)
-    W = window_size(g)
-    tooth0 = -math.pi / 2 + math.pi / g.z2
-    margin = kernel.MARGIN_PITCH * 2 * math.pi / g.z2 + g.backlash / (2 * g.r2)
-    cap = 2 * W * S
+    g, S, fg, W, tooth0, margin, cap = _setup("screw_jack")
     P = pose.displaced_params(fg.params, np.zeros(g.z2))
     memo = kernel.flank_memo(fg, g.z2)
     reach = memo[1][3]
@@ -161,13 +157,7 @@ def test_merging_kernel_leaves_slice_frames_to_the_samples():
     """find_packed merging 4 slices per contact gives the slice contacts of the unmerged call bit for bit, and leaves
     their frames out (MuJoCo gets the merged ones); contact_frames on its normals, as the samples compute them
     (FlankContacts.slice_rows, flank_samples.contact_rows), are the unmerged call's frames."""
-    g = derive(load_scenario(SCENARIOS / "screw_jack.yaml").gear)
-    S = 16
-    fg = grid.flank_grid(g, S)
-    W = window_size(g)
-    tooth0 = -math.pi / 2 + math.pi / g.z2
-    margin = kernel.MARGIN_PITCH * 2 * math.pi / g.z2 + g.backlash / (2 * g.r2)
-    cap = 2 * W * S
+    g, S, fg, W, tooth0, margin, cap = _setup("screw_jack")
     plain = kernel.PackedKernel(fg, fg.params, cap, W, g.z2)
     merged = kernel.PackedKernel(fg, fg.params, cap, W, g.z2, merge=4)
     frames = np.zeros((cap, 9))

@@ -43,6 +43,8 @@ MARGIN_PITCH = 0.10  # candidate points: conjugate angle within this fraction of
 MEMO_GAP_SHARE = 0.5  # a memorised open slice is skipped while its bound keeps this share of the gap it had
 MEMO_JITTER_MODULE = 1e-3  # allowance (x m_x) for the slice minimum's change at constant TE (measured <= 1.5e-5)
 MEMO_AGE_CYCLE = 1.0 / 8  # a memorised slice is evaluated again after this share of a mesh cycle of worm rotation
+# _line_share's tip tuple where the line has no active segment or no neighbour: inside the tip edge, whole segment
+_NO_TIP = (0.0, 0.0, 0.0, True, 1.0, 1e9)
 MEMO_COLS = 5  # the memo table's columns: gline, TE, theta1, the pose's drift (_pose_drift) when it was evaluated;
 # the slice's start point + 1 at its last evaluation (0: none; _start_near's hint, kept when the rest is forgotten)
 MEMO_CONSTS = 4  # rho_max, jitter allowance, age, the largest distance of a grid point from the wheel's origin
@@ -651,27 +653,13 @@ def _line_share(xy, sc, zeta, sg, j, hint, ca, sa, P, tmp):
         i0 = (a + b) // 2
         x0, y0 = xy[sg, j, i0, 0], xy[sg, j, i0, 1]
         e0 = _excess(x0, y0, zeta[j], ca, sa, P, tmp)
-        return _covered(e0, _face_slope(x0, y0, zeta[j], dz, ca, sa, P, tmp), 0.0), (
-            0.0,
-            0.0,
-            0.0,
-            True,
-            1.0,
-            1e9,
-        )
+        return _covered(e0, _face_slope(x0, y0, zeta[j], dz, ca, sa, P, tmp), 0.0), _NO_TIP
     x0, y0 = lcache[j, 2], lcache[j, 3]
     e0 = _line_excess(sc, j, zeta, ca, sa, P, tmp)
     im = int(lcache[j - 1, 1]) if j > 0 else -1
     ip = int(lcache[j + 1, 1]) if j < S - 1 else -1
     if im < 0 and ip < 0:
-        return _covered(e0, _face_slope(x0, y0, zeta[j], dz, ca, sa, P, tmp), 0.0), (
-            0.0,
-            0.0,
-            0.0,
-            True,
-            1.0,
-            1e9,
-        )
+        return _covered(e0, _face_slope(x0, y0, zeta[j], dz, ca, sa, P, tmp), 0.0), _NO_TIP
     t0, seg = lcache[j, 4], lcache[j, 5]
     tm = lcache[j - 1, 4] if im >= 0 else 0.0
     tp = lcache[j + 1, 4] if ip >= 0 else 0.0
