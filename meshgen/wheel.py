@@ -77,11 +77,10 @@ def _newton_max(g: GearGeometry, rho, zeta, beta, side, box, n_newton: int):
     """Newton on dF/dbeta = 0 (central differences) from the grid's best beta, each step at most one grid step
     (box = (lo, hi, that step)), kept in [lo, hi]; returns beta. Safeguarded: a step that lowers sgn F by more than
     NEWTON_DROP_M is taken back and the point's later steps are halved, and such a point gets NEWTON_RETRIES more
-    steps. Near the envelope's limit line (high lead angles: z1 4, q 6, gamma 33.7 deg, near the wheel tip) the
-    maximum is flat and lopsided (F'' small, F''' not): the plain iteration overshot by a grid step, the next step
-    came back, and it ended on the worse of the two, up to 29 um below the maximum (the point then lies inside the
-    thread and wormsim.tooth.trim cut it away, a hole in the flank grid). Where no step is taken back the iteration
-    is the plain one, bit for bit."""
+    steps. Near the envelope's limit line (high lead angles, near the wheel tip) the maximum is flat and lopsided
+    (F'' small, F''' not), where a plain Newton step overshoots by a grid step and the next comes back; the safeguard
+    keeps the better point (docs/decisions/0056-envelope-maximum-safeguarded-newton.md). Where no step is taken back
+    the iteration is the plain Newton one."""
     lo, hi, dmax = (np.broadcast_to(a, np.shape(beta)) for a in box)
     rho, zeta = np.broadcast_to(rho, np.shape(beta)), np.broadcast_to(zeta, np.shape(beta))
     sgn = float(side)

@@ -21,7 +21,7 @@ that are computed correctly but that a user should not read as the gear's steady
   flowing from the wheel into a worm-driven pair (an overhauling load); a pair that does not turn (no ratio and no
   efficiency); a speed drive at its peak torque outside a held back-drive (the shaft follows the limit, not its
   command); a held back-drive whose worm creeps above HOLD_CREEP_SHARE of its free speed (the mesh slipped under the
-stalled drive's torque). The root stress above its limit is the rating's warning (wormsim.rating.fe_root).
+  stalled drive's torque). The root stress above its limit is the rating's warning (wormsim.rating.fe_root).
 """
 
 from __future__ import annotations
