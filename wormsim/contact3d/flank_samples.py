@@ -5,7 +5,7 @@ the per-sample Python (~45-60 us a sample: dispatch, guards, the series column) 
 Per sample, in the runner's order and with its floating-point operations (bit-identical series, pattern and radius
 logs, contact points: tests/contact3d/test_flank_samples.py): the steps; the state read from d (shaft angles and speeds,
 d.time); the runner's Guards.state checks (non-finite state or MuJoCo's bad-qacc warning, overspeed, teeth jumped);
-mu from the friction law with its stick state (wormsim.physics.friction.mu_at, stuck_after);
+mu from the friction law (wormsim.physics.friction.mu_at) where the pair slides;
 flank_loop.sample_flanks (with displaced poses, errors: or shafts:, the points go into tooth 0's frame through the
 displaced wheel body's frame); the penetration and lock checks of Guards.contact; the shafts' log (ShaftLog.record:
 mj_rnePostConstraint by address where a bearing is rigid, then its raw values, wormsim.contact3d.shafts.gather); the
@@ -15,7 +15,8 @@ Anything else hands the sample back to the runner's Python path, after its steps
 work: a guard that would act (it raises or keeps state: a stuck drive, the friction guard's next check), a friction
 coefficient that starts or stops being zero (FlankContacts.set_friction changes the cone's dimension; other changes
 are written into the hand-off's records here, as set_template leaves them), a contact log that needs room, contacts
-MuJoCo did not take.
+MuJoCo did not take, the friction law's stick state (a pair that is stuck or sticks again: the runner takes its
+break-away from MuJoCo's constraint rows, wormsim.contact3d.breakaway; only runs with a stick state have one).
 The runner then does that sample (runner._sample), so errors and their messages are the Python guards' own.
 
 d's scalar fields (time, ncon, nefc) and arena pointers (contact, efc_force) are read at their byte offsets in
@@ -49,11 +50,11 @@ ADR_CAP = 4096  # contacts per step the compiled sample reads (more: the sample 
 # io: what changes between calls (in) and what run_samples hands back (out), by slot
 # out (IO_TURN_MAX, IO_PM, IO_RM in too)
 IO_NEXT, IO_PENDING, IO_TURN_MAX, IO_PM, IO_RM, IO_DROPPED, IO_EVENT = range(7)
-# in (IO_MU and IO_STUCK out too: the contacts' mu and the friction law's stick state after the call)
+# in (IO_MU out too: the contacts' mu after the call)
 IO_NEXT_CHECK, IO_MU, IO_E_STAR, IO_LOCKED, IO_STUCK = range(7, 12)
 IO_LEN = 12
 # io[IO_EVENT]: why run_samples handed a sample back to the runner's Python path (0: it did not)
-EV_NONE, EV_GUARD, EV_FRICTION_CHECK, EV_CONE, EV_LOG_FULL, EV_DROPPED = range(6)
+EV_NONE, EV_GUARD, EV_FRICTION_CHECK, EV_CONE, EV_LOG_FULL, EV_DROPPED, EV_STICK = range(7)
 
 
 class SampleParams(NamedTuple):
@@ -193,10 +194,11 @@ def run_samples(tables, mj, cmds, span, S, p, room, io, mrg, shaft):
             io[IO_EVENT] = EV_FRICTION_CHECK
             return
         vs = abs(w1) * p.r1 / p.cos_gamma  # the sliding speed Vs
-        stuck = stuck_after(io[IO_STUCK] != 0.0, vs, p.stick_v)  # idempotent: a hand-back repeats it
-        io[IO_STUCK] = 1.0 if stuck else 0.0
+        if io[IO_STUCK] != 0.0 or stuck_after(False, vs, p.stick_v, 0.0):  # stuck, or sticking again: the
+            io[IO_EVENT] = EV_STICK  # runner's stick state (its break-away reads MuJoCo's rows: contact3d.breakaway)
+            return
         law = p.mu_law
-        mu = mu_at(0.0 if stuck else vs, law.kind, law.a, law.b, law.c)
+        mu = mu_at(vs, law.kind, law.a, law.b, law.c)
         if mu != mu_now:  # FlankContacts.set_friction: the records' friction, where the cone's dimension stays
             if (mu > 0.0) != (mu_now > 0.0):  # the cone's dimension changes (FlankContacts.set_friction)
                 io[IO_EVENT] = EV_CONE
@@ -302,6 +304,5 @@ class FlankSamples:
             fc.template.friction = [fc.mu, fc.mu, 0.0, 0.0, 0.0]
         loop.dropped += int(io[IO_DROPPED])
         guards.turn_max = float(io[IO_TURN_MAX])
-        guards.stuck = bool(io[IO_STUCK] != 0.0)
         pattern.m, rlog.m = int(io[IO_PM]), int(io[IO_RM])
         return int(io[IO_NEXT]), int(io[IO_EVENT])
