@@ -136,6 +136,11 @@ def mu_law(contact: Contact) -> MuLaw:
     return MuLaw(CONSTANT, float(mu), 0.0, 0.0)
 
 
+def mu_varies(contact: Contact) -> bool:
+    """mu depends on the sliding speed (a static/dynamic pair or a friction group; not a constant mu)."""
+    return mu_law(contact).kind != CONSTANT
+
+
 def rho_rad(vs_m_s, group: str | None = None, friction: float | None = None):
     """Friction angle rho(Vs) in rad for material `group` (I, II, III) or a constant `friction`.
 
