@@ -28,30 +28,42 @@ ramp).
 
 from __future__ import annotations
 
+import math
+
 import mujoco
+import numba
 import numpy as np
 
 
+@numba.njit(cache=True)
+def hinge_utilisation(adr, dim, mu, n, efc_force, col, smooth):
+    """need / limit (module docstring) over contacts 0..n-1 (their efc addresses adr, dimensions dim, friction
+    coefficients mu), the constraint forces efc_force, the hinge's Jacobian column col and its qfrc_smooth; 0 where no
+    contact carries friction. The compiled samples (wormsim.contact3d.flank_samples) and static_utilisation call it."""
+    need = smooth
+    limit = 0.0
+    for k in range(n):
+        a = adr[k]
+        if a < 0 or dim[k] < 3:
+            continue
+        fn = efc_force[a]
+        need += col[a] * fn
+        limit += mu[k] * fn * math.hypot(col[a + 1], col[a + 2])
+    if limit <= 0.0:
+        return 0.0
+    return abs(need) / limit
+
+
 def static_utilisation(m: mujoco.MjModel, d: mujoco.MjData, dof: int) -> float:
-    """need / limit on the worm's hinge `dof` (module docstring) from d's contacts and constraint forces after a step;
-    0 where no contact carries friction (nothing to hold with: the stick state waits for the contacts)."""
+    """need / limit on the worm's hinge `dof` (module docstring) from d's contacts and constraint forces after a step
+    (hinge_utilisation); 0 where no contact carries friction (nothing to hold with: the stick state waits for the
+    contacts)."""
     n = d.ncon
     if n == 0:
         return 0.0
-    con = d.contact
-    adr = np.asarray(con.efc_address[:n])
-    keep = (adr >= 0) & (np.asarray(con.dim[:n]) >= 3)
-    if not keep.any():
-        return 0.0
-    adr, mu = adr[keep], np.asarray(con.friction[:n, 0])[keep]
     unit = np.zeros(m.nv)
     unit[dof] = 1.0
     col = np.zeros(d.nefc)
     mujoco.mj_mulJacVec(m, d, col, unit)  # the worm hinge's column of the constraint Jacobian
-    f = d.efc_force
-    fn = f[adr]
-    limit = float(np.sum(mu * fn * np.hypot(col[adr + 1], col[adr + 2])))
-    if limit <= 0.0:
-        return 0.0
-    need = abs(float(np.dot(col[adr], fn)) + float(d.qfrc_smooth[dof]))
-    return need / limit
+    con = d.contact
+    return hinge_utilisation(con.efc_address, con.dim, con.friction[:, 0], n, d.efc_force, col, d.qfrc_smooth[dof])
