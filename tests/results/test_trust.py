@@ -325,7 +325,7 @@ def test_contact3d_stuck_pair_breaks_away_where_static_friction_is_exceeded(temp
     runs back on the dynamic friction (measured 619 rpm at 0.03 s, mu 0.089). contact3d's own boundary lies between
     1.1 x (holds) and 1.4 x (runs): its contacts off the pitch point lock with 23 % more margin than the pitch-point
     formula (the hinge's need 0.939 of the static limit against tan(gamma) / tan(rho'_s) = 0.950)."""
-    _, sc = user_run(template, *HOLD_FROM_REST, "drive.ramp_s=0.002")
+    sc = load_scenario(template, [*USER_GEAR, *HOLD_FROM_REST, "drive.ramp_s=0.002"])
     t_nm = share * _breakaway_torque_nm(sc)
     assert 0.18 < t_nm / share < 0.21  # 3.75 N m tan(0.3 deg) / tan(5.71 deg)
     s, _ = user_run(template, *HOLD_FROM_REST, "drive.ramp_s=0.002", *_assist(t_nm))
