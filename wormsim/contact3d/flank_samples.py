@@ -154,22 +154,37 @@ def hinge_need(m_addr, d_addr, off, p, hold):
     return hinge_utilisation(adr, dims, mus, ncon, efc, col, smooth[p.dof1])
 
 
+@numba.njit(cache=True)
+def stick_mu(mj, off, p, hold, stuck, vs):
+    """(the friction law's stick state after the sample at the sliding speed vs, the mu it gives): stuck_after, a
+    stuck pair's need from hinge_need (only runs with a stick state are ever stuck); mu -1 where hinge_need's room is
+    too small."""
+    u = 0.0
+    if stuck:
+        u = hinge_need(mj[0], mj[1], off, p, hold)
+        if u < 0.0:
+            return stuck, -1.0
+    stuck = stuck_after(stuck, vs, p.stick_v, u)
+    law = p.mu_law
+    return stuck, mu_at(0.0 if stuck else vs, law.kind, law.a, law.b, law.c)
+
+
 @numba.njit(cache=True, nogil=True)
-def run_samples(tables, mj, cmds, span, S, p, room, io, mrg, shaft, hold):
+def run_samples(tables, mj, cmds, span, S, p, room, io, mrg, shaft):
     """Samples i0..i1-1 of span = (i0, i1, o0, rec) (module docstring); sample i's steps are o0 + (i - i0) rec ..
     + rec of cmds = (drive, load). tables = flank_loop's run and sample tables (T, Ts); mj = (the model's and the
     data's address); S the series (series.SERIES rows); p the run's SampleParams; room = (the checked mjData offsets
     (native.mjdata_offsets), the kernel's contact frames, points and normals, ADR_CAP work room, the pattern's and
-    the radius log's rows); io: IO_*; mrg: the kernel's (grp, share, mfric, mwrap) and the per-slice rows' room
-    (FlankContacts.slice_rows), used with one contact per tooth flank (the kernel's merge flag, ib[6]); shaft =
+    the radius log's rows, hinge_need's room); io: IO_*; mrg: the kernel's (grp, share, mfric, mwrap) and the
+    per-slice rows' room (FlankContacts.slice_rows), used with one contact per tooth flank (the kernel's merge flag,
+    ib[6]); shaft =
     (mj_rnePostConstraint's address or 0, the shaft log's raw addresses, its raw rows:
-    wormsim.contact3d.shafts.ShaftLog), the addresses empty without `shafts:`; hold: hinge_need's room (read only
-    with a stick state)."""
+    wormsim.contact3d.shafts.ShaftLog), the addresses empty without `shafts:`."""
     T, Ts = tables
     m_addr, d_addr = mj
     cmd, load = cmds
     i0, i1_, o0, rec = span
-    off, frame, pos, nrm, adr, pat_buf, r_buf = room
+    off, frame, pos, nrm, adr, pat_buf, r_buf, hold = room
     rne, sh_adr, sh_raw = shaft
     acc, state, ib = f1(T, Row.acc), i1(T, Row.state), i1(T, Row.ib)
     merged = ib[6] != 0  # one contact per tooth flank (the kernel's merge flag, wormsim.tooth.merge)
@@ -217,17 +232,11 @@ def run_samples(tables, mj, cmds, span, S, p, room, io, mrg, shaft, hold):
             io[IO_EVENT] = EV_FRICTION_CHECK
             return
         vs = abs(w1) * p.r1 / p.cos_gamma  # the sliding speed Vs
-        stuck = io[IO_STUCK] != 0.0  # written back with the sample's end: a hand-back repeats stuck_after
-        if p.stick_v > 0.0:
-            u = 0.0
-            if stuck:  # the share of the static limit that holding the worm needs (wormsim.contact3d.breakaway)
-                u = hinge_need(m_addr, d_addr, off, p, hold)
-                if u < 0.0:  # more contacts or rows than the work room: the Python path
-                    io[IO_EVENT] = EV_STICK
-                    return
-            stuck = stuck_after(stuck, vs, p.stick_v, u)
-        law = p.mu_law
-        mu = mu_at(0.0 if stuck else vs, law.kind, law.a, law.b, law.c)
+        # the stick state, written back at the sample's end (a hand-back repeats stuck_after), and mu
+        stuck, mu = stick_mu(mj, off, p, hold, io[IO_STUCK] != 0.0, vs)
+        if mu < 0.0:  # more contacts or rows than hinge_need's room: the Python path
+            io[IO_EVENT] = EV_STICK
+            return
         if mu != mu_now:  # FlankContacts.set_friction: the records' friction, where the cone's dimension stays
             if (mu > 0.0) != (mu_now > 0.0):  # the cone's dimension changes (FlankContacts.set_friction)
                 io[IO_EVENT] = EV_CONE
@@ -331,11 +340,10 @@ class FlankSamples:
         io[IO_LOCKED] = float(guards.locked_since is not None)
         io[IO_STUCK] = float(guards.stuck)
         io[IO_TURN_MAX], io[IO_PM], io[IO_RM] = guards.turn_max, pattern.m, rlog.m
-        room = (self.off, fc.frame, fc.pos, fc.nrm, self.adr, pattern.buf, rlog.buf)
+        room = (self.off, fc.frame, fc.pos, fc.nrm, self.adr, pattern.buf, rlog.buf, self.hold)
         mrg = (k.grp, k.share, k.mfric, k.mwrap, fc.slice_adr, fc.slice_efc)  # read only with merge (run_samples)
         mj = (loop.m._address, loop.d._address)
-        span = (i0, i1, o0, self.rec)
-        run_samples(tables, mj, (cmd, load), span, self.S, self.params, room, io, mrg, self.shaft, self.hold)
+        run_samples(tables, mj, (cmd, load), (i0, i1, o0, self.rec), self.S, self.params, room, io, mrg, self.shaft)
         loop.sync()
         if io[IO_MU] != fc.mu:  # changed in the call (run_samples): as FlankContacts.set_friction leaves it
             fc.mu = float(io[IO_MU])
