@@ -298,7 +298,7 @@ def test_contact3d_user_gear_holds_from_rest_under_a_2_ms_load(template):
     wheel in 2 ms, the worm free, static friction 0.3 deg above and dynamic 0.3 deg below the locking boundary. The
     contact's elastic pre-slip passes contact.transition_velocity_m_s (1 mm/s) at 0.4 ms, but the stuck pair breaks
     away only where the friction it needs on the worm's hinge reaches mu_s times its normal forces
-    (wormsim.contact3d.breakaway: 0.939 of it here, through the ramp): measured 0.0071 rpm (1.5e-6 of free), as a 20 ms
+    (wormsim.contact3d.breakaway: 0.940 of it here, through the ramp): measured 0.0071 rpm (1.5e-6 of free), as a 20 ms
     ramp (0.0070 rpm) and constant mu_s (0.0071 rpm). Before (break-away at a slip speed of 1 mm/s): 230 rpm at 0.03 s,
     4.9 % of free (docs/decisions/0058-breakaway-on-static-friction.md)."""
     s, _ = user_run(template, *HOLD_FROM_REST, "drive.ramp_s=0.002")
@@ -323,8 +323,8 @@ def test_contact3d_stuck_pair_breaks_away_where_static_friction_is_exceeded(temp
     (from 5 ms over 2 ms): static friction holds it below the hand formula's break-away torque (_breakaway_torque_nm,
     0.196 N m) and gives way above it. At half of it the pair holds (measured 0.0075 rpm); at twice it breaks away and
     runs back on the dynamic friction (measured 619 rpm at 0.03 s, mu 0.089). contact3d's own boundary lies between
-    1.1 x (holds) and 1.4 x (runs): its contacts off the pitch point lock with 23 % more margin than the pitch-point
-    formula (the hinge's need 0.939 of the static limit against tan(gamma) / tan(rho'_s) = 0.950)."""
+    1.1 x (holds) and 1.4 x (runs): its contacts off the pitch point lock with 20 % more margin than the pitch-point
+    formula (the hinge's need 0.940 of the static limit against tan(gamma) / tan(rho'_s) = 0.950)."""
     sc = load_scenario(template, [*USER_GEAR, *HOLD_FROM_REST, "drive.ramp_s=0.002"])
     t_nm = share * _breakaway_torque_nm(sc)
     assert 0.18 < t_nm / share < 0.21  # 3.75 N m tan(0.3 deg) / tan(5.71 deg)

@@ -17,13 +17,12 @@ with J the constraint rows' Jacobian column of the worm's hinge (mj_mulJacVec on
 row's force (efc_force), mu_i the contact's own friction coefficient (MuJoCo's cone: mu(0), with a merged contact's
 factor). `static_utilisation` = need / limit; the pair breaks away at 1 (friction.BREAKAWAY). This is the
 self-locking condition of the whole mesh, rho' >= gamma, evaluated on the run's own contacts and loads: where the
-wheel alone loads the mesh it is a geometric ratio, tan(gamma) / tan(rho') near the pitch point, whatever the load's
-size or rate (the user's gear, rho' = gamma + 0.3 deg: 0.939 through a 2 ms and a 20 ms ramp of 150 N m).
+wheel alone loads the mesh it is a geometric ratio near the pitch point's tan(gamma) / tan(rho'), whatever the load's
+size or rate.
 
 MuJoCo's own friction forces cannot tell holding from sliding here: its friction rows carry no position term, so a
-pair whose load rises sits on the cone (|f_t| = mu f_n on every contact) while it holds (the same gear, 20 ms ramp:
-|f_t| / (mu f_n) 1.000 on each contact, 0.998 summed, the worm creeping at 0.15 rpm and held at 0.007 rpm after the
-ramp).
+pair whose load rises sits on the cone (|f_t| = mu f_n on every contact) while it holds. The measurements are in
+docs/decisions/0058-breakaway-on-static-friction.md.
 """
 
 from __future__ import annotations
