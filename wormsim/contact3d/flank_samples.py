@@ -177,8 +177,7 @@ def run_samples(tables, mj, cmds, span, S, p, room, io, mrg, shaft):
     (native.mjdata_offsets), the kernel's contact frames, points and normals, ADR_CAP work room, the pattern's and
     the radius log's rows, hinge_need's room); io: IO_*; mrg: the kernel's (grp, share, mfric, mwrap) and the
     per-slice rows' room (FlankContacts.slice_rows), used with one contact per tooth flank (the kernel's merge flag,
-    ib[6]); shaft =
-    (mj_rnePostConstraint's address or 0, the shaft log's raw addresses, its raw rows:
+    ib[6]); shaft = (mj_rnePostConstraint's address or 0, the shaft log's raw addresses, its raw rows:
     wormsim.contact3d.shafts.ShaftLog), the addresses empty without `shafts:`."""
     T, Ts = tables
     m_addr, d_addr = mj
@@ -317,7 +316,7 @@ class FlankSamples:
         dims, mus = np.zeros(ADR_CAP, dtype=np.int64), np.zeros(ADR_CAP)
         smooth = loop.d.qfrc_smooth  # a view of d's buffer (not its arena): the same address every step
         self.hold = (address("mj_mulJacVec"), unit.ctypes.data, col.ctypes.data, col, dims, mus, smooth)
-        self._hold_room = (unit, col)
+        self._unit = unit  # hold carries only its address
         self.io = np.zeros(IO_LEN)
         self._store = store
         rne_fn = address("mj_rnePostConstraint") if slog is not None and slog.reactions else 0
