@@ -52,8 +52,6 @@ LONG_TESTS: dict[str, set[str] | None] = {
     "scenario/test_rexs.py": {"contact3d_fva", "contact3d_other"},
     # the FE mesher's every retry on a 120-tooth wheel (a strict xfail, minutes)
     "contact3d/test_mjcf.py": {"test_tooth_compliance_on_a_120_tooth_wheel"},
-    # the user's gear held from rest at contact3d (a strict xfail; the teeth's compliance of a new face width)
-    "results/test_trust.py": {"test_contact3d_user_gear_holds_from_rest_under_a_2_ms_load"},
     # 100 random gears through every command (~1 min each); a handful stay in `make test`
     "cli/test_commands_random.py": {
         "test_random_gear_every_command_exits_0_2_or_3_long",

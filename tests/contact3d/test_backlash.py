@@ -28,7 +28,7 @@ from wormsim import cli
 from wormsim.contact3d.backlash import UM, flank_clearance_m, min_backlash_m, piece_bulge_m, piece_play
 from wormsim.contact3d.mjcf import build_model
 from wormsim.contact3d.runner import run_model, simulate
-from wormsim.physics.friction import STICK_RELEASE, stuck_after
+from wormsim.physics.friction import BREAKAWAY, STICK_RELEASE, stuck_after
 from wormsim.physics.plan import gear_plan
 from wormsim.physics.units import MM
 from wormsim.scenario import ScenarioError, load_scenario
@@ -259,8 +259,9 @@ def test_contact3d_static_friction_governs_from_rest(demo_geometry, contact3d_fr
 
 def test_stick_state_only_where_the_wheel_drives_a_pair_self_locking_at_rest(demo_geometry):
     """The stick state (wormsim.physics.locking.stick_velocity_m_s) is v_t where the wheel drives a pair that self-locks at
-    rest and 0 elsewhere (forward runs, a pair that does not self-lock: their mu(Vs) is unchanged); stuck_after
-    breaks away at v_t and sticks again below STICK_RELEASE v_t."""
+    rest with a speed-dependent mu and 0 elsewhere (forward runs, a pair that does not self-lock, a constant mu: their
+    mu(Vs) is unchanged); stuck_after breaks away where the friction needed reaches the static limit (utilisation
+    BREAKAWAY), whatever the slip speed, and sticks again below STICK_RELEASE v_t."""
     lock = _friction(_mu_at(demo_geometry, +0.3), _mu_at(demo_geometry, -0.3))
     free = _friction(_mu_at(demo_geometry, -0.3), _mu_at(demo_geometry, -0.5))
     v_t = load_scenario(DEMO).contact.transition_velocity_m_s
@@ -271,9 +272,10 @@ def test_stick_state_only_where_the_wheel_drives_a_pair_self_locking_at_rest(dem
     assert stick([*BACKDRIVE, *lock]) == v_t
     assert stick([*BACKDRIVE, *free]) == 0.0
     assert stick(lock) == 0.0  # the worm drives
-    assert stuck_after(True, 0.99 * v_t, v_t) and not stuck_after(True, v_t, v_t)
-    assert not stuck_after(False, 0.5 * v_t, v_t) and stuck_after(False, 0.99 * STICK_RELEASE * v_t, v_t)
-    assert not stuck_after(True, 0.0, 0.0)
+    assert stick([*BACKDRIVE, *_friction(_mu_at(demo_geometry, +0.3))]) == 0.0  # constant mu: its own static value
+    assert stuck_after(True, 10.0 * v_t, v_t, 0.99 * BREAKAWAY) and not stuck_after(True, 0.0, v_t, BREAKAWAY)
+    assert not stuck_after(False, 0.5 * v_t, v_t, 0.0) and stuck_after(False, 0.99 * STICK_RELEASE * v_t, v_t, 2.0)
+    assert not stuck_after(True, 0.0, 0.0, 0.0)
 
 
 def test_contact3d_static_friction_holds_from_rest_in_flank_contact(demo_geometry, contact3d_free_rpm):

@@ -29,6 +29,28 @@ CASES = {
         JACK,
         SHORT + ["contact.friction_static=null", "contact.friction_dynamic=null", "contact.friction=0"],
     ),
+    # the friction law's stick state (wheel-driven, mu_s 0.3 deg above and mu_d 0.3 deg below the locking boundary): a
+    # worm torque assisting the back-drive at 2 x the break-away torque, T2 / i tan(0.3 deg) / tan(gamma); the stuck
+    # samples go to the Python path (wormsim.contact3d.breakaway), the sliding ones stay compiled
+    "stick state, breaking away": (
+        DEMO,
+        [
+            "simulation.resolution=coarse",
+            "simulation.duration_s=0.012",
+            "drive.on=wheel",
+            "drive.speed_rpm=null",
+            "drive.torque_nm=2.0",
+            "drive.ramp_s=0.002",
+            "load.on=worm",
+            "load.torque_nm=-0.0047",
+            "load.start_s=0.003",
+            "load.ramp_s=0.001",
+            "contact.friction=null",
+            "contact.friction_static=0.0877",
+            "contact.friction_dynamic=0.0773",
+            "simulation.record_every=1",
+        ],
+    ),
     # displaced poses (wormsim.tooth.pose): assembly errors, and shafts on bearings (a compliant worm shaft that
     # bends: springs; a rigid wheel shaft: mj_rnePostConstraint's reactions)
     "errors": (JACK, SHORT + ["errors.center_distance_mm=0.02", "errors.shaft_angle_deg=0.05"]),

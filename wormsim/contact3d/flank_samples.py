@@ -5,7 +5,8 @@ the per-sample Python (~45-60 us a sample: dispatch, guards, the series column) 
 Per sample, in the runner's order and with its floating-point operations (bit-identical series, pattern and radius
 logs, contact points: tests/contact3d/test_flank_samples.py): the steps; the state read from d (shaft angles and speeds,
 d.time); the runner's Guards.state checks (non-finite state or MuJoCo's bad-qacc warning, overspeed, teeth jumped);
-mu from the friction law with its stick state (wormsim.physics.friction.mu_at, stuck_after);
+mu from the friction law with its stick state (wormsim.physics.friction.mu_at, stuck_after; a stuck pair's
+break-away from MuJoCo's rows on the worm's hinge, wormsim.contact3d.breakaway);
 flank_loop.sample_flanks (with displaced poses, errors: or shafts:, the points go into tooth 0's frame through the
 displaced wheel body's frame); the penetration and lock checks of Guards.contact; the shafts' log (ShaftLog.record:
 mj_rnePostConstraint by address where a bearing is rigid, then its raw values, wormsim.contact3d.shafts.gather); the
@@ -15,7 +16,7 @@ Anything else hands the sample back to the runner's Python path, after its steps
 work: a guard that would act (it raises or keeps state: a stuck drive, the friction guard's next check), a friction
 coefficient that starts or stops being zero (FlankContacts.set_friction changes the cone's dimension; other changes
 are written into the hand-off's records here, as set_template leaves them), a contact log that needs room, contacts
-MuJoCo did not take.
+MuJoCo did not take, a stuck pair with more contacts or constraint rows than hinge_need's room.
 The runner then does that sample (runner._sample), so errors and their messages are the Python guards' own.
 
 d's scalar fields (time, ncon, nefc) and arena pointers (contact, efc_force) are read at their byte offsets in
@@ -34,9 +35,10 @@ from typing import NamedTuple
 import numba
 import numpy as np
 
+from wormsim.contact3d.breakaway import hinge_utilisation
 from wormsim.contact3d.flank_loop import FV, ContactRows, Row, SampleRow, records, run_table, sample_table
 from wormsim.contact3d.guards import PENETRATED, RUNNING, STUCK, contact_event, state_event
-from wormsim.contact3d.native import address, call_stage, f1, f64_at, i1, i32_at, i64_at, mjdata_offsets
+from wormsim.contact3d.native import address, call_mul, call_stage, f1, f64_at, i1, i32_at, i64_at, mjdata_offsets
 from wormsim.contact3d.series import column
 from wormsim.contact3d.shafts import gather
 from wormsim.physics.friction import MuLaw, mu_at, stuck_after
@@ -53,7 +55,7 @@ IO_NEXT, IO_PENDING, IO_TURN_MAX, IO_PM, IO_RM, IO_DROPPED, IO_EVENT = range(7)
 IO_NEXT_CHECK, IO_MU, IO_E_STAR, IO_LOCKED, IO_STUCK = range(7, 12)
 IO_LEN = 12
 # io[IO_EVENT]: why run_samples handed a sample back to the runner's Python path (0: it did not)
-EV_NONE, EV_GUARD, EV_FRICTION_CHECK, EV_CONE, EV_LOG_FULL, EV_DROPPED = range(6)
+EV_NONE, EV_GUARD, EV_FRICTION_CHECK, EV_CONE, EV_LOG_FULL, EV_DROPPED, EV_STICK = range(7)
 
 
 class SampleParams(NamedTuple):
@@ -131,21 +133,57 @@ def contact_rows(d_addr, off, adr, ncon, n_fc, cone3, pts, nh, merged, mrg):
     return ContactRows(adr[:ncon], efc, frame, pos, np.int64(ncon), n_fc, True, cone3)
 
 
+@numba.njit(cache=True)
+def hinge_need(m_addr, d_addr, off, p, hold):
+    """breakaway.hinge_utilisation of d's contacts (read at the checked offsets off) on the worm's hinge p.dof1:
+    hold = (mj_mulJacVec's address, the unit vector's and the column's addresses, the column, the contacts'
+    dimension and friction rows' room, qfrc_smooth); -1 where the contacts or rows do not fit the room."""
+    mul, unit_addr, col_addr, col, dims, mus, smooth = hold
+    ncon, nefc = i32_at(d_addr + off[1])[0], i32_at(d_addr + off[2])[0]
+    if ncon > dims.shape[0] or nefc > col.shape[0]:
+        return -1.0
+    adr = np.empty(ncon, dtype=np.int64)
+    size, cbase = off[6], i64_at(d_addr + off[3])[0]
+    for k in range(ncon):
+        c = cbase + k * size
+        adr[k] = i32_at(c + off[7])[0]
+        dims[k] = i32_at(c + off[9])[0]
+        mus[k] = f64_at(c + off[10])[0]
+    call_mul(mul, m_addr, d_addr, col_addr, unit_addr)  # the hinge's column of the constraint Jacobian
+    efc = numba.carray(f64_at(i64_at(d_addr + off[4])[0]), (max(nefc, 0),))
+    return hinge_utilisation(adr, dims, mus, ncon, efc, col, smooth[p.dof1])
+
+
+@numba.njit(cache=True)
+def stick_mu(mj, off, p, hold, stuck, vs):
+    """(the friction law's stick state after the sample at the sliding speed vs, the mu it gives): stuck_after, a
+    stuck pair's need from hinge_need (only runs with a stick state are ever stuck); mu -1 where hinge_need's room is
+    too small."""
+    u = 0.0
+    if stuck:
+        u = hinge_need(mj[0], mj[1], off, p, hold)
+        if u < 0.0:
+            return stuck, -1.0
+    stuck = stuck_after(stuck, vs, p.stick_v, u)
+    law = p.mu_law
+    return stuck, mu_at(0.0 if stuck else vs, law.kind, law.a, law.b, law.c)
+
+
 @numba.njit(cache=True, nogil=True)
 def run_samples(tables, mj, cmds, span, S, p, room, io, mrg, shaft):
     """Samples i0..i1-1 of span = (i0, i1, o0, rec) (module docstring); sample i's steps are o0 + (i - i0) rec ..
     + rec of cmds = (drive, load). tables = flank_loop's run and sample tables (T, Ts); mj = (the model's and the
     data's address); S the series (series.SERIES rows); p the run's SampleParams; room = (the checked mjData offsets
     (native.mjdata_offsets), the kernel's contact frames, points and normals, ADR_CAP work room, the pattern's and
-    the radius log's rows); io: IO_*; mrg: the kernel's (grp, share, mfric, mwrap) and the per-slice rows' room
-    (FlankContacts.slice_rows), used with one contact per tooth flank (the kernel's merge flag, ib[6]); shaft =
-    (mj_rnePostConstraint's address or 0, the shaft log's raw addresses, its raw rows:
+    the radius log's rows, hinge_need's room); io: IO_*; mrg: the kernel's (grp, share, mfric, mwrap) and the
+    per-slice rows' room (FlankContacts.slice_rows), used with one contact per tooth flank (the kernel's merge flag,
+    ib[6]); shaft = (mj_rnePostConstraint's address or 0, the shaft log's raw addresses, its raw rows:
     wormsim.contact3d.shafts.ShaftLog), the addresses empty without `shafts:`."""
     T, Ts = tables
     m_addr, d_addr = mj
     cmd, load = cmds
     i0, i1_, o0, rec = span
-    off, frame, pos, nrm, adr, pat_buf, r_buf = room
+    off, frame, pos, nrm, adr, pat_buf, r_buf, hold = room
     rne, sh_adr, sh_raw = shaft
     acc, state, ib = f1(T, Row.acc), i1(T, Row.state), i1(T, Row.ib)
     merged = ib[6] != 0  # one contact per tooth flank (the kernel's merge flag, wormsim.tooth.merge)
@@ -193,10 +231,11 @@ def run_samples(tables, mj, cmds, span, S, p, room, io, mrg, shaft):
             io[IO_EVENT] = EV_FRICTION_CHECK
             return
         vs = abs(w1) * p.r1 / p.cos_gamma  # the sliding speed Vs
-        stuck = stuck_after(io[IO_STUCK] != 0.0, vs, p.stick_v)  # idempotent: a hand-back repeats it
-        io[IO_STUCK] = 1.0 if stuck else 0.0
-        law = p.mu_law
-        mu = mu_at(0.0 if stuck else vs, law.kind, law.a, law.b, law.c)
+        # the stick state, written back at the sample's end (a hand-back repeats stuck_after), and mu
+        stuck, mu = stick_mu(mj, off, p, hold, io[IO_STUCK] != 0.0, vs)
+        if mu < 0.0:  # more contacts or rows than hinge_need's room: the Python path
+            io[IO_EVENT] = EV_STICK
+            return
         if mu != mu_now:  # FlankContacts.set_friction: the records' friction, where the cone's dimension stays
             if (mu > 0.0) != (mu_now > 0.0):  # the cone's dimension changes (FlankContacts.set_friction)
                 io[IO_EVENT] = EV_CONE
@@ -225,6 +264,7 @@ def run_samples(tables, mj, cmds, span, S, p, room, io, mrg, shaft):
         col = column((t, th1, th2, w1, w2, cmd_i), sums, rec, (nteeth, pen2, mu, te, fr, r_c), p.rpm)
         for k in range(len(col)):
             S[k, i] = col[k]
+        io[IO_STUCK] = 1.0 if stuck else 0.0
         io[IO_PENDING] = 0.0
     io[IO_NEXT] = i1_
     io[IO_TURN_MAX] = turn_max
@@ -270,6 +310,13 @@ class FlankSamples:
             z2=int(geo.z2),
         )
         self.adr = np.zeros(ADR_CAP, dtype=np.int64)
+        # hinge_need's room: the worm hinge's unit vector, the Jacobian column, the contacts' dimensions and mu
+        unit, col = np.zeros(loop.m.nv), np.zeros(8 * ADR_CAP)
+        unit[bm.worm_dof] = 1.0
+        dims, mus = np.zeros(ADR_CAP, dtype=np.int64), np.zeros(ADR_CAP)
+        smooth = loop.d.qfrc_smooth  # a view of d's buffer (not its arena): the same address every step
+        self.hold = (address("mj_mulJacVec"), unit.ctypes.data, col.ctypes.data, col, dims, mus, smooth)
+        self._unit = unit  # hold carries only its address
         self.io = np.zeros(IO_LEN)
         self._store = store
         rne_fn = address("mj_rnePostConstraint") if slog is not None and slog.reactions else 0
@@ -292,7 +339,7 @@ class FlankSamples:
         io[IO_LOCKED] = float(guards.locked_since is not None)
         io[IO_STUCK] = float(guards.stuck)
         io[IO_TURN_MAX], io[IO_PM], io[IO_RM] = guards.turn_max, pattern.m, rlog.m
-        room = (self.off, fc.frame, fc.pos, fc.nrm, self.adr, pattern.buf, rlog.buf)
+        room = (self.off, fc.frame, fc.pos, fc.nrm, self.adr, pattern.buf, rlog.buf, self.hold)
         mrg = (k.grp, k.share, k.mfric, k.mwrap, fc.slice_adr, fc.slice_efc)  # read only with merge (run_samples)
         mj = (loop.m._address, loop.d._address)
         run_samples(tables, mj, (cmd, load), (i0, i1, o0, self.rec), self.S, self.params, room, io, mrg, self.shaft)

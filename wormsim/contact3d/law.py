@@ -52,8 +52,9 @@ from the sliding speed Vs = omega1 r1 / cos(gamma) (seed 000):
                                           the transition velocity v_t = contact.transition_velocity_m_s)
   friction_group: mu(Vs) = tan(rho(Vs)), rho of seed 000 (wormsim.physics.friction)
   none given: mu = 0.05 (lubricated steel/bronze, DEFAULT_FRICTION).
-Where the wheel drives a pair that self-locks at rest, mu keeps its static value mu(0) until Vs reaches v_t
-(the stick state, wormsim.physics.friction.stuck_after; docs/decisions/0039-static-holding.md).
+Where the wheel drives a pair that self-locks at rest, mu keeps its static value mu(0) until the friction the pair
+needs reaches its static limit (the stick state, wormsim.physics.friction.stuck_after, wormsim.contact3d.breakaway;
+docs/decisions/0039-static-holding.md, 0058-breakaway-on-static-friction.md).
 
 Friction hardness (opt.impratio). MuJoCo's elliptic friction rows have no position term: their reference
 acceleration is a_ref = -b v_t (b = B / d, the normal row's damping) and their regulariser is

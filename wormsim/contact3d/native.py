@@ -150,6 +150,21 @@ def call_add(typingctx, fn, m_addr, d_addr, c_addr):
     return sig, codegen
 
 
+@intrinsic
+def call_mul(typingctx, fn, m_addr, d_addr, res_addr, vec_addr):
+    """void fn(const mjModel*, const mjData*, mjtNum* res, const mjtNum* vec) called through its address (all
+    int64): mj_mulJacVec."""
+    sig = types.void(types.int64, types.int64, types.int64, types.int64, types.int64)
+
+    def codegen(context, builder, signature, args):
+        fnty = ir.FunctionType(ir.VoidType(), [ir.IntType(8).as_pointer()] * 4)
+        f = builder.inttoptr(args[0], fnty.as_pointer())
+        builder.call(f, [builder.inttoptr(a, ir.IntType(8).as_pointer()) for a in args[1:]])
+        return context.get_dummy_value()
+
+    return sig, codegen
+
+
 def _pointer_at(nbtype):
     """An intrinsic: the `nbtype` pointer at an address (int64)."""
 
@@ -217,7 +232,7 @@ _SCALARS = {
 # badq_number: the count of mjWARN_BADQPOS, whose mjWarningStat is followed by BADQVEL's and BADQACC's (warning_size
 # apart): MuJoCo resets the state and the time on each (mj_checkPos / mj_checkVel / mj_checkAcc)
 FIELDS = ("time", "ncon", "nefc", "contact", "efc_force", "badq_number", "contact_size", "contact_efc_address")
-FIELDS += ("warning_size",)
+FIELDS += ("warning_size", "contact_dim", "contact_friction")
 BAD_STATE_WARNINGS = ("mjWARN_BADQPOS", "mjWARN_BADQVEL", "mjWARN_BADQACC")
 
 
@@ -271,6 +286,8 @@ def declared_offsets() -> np.ndarray:
             ctypes.sizeof(C),
             C.efc_address.offset,
             ctypes.sizeof(W),
+            C.dim.offset,
+            C.friction.offset,
         ],
         dtype=np.int64,
     )
@@ -304,10 +321,14 @@ def check(off: np.ndarray) -> list[str]:
         "contact_size": (o[6], np.asarray(d.contact.dist).strides[0]),
     }
     if d.ncon >= 1:
-        last = ctypes.c_int.from_address(con + o[6] * (d.ncon - 1) + o[7]).value
-        got["contact_efc_address"] = (last, int(d.contact.efc_address[d.ncon - 1]))
+        k = d.ncon - 1
+        last = con + o[6] * k
+        got["contact_efc_address"] = (ctypes.c_int.from_address(last + o[7]).value, int(d.contact.efc_address[k]))
+        got["contact_dim"] = (ctypes.c_int.from_address(last + o[9]).value, int(d.contact.dim[k]))
+        d.contact.friction[k, 0] = 0.375  # a value of its own (the box's friction is the default's)
+        got["contact_friction"] = (ctypes.c_double.from_address(last + o[10]).value, 0.375)
     else:
-        got["contact_efc_address"] = (0, 1)
+        got["contact_efc_address"] = got["contact_dim"] = got["contact_friction"] = (0, 1)
     for w in BAD_STATE_WARNINGS:
         d.warning[getattr(mujoco.mjtWarning, w)].number = 0
     return [k for k, (x, y) in got.items() if x != y]

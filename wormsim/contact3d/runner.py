@@ -30,6 +30,7 @@ import mujoco
 import numpy as np
 
 from wormsim.contact3d import jit_warmup, mass_scaling
+from wormsim.contact3d.breakaway import static_utilisation
 from wormsim.contact3d.contact_sums import RadiusLog
 from wormsim.contact3d.diagnosis import diverged_error
 from wormsim.contact3d.guards import Guards, bad_state_warnings
@@ -187,7 +188,9 @@ def _sample(lp: _Loop, i: int, cmd: float, sums) -> None:
     t = float(d.time) if not bad_state_warnings(d) else (i + 1) * lp.rec * bm.timestep_s  # (MuJoCo reset d.time)
     te = guards.state(d, t, th1, th2, w1, w2)
     vs = abs(w1) * geo.r_m1 / math.cos(geo.gamma_m)  # the sliding speed Vs
-    guards.stuck = stuck_after(guards.stuck, vs, bm.plan.stick_velocity_m_s)
+    # a stuck pair: the share of its static friction that holding the worm needs (wormsim.contact3d.breakaway)
+    u = static_utilisation(m, d, bm.worm_dof) if guards.stuck else 0.0
+    guards.stuck = stuck_after(guards.stuck, vs, bm.plan.stick_velocity_m_s, u)
     mu = mu_of(0.0 if guards.stuck else vs, bm.plan.mu_law)  # static while stuck (friction.stuck_after)
     # each contact's force turned about the worm axis onto the line of centres: the radial force DIN 3975's
     # single pitch-point contact means; the force-weighted contact radius and efficiency there (contact_sums)

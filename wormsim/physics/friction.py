@@ -89,19 +89,25 @@ def mu_at(vs, kind, a, b, c):
 
 
 STICK_RELEASE = 0.1  # stuck_after: a sliding pair sticks again below this fraction of v_stick
+BREAKAWAY = 1.0  # stuck_after: a stuck pair breaks away where the friction it needs reaches this share of mu_s f_n
 
 
 @numba.njit(cache=True, inline="always")
-def stuck_after(stuck, vs, v_stick):
-    """The stick state after a sample at the sliding speed vs (pre-sliding, as a static friction model's stick
-    phase: the static coefficient holds until the slip breaks away): a stuck pair stays stuck while vs < v_stick
-    and breaks away at vs >= v_stick; a sliding pair sticks again below STICK_RELEASE v_stick. While stuck, mu is
-    mu(0) (mu_at(0.0, ...)), else mu(vs). v_stick <= 0: never stuck (mu(vs) throughout). contact3d runs with
-    v_stick = contact.transition_velocity_m_s where the wheel drives a pair that self-locks at rest, starting stuck
-    (wormsim.physics.locking.stick_velocity_m_s), and with 0 otherwise."""
+def stuck_after(stuck, vs, v_stick, utilisation):
+    """The stick state after a sample at the sliding speed vs (a static friction model's stick phase: the static
+    coefficient holds until the friction the pair needs reaches the static limit, Coulomb's break-away): a stuck pair
+    stays stuck while `utilisation`, the friction it needs over mu(0) times its normal forces, is below BREAKAWAY, and
+    breaks away at BREAKAWAY (contact3d: wormsim.contact3d.breakaway.static_utilisation, on the worm's hinge, whatever
+    the slip speed; docs/decisions/0058-breakaway-on-static-friction.md); a sliding pair sticks again below
+    STICK_RELEASE v_stick (utilisation is not used). While stuck, mu is mu(0) (mu_at(0.0, ...)), else mu(vs).
+    v_stick <= 0: never stuck (mu(vs) throughout). contact3d runs with v_stick = contact.transition_velocity_m_s where
+    the wheel drives a pair that self-locks at rest, starting stuck (wormsim.physics.locking.stick_velocity_m_s), and
+    with 0 otherwise."""
     if v_stick <= 0.0:
         return False
-    return vs < (v_stick if stuck else STICK_RELEASE * v_stick)
+    if stuck:
+        return utilisation < BREAKAWAY
+    return vs < STICK_RELEASE * v_stick
 
 
 @numba.njit(cache=True)
@@ -128,6 +134,11 @@ def mu_law(contact: Contact) -> MuLaw:
         return MuLaw(STEP, float(contact.friction_static), v_t, float(contact.friction_dynamic))
     mu = DEFAULT_FRICTION if contact.friction is None else contact.friction
     return MuLaw(CONSTANT, float(mu), 0.0, 0.0)
+
+
+def mu_varies(contact: Contact) -> bool:
+    """mu depends on the sliding speed (a static/dynamic pair or a friction group; not a constant mu)."""
+    return mu_law(contact).kind != CONSTANT
 
 
 def rho_rad(vs_m_s, group: str | None = None, friction: float | None = None):

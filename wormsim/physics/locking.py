@@ -83,15 +83,20 @@ def stall_torque_nm(expected_drive_torque_nm: float, peak_torque_nm: float | Non
 
 
 def stick_velocity_m_s(
-    drive: Drive, lead_angle_rad: float, rho_static_rad: float, transition_velocity_m_s: float
+    drive: Drive, lead_angle_rad: float, rho_static_rad: float, transition_velocity_m_s: float, mu_varies: bool = True
 ) -> float:
     """The friction law's stick state at contact3d (wormsim.physics.friction.stuck_after): v_t =
     contact.transition_velocity_m_s where the wheel drives (the worm undriven) a pair that self-locks at rest,
-    rho'(mu(0)) >= gamma, else 0 (no stick state: mu follows mu(Vs) from the first sample, as on every other run).
-    Holding from rest needs it: the soft contact lets a freshly loaded pair slide a little (measured on the seat
-    motor demo gear, 2 N m in 2 ms, mu 0.0877 constant: the worm reaches Vs 0.90 mm/s at 1 ms, then creeps at
-    0.09 rpm), and with mu(Vs) blending towards the dynamic value over that slip the pair ran back."""
-    if drive.on != "wheel" or not gt.self_locking(lead_angle_rad, rho_static_rad):
+    rho'(mu(0)) >= gamma, and mu depends on the sliding speed (mu_varies: a static/dynamic pair or a friction group),
+    else 0 (no stick state: mu follows mu(Vs) from the first sample, as on every other run; a constant mu is its own
+    static value). Holding from rest needs it: the soft contact lets a freshly loaded pair slide a little (measured on
+    the seat motor demo gear, 2 N m in 2 ms, mu 0.0877 constant: the worm reaches Vs 0.90 mm/s at 1 ms, then creeps at
+    0.09 rpm), and with mu(Vs) blending towards the dynamic value over that slip the pair ran back. The stuck pair
+    breaks away when the friction it needs on the worm's hinge reaches mu(0) times its normal forces
+    (wormsim.contact3d.breakaway), not at a slip speed: under a fast load that slip passes v_t long before static
+    friction is used up (docs/decisions/0058-breakaway-on-static-friction.md); v_t is where a sliding pair's mu(Vs)
+    reaches the dynamic value, and it sticks again below STICK_RELEASE v_t."""
+    if drive.on != "wheel" or not mu_varies or not gt.self_locking(lead_angle_rad, rho_static_rad):
         return 0.0
     return float(transition_velocity_m_s)
 

@@ -19,7 +19,7 @@ from meshgen.displaced import Deviations
 from meshgen.geometry import GearGeometry
 from meshgen.kinematic_tca import KinematicTCA
 from wormsim.physics import gear_theory as gt
-from wormsim.physics.friction import friction_coefficient, friction_mode
+from wormsim.physics.friction import friction_coefficient, friction_mode, mu_varies
 from wormsim.physics.geometry import derive, displaced_pair
 from wormsim.physics.locking import backdrive_self_locks, stick_velocity_m_s
 from wormsim.scenario import Contact, Errors, Materials, Scenario, ScenarioError, Shafts, Simulation
@@ -93,5 +93,5 @@ def gear_plan(scenario: Scenario, geometry: GearGeometry | None = None) -> GearP
         servo_gain_nm_s=gt.servo_gain_of(drv, t_drive) if duty.speed_driven else None,
         worm_speed_rad_s=gt.worm_speed_command_rad_s(drv, g.ratio),
         backdrive_self_locks=backdrive_self_locks(drv, g.gamma_m, rho0),
-        stick_velocity_m_s=stick_velocity_m_s(drv, g.gamma_m, rho0, c.transition_velocity_m_s),
+        stick_velocity_m_s=stick_velocity_m_s(drv, g.gamma_m, rho0, c.transition_velocity_m_s, mu_varies(c)),
     )
