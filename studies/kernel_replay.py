@@ -78,9 +78,10 @@ DOUBLE = {
     ],
     "_memo_skips": [
         (
-            "                if use_memo and _memo_skips(mtab, mc, k, sg, j, theta1, te, drift):\n",
-            "                skip2 = use_memo and _memo_skips(mtab, mc, k, sg, j, theta1 + 0.0 * tmp[0], te, drift)\n"
-            "                if use_memo and (_memo_skips(mtab, mc, k, sg, j, theta1, te, drift) or skip2):\n",
+            "                if use_memo and _memo_skips(mtab, mc, k, sg, j, theta1, te, drift, rate):\n",
+            "                skip2 = use_memo and _memo_skips(mtab, mc, k, sg, j, theta1 + 0.0 * tmp[0], te, drift, "
+            "rate)\n"
+            "                if use_memo and (_memo_skips(mtab, mc, k, sg, j, theta1, te, drift, rate) or skip2):\n",
         )
     ],
     "slice_weights + merge + frames": [
@@ -110,8 +111,8 @@ COUNT = [
         f"                tmp[{C0}] += 1.0\n",
     ),
     (
-        "                if use_memo and _memo_skips(mtab, mc, k, sg, j, theta1, te, drift):\n",
-        "                if use_memo and _memo_skips(mtab, mc, k, sg, j, theta1, te, drift):\n"
+        "                if use_memo and _memo_skips(mtab, mc, k, sg, j, theta1, te, drift, rate):\n",
+        "                if use_memo and _memo_skips(mtab, mc, k, sg, j, theta1, te, drift, rate):\n"
         f"                    tmp[{C0 + 1}] += 1.0\n",
     ),
     ("                sid += 1\n", f"                sid += 1\n                tmp[{C0 + 2}] += 1.0\n"),
@@ -122,7 +123,7 @@ COUNT = [
         'no angle (the face slope needs no gap)."""\n',
         f'no angle (the face slope needs no gap)."""\n    tmp[{C0 + 6}] += 1.0\n',
     ),
-    ("    span, c, c_line = sc\n", f"    span, c, c_line = sc\n    tmp[{C0 + 7}] += 1.0\n"),
+    ("    S = zeta.shape[0]\n    dz = ", f"    S = zeta.shape[0]\n    tmp[{C0 + 7}] += 1.0\n    dz = "),
 ]
 
 
