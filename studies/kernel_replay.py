@@ -15,7 +15,8 @@ contacts' frames.
 A counting variant counts per call: slices in the candidate window, skipped by the memo, evaluated, gap evaluations,
 the descent's walk beyond its first three points, contacts, _excess evaluations.
 
---base COMMIT: the kernel.py of that commit is the one whose parts are measured (default: this one); with --other
+--base COMMIT: the kernel.py of that commit (with that commit's worm gap, wormsim/tooth/gap.py, where it differs
+from this one's) is the one whose parts are measured (default: this one); with --other
 FILE (another version of kernel.py, e.g. this one) that one is replayed too, interleaved with the base, and their
 contacts compared per step (--only none: no part doubled).
 
@@ -41,6 +42,7 @@ SPEED = ["contact.geometry=flanks", "simulation.mass_scaling=1", "simulation.rec
 VARIANT_DIR = Path("/tmp/wormsim_kernel_variants")
 COUNTERS = ("candidate slices", "memo skips", "evaluated slices", "gap evaluations", "descent walk points")
 COUNTERS += ("contacts", "_excess evaluations", "_line_share calls")
+GAP_IMPORT = "from wormsim.tooth.gap import worm_gap_ext, wrap\n"  # kernel.py's; a base's gap.py replaces it
 C0 = 6  # the counting variant's counters in tmp[C0:], its tmp enlarged
 
 # each variant: (source line or fragment, its replacement); the part is done twice, its second result discarded
@@ -78,9 +80,10 @@ DOUBLE = {
     ],
     "_memo_skips": [
         (
-            "                if use_memo and _memo_skips(mtab, mc, k, sg, j, theta1, te, drift):\n",
-            "                skip2 = use_memo and _memo_skips(mtab, mc, k, sg, j, theta1 + 0.0 * tmp[0], te, drift)\n"
-            "                if use_memo and (_memo_skips(mtab, mc, k, sg, j, theta1, te, drift) or skip2):\n",
+            "                if use_memo and _memo_skips(mtab, mc, k, sg, j, theta1, te, drift, rate):\n",
+            "                skip2 = use_memo and _memo_skips(mtab, mc, k, sg, j, theta1 + 0.0 * tmp[0], te, drift, "
+            "rate)\n"
+            "                if use_memo and (_memo_skips(mtab, mc, k, sg, j, theta1, te, drift, rate) or skip2):\n",
         )
     ],
     "slice_weights + merge + frames": [
@@ -110,8 +113,8 @@ COUNT = [
         f"                tmp[{C0}] += 1.0\n",
     ),
     (
-        "                if use_memo and _memo_skips(mtab, mc, k, sg, j, theta1, te, drift):\n",
-        "                if use_memo and _memo_skips(mtab, mc, k, sg, j, theta1, te, drift):\n"
+        "                if use_memo and _memo_skips(mtab, mc, k, sg, j, theta1, te, drift, rate):\n",
+        "                if use_memo and _memo_skips(mtab, mc, k, sg, j, theta1, te, drift, rate):\n"
         f"                    tmp[{C0 + 1}] += 1.0\n",
     ),
     ("                sid += 1\n", f"                sid += 1\n                tmp[{C0 + 2}] += 1.0\n"),
@@ -122,7 +125,7 @@ COUNT = [
         'no angle (the face slope needs no gap)."""\n',
         f'no angle (the face slope needs no gap)."""\n    tmp[{C0 + 6}] += 1.0\n',
     ),
-    ("    span, c, c_line = sc\n", f"    span, c, c_line = sc\n    tmp[{C0 + 7}] += 1.0\n"),
+    ("    S = zeta.shape[0]\n    dz = ", f"    S = zeta.shape[0]\n    tmp[{C0 + 7}] += 1.0\n    dz = "),
 ]
 
 
@@ -292,6 +295,11 @@ def main() -> None:
     if a.base:
         git = ["git", "-C", str(ROOT), "show", f"{a.base}:wormsim/tooth/kernel.py"]
         src = subprocess.run(git, check=True, capture_output=True, text=True).stdout
+        git[-1] = f"{a.base}:wormsim/tooth/gap.py"
+        gap_src = subprocess.run(git, check=True, capture_output=True, text=True).stdout
+        if gap_src != (ROOT / "wormsim" / "tooth" / "gap.py").read_text():  # the base's worm gap too
+            sys.modules["kernel_variant_gap_base"] = load_module("gap_base", gap_src)
+            src = _rewrite(src, [(GAP_IMPORT, GAP_IMPORT.replace("wormsim.tooth.gap", "kernel_variant_gap_base"))])
     else:
         src = KERNEL.read_text()
     mods = {"plain": load_module("plain", src)}
@@ -351,6 +359,8 @@ def main() -> None:
     if a.other:
         out["other_over_base"] = med["other"] / base
         out["other_over_base_rounds"] = [x / y for x, y in zip(cpu["other"], cpu["plain"], strict=True)]
+        # the rounds' own ratios (each round runs both back to back): robust where the machine's speed drifts
+        out["other_over_base_median_of_rounds"] = float(np.median(out["other_over_base_rounds"]))
         print("other / base:", out["other_over_base"], out["other_over_base_rounds"], checks["other"], flush=True)
     if a.record:
         cmd = "python studies/kernel_replay.py" + "".join(f" {x}" for x in sys.argv[1:])

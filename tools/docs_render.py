@@ -259,7 +259,13 @@ def kernel_replay_table(name: str = "kernel_replay") -> str:
         chk = r["contacts_check"]["other"]
         text += (
             f"\n`{r['other']}` against the base ({r['base']}): {r['us_per_call']['other']:.1f} against {base:.1f} us "
-            f"per call, ratio {r['other_over_base']:.2f} (rounds "
+            f"per call, ratio {r['other_over_base']:.2f}"
+            + (
+                f", the rounds' own ratios' median {r['other_over_base_median_of_rounds']:.2f}"
+                if "other_over_base_median_of_rounds" in r
+                else ""
+            )
+            + " (rounds "
             + " / ".join(f"{x:.2f}" for x in r["other_over_base_rounds"])
             + f"); contacts per step equal: {'yes' if chk['contacts_equal'] else 'no'}, the last step's merged "
             f"contacts' largest difference {chk['last_step_max_abs_diff']:.1e}.\n"
@@ -1466,6 +1472,7 @@ TABLES: dict[str, Callable[[], str]] = {
     "seat_motor_profile": seat_motor_profile_table,
     "seat_motor_levers": seat_motor_levers_table,
     "kernel_replay": kernel_replay_table,
+    "kernel_search": lambda: kernel_replay_table("kernel_search"),
     "flank_contacts": flank_contacts_table,
     "flank_contacts_default": flank_contacts_default_table,
     "bench_shafts": bench_shafts_table,

@@ -45,8 +45,12 @@ MEMO_JITTER_MODULE = 1e-3  # allowance (x m_x) for the slice minimum's change at
 MEMO_AGE_CYCLE = 1.0 / 8  # a memorised slice is evaluated again after this share of a mesh cycle of worm rotation
 # _line_share's tip tuple where the line has no active segment or no neighbour: inside the tip edge, whole segment
 _NO_TIP = (0.0, 0.0, 0.0, True, 1.0, 1e9)
-MEMO_COLS = 5  # the memo table's columns: gline, TE, theta1, the pose's drift (_pose_drift) when it was evaluated;
-# the slice's start point + 1 at its last evaluation (0: none; _start_near's hint, kept when the rest is forgotten)
+MEMO_COLS = 6  # the memo table's columns: gline, TE, theta1, the pose's drift (_pose_drift) when it was evaluated;
+# the slice's start point + 1 at its last evaluation (0: none; _start_near's hint, kept when the rest is forgotten);
+# 1 where the slice is memorised by the motion's rate (its minimum at the profile's end or past the worm's edge)
+MEMO_RATE_REACH = 2.0  # a rate-memorised slice's parabola has its vertex within this many profile points of ib
+MEMO_RATE_GAIN = 20.0  # allowance on a grid point's gap change for the gaps derived from it (the parabola's value
+# within MEMO_RATE_REACH points, its blend and the edge's interpolation: Lebesgue constants <= 17)
 MEMO_CONSTS = 4  # rho_max, jitter allowance, age, the largest distance of a grid point from the wheel's origin
 LINE_COLS = 7  # _line_point's cache per slice: f, i0, x, y, the tip's distance and its segment, the excess
 TIP_SUBSTEPS = 32  # points across a slice where the contact line crosses the wheel's tip edge (_tip_depth)
@@ -97,9 +101,11 @@ def find_contacts(grid, ks, theta1, theta2, margin, P, out, taper_rad=0.0, memo=
 
 def flank_memo(grid: FlankGrid, z2: int) -> tuple[np.ndarray, np.ndarray]:
     """Preallocated state of find_contacts' open-slice memo for one grid: table (z2, 2, S, MEMO_COLS) = per (tooth
-    mod z2, flank, slice) the line depth's gap gline (> 0; 0 = nothing memorised), TE, theta1 and the poses' drift
-    when it was evaluated, and consts = (largest radius of a grid point, jitter allowance, largest worm-angle age,
-    largest distance of a grid point from the wheel's origin) (`_find_contacts`, `_pose_drift`)."""
+    mod z2, flank, slice) the line depth's gap gline (> 0; 0 = nothing memorised; the slice's smallest gap where it is
+    memorised by the motion's rate), TE, theta1 and the poses' drift when it was evaluated, the start point's hint
+    and whether it is memorised by the motion's rate, and consts = (largest radius of a grid point, jitter
+    allowance, largest worm-angle age, largest distance of a grid point from the wheel's origin) (`_find_contacts`,
+    `_pose_drift`)."""
     P = grid.params
     z1 = abs(P[12]) * 2 * math.pi / P[11]
     rho = float(np.nanmax(np.where(np.isfinite(grid.c), grid.rho[None], np.nan)))
@@ -128,7 +134,18 @@ def _find_contacts(grid, ks, theta1, theta2, margin, taper_rad, P, out, work, me
     lies from where the nominal assembly puts it: the gap then differs from the nominal assembly's by at most 2 delta
     (the same factor 2), so the nominal bound holds with 2 (delta + delta_e) more; delta = 0 for the nominal poses. A
     skipped slice gives no contact, as its evaluation would: tests/tooth/test_kernel_memo.py compares with and without
-    over mesh cycles, nominal and with moving poses."""
+    over mesh cycles, nominal and with moving poses.
+
+    An open slice whose minimum lies at the active profile's end or past the worm's edge (the contact line off the
+    profile or the threaded region: its gap changes with the worm angle too) is memorised by the motion's rate with
+    ge = min(gmin, gline, gvert) > 0 where its parabola's vertex lies within MEMO_RATE_REACH points, and skipped while
+        ge - L (2 rho_max |TE - TE_e| + 2 (delta + delta_e) + (|p| + 2 rho_max |z1 / z2|) |theta1 - theta1_e|) - J
+        > MEMO_GAP_SHARE ge
+    and |theta1 - theta1_e| <= age: a wheel grid point's gap changes by at most |p| per unit of worm angle (the
+    thread is a helicoid: turning the worm is moving it by p along its axis; |dG/dtheta1| = |p| / |grad| <= |p|) and
+    by 2 rho_max per unit of wheel angle (theta2 - theta2_e = z1 / z2 (theta1 - theta1_e) + TE - TE_e), and the gaps
+    derived from the grid points (the parabola within its reach, its blend, the edge's interpolation) by at most
+    L = MEMO_RATE_GAIN times that."""
     xy, c, c_range, span, zeta = grid
     tmp, gaps, exc, pts, nrs, stamp, lcache, lstamp = work
     mtab, mc = memo
@@ -137,6 +154,7 @@ def _find_contacts(grid, ks, theta1, theta2, margin, taper_rad, P, out, work, me
     pitch = P[11]
     te = wrap(theta2 - P[12] * theta1, pitch)
     drift = _pose_drift(P, theta2, mc[3]) if use_memo and P.shape[0] > N_WORM_PARAMS else 0.0
+    rate = abs(P[0]) + 2.0 * mc[0] * abs(P[12]) if use_memo else 0.0  # _memo_skips' bound per unit of worm angle
     taper_end = margin  # edge contacts fade to zero at this distance past the profile's conjugate range
     margin = margin + abs(te)
     stamp[:] = -1
@@ -163,7 +181,7 @@ def _find_contacts(grid, ks, theta1, theta2, margin, taper_rad, P, out, work, me
                 # (a property of the slice's position, not of the wheel's lag; zero before the window cuts)
                 past = max(c_range[sg, j, 0] - target, target - c_range[sg, j, 1], 0.0)
                 taper = min(max((taper_end - past) / taper_rad, 0.0), 1.0)
-                if use_memo and _memo_skips(mtab, mc, k, sg, j, theta1, te, drift):
+                if use_memo and _memo_skips(mtab, mc, k, sg, j, theta1, te, drift, rate):
                     continue
                 if span[sg, j, 0] < 0:
                     continue
@@ -186,14 +204,19 @@ def _find_contacts(grid, ks, theta1, theta2, margin, taper_rad, P, out, work, me
 
 
 @numba.njit(cache=True, inline="always")
-def _memo_skips(mtab, mc, k, sg, j, theta1, te, drift):
+def _memo_skips(mtab, mc, k, sg, j, theta1, te, drift, rate):
     """The open-slice memo's check of (tooth k, flank sg, slice j) (_find_contacts); a memorised slice that is not
-    skipped is forgotten."""
+    skipped is forgotten. rate: |p| + 2 rho_max |z1 / z2| (the rate-memorised slices' bound per unit of worm angle)."""
     km = k % mtab.shape[0]
     ge = mtab[km, sg, j, 0]
     if ge > 0.0:
-        if (
-            abs(theta1 - mtab[km, sg, j, 2]) <= mc[2]
+        d1 = abs(theta1 - mtab[km, sg, j, 2])
+        if mtab[km, sg, j, 5] > 0.0:
+            moved = 2.0 * mc[0] * abs(te - mtab[km, sg, j, 1]) + 2.0 * (drift + mtab[km, sg, j, 3]) + rate * d1
+            if d1 <= mc[2] and ge - MEMO_RATE_GAIN * moved - mc[1] > MEMO_GAP_SHARE * ge:
+                return True
+        elif (
+            d1 <= mc[2]
             and ge - 2.0 * mc[0] * abs(te - mtab[km, sg, j, 1]) - mc[1] - 2.0 * (drift + mtab[km, sg, j, 3])
             > MEMO_GAP_SHARE * ge
         ):
@@ -346,10 +369,17 @@ def _slice_contact(ev, sc, zeta, slc, i_s, sid, taper, memo_row, out, n):
     gvert = best - qa * qa / (4.0 * qb) if qb > 0.0 else gline
     if gmin >= 0.0 and gline >= 0.0 and gvert >= 0.0:
         use_memo, mtab, te, drift = memo_row
-        if use_memo and par and e_x <= 0.0 and gline > 0.0 and span[sg, j, 0] < ib < span[sg, j, 1]:
-            km = k % mtab.shape[0]
-            mtab[km, sg, j, 0], mtab[km, sg, j, 1], mtab[km, sg, j, 2] = gline, te, ev[3]
-            mtab[km, sg, j, 3] = drift
+        if use_memo and gline > 0.0:
+            # conjugate (the line's point inside the profile and the threaded region): by the TE; else (the
+            # minimum at the profile's end or past the worm's edge) by the motion's rate, on the smallest of the
+            # slice's gaps, where the parabola's vertex lies within MEMO_RATE_REACH points (_find_contacts)
+            conj = par and e_x <= 0.0 and span[sg, j, 0] < ib < span[sg, j, 1]
+            ge = gline if conj else min(gmin, gline, gvert)
+            if conj or (ge > 0.0 and qb > 0.0 and abs(qa) <= 2.0 * MEMO_RATE_REACH * qb):
+                km = k % mtab.shape[0]
+                mtab[km, sg, j, 0], mtab[km, sg, j, 1], mtab[km, sg, j, 2] = ge, te, ev[3]
+                mtab[km, sg, j, 3] = drift
+                mtab[km, sg, j, 5] = 0.0 if conj else 1.0
         return n, False
     if gmin == np.inf:
         x = x_l  # no edge inside reach: the line's point (only its weight can make it carry)
