@@ -181,33 +181,33 @@ def test_local_cluster_two_workers_with_a_failing_point(local_run):
     assert not (out / "runs").exists()  # per-point folders only with --keep-runs
 
 
-def test_a_sweep_whose_every_point_fails_exits_3_with_the_first_message(tmp_path, capsys):
+def _torsional_sweep(tmp_path, capsys, name: str, duration_s: float, grid: str):
+    """`wormsim sweep` on one worker of the screw jack at torsional over `grid`: (exit code, stderr, the table's rows)."""
     f = _write(
-        tmp_path / "all_fail.yaml",
-        f"name: all_fail\nbase: {SCREW_JACK}\nset: {{model: torsional, simulation.duration_s: 0.12}}\n"
-        "grid: {load.torque_nm: [30000, 40000]}\n",
+        tmp_path / f"{name}.yaml",
+        f"name: {name}\nbase: {SCREW_JACK}\nset: {{model: torsional, simulation.duration_s: {duration_s}}}\n"
+        f"grid: {{{grid}}}\n",
     )
     out = tmp_path / "out"
-    assert cli.main(["sweep", str(f), "--out", str(out), "--workers", "1", "--no-progress"]) == 3
-    err = capsys.readouterr().err
+    rc = cli.main(["sweep", str(f), "--out", str(out), "--workers", "1", "--no-progress"])
+    return rc, capsys.readouterr().err, _rows(out)
+
+
+def test_a_sweep_whose_every_point_fails_exits_3_with_the_first_message(tmp_path, capsys):
+    rc, err, rows = _torsional_sweep(tmp_path, capsys, "all_fail", 0.12, "load.torque_nm: [30000, 40000]")
+    assert rc == 3
     assert "every point of sweep all_fail failed" in err and "teeth would skip" in err
-    assert [r["status"] for r in _rows(out)] == ["failed", "failed"]  # the table is still written
+    assert [r["status"] for r in rows] == ["failed", "failed"]  # the table is still written
 
 
 def test_a_sweep_whose_every_point_is_invalid_input_exits_2_naming_the_field(tmp_path, capsys):
     """Every point refused by the scenario checks (a face width past the root torus's limit on every point; the random
     gears' test found 21 of 66 such sweeps exiting 3, "simulation failed"): the input is at fault, exit 2 with the
     first point's field."""
-    f = _write(
-        tmp_path / "all_invalid.yaml",
-        f"name: all_invalid\nbase: {SCREW_JACK}\nset: {{model: torsional, simulation.duration_s: 0.05}}\n"
-        "grid: {gear.face_width_mm: [200, 300]}\n",
-    )
-    out = tmp_path / "out"
-    assert cli.main(["sweep", str(f), "--out", str(out), "--workers", "1", "--no-progress"]) == 2
-    err = capsys.readouterr().err
+    rc, err, rows = _torsional_sweep(tmp_path, capsys, "all_invalid", 0.05, "gear.face_width_mm: [200, 300]")
+    assert rc == 2
     assert "error: every point of sweep all_invalid is invalid input (the first: gear.face_width_mm" in err, err
-    assert [r["status"] for r in _rows(out)] == ["failed", "failed"]
+    assert [r["status"] for r in rows] == ["failed", "failed"]
 
 
 def _start(args: list[str], log: Path) -> subprocess.Popen:

@@ -65,14 +65,14 @@ def jump_error(t: float, te_pitch: float, dt: float, bm: BuiltModel) -> Simulati
     )
 
 
-def overspeed_error(t: float, w1: float, dt: float, bm: BuiltModel | None = None) -> SimulationError:
+def overspeed_error(t: float, w1: float, dt: float, bm: BuiltModel) -> SimulationError:
     """The worm turns more than OVERSPEED_GUARD x MAX_WORM_TURN_PER_STEP_RAD per step (a torque drive running away,
     or a timestep set past the speed check): its pieces would pass through the wheel's between steps. A torque drive
     above the torque the load takes (the plan's expected drive torque, gear_theory.expected_drive_torque_of: T2 /
     (i eta) on the worm) runs away, and the message says so first: a smaller timestep only lets it run further."""
     lim = speed_timestep_limit_s(abs(w1))
     runaway = ""
-    gp = bm.plan.gear if bm is not None else None
+    gp = bm.plan.gear
     drv = gp.duty.drive if gp is not None else None
     if gp is not None and drv is not None and drv.torque_nm is not None and abs(drv.torque_nm) > gp.drive_torque_nm:
         runaway = (

@@ -136,13 +136,12 @@ def contact_rows(d_addr, off, adr, ncon, n_fc, cone3, pts, nh, merged, mrg):
 @numba.njit(cache=True)
 def hinge_need(m_addr, d_addr, off, p, hold):
     """breakaway.hinge_utilisation of d's contacts (read at the checked offsets off) on the worm's hinge p.dof1:
-    hold = (mj_mulJacVec's address, the unit vector's and the column's addresses, the column, the contacts'
-    dimension and friction rows' room, qfrc_smooth); -1 where the contacts or rows do not fit the room."""
-    mul, unit_addr, col_addr, col, dims, mus, smooth = hold
+    hold = (mj_mulJacVec's address, the unit vector's and the column's addresses, the column, the contacts' efc
+    address, dimension and friction rows' room, qfrc_smooth); -1 where the contacts or rows do not fit the room."""
+    mul, unit_addr, col_addr, col, adr, dims, mus, smooth = hold
     ncon, nefc = i32_at(d_addr + off[1])[0], i32_at(d_addr + off[2])[0]
     if ncon > dims.shape[0] or nefc > col.shape[0]:
         return -1.0
-    adr = np.empty(ncon, dtype=np.int64)
     size, cbase = off[6], i64_at(d_addr + off[3])[0]
     for k in range(ncon):
         c = cbase + k * size
@@ -310,12 +309,13 @@ class FlankSamples:
             z2=int(geo.z2),
         )
         self.adr = np.zeros(ADR_CAP, dtype=np.int64)
-        # hinge_need's room: the worm hinge's unit vector, the Jacobian column, the contacts' dimensions and mu
+        # hinge_need's room: the worm hinge's unit vector, the Jacobian column, the contacts' efc addresses,
+        # dimensions and mu
         unit, col = np.zeros(loop.m.nv), np.zeros(8 * ADR_CAP)
         unit[bm.worm_dof] = 1.0
-        dims, mus = np.zeros(ADR_CAP, dtype=np.int64), np.zeros(ADR_CAP)
+        adrs, dims, mus = np.zeros(ADR_CAP, dtype=np.int64), np.zeros(ADR_CAP, dtype=np.int64), np.zeros(ADR_CAP)
         smooth = loop.d.qfrc_smooth  # a view of d's buffer (not its arena): the same address every step
-        self.hold = (address("mj_mulJacVec"), unit.ctypes.data, col.ctypes.data, col, dims, mus, smooth)
+        self.hold = (address("mj_mulJacVec"), unit.ctypes.data, col.ctypes.data, col, adrs, dims, mus, smooth)
         self._unit = unit  # hold carries only its address
         self.io = np.zeros(IO_LEN)
         self._store = store

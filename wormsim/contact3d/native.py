@@ -123,18 +123,22 @@ def stage_addresses() -> np.ndarray:
 # ---------------------------------------------------------------------------------------------------- intrinsics
 
 
-@intrinsic
-def call_stage(typingctx, fn, m_addr, d_addr):
-    """void fn(const mjModel*, mjData*) called through its address (all int64)."""
-    sig = types.void(types.int64, types.int64, types.int64)
+def _void_call(n):
+    """codegen of void fn(n pointers) called through its address (the first argument; all int64)."""
 
     def codegen(context, builder, signature, args):
-        fnty = ir.FunctionType(ir.VoidType(), [ir.IntType(8).as_pointer()] * 2)
+        fnty = ir.FunctionType(ir.VoidType(), [ir.IntType(8).as_pointer()] * n)
         f = builder.inttoptr(args[0], fnty.as_pointer())
         builder.call(f, [builder.inttoptr(a, ir.IntType(8).as_pointer()) for a in args[1:]])
         return context.get_dummy_value()
 
-    return sig, codegen
+    return codegen
+
+
+@intrinsic
+def call_stage(typingctx, fn, m_addr, d_addr):
+    """void fn(const mjModel*, mjData*) called through its address (all int64)."""
+    return types.void(types.int64, types.int64, types.int64), _void_call(2)
 
 
 @intrinsic
@@ -154,15 +158,7 @@ def call_add(typingctx, fn, m_addr, d_addr, c_addr):
 def call_mul(typingctx, fn, m_addr, d_addr, res_addr, vec_addr):
     """void fn(const mjModel*, const mjData*, mjtNum* res, const mjtNum* vec) called through its address (all
     int64): mj_mulJacVec."""
-    sig = types.void(types.int64, types.int64, types.int64, types.int64, types.int64)
-
-    def codegen(context, builder, signature, args):
-        fnty = ir.FunctionType(ir.VoidType(), [ir.IntType(8).as_pointer()] * 4)
-        f = builder.inttoptr(args[0], fnty.as_pointer())
-        builder.call(f, [builder.inttoptr(a, ir.IntType(8).as_pointer()) for a in args[1:]])
-        return context.get_dummy_value()
-
-    return sig, codegen
+    return types.void(types.int64, types.int64, types.int64, types.int64, types.int64), _void_call(4)
 
 
 def _pointer_at(nbtype):
