@@ -18,6 +18,7 @@ configurations are coarse, 8 slices). --save writes each run's contact pattern t
 compares F x the default count against 2 F x it (the record's default_slices is then F x the default). --impedance D
 runs with the contacts' impedance d = D (wormsim.contact3d.law.IMPEDANCE, the constraint's added mass d / (1 - d)
 of the mesh's effective mass per contact row) instead of the model's; the record says which (`impedance`).
+--n-profile N: the flank grid's points along the profile instead of wormsim.tooth.grid.N_PROFILE (`n_profile`).
 """
 
 from __future__ import annotations
@@ -134,14 +135,21 @@ def main() -> None:
     ap.add_argument("--save", type=Path, help="folder: each run's contact pattern table and F_t (npz)")
     ap.add_argument("--factor", type=int, default=1, help="compare factor x the default against twice that")
     ap.add_argument("--impedance", type=float, help="the contacts' impedance d instead of law.IMPEDANCE")
+    ap.add_argument("--n-profile", type=int, help="points along the profile (default: wormsim.tooth.grid.N_PROFILE)")
     a = ap.parse_args()
+    if a.n_profile is not None:  # a study of the profile's resolution (grid.flank_grid reads it when called)
+        from wormsim.tooth import grid
+
+        grid.N_PROFILE = a.n_profile
     if a.impedance is not None:  # an experiment on the law's constant (contact_law reads it at each build)
         from wormsim.contact3d import law
 
         law.IMPEDANCE = a.impedance
     from wormsim.contact3d.law import IMPEDANCE
+    from wormsim.tooth.grid import N_PROFILE
 
-    out: dict = {"band_hz": BAND_HZ, "medium": a.medium, "factor": a.factor, "impedance": IMPEDANCE, "cases": {}}
+    out: dict = {"band_hz": BAND_HZ, "medium": a.medium, "factor": a.factor, "impedance": IMPEDANCE}
+    out |= {"n_profile": N_PROFILE, "cases": {}}
     for name in a.cases:
         s0 = a.factor * flank_slices(scenario(name, None, a.medium))
         try:

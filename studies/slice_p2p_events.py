@@ -7,7 +7,10 @@ ringing's frequency (zero crossings of F_t above BAND_HZ in the 3 ms after the l
 and the largest lines of F_t's spectrum.
 
     .venv/bin/python studies/slice_p2p_events.py [--case left-q6-4start] [--slices 32 64 128] [--speed RPM]
-        [--step S] [--record NAME]
+        [--step S] [--n-profile N] [--record NAME]
+
+--n-profile N: the flank grid's points along the profile (wormsim.tooth.grid.N_PROFILE) for a study of the profile's
+resolution (docs/decisions/0060-128-profile-points.md).
 """
 
 from __future__ import annotations
@@ -88,8 +91,16 @@ def main() -> None:
     ap.add_argument("--speed", type=float, help="worm speed, rpm (default: the case's)")
     ap.add_argument("--step", type=float, help="timestep, s (default: the case's)")
     ap.add_argument("--record")
+    ap.add_argument("--n-profile", type=int, help="points along the profile (default: wormsim.tooth.grid.N_PROFILE)")
     a = ap.parse_args()
-    out: dict = {"case": a.case, "band_hz": BAND_HZ, "speed_rpm": a.speed, "timestep_s": a.step, "runs": []}
+    if a.n_profile is not None:  # a study of the profile's resolution (grid.flank_grid reads it when called)
+        from wormsim.tooth import grid
+
+        grid.N_PROFILE = a.n_profile
+    from wormsim.tooth.grid import N_PROFILE
+
+    out: dict = {"case": a.case, "band_hz": BAND_HZ, "speed_rpm": a.speed, "timestep_s": a.step, "n_profile": N_PROFILE}
+    out["runs"] = []
     for S in a.slices:
         r = run(a.case, S, a.speed, a.step)
         out["runs"].append(r)

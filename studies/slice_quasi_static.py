@@ -8,7 +8,10 @@ r^2 / (1 - r^2 + 2 i zeta r), r = f / f_n, f_n = sqrt(k_mean / m_eff) / 2 pi; de
 at S and 2 S.
 
     .venv/bin/python studies/slice_quasi_static.py --cases screw_jack ZA-a25-z60-3start [--slices 16 32 64]
-        [--samples 2048] [--record NAME]
+        [--samples 2048] [--n-profile N] [--record NAME]
+
+--n-profile N: the flank grid's points along the profile (wormsim.tooth.grid.N_PROFILE). The record also holds the
+mesh stiffness's harmonics 14-17 (share of its mean) per count.
 """
 
 from __future__ import annotations
@@ -66,6 +69,7 @@ def case(name: str, slices: list[int] | None, samples: int) -> dict:
             "k_p2p_share": float(np.ptp(k) / k.mean()),
             "f_n_hz": f_n,
             "dyn_p2p_share": float(np.ptp(dyn)),
+            "k_harmonics_14_17_share": [float(v) for v in np.abs(np.fft.rfft(kappa))[14:18] * 2 / len(kappa)],
             "cpu_s": cpu,
         }
         if ref is None:
@@ -88,8 +92,15 @@ def main() -> None:
     ap.add_argument("--slices", type=int, nargs="+")
     ap.add_argument("--samples", type=int, default=2048)
     ap.add_argument("--record")
+    ap.add_argument("--n-profile", type=int, help="points along the profile (default: wormsim.tooth.grid.N_PROFILE)")
     a = ap.parse_args()
-    out: dict = {"samples": a.samples, "approach_m": APPROACH_M, "cases": {}}
+    if a.n_profile is not None:  # a study of the profile's resolution (grid.flank_grid reads it when called)
+        from wormsim.tooth import grid
+
+        grid.N_PROFILE = a.n_profile
+    from wormsim.tooth.grid import N_PROFILE
+
+    out: dict = {"samples": a.samples, "approach_m": APPROACH_M, "n_profile": N_PROFILE, "cases": {}}
     for name in a.cases:
         out["cases"][name] = case(name, a.slices, a.samples)
         if a.record:

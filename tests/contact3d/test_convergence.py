@@ -82,11 +82,13 @@ def test_flank_fluctuation_converged_in_slices(name, key):
     """The default slice count (the CI run, medium: flanks.default_slices) against twice it: within 10 % (issue 31:
     F_t p2p and p_H max, wormsim.tooth.hertz (4); and the TE p2p). With the slice weights along the contact line
     (decision 0051), the slice's depth where the line leaves the profile (decision 0052) and 4 contacts per flank
-    (decision 0049), at least 32 slices (decision 0054): involute_41 F_t p2p 688.2 -> 701.2 N (-1.8 %; 701.9 -> 690.0
-    N at 24, 583.6 -> 271.7 N before decision 0051), p_H max 253.8 -> 253.9 MPa; screw jack F_t p2p 6.712 -> 6.549 N
-    (+2.5 %; 8.351 -> 6.712 N, +24.4 %, at 16 slices), p_H max 324.2 -> 324.4 MPa; seat motor (F_t p2p 0.07 % of its
-    mean): F_t p2p 0.881 -> 0.885 N, p_H max 662.7 -> 629.4 MPa (+5.3 %) (studies/slice_convergence_default.py
-    --medium; law (5) of wormsim.contact3d.law)."""
+    (decision 0049), at least 32 slices (decision 0054), 128 points along the profile (decision 0060): involute_41
+    F_t p2p 683.9 -> 694.8 N (-1.6 %; 701.9 -> 690.0 N at 24 slices with 64 points, 583.6 -> 271.7 N before decision
+    0051), p_H max 253.8 -> 253.9 MPa; screw jack F_t p2p 7.098 -> 6.960 N (+2.0 %; 8.351 -> 6.712 N, +24.4 %, at 16
+    slices with 64 points), p_H max 320.8 -> 321.5 MPa; seat motor (F_t p2p 0.06 % of its mean): F_t p2p 0.787 ->
+    0.725 N (+8.6 %; 0.881 -> 0.885 N with 64 points), p_H max 774.4 -> 751.5 MPa (+3.0 %; 662.7 -> 629.4 MPa with
+    64 points) (studies/slice_convergence_default.py --medium, docs/data/profile_points_convergence_128.json; law (5)
+    of wormsim.contact3d.law)."""
     n = DEFAULT_SLICES[name]
     a, b = run(name), run(name, f"contact.slices={2 * n}")
     assert a["flank_slices"] == n and b["flank_slices"] == 2 * n
@@ -96,9 +98,9 @@ def test_flank_fluctuation_converged_in_slices(name, key):
 @pytest.mark.parametrize("name", list(DEFAULT_SLICES))
 def test_flank_mesh_band_converged_in_slices(name):
     """F_t's meshing band (below 1 kHz, under the contact modes) at the default against twice the slices, within 10 %:
-    screw jack 0.336 -> 0.324 N, involute_41 413.4 -> 428.2 N (-3.5 %; +12.7 % at 24 slices, where its 941 Hz contact
-    mode inside the band rang differently at each count), seat motor 0.828 -> 0.871 N (32 -> 64;
-    studies/slice_convergence_default.py --medium; decisions 0051, 0052, 0054)."""
+    screw jack 0.334 -> 0.321 N, involute_41 412.4 -> 426.8 N (-3.4 %; +12.7 % at 24 slices, where its 941 Hz contact
+    mode inside the band rang differently at each count), seat motor 0.737 -> 0.726 N (32 -> 64;
+    studies/slice_convergence_default.py --medium; decisions 0051, 0052, 0054, 0060)."""
     n = DEFAULT_SLICES[name]
     a, b = mesh_band_p2p(name), mesh_band_p2p(name, f"contact.slices={2 * n}")
     assert b == pytest.approx(a, rel=0.10), (a, b)

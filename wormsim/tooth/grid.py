@@ -29,7 +29,10 @@ from wormsim.tooth.mesh_stiffness import mesh_stiffness
 from wormsim.tooth.trim import cut_points
 from wormsim.tooth.window import window_size
 
-N_PROFILE = 64  # points along the profile per slice (the parabola refines between them)
+# points along the profile per slice (the gap's parabola refines between them); 128: near the envelope's limit line
+# the gap along the profile is no parabola about the contact line, and 64 points left a slice's depth there depending
+# on where the line lay between points (docs/decisions/0060-128-profile-points.md)
+N_PROFILE = 128
 SLICES_COARSE = 8  # simulation.resolution coarse: a quick look (not converged; docs/contact3d.md)
 SLICES_FINE_FACTOR = 2  # fine: this many times medium's count (the count medium's convergence is measured against)
 SLICE_SHARE = 0.2  # medium: a slice's stiffness K / S at most this share of the mesh stiffness's p2p
@@ -79,10 +82,15 @@ class FlankGrid:
     params: np.ndarray  # worm scalars for the kernel (worm_params)
 
 
-@functools.lru_cache(maxsize=16)
-def flank_grid(g: GearGeometry, slices: int, n_profile: int = N_PROFILE) -> FlankGrid:
-    """The grids of the module docstring (meshgen.wheel's envelope, both flanks of tooth 0); in process and on disk
+def flank_grid(g: GearGeometry, slices: int, n_profile: int | None = None) -> FlankGrid:
+    """The grids of the module docstring (meshgen.wheel's envelope, both flanks of tooth 0) at n_profile points along
+    the profile (None: the module's N_PROFILE when called, which a study may set); in process and on disk
     (meshgen.cache, keyed by the geometry, the grid size and the source of the modules that compute the grid)."""
+    return _flank_grid_cached(g, slices, N_PROFILE if n_profile is None else n_profile)
+
+
+@functools.lru_cache(maxsize=16)
+def _flank_grid_cached(g: GearGeometry, slices: int, n_profile: int) -> FlankGrid:
     parts = {"g": asdict(g), "slices": slices, "n_profile": n_profile, "code": _grid_code_hash()}
     return cached("flankgrid", parts, lambda: _flank_grid(g, slices, n_profile))
 

@@ -60,7 +60,7 @@ import numpy as np
 
 from meshgen import wheel, worm
 from meshgen.geometry import GearGeometry
-from wormsim.tooth.grid import N_PROFILE, flank_grid
+from wormsim.tooth.grid import flank_grid
 
 H_STEP_MX = 0.02  # finite-difference step of (1), in axial modules
 EXTENT_LOAD_SHARE = 0.95  # contact_pattern_extent_face_mm: the face span holding this share of the load
@@ -136,7 +136,7 @@ def _static(g: GearGeometry, X: np.ndarray, c: np.ndarray) -> np.ndarray:
 
 
 @functools.lru_cache(maxsize=16)
-def flank_curvature(g: GearGeometry, slices: int, n_profile: int = N_PROFILE) -> FlankCurvature:
+def flank_curvature(g: GearGeometry, slices: int, n_profile: int | None = None) -> FlankCurvature:
     """(1), (2) on flank_grid(g, slices)'s active points."""
     fg = flank_grid(g, slices, n_profile)
     S, N = fg.rho.shape
