@@ -256,7 +256,7 @@ def test_pressure_maximum_is_the_line_load_averaged_over_one_module_of_line():
 def test_window_rows_are_the_tables_rows_in_the_window_bit_for_bit():
     """PatternLog.window_rows (compiled, one pass over the log) against its definition: table()'s rows with F_n > 0 in
     the window's samples and averaged_pressure_pa of the whole table at those rows, bit for bit (nan where (4) has no
-    value). A random log of the screw jack's 16 slices: 40 samples, contact lines on both flanks over runs of
+    value); the grid's cells against numpy's add.at and maximum.at. A random log of the screw jack's 16 slices: 40 samples, contact lines on both flanks over runs of
     consecutive slices with gaps, zero and negative forces, contacts without a p_H (3)."""
     g = derive(load_scenario(SCENARIOS / "screw_jack.yaml").gear)
     log = FO.PatternLog.__new__(FO.PatternLog)
@@ -286,3 +286,14 @@ def test_window_rows_are_the_tables_rows_in_the_window_bit_for_bit():
     assert np.array_equal(sel, T[keep], equal_nan=True)
     assert np.array_equal(pavg, log.averaged_pressure_pa(T)[keep], equal_nan=True)
     assert 50 < np.isfinite(pavg).sum() < len(pavg)  # both kinds of row
+    # the grid's cells (compiled) against numpy's add.at / maximum.at over the same rows
+    log.fc = type("FC", (), {"grid": flank_grid(g, 16)})()
+    grid = log.grid(t_s, window)
+    load, pmax = np.zeros(cv.inv_rho.shape), np.zeros(cv.inv_rho.shape)
+    sg, j = sel[:, 1].astype(int), sel[:, 2].astype(int)
+    i = np.clip(np.rint(sel[:, 3]).astype(int), 0, cv.inv_rho.shape[2] - 1)
+    np.add.at(load, (sg, j, i), sel[:, 4])
+    k = np.isfinite(pavg)
+    np.maximum.at(pmax, (sg[k], j[k], i[k]), pavg[k])
+    assert np.array_equal(grid["load"], load) and np.array_equal(grid["pressure_max_pa"], pmax)
+    assert (load > 0).sum() > 50

@@ -245,6 +245,21 @@ def _window_rows(buf, m, inwin, inv_rho, rho3, zeta, e_star, length, n):
 
 
 @numba.njit(cache=True)
+def _grid_cells(sel, pavg, load, pmax):
+    """PatternLog.grid's cells: per window row (sel, its averaged pressure pavg) its F_n added to load[sigma, j, i] and
+    a finite pavg into pmax's maximum there, i the nearest profile point (rounded half to even, clipped); row by row
+    in order, as numpy's add.at and maximum.at do."""
+    N = load.shape[2]
+    for r in range(sel.shape[0]):
+        sg, j = int(sel[r, 1]), int(sel[r, 2])
+        i = min(max(int(np.rint(sel[r, 3])), 0), N - 1)
+        load[sg, j, i] += sel[r, 4]
+        p = pavg[r]
+        if math.isfinite(p) and p > pmax[sg, j, i]:
+            pmax[sg, j, i] = p
+
+
+@numba.njit(cache=True)
 def pattern_rows(i, adr, efc_force, meta, weight, inv_rho, line_len, e_star, out, m):
     """Appends (i, sigma, j, f, F_n, p_H (3)) per contact with a constraint row to out (float32) from row m. The
     contact carries the share weight[c] of its slice (kernel.slice_weights), so its line is weight[c] x L long."""
@@ -412,11 +427,7 @@ class PatternLog:
         load = np.zeros((2, S, N))
         pmax = np.zeros((2, S, N))
         if len(T):
-            sg, j = T[:, 1].astype(int), T[:, 2].astype(int)
-            i = np.clip(np.rint(T[:, 3]).astype(int), 0, N - 1)
-            np.add.at(load, (sg, j, i), T[:, 4])
-            k = np.isfinite(pavg)  # the averaged pressure (4) the summary's maximum takes
-            np.maximum.at(pmax, (sg[k], j[k], i[k]), pavg[k])
+            _grid_cells(T, pavg, load, pmax)
         return {
             "load": load,
             "pressure_max_pa": pmax,
