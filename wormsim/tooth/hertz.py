@@ -426,8 +426,7 @@ class PatternLog:
         S, N = self.cv.rho.shape
         load = np.zeros((2, S, N))
         pmax = np.zeros((2, S, N))
-        if len(T):
-            _grid_cells(T, pavg, load, pmax)
+        _grid_cells(T, pavg, load, pmax)  # also without rows: a run's first call loads the compiled code
         return {
             "load": load,
             "pressure_max_pa": pmax,
