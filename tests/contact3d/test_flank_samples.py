@@ -116,6 +116,23 @@ def test_compiled_samples_equal_the_python_path(case, monkeypatch):
     assert pa.keys() == pb.keys() and all(_same(pa[k], pb[k]) for k in pa)
 
 
+def test_friction_checks_that_pass_stay_compiled(monkeypatch):
+    """The friction guard's checks after the ramps (every CHECK_EVERY_S, 0.5 ms: 50 of them over 25 ms) pass inside
+    the compiled samples (flank_samples.friction_aligned) instead of each handing its sample to the Python path; the
+    run is the Python path's bit for bit, and the guard's next check is where FrictionGuard.check leaves it."""
+    from wormsim.contact3d.friction_guard import CHECK_EVERY_S
+
+    sets = SHORT + ["drive.ramp_s=0.005", "load.ramp_s=0.005", "simulation.record_every=1"]
+    counts = {"compiled": 0, "python": 0}
+    fast = _run(JACK, sets, True, monkeypatch, counts)
+    slow = _run(JACK, sets, False, monkeypatch)
+    checks = (0.03 - 0.005) / CHECK_EVERY_S
+    assert counts["python"] < 0.2 * checks, counts
+    assert [k for k in fast.series if not _same(fast.series[k], slow.series[k])] == []
+    differ = [k for k in fast.summary if k not in WALL and not _equal(fast.summary[k], slow.summary[k])]
+    assert differ == [], [(k, fast.summary[k], slow.summary[k]) for k in differ]
+
+
 HELD = (
     JACK,
     [

@@ -229,8 +229,9 @@ def test_pressure_maximum_is_the_line_load_averaged_over_one_module_of_line():
     for (i, j), (F, _) in line.items():
         p3 = FO.hertz_line_pressure_pa(F / sL[i, j], log.e_star, k[j])  # the contact's own (3), as _rows makes it
         rows.append([i, 0, j, f[j], F, p3, cv.zeta[j], 28e-3])
-    T = np.array(rows)
-    log.table, log.m, log._rows = (lambda: T), len(T), None  # the log's rows as T (PatternLog.rows reads table())
+    T = np.array(rows).astype(np.float32).astype(float)  # the log's rows as its float32 buffer holds them
+    log.buf, log.m, log._rows = T[:, :6].astype(np.float32), len(T), None
+    log.rho3 = np.ascontiguousarray(np.broadcast_to(cv.rho, cv.inv_rho.shape))
     assert T[0, 5] > 1.5e9  # the entering contact's (3)
 
     def by_hand(keys):
@@ -250,3 +251,49 @@ def test_pressure_maximum_is_the_line_load_averaged_over_one_module_of_line():
     assert s["contact_pressure_max_face_mm"] == pytest.approx(cv.zeta[kmax[1]] * 1e3)
     fn, p3 = T[:, 4], T[:, 5]
     assert s["contact_pressure_mean_mpa"] == pytest.approx((fn * p3).sum() / fn.sum() * 1e-6, rel=1e-12)
+
+
+def test_window_rows_are_the_tables_rows_in_the_window_bit_for_bit():
+    """PatternLog.window_rows (compiled, one pass over the log) against its definition: table()'s rows with F_n > 0 in
+    the window's samples and averaged_pressure_pa of the whole table at those rows, bit for bit (nan where (4) has no
+    value); the grid's cells against numpy's add.at and maximum.at. A random log of the screw jack's 16 slices: 40 samples, contact lines on both flanks over runs of
+    consecutive slices with gaps, zero and negative forces, contacts without a p_H (3)."""
+    g = derive(load_scenario(SCENARIOS / "screw_jack.yaml").gear)
+    log = FO.PatternLog.__new__(FO.PatternLog)
+    log.geo, log.e_star, log.cv = g, 1.3e11, FO.flank_curvature(g, 16)
+    cv = log.cv
+    log.rho3 = np.ascontiguousarray(np.broadcast_to(cv.rho, cv.inv_rho.shape))
+    rng = np.random.default_rng(7)
+    rows = []
+    for i in range(40):
+        for sg in (0, 1):
+            j0 = int(rng.integers(0, 12))
+            for j in range(j0, min(16, j0 + int(rng.integers(1, 8)))):
+                if rng.random() < 0.1:
+                    continue  # a gap: a new line after it
+                f = float(rng.uniform(0.0, cv.inv_rho.shape[2] - 1))
+                fn = float(rng.choice([0.0, -1.0, *rng.uniform(0.1, 50.0, 6)]))
+                ph = float(rng.choice([np.nan, *rng.uniform(1e8, 1e9, 6)]))
+                rows.append([i, sg, j, f, fn, ph])
+    log.buf = np.array(rows, dtype=np.float32)
+    log.m, log._rows = len(rows), None
+    t_s = np.arange(40) * 1e-3
+    window = (8e-3, 31e-3)
+    T = log.table()
+    keep = ((t_s >= window[0]) & (t_s <= window[1]))[T[:, 0].astype(int)] & (T[:, 4] > 0)
+    sel, pavg = log.window_rows(t_s, window)
+    assert 0 < len(sel) < len(T)
+    assert np.array_equal(sel, T[keep], equal_nan=True)
+    assert np.array_equal(pavg, log.averaged_pressure_pa(T)[keep], equal_nan=True)
+    assert 50 < np.isfinite(pavg).sum() < len(pavg)  # both kinds of row
+    # the grid's cells (compiled) against numpy's add.at / maximum.at over the same rows
+    log.fc = type("FC", (), {"grid": flank_grid(g, 16)})()
+    grid = log.grid(t_s, window)
+    load, pmax = np.zeros(cv.inv_rho.shape), np.zeros(cv.inv_rho.shape)
+    sg, j = sel[:, 1].astype(int), sel[:, 2].astype(int)
+    i = np.clip(np.rint(sel[:, 3]).astype(int), 0, cv.inv_rho.shape[2] - 1)
+    np.add.at(load, (sg, j, i), sel[:, 4])
+    k = np.isfinite(pavg)
+    np.maximum.at(pmax, (sg[k], j[k], i[k]), pavg[k])
+    assert np.array_equal(grid["load"], load) and np.array_equal(grid["pressure_max_pa"], pmax)
+    assert (load > 0).sum() > 50

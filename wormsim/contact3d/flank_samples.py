@@ -4,16 +4,18 @@ the per-sample Python (~45-60 us a sample: dispatch, guards, the series column) 
 
 Per sample, in the runner's order and with its floating-point operations (bit-identical series, pattern and radius
 logs, contact points: tests/contact3d/test_flank_samples.py): the steps; the state read from d (shaft angles and speeds,
-d.time); the runner's Guards.state checks (non-finite state or MuJoCo's bad-qacc warning, overspeed, teeth jumped);
-mu from the friction law with its stick state (wormsim.physics.friction.mu_at, stuck_after; a stuck pair's
-break-away from MuJoCo's rows on the worm's hinge, wormsim.contact3d.breakaway);
-flank_loop.sample_flanks (with displaced poses, errors: or shafts:, the points go into tooth 0's frame through the
-displaced wheel body's frame); the penetration and lock checks of Guards.contact; the shafts' log (ShaftLog.record:
-mj_rnePostConstraint by address where a bearing is rigid, then its raw values, wormsim.contact3d.shafts.gather); the
-series column (series.SERIES order).
+d.time); the runner's Guards.state checks (non-finite state or MuJoCo's bad-qacc warning, overspeed, teeth jumped;
+the friction guard's check every CHECK_EVERY_S, FrictionGuard.check, where it passes: the sliding contacts' friction
+aligned with their slip and no misalignment held); mu from the friction law with its stick state
+(wormsim.physics.friction.mu_at, stuck_after; a stuck pair's break-away from MuJoCo's rows on the worm's hinge,
+wormsim.contact3d.breakaway); flank_loop.sample_flanks (with displaced poses, errors: or shafts:, the points go into
+tooth 0's frame through the displaced wheel body's frame); the penetration and lock checks of Guards.contact; the
+shafts' log (ShaftLog.record: mj_rnePostConstraint by address where a bearing is rigid, then its raw values,
+wormsim.contact3d.shafts.gather); the series column (series.SERIES order).
 
 Anything else hands the sample back to the runner's Python path, after its steps and before any of its per-sample
-work: a guard that would act (it raises or keeps state: a stuck drive, the friction guard's next check), a friction
+work: a guard that would act (it raises or keeps state: a stuck drive, a friction guard's check that finds the
+friction against the slip or holds a misalignment), a friction
 coefficient that starts or stops being zero (FlankContacts.set_friction changes the cone's dimension; other changes
 are written into the hand-off's records here, as set_template leaves them), a contact log that needs room, contacts
 MuJoCo did not take, a stuck pair with more contacts or constraint rows than hinge_need's room.
@@ -37,6 +39,7 @@ import numpy as np
 
 from wormsim.contact3d.breakaway import hinge_utilisation
 from wormsim.contact3d.flank_loop import FV, ContactRows, Row, SampleRow, records, run_table, sample_table
+from wormsim.contact3d.friction_guard import ALIGN_MIN, CHECK_EVERY_S, alignment_rows
 from wormsim.contact3d.guards import PENETRATED, RUNNING, STUCK, contact_event, state_event
 from wormsim.contact3d.native import address, call_mul, call_stage, f1, f64_at, i1, i32_at, i64_at, mjdata_offsets
 from wormsim.contact3d.series import column
@@ -51,9 +54,10 @@ ADR_CAP = 4096  # contacts per step the compiled sample reads (more: the sample 
 # io: what changes between calls (in) and what run_samples hands back (out), by slot
 # out (IO_TURN_MAX, IO_PM, IO_RM in too)
 IO_NEXT, IO_PENDING, IO_TURN_MAX, IO_PM, IO_RM, IO_DROPPED, IO_EVENT = range(7)
-# in (IO_MU and IO_STUCK out too: the contacts' mu and the friction law's stick state after the call)
-IO_NEXT_CHECK, IO_MU, IO_E_STAR, IO_LOCKED, IO_STUCK = range(7, 12)
-IO_LEN = 12
+# in (IO_MU, IO_STUCK and IO_NEXT_CHECK out too: the contacts' mu, the friction law's stick state and the friction
+# guard's next check after the call; IO_ALIGNED: the friction guard holds no misalignment, its `since` is None)
+IO_NEXT_CHECK, IO_MU, IO_E_STAR, IO_LOCKED, IO_STUCK, IO_ALIGNED = range(7, 13)
+IO_LEN = 13
 # io[IO_EVENT]: why run_samples handed a sample back to the runner's Python path (0: it did not)
 EV_NONE, EV_GUARD, EV_FRICTION_CHECK, EV_CONE, EV_LOG_FULL, EV_DROPPED, EV_STICK = range(7)
 
@@ -73,6 +77,7 @@ class SampleParams(NamedTuple):
     cos_gamma: float
     mu_law: MuLaw  # wormsim.physics.friction.mu_at's law
     stick_v: float  # the friction law's stick state: v_stick (Prepared.stick_velocity_m_s; 0: none)
+    v_slide: float  # the friction guard's slip speed (FrictionGuard.v_min: contact.transition_velocity_m_s)
     rpm: float  # (rad/s) per rpm
     a: float
     speed_driven: bool
@@ -154,6 +159,27 @@ def hinge_need(m_addr, d_addr, off, p, hold):
 
 
 @numba.njit(cache=True)
+def friction_aligned(d_addr, off, hold, v_min):
+    """FrictionGuard.check's reading of d's contacts (read at the checked offsets off into hinge_need's room hold)
+    at or above ALIGN_MIN: the check passes; False where it does not, or where the contacts do not fit the room."""
+    adr, dims, mus = hold[4], hold[5], hold[6]
+    ncon, nefc = i32_at(d_addr + off[1])[0], i32_at(d_addr + off[2])[0]
+    if ncon > dims.shape[0]:
+        return False
+    size, cbase = off[6], i64_at(d_addr + off[3])[0]
+    for k in range(ncon):
+        c = cbase + k * size
+        adr[k] = i32_at(c + off[7])[0]
+        dims[k] = i32_at(c + off[9])[0]
+        mus[k] = f64_at(c + off[10])[0]
+    n = max(nefc, 0)
+    efc = numba.carray(f64_at(i64_at(d_addr + off[4])[0]), (n,))
+    vel = numba.carray(f64_at(i64_at(d_addr + off[11])[0]), (n,))
+    cos = alignment_rows(adr[:ncon], dims[:ncon], mus[:ncon], efc, vel, v_min)[0]
+    return cos >= ALIGN_MIN
+
+
+@numba.njit(cache=True)
 def stick_mu(mj, off, p, hold, stuck, vs):
     """(the friction law's stick state after the sample at the sliding speed vs, the mu it gives): stuck_after, a
     stuck pair's need from hinge_need (only runs with a stick state are ever stuck); mu -1 where hinge_need's room is
@@ -226,9 +252,11 @@ def run_samples(tables, mj, cmds, span, S, p, room, io, mrg, shaft):
         if event != 0:  # Guards.state raises: the Python path
             io[IO_EVENT] = EV_GUARD
             return
-        if t > io[IO_NEXT_CHECK]:  # the friction guard's next check
-            io[IO_EVENT] = EV_FRICTION_CHECK
-            return
+        if t > io[IO_NEXT_CHECK]:  # the friction guard's next check: compiled where it passes with no misalignment
+            if io[IO_ALIGNED] == 0.0 or not friction_aligned(d_addr, off, hold, p.v_slide):
+                io[IO_EVENT] = EV_FRICTION_CHECK  # FrictionGuard.check keeps state or acts: the Python path
+                return
+            io[IO_NEXT_CHECK] = t + CHECK_EVERY_S  # as FrictionGuard.check leaves it (since stays None)
         vs = abs(w1) * p.r1 / p.cos_gamma  # the sliding speed Vs
         # the stick state, written back at the sample's end (a hand-back repeats stuck_after), and mu
         stuck, mu = stick_mu(mj, off, p, hold, io[IO_STUCK] != 0.0, vs)
@@ -298,6 +326,7 @@ class FlankSamples:
             cos_gamma=math.cos(geo.gamma),
             mu_law=bm.plan.mu_law,
             stick_v=float(bm.plan.stick_velocity_m_s),
+            v_slide=float(guards.friction.v_min),
             rpm=RPM,
             a=float(geo.a),
             speed_driven=bool(guards.speed_driven),
@@ -337,6 +366,7 @@ class FlankSamples:
         k = fc.kernel
         io[IO_NEXT_CHECK], io[IO_MU], io[IO_E_STAR] = guards.friction.next_check, fc.mu, pattern.e_star
         io[IO_LOCKED] = float(guards.locked_since is not None)
+        io[IO_ALIGNED] = float(guards.friction.since is None)
         io[IO_STUCK] = float(guards.stuck)
         io[IO_TURN_MAX], io[IO_PM], io[IO_RM] = guards.turn_max, pattern.m, rlog.m
         room = (self.off, fc.frame, fc.pos, fc.nrm, self.adr, pattern.buf, rlog.buf, self.hold)
@@ -349,6 +379,7 @@ class FlankSamples:
             fc.template.friction = [fc.mu, fc.mu, 0.0, 0.0, 0.0]
         loop.dropped += int(io[IO_DROPPED])
         guards.turn_max = float(io[IO_TURN_MAX])
+        guards.friction.next_check = float(io[IO_NEXT_CHECK])
         guards.stuck = bool(io[IO_STUCK] != 0.0)
         pattern.m, rlog.m = int(io[IO_PM]), int(io[IO_RM])
         return int(io[IO_NEXT]), int(io[IO_EVENT])

@@ -51,7 +51,15 @@ def friction_alignment(d: mujoco.MjData, v_min: float) -> tuple[float, float, fl
 @numba.njit(cache=True, error_model="numpy")
 def _alignment(adr, dim, friction, f, v, v_min):
     """friction_alignment over the contacts' rows, compiled (a numpy version cost ~150 us per call, 0.3 s per
-    seat-motor 20 s run). |f_t| cos = -(f_t . v_t) / |v_t|, summed and divided by the summed |f_t|."""
+    seat-motor 20 s run)."""
+    return alignment_rows(adr, dim, friction[:, 0], f, v, v_min)
+
+
+@numba.njit(cache=True, error_model="numpy")
+def alignment_rows(adr, dim, mu, f, v, v_min):
+    """friction_alignment of contacts with efc addresses adr, dimensions dim and friction coefficients mu (the
+    compiled samples read them from d: wormsim.contact3d.flank_samples). |f_t| cos = -(f_t . v_t) / |v_t|, summed and
+    divided by the summed |f_t|."""
     proj = fs = fn_sum = 0.0
     rows = sliding = 0
     for k in range(adr.size):
@@ -62,7 +70,7 @@ def _alignment(adr, dim, friction, f, v, v_min):
         fn, f1, f2, v1, v2 = f[a], f[a + 1], f[a + 2], v[a + 1], v[a + 2]
         fn_sum += fn
         ft, vt = math.hypot(f1, f2), math.hypot(v1, v2)
-        if vt > v_min and fn > 0 and ft >= ON_CONE * friction[k, 0] * fn:
+        if vt > v_min and fn > 0 and ft >= ON_CONE * mu[k] * fn:
             sliding += 1
             proj -= (f1 * v1 + f2 * v2) / vt
             fs += ft

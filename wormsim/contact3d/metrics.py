@@ -37,7 +37,7 @@ def contact3d_summary(S: dict, bm) -> dict:
         # and the meshing harmonics lie outside its band
         **mesh_line_keys(t, S, sl, f_theory, "tangential_force_n"),
         "force_peak_full_band_hz": f_full,
-        "mesh_frequency_radial_hz": mesh_line(t[sl], S["radial_force_n"][sl], f_theory)["f_hz"],
+        "mesh_frequency_radial_hz": mesh_line(t[sl], S["radial_force_n"][sl], f_theory, harmonics=False)["f_hz"],
         "contacts_mean": float(np.mean(S["contacts"][sl])),
         "teeth_in_contact_mean": float(np.mean(S["teeth_in_contact"][sl])),
         "max_penetration_um": float(np.max(S["max_penetration_m"][sl]) * 1e6),

@@ -228,7 +228,7 @@ _SCALARS = {
 # badq_number: the count of mjWARN_BADQPOS, whose mjWarningStat is followed by BADQVEL's and BADQACC's (warning_size
 # apart): MuJoCo resets the state and the time on each (mj_checkPos / mj_checkVel / mj_checkAcc)
 FIELDS = ("time", "ncon", "nefc", "contact", "efc_force", "badq_number", "contact_size", "contact_efc_address")
-FIELDS += ("warning_size", "contact_dim", "contact_friction")
+FIELDS += ("warning_size", "contact_dim", "contact_friction", "efc_vel")
 BAD_STATE_WARNINGS = ("mjWARN_BADQPOS", "mjWARN_BADQVEL", "mjWARN_BADQACC")
 
 
@@ -284,6 +284,7 @@ def declared_offsets() -> np.ndarray:
             ctypes.sizeof(W),
             C.dim.offset,
             C.friction.offset,
+            D.efc_vel.offset,
         ],
         dtype=np.int64,
     )
@@ -315,6 +316,7 @@ def check(off: np.ndarray) -> list[str]:
             [7 + k for k in range(len(BAD_STATE_WARNINGS))],
         ),
         "contact_size": (o[6], np.asarray(d.contact.dist).strides[0]),
+        "efc_vel": (ctypes.c_int64.from_address(a + o[11]).value, np.asarray(d.efc_vel).ctypes.data),
     }
     if d.ncon >= 1:
         k = d.ncon - 1

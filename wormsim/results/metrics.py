@@ -101,13 +101,14 @@ def _hann_dtft_amplitude(tt: np.ndarray, y: np.ndarray, wsum: float, f: float) -
     return float(2.0 * abs(np.dot(y, np.exp(-2j * np.pi * f * tt))) / max(wsum, 1e-300))
 
 
-def mesh_line(t: np.ndarray, x: np.ndarray, f_theory_hz: float) -> dict:
+def mesh_line(t: np.ndarray, x: np.ndarray, f_theory_hz: float, harmonics: bool = True) -> dict:
     """The meshing line of x(t) (uniform grid) near f_theory_hz = z1 n1 / 60 (see the module docstring).
 
     Returns {"f_hz", "resolution_hz", "cycles", "amplitudes", "found"}: the line's frequency (NaN when x is too short
     or f_theory_hz not positive), the bin width 1 / T, the mesh periods in the window (T f_theory_hz), the amplitudes
-    of x at k f_hz for k = 1..MESH_HARMONICS (x's unit) and whether the band's largest value is an interior peak
-    (False: the largest value sits at the band's edge, no line near the theory)."""
+    of x at k f_hz for k = 1..MESH_HARMONICS (x's unit; nan without `harmonics`: a caller that takes the frequency
+    alone) and whether the band's largest value is an interior peak (False: the largest value sits at the band's edge,
+    no line near the theory)."""
     from scipy.optimize import minimize_scalar
 
     n = len(x)
@@ -141,7 +142,9 @@ def mesh_line(t: np.ndarray, x: np.ndarray, f_theory_hz: float) -> dict:
         lambda f: -_hann_dtft_amplitude(tt, y, wsum, f), bounds=(a, b), method="bounded", options={"xatol": 1e-6 * a}
     )
     f = float(opt.x) if opt.success else float(freqs[k])
-    amps = [_hann_dtft_amplitude(tt, y, wsum, j * f) for j in range(1, MESH_HARMONICS + 1)]
+    amps = [
+        _hann_dtft_amplitude(tt, y, wsum, j * f) if harmonics else float("nan") for j in range(1, MESH_HARMONICS + 1)
+    ]
     return {"f_hz": f, "resolution_hz": 1.0 / span, "cycles": span * f_theory_hz, "amplitudes": amps, "found": found}
 
 
