@@ -9,6 +9,11 @@ under the same PYTHONPATH). The trees take turns (in order, then reversed), firs
 - preload: the CPU seconds (user + system) of a process that imports wormsim.sweep.preload_warm, the local cluster's
   fork server's work before it forks the first worker (the workers' imports, numba's start-up, the kernels loaded,
   the short run): the path before a sweep's first point on a machine with a core free beside the client;
+then --worker-repeats times:
+- workers: a local cluster of --workers workers started as the sweep starts it (the warm fork server, the warm-up
+  plugin), one short screw-jack point per worker; each worker process's CPU seconds less its point's thread CPU
+  seconds: what a worker costs between its fork and its first point (start, registration, the first task unpickled),
+  averaged over the workers;
 then --repeats times:
 - command: a sweep of --points screw-jack points of --duration s at contact3d on --workers workers, its wall time,
   the time before its first point and after its last (sweep.json's timing), fixed = command less the points' span.
@@ -53,6 +58,47 @@ def preload_cpu(tree: Path) -> float:
     return (r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime)
 
 
+# run with PYTHONPATH=tree: argv scenario, workers; prints the workers' mean CPU seconds outside their points
+WORKER_PROBE = """
+import inspect, json, os, sys
+from wormsim.scenario import load_scenario
+from wormsim.sweep.cluster import close_cluster, open_client, start_fork_server, warm_workers
+from wormsim.sweep.runner import run_point
+
+
+def cpu():
+    t = os.times()
+    return t.user + t.system
+
+
+start_fork_server(True)
+kw = {"warm": True} if "warm" in inspect.signature(open_client).parameters else {}
+client, cluster, info = open_client(None, int(sys.argv[2]), **kw)
+try:
+    warm_workers(client, info)
+    sc = load_scenario(sys.argv[1], ["model=contact3d", "simulation.duration_s=0.01"]).model_dump(mode="json")
+    futs = [client.submit(run_point, sc, False, pure=False, key=f"probe-{i}") for i in range(info["workers"])]
+    res = client.gather(futs)
+    cpus = client.run(cpu)
+finally:
+    close_cluster(client, cluster)
+print(json.dumps((sum(cpus.values()) - sum(r["timing"]["thread_cpu_s"] for r in res)) / len(cpus)))
+"""
+
+
+def worker_cpu(tree: Path, workers: int) -> float:
+    """The mean CPU seconds of a local cluster's workers outside their points (WORKER_PROBE) with `tree`'s code."""
+    cp = subprocess.run(
+        [sys.executable, "-c", WORKER_PROBE, str(ROOT / "scenarios" / "screw_jack.yaml"), str(workers)],
+        env=_env(tree),
+        check=True,
+        cwd=tree,
+        capture_output=True,
+        text=True,
+    )
+    return float(cp.stdout.splitlines()[-1])
+
+
 def command(tree: Path, sweep: Path, out: Path, workers: int) -> dict:
     if out.exists():
         for f in out.iterdir():
@@ -83,6 +129,7 @@ def main() -> None:
     ap.add_argument("--label-compare", default="compare")
     ap.add_argument("--repeats", type=int, default=6, help="commands per tree")
     ap.add_argument("--preload-repeats", type=int, default=10, help="preload processes per tree")
+    ap.add_argument("--worker-repeats", type=int, default=4, help="worker probes per tree")
     ap.add_argument("--points", type=int, default=4)
     ap.add_argument("--duration", type=float, default=0.05)
     ap.add_argument("--workers", type=int, default=2)
@@ -102,22 +149,32 @@ def main() -> None:
     for rep in range(args.preload_repeats):
         for name in trees if rep % 2 == 0 else list(trees)[::-1]:
             preload[name].append(preload_cpu(trees[name]))
+    wcpu: dict[str, list[float]] = {k: [] for k in trees}
+    for rep in range(args.worker_repeats):
+        for name in trees if rep % 2 == 0 else list(trees)[::-1]:
+            wcpu[name].append(worker_cpu(trees[name], args.workers))
     for rep in range(args.repeats):
         for name in trees if rep % 2 == 0 else list(trees)[::-1]:
             runs[name].append(command(trees[name], sweep, out / name, args.workers))
     keys = ("command_s", "before_first_point_s", "after_last_point_s", "fixed_s")
     med = {
-        n: {"preload_cpu_s": statistics.median(preload[n]), **{k: statistics.median(r[k] for r in rs) for k in keys}}
+        n: {
+            "preload_cpu_s": statistics.median(preload[n]),
+            **({"worker_cpu_s": statistics.median(wcpu[n])} if wcpu[n] else {}),
+            **{k: statistics.median(r[k] for r in rs) for k in keys},
+        }
         for n, rs in runs.items()
     }
-    keys = ("preload_cpu_s", *keys)
+    keys = ("preload_cpu_s", *(("worker_cpu_s",) if args.worker_repeats else ()), *keys)
     rec = {
         "provenance": provenance(
             f"python studies/measure_sweep_fixed.py --compare TREE_OF_{args.label_compare} "
-            f"--label-compare {args.label_compare} --repeats {args.repeats} --preload-repeats {args.preload_repeats}"
+            f"--label-compare {args.label_compare} --repeats {args.repeats} --preload-repeats {args.preload_repeats} "
+            f"--worker-repeats {args.worker_repeats}"
         ),
         "what": f"`wormsim sweep` of {args.points} contact3d screw-jack points ({args.duration} s) on {args.workers} "
-        f"workers ({args.repeats} each) and the fork server's preload ({args.preload_repeats} each), this checkout "
+        f"workers ({args.repeats} each), the fork server's preload ({args.preload_repeats} each) and the workers' CPU "
+        f"outside their first points ({args.worker_repeats} clusters each), this checkout "
         f"against {args.label_compare}, taking turns",
         "cpu_count": os.cpu_count(),
         "load_average_before": load_before,
@@ -125,6 +182,7 @@ def main() -> None:
         "medians": med,
         "ratio_this_over_compare": {k: med["this"][k] / med[args.label_compare][k] for k in keys},
         "preload_cpu_s": preload,
+        "worker_cpu_s": wcpu,
         "runs": runs,
     }
     Path(args.record).write_text(json.dumps(rec, indent=1) + "\n")

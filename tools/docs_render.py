@@ -536,6 +536,7 @@ def sweep_fixed_cost_table(name: str = "sweep_fixed_cost") -> str:
     r = load(name)
     keys = [
         ("preload_cpu_s", "fork server's preload, CPU s"),
+        ("worker_cpu_s", "a worker before its first point, CPU s"),
         ("before_first_point_s", "before the first point s"),
         ("after_last_point_s", "after the last point s"),
         ("fixed_s", "fixed s"),
@@ -545,6 +546,7 @@ def sweep_fixed_cost_table(name: str = "sweep_fixed_cost") -> str:
     rows = [
         [label, *(f"{r['medians'][n][k]:.2f}" for n in names), f"{r['ratio_this_over_compare'][k]:.2f}"]
         for k, label in keys
+        if k in r["ratio_this_over_compare"]  # (worker_cpu_s: records from 2026-11-28 on)
     ]
     head = ["median", *(("this commit" if n == "this" else n) for n in names), "ratio"]
     text = _table(head, rows)

@@ -161,3 +161,34 @@ def test_cli_stops_the_fork_server_of_an_invalid_sweep_file(tmp_path):
     f.write_text(f"name: bad\nbase: {SCREW_JACK}\ngrid: {{drive.speed_rpm: {{linspace: [1, 2]}}}}\n")
     rec = _record(["sweep", str(f), "--out", str(tmp_path / "o")])
     assert rec == {"code": 2, "events": [["fork server", True, []], ["stopped"]]}
+
+
+# a forked worker's state before its first task: the fork server's preload, then the task's bytes unpickled
+_FIRST_TASK = """
+import json, sys
+import distributed.versions as v
+import wormsim.sweep.preload  # noqa: F401
+from distributed.protocol.pickle import loads
+before = set(sys.modules)
+loads(bytes.fromhex(sys.argv[1]))
+print(json.dumps({"new": sorted(set(sys.modules) - before), "tqdm": "tqdm" in sys.modules,
+                  "versions_cached": v._version_cached.cache_info().currsize}))
+"""
+
+
+def test_the_preload_holds_what_a_worker_needs_before_its_first_point():
+    """After the fork server's preload (wormsim.sweep.preload) a worker unpickles its first task (run_point,
+    run_points) without importing a module, never imports tqdm (the client's progress bar), and has the package
+    versions it registers with cached (distributed.versions.get_versions: not run again in each forked worker)."""
+    from distributed.protocol.pickle import dumps
+
+    from wormsim.sweep.runner import run_point, run_points
+
+    task = dumps((run_point, run_points, ({"name": "x"}, False)))
+    cp = subprocess.run(
+        [sys.executable, "-c", _FIRST_TASK, task.hex()], capture_output=True, text=True, timeout=300, cwd=ROOT
+    )
+    assert cp.returncode == 0, cp.stderr
+    got = json.loads(cp.stdout.splitlines()[-1])
+    assert got["new"] == [] and got["tqdm"] is False, got
+    assert got["versions_cached"] > 0

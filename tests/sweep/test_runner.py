@@ -66,7 +66,8 @@ def test_an_invalid_point_exits_2_with_the_cluster_started(tmp_path, capsys):
 
 def test_local_workers_start_warm_from_the_fork_server(tmp_path):
     """A contact3d sweep's local workers are forked from a fork server that loaded the compiled kernels once
-    (wormsim.sweep.preload_warm): each point finds them loaded before it starts, on every worker."""
+    (wormsim.sweep.preload_warm): each point finds them loaded before it starts, on every worker; the warm-up plugin
+    came with the workers (wormsim.sweep.cluster.open_client), not registered after they started."""
     f = tmp_path / "s.yaml"
     f.write_text(
         "name: warm\nbase: {base}\nset: {{model: contact3d, simulation.duration_s: 0.004}}\n"
@@ -85,6 +86,8 @@ def test_local_workers_start_warm_from_the_fork_server(tmp_path):
     assert len(timing) == 2, timing
     warmed_by = {t["warmed_by_pid"] for t in timing}
     assert len(warmed_by) == 1 and None not in warmed_by and not warmed_by & {t["pid"] for t in timing}, timing
+    # the workers got the warm-up plugin when they were made: the client registered none before the first point
+    assert doc["cluster"]["warm_at_start"] is True and doc["cluster"]["warm_s"] == 0.0, doc["cluster"]
     # each point's thread CPU seconds: spent, and within its wall time (a thread runs on one core at a time)
     assert all(0.0 < t["thread_cpu_s"] <= t["end"] - t["start"] + 0.01 for t in timing), timing
 

@@ -152,9 +152,12 @@ def early_fork_server(sweep_path: str | Path, scheduler: str | None) -> bool:
     return True
 
 
-def open_client(scheduler: str | None, workers: int | None):
-    """(client, cluster or None, info). scheduler None: a LocalCluster of `workers` single-threaded processes.
-    Raises ScenarioError for a bad --workers or a scheduler that does not answer."""
+def open_client(scheduler: str | None, workers: int | None, warm: bool = False):
+    """(client, cluster or None, info). scheduler None: a LocalCluster of `workers` single-threaded processes, with
+    `warm` each of them given the plugin wormsim.sweep.warm.WarmKernels when it is made (a worker forked from the
+    warm fork server skips it; one the nanny restarts loads the kernels before it registers), so that warm_workers
+    has nothing to register (info "warm_at_start"). Raises ScenarioError for a bad --workers or a scheduler that does
+    not answer."""
     if workers is not None and workers < 1:
         raise ScenarioError(f"--workers {workers}: allowed an integer >= 1")
     from distributed import Client, LocalCluster
@@ -185,15 +188,26 @@ def open_client(scheduler: str | None, workers: int | None):
         # dask's own log lines stay off stderr up to ERROR: on a loaded machine a worker's heartbeat times out and
         # distributed logs it with a traceback, though the worker reconnects and the sweep ends well (a point that
         # fails, or a lost worker, is a row with its message in sweep.csv / sweep.json)
+        plugins: tuple = ()
+        if warm:
+            from wormsim.sweep.warm import WarmKernels
+
+            plugins = (WarmKernels(),)
         with dask.config.set({"distributed.worker.multiprocessing-method": LOCAL_START_METHOD, **LOCAL_DASK_CONFIG}):
             cluster = LocalCluster(
-                n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0", silence_logs=logging.CRITICAL
+                n_workers=n,
+                threads_per_worker=1,
+                processes=True,
+                dashboard_address=":0",
+                silence_logs=logging.CRITICAL,
+                plugins=plugins,
             )
         client = Client(cluster)
         kind = "LocalCluster (processes)"
     ws = client.scheduler_info().get("workers", {})
     info = {
         "kind": kind,
+        "warm_at_start": bool(warm and cluster is not None),
         "scheduler": client.scheduler.address,
         "start_s": time.perf_counter() - t0,
         "workers": len(ws),
@@ -207,10 +221,15 @@ def open_client(scheduler: str | None, workers: int | None):
 
 def warm_workers(client, info: dict) -> None:
     """Every worker loads (the machine's first compiles, once) the contact3d kernels before the points go out
-    (wormsim.sweep.warm.WarmKernels; also on workers that join later). info gets "warm_s"."""
+    (wormsim.sweep.warm.WarmKernels; also on workers that join later). info gets "warm_s". Nothing to do where the
+    workers got the plugin when they were made (open_client's `warm`): no round trip to every worker before the
+    first point."""
     from wormsim.sweep.warm import WarmKernels
 
     t0 = time.perf_counter()
+    if info.get("warm_at_start"):
+        info["warm_s"] = 0.0
+        return
     try:
         client.register_plugin(WarmKernels())
     except Exception:  # (a worker that cannot warm compiles or loads in its first point)
@@ -232,13 +251,13 @@ class ClusterStart:
         if scheduler is None:
             start_fork_server(warm)
         self._thread = threading.Thread(
-            target=self._run, args=(scheduler, workers), name="wormsim-cluster-start", daemon=True
+            target=self._run, args=(scheduler, workers, warm), name="wormsim-cluster-start", daemon=True
         )
         self._thread.start()
 
-    def _run(self, scheduler, workers) -> None:
+    def _run(self, scheduler, workers, warm) -> None:
         try:
-            self._result = open_client(scheduler, workers)
+            self._result = open_client(scheduler, workers, warm)
         except BaseException as exc:  # (re-raised by get in the main thread)
             self._error = exc
 

@@ -24,8 +24,6 @@ import time
 from importlib import metadata
 from pathlib import Path
 
-from tqdm import tqdm
-
 from wormsim.runfolder.writer import ResultDir, write_json_atomic
 from wormsim.scenario import ScenarioError
 from wormsim.sweep.cluster import (  # noqa: F401  (the cluster's names, as they were here)
@@ -230,6 +228,9 @@ class SweepProgress:
         tty = self._stream.isatty() if hasattr(self._stream, "isatty") else False
         bar = bool(enabled) if enabled is not None else (tty and not off)
         self._log = enabled is None and not tty and not off
+        from tqdm import tqdm  # (here, not at the top: a worker imports this module for its tasks, never a bar)
+
+        self._tqdm = tqdm
         self._bar = tqdm(
             total=total,
             initial=done,
@@ -245,7 +246,7 @@ class SweepProgress:
 
     def say(self, text: str) -> None:
         if self._log or not self._bar.disable:
-            tqdm.write(text, file=self._stream)
+            self._tqdm.write(text, file=self._stream)
 
     def point_done(self, failed: bool) -> None:
         self._done += 1

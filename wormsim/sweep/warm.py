@@ -1,13 +1,13 @@
 """The sweep's worker plugin: each dask worker loads the compiled contact3d kernels before its first point.
 
-`WarmKernels.setup` runs on every worker that joins (distributed's WorkerPlugin, registered by the sweep when its
-points include contact3d runs) in a thread of the worker, so the worker's event loop keeps answering the scheduler:
-wormsim.runtime.jit_cache.ensure_warm (the machine's first worker compiles, holding the cache's lock; the others wait
-for it
-and load), then one short run (jit_cache.WARM_RUNS' first, SAMPLED_STEPS steps: long enough for the samples that
-leave the compiled stretch) and the friction check, which load every compiled function a screw-jack point calls,
-numba's start-up and the imports into the worker process. A worker's first point then costs what its others cost.
-A failure is dropped: the point compiles or loads for itself.
+`WarmKernels.setup` runs on every worker that joins (distributed's WorkerPlugin, when the sweep's points include
+contact3d runs: given to a local cluster's workers when they are made, before they register, and registered by the
+client on a cluster given by address) in a thread of the worker, so the worker's event loop keeps answering the
+scheduler: wormsim.runtime.jit_cache.ensure_warm (the machine's first worker compiles, holding the cache's lock; the
+others wait for it and load), then one short run (jit_cache.WARM_RUNS' first, SAMPLED_STEPS steps: long enough for
+the samples that leave the compiled stretch) and the friction check, which load every compiled function a screw-jack
+point calls, numba's start-up and the imports into the worker process. A worker's first point then costs what its
+others cost. A failure is dropped: the point compiles or loads for itself.
 """
 
 from __future__ import annotations
