@@ -297,3 +297,27 @@ def test_window_rows_are_the_tables_rows_in_the_window_bit_for_bit():
     np.maximum.at(pmax, (sg[k], j[k], i[k]), pavg[k])
     assert np.array_equal(grid["load"], load) and np.array_equal(grid["pressure_max_pa"], pmax)
     assert (load > 0).sum() > 50
+
+
+def test_flank_curvature_is_cached_on_disk_per_gear_grid_and_profile_count(tmp_path, monkeypatch):
+    """flank_curvature's disk cache (meshgen.cache): a second process's call loads what the first computed, equal
+    bit for bit; another profile count or gear is its own entry; None takes the grid's N_PROFILE when called."""
+    from wormsim.tooth import grid
+
+    monkeypatch.setenv("WORMSIM_CACHE", str(tmp_path))
+    g = derive(load_scenario(SCENARIOS / "screw_jack.yaml").gear)
+    FO._flank_curvature_cached.cache_clear()
+    a = FO.flank_curvature(g, 8, 16)
+    files = sorted(p.name for p in tmp_path.glob("flankcurv-*.pkl"))
+    assert len(files) == 1
+    FO._flank_curvature_cached.cache_clear()  # as a new process: from disk
+    b = FO.flank_curvature(g, 8, 16)
+    assert b is not a
+    for k in ("inv_rho", "line_tz", "line_len", "rho", "zeta"):
+        np.testing.assert_array_equal(getattr(a, k), getattr(b, k))
+    FO.flank_curvature(g, 8, 24)
+    FO.flank_curvature(derive(load_scenario(SCENARIOS / "seat_motor.yaml").gear), 8, 16)
+    assert len(list(tmp_path.glob("flankcurv-*.pkl"))) == 3
+    monkeypatch.setattr(grid, "N_PROFILE", 16)
+    assert FO.flank_curvature(g, 8) is FO.flank_curvature(g, 8, 16)
+    FO._flank_curvature_cached.cache_clear()

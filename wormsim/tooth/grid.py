@@ -91,12 +91,12 @@ def flank_grid(g: GearGeometry, slices: int, n_profile: int | None = None) -> Fl
 
 @functools.lru_cache(maxsize=16)
 def _flank_grid_cached(g: GearGeometry, slices: int, n_profile: int) -> FlankGrid:
-    parts = {"g": asdict(g), "slices": slices, "n_profile": n_profile, "code": _grid_code_hash()}
+    parts = {"g": asdict(g), "slices": slices, "n_profile": n_profile, "code": grid_code_hash()}
     return cached("flankgrid", parts, lambda: _flank_grid(g, slices, n_profile))
 
 
 @functools.cache
-def _grid_code_hash() -> str:
+def grid_code_hash() -> str:
     """SHA-256 of the source that determines flank_grid's result (this module, the trim, the pose, the window and
     meshgen's geometry, worm and wheel)."""
     import inspect

@@ -1,6 +1,6 @@
 """Contact pattern and Hertz contact stress from the exact-flank contacts (`contact.geometry: flanks`).
 
-Geometry, once per gear and slice count (`flank_curvature`, cached in process), on the kernel's grid
+Geometry, once per gear and slice count (`flank_curvature`, cached in process and on disk), on the kernel's grid
 (wormsim.tooth.kernel.flank_grid: flank sigma, slice j, profile point i): at each active point, the wheel flank
 and the worm thread in the rigid conjugate pose at which that point is on the contact line (wheel angle c, the
 point's conjugate angle; worm angle c / (hand z1 / z2); the unshifted space-0 flank, i.e. without backlash). There
@@ -52,14 +52,17 @@ over l_H. Measured with (3) per contact (the maximum over contacts above 1 % of 
 from __future__ import annotations
 
 import functools
+import hashlib
 import math
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 
 import numba
 import numpy as np
 
 from meshgen import wheel, worm
+from meshgen.cache import cached
 from meshgen.geometry import GearGeometry
+from wormsim.tooth import grid
 from wormsim.tooth.grid import flank_grid
 
 H_STEP_MX = 0.02  # finite-difference step of (1), in axial modules
@@ -135,9 +138,30 @@ def _static(g: GearGeometry, X: np.ndarray, c: np.ndarray) -> np.ndarray:
     return np.stack([y + g.a, -X[..., 2], -x], axis=-1)
 
 
-@functools.lru_cache(maxsize=16)
 def flank_curvature(g: GearGeometry, slices: int, n_profile: int | None = None) -> FlankCurvature:
-    """(1), (2) on flank_grid(g, slices)'s active points."""
+    """(1), (2) on flank_grid(g, slices, n_profile)'s active points (None: the grid's N_PROFILE when called); in
+    process and on disk (meshgen.cache, keyed by the geometry, the grid size and the source of this module and of
+    the grid's modules), like the grid it is computed on."""
+    return _flank_curvature_cached(g, slices, grid.N_PROFILE if n_profile is None else n_profile)
+
+
+@functools.lru_cache(maxsize=16)
+def _flank_curvature_cached(g: GearGeometry, slices: int, n_profile: int) -> FlankCurvature:
+    parts = {"g": asdict(g), "slices": slices, "n_profile": n_profile, "code": _curvature_code_hash()}
+    return cached("flankcurv", parts, lambda: _flank_curvature(g, slices, n_profile))
+
+
+@functools.cache
+def _curvature_code_hash() -> str:
+    """SHA-256 of this module's source and of the grid's code hash (the envelope, the trim, the worm)."""
+    import inspect
+    import sys
+
+    src = inspect.getsource(sys.modules[__name__]) + grid.grid_code_hash()
+    return hashlib.sha256(src.encode()).hexdigest()
+
+
+def _flank_curvature(g: GearGeometry, slices: int, n_profile: int) -> FlankCurvature:
     fg = flank_grid(g, slices, n_profile)
     S, N = fg.rho.shape
     Z = np.broadcast_to(fg.zeta[:, None], (S, N))
