@@ -138,6 +138,18 @@ def contact_rows(d_addr, off, adr, ncon, n_fc, cone3, pts, nh, merged, mrg):
     return ContactRows(adr[:ncon], efc, frame, pos, np.int64(ncon), n_fc, True, cone3)
 
 
+@numba.njit(cache=True, inline="always")
+def _read_contacts(d_addr, off, ncon, adr, dims, mus):
+    """d's first ncon contacts' efc addresses, dimensions and first friction coefficients (the checked offsets off)
+    into adr, dims, mus."""
+    size, cbase = off[6], i64_at(d_addr + off[3])[0]
+    for k in range(ncon):
+        c = cbase + k * size
+        adr[k] = i32_at(c + off[7])[0]
+        dims[k] = i32_at(c + off[9])[0]
+        mus[k] = f64_at(c + off[10])[0]
+
+
 @numba.njit(cache=True)
 def hinge_need(m_addr, d_addr, off, p, hold):
     """breakaway.hinge_utilisation of d's contacts (read at the checked offsets off) on the worm's hinge p.dof1:
@@ -147,12 +159,7 @@ def hinge_need(m_addr, d_addr, off, p, hold):
     ncon, nefc = i32_at(d_addr + off[1])[0], i32_at(d_addr + off[2])[0]
     if ncon > dims.shape[0] or nefc > col.shape[0]:
         return -1.0
-    size, cbase = off[6], i64_at(d_addr + off[3])[0]
-    for k in range(ncon):
-        c = cbase + k * size
-        adr[k] = i32_at(c + off[7])[0]
-        dims[k] = i32_at(c + off[9])[0]
-        mus[k] = f64_at(c + off[10])[0]
+    _read_contacts(d_addr, off, ncon, adr, dims, mus)
     call_mul(mul, m_addr, d_addr, col_addr, unit_addr)  # the hinge's column of the constraint Jacobian
     efc = numba.carray(f64_at(i64_at(d_addr + off[4])[0]), (max(nefc, 0),))
     return hinge_utilisation(adr, dims, mus, ncon, efc, col, smooth[p.dof1])
@@ -166,12 +173,7 @@ def friction_aligned(d_addr, off, hold, v_min):
     ncon, nefc = i32_at(d_addr + off[1])[0], i32_at(d_addr + off[2])[0]
     if ncon > dims.shape[0]:
         return False
-    size, cbase = off[6], i64_at(d_addr + off[3])[0]
-    for k in range(ncon):
-        c = cbase + k * size
-        adr[k] = i32_at(c + off[7])[0]
-        dims[k] = i32_at(c + off[9])[0]
-        mus[k] = f64_at(c + off[10])[0]
+    _read_contacts(d_addr, off, ncon, adr, dims, mus)
     n = max(nefc, 0)
     efc = numba.carray(f64_at(i64_at(d_addr + off[4])[0]), (n,))
     vel = numba.carray(f64_at(i64_at(d_addr + off[11])[0]), (n,))
