@@ -192,3 +192,28 @@ def test_the_preload_holds_what_a_worker_needs_before_its_first_point():
     got = json.loads(cp.stdout.splitlines()[-1])
     assert got["new"] == [] and got["tqdm"] is False, got
     assert got["versions_cached"] > 0
+
+
+def test_the_cluster_start_thread_imports_matplotlib_before_distributed(tmp_path):
+    """One thread imports matplotlib and distributed (cluster.plot_imports, then open_client): in a fresh interpreter
+    the cluster's start thread finds matplotlib.pyplot imported and distributed not yet when it opens the client, so
+    no two threads import at once (importlib's _DeadlockError between pyparsing's `html` and tornado's
+    `html.entities`, a command's exit 1)."""
+    import subprocess
+    import sys
+
+    code = (
+        "import sys, threading\n"
+        "from wormsim.sweep import cluster\n"
+        "seen = {}\n"
+        "def fake(scheduler, workers, warm=False):\n"
+        "    seen.update(mpl='matplotlib.pyplot' in sys.modules, dist='distributed' in sys.modules,\n"
+        "                thread=threading.current_thread().name)\n"
+        "    return (None, None, {})\n"
+        "cluster.open_client = fake\n"
+        "cluster.ClusterStart('tcp://127.0.0.1:1', 1, warm=False).get()\n"
+        "print(seen['mpl'], seen['dist'], seen['thread'], 'matplotlib.pyplot' in sys.modules)\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=tmp_path, timeout=120)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.split() == ["True", "False", "wormsim-cluster-start", "True"], out.stdout

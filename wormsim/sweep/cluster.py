@@ -237,6 +237,23 @@ def warm_workers(client, info: dict) -> None:
     info["warm_s"] = time.perf_counter() - t0
 
 
+def plot_imports() -> None:
+    """matplotlib's import (pyplot on the Agg backend, what sweep.png needs), in the cluster's start thread before
+    distributed's: one thread imports both. Two threads that import them at once can stop the command with
+    importlib's _DeadlockError (CPython's per-module locks taken in opposite orders for a package and its submodule:
+    pyparsing imports `html`, whose __init__ imports `html.entities`, which tornado imports directly). The start waits
+    for the fork server's preload on another core, so the import costs it no time; a failure is dropped (the figure
+    imports for itself)."""
+    try:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.backends.backend_agg  # noqa: F401  (savefig's PNG)
+        import matplotlib.pyplot  # noqa: F401
+    except Exception:
+        pass
+
+
 class ClusterStart:
     """open_client in a thread, started before the sweep file is validated (the cluster's start overlaps it);
     `get()` waits for it (and re-raises its error; `used` then True), `close()` closes what it opened."""
@@ -256,6 +273,7 @@ class ClusterStart:
         self._thread.start()
 
     def _run(self, scheduler, workers, warm) -> None:
+        plot_imports()
         try:
             self._result = open_client(scheduler, workers, warm)
         except BaseException as exc:  # (re-raised by get in the main thread)

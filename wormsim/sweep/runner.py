@@ -375,12 +375,10 @@ def run_sweep(
     client = cluster = cluster_info = None
     interrupted = False
     t_sweep = time.perf_counter()
-    png = _PlotImport()
     try:
         if todo:
             if started is None:
                 started = ClusterStart(scheduler, workers, warm=any(p.scenario.model == "contact3d" for p in todo))
-            png.start()  # matplotlib's import while the cluster starts: this process waits for its workers
             client, cluster, cluster_info = started.get()
             started = None
             if any(p.scenario.model == "contact3d" for p in todo):
@@ -417,7 +415,7 @@ def run_sweep(
             finished=time.strftime("%Y-%m-%dT%H:%M:%S%z"), interrupted=interrupted, wall_s=time.perf_counter() - t_sweep
         )
         write_json_atomic(out / JSON_NAME, _json_doc(sweep, rows, timing, machine, cluster_info, state))
-        _close_and_plot(client, cluster, png, sweep, [rows[i] for i in sorted(rows)], None if interrupted else out)
+        _close_and_plot(client, cluster, sweep, [rows[i] for i in sorted(rows)], None if interrupted else out)
     if interrupted:
         raise KeyboardInterrupt
     n_ok = sum(1 for r in rows.values() if r.get("status") == "ok")
@@ -425,18 +423,17 @@ def run_sweep(
             "ran": len(todo), "cluster": cluster_info}  # fmt: skip
 
 
-def _close_and_plot(client, cluster, png: _PlotImport, sweep: Sweep, ordered: list[dict], out: Path | None) -> None:
+def _close_and_plot(client, cluster, sweep: Sweep, ordered: list[dict], out: Path | None) -> None:
     """The results are safe (sweep.csv and sweep.json final): the cluster closes in a thread while sweep.png is drawn
     into out (None: not drawn, an interrupted sweep). A figure that fails raises, with no sweep.png left in out."""
     import threading
 
+    from wormsim.sweep import plot  # (before the closing thread: no two threads import at once, cluster.plot_imports)
+
     closing = threading.Thread(target=close_cluster, args=(client, cluster), name="wormsim-cluster-close", daemon=True)
     closing.start()
     try:
-        png.join()
         if out is not None:
-            from wormsim.sweep import plot
-
             try:
                 plot.write_sweep_png(ordered, sweep.swept_paths, sweep.spec.plot, out / PNG_NAME, title=sweep.spec.name)
             except BaseException:  # the tables stay; an earlier sweep.png would look like theirs
@@ -510,34 +507,6 @@ def _dispatch(client, todo: list[Point], keep_runs: bool, cluster_info: dict, on
                 for p in ps
             ]
         on_results(ps, results, t_submit, time.time())
-
-
-class _PlotImport:
-    """matplotlib's import (pyplot on the Agg backend, what sweep.png needs; not the run writers' rerun) in a thread
-    while the cluster starts (the workers' fork server preloads on another core; once the points run, every core
-    is theirs); a failure is dropped (the plot imports for itself)."""
-
-    def __init__(self):
-        self._thread = None
-
-    def start(self) -> None:
-        import threading
-
-        def work():
-            try:
-                import matplotlib
-
-                matplotlib.use("Agg")
-                import matplotlib.pyplot  # noqa: F401
-            except Exception:
-                pass
-
-        self._thread = threading.Thread(target=work, name="wormsim-sweep-plot-import", daemon=True)
-        self._thread.start()
-
-    def join(self) -> None:
-        if self._thread is not None:
-            self._thread.join(60.0)
 
 
 def _write_run_dir(path: Path, files: dict[str, bytes], summary: dict) -> None:
