@@ -18,6 +18,38 @@ from wormsim.tooth import hertz as FO
 from wormsim.tooth.grid import flank_grid
 
 
+def averaged_pressure_reference(log, T: np.ndarray) -> np.ndarray:
+    """(4) of wormsim.tooth.hertz per row of table() rows T, in numpy (the definition PatternLog.window_rows' compiled
+    pass is checked against, bit for bit): the line load and curvature averaged over the window of slices centred on
+    the row, within its contact line (a new line where the sample, the flank or the slice run changes); nan for a row
+    without a p_H of its own."""
+    n_rows = len(T)
+    if not n_rows:
+        return np.zeros(0)
+    cv, g = log.cv, log.geo
+    sg, j = T[:, 1].astype(np.int64), T[:, 2].astype(np.int64)
+    k = FO._lerp_rows(cv.inv_rho, sg, j, T[:, 3])
+    ok = np.isfinite(k) & (k > 0) & np.isfinite(T[:, 5]) & (T[:, 5] > 0) & (T[:, 4] > 0)
+    F = np.where(ok, T[:, 4], 0.0)
+    with np.errstate(divide="ignore", invalid="ignore"):  # the contact's own line length s L, from its (3)
+        L = np.where(ok, F * log.e_star * k / (math.pi * T[:, 5] ** 2), 0.0)
+    length = FO.PRESSURE_LENGTH_MX * g.m_x
+    n = max(1, math.ceil(length / cv.slice_width - 1e-9))
+    new = np.ones(n_rows, dtype=bool)
+    new[1:] = (T[1:, 0] != T[:-1, 0]) | (sg[1:] != sg[:-1]) | (j[1:] != j[:-1] + 1)
+    start = np.flatnonzero(new)
+    gid = np.cumsum(new) - 1
+    end = np.append(start[1:], n_rows)  # one past each line's last row
+    r = np.arange(n_rows)
+    lo = np.maximum(start[gid], r - (n - 1) // 2)
+    hi = np.minimum(end[gid], r + n // 2 + 1)
+    cF, cL, cK = (np.concatenate([[0.0], np.cumsum(x)]) for x in (F, L, np.where(ok, F * k, 0.0)))
+    sF, sL, sK = cF[hi] - cF[lo], cL[hi] - cL[lo], cK[hi] - cK[lo]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        p = FO.hertz_line_pressure_pa(sF / np.maximum(sL, length), log.e_star, sK / sF)
+    return np.where(ok & (sF > 0), p, np.nan)
+
+
 def _quad_hessian(uv: np.ndarray, h: np.ndarray) -> np.ndarray:
     """Hessian of the least-squares quadratic h = c0 + c1 u + c2 v + c3 u^2 / 2 + c4 u v + c5 v^2 / 2."""
     u, v = uv[:, 0], uv[:, 1]
@@ -242,8 +274,9 @@ def test_pressure_maximum_is_the_line_load_averaged_over_one_module_of_line():
 
     # each contact's window within its line: slices j and j + 1, clipped to the line
     expect = {key: by_hand([x for x in ((key[0], key[1]), (key[0], key[1] + 1)) if x in line]) for key in line}
-    p = log.averaged_pressure_pa(T)
+    p = log.window_rows(np.array([0.0, 1.0]), (0.0, 1.0))[1]  # every row: samples 0 and 1, F_n > 0
     assert p == pytest.approx(list(expect.values()), rel=1e-6)
+    assert np.array_equal(p, averaged_pressure_reference(log, T))
     s = log.summary(np.array([0.0, 1.0]), (0.0, 1.0))
     kmax = max(expect, key=expect.get)
     assert s["contact_pressure_max_mpa"] == pytest.approx(expect[kmax] * 1e-6, rel=1e-6)
@@ -255,7 +288,7 @@ def test_pressure_maximum_is_the_line_load_averaged_over_one_module_of_line():
 
 def test_window_rows_are_the_tables_rows_in_the_window_bit_for_bit():
     """PatternLog.window_rows (compiled, one pass over the log) against its definition: table()'s rows with F_n > 0 in
-    the window's samples and averaged_pressure_pa of the whole table at those rows, bit for bit (nan where (4) has no
+    the window's samples and (4) of the whole table (averaged_pressure_reference) at those rows, bit for bit (nan where (4) has no
     value); the grid's cells against numpy's add.at and maximum.at. A random log of the screw jack's 16 slices: 40 samples, contact lines on both flanks over runs of
     consecutive slices with gaps, zero and negative forces, contacts without a p_H (3)."""
     g = derive(load_scenario(SCENARIOS / "screw_jack.yaml").gear)
@@ -284,7 +317,7 @@ def test_window_rows_are_the_tables_rows_in_the_window_bit_for_bit():
     sel, pavg = log.window_rows(t_s, window)
     assert 0 < len(sel) < len(T)
     assert np.array_equal(sel, T[keep], equal_nan=True)
-    assert np.array_equal(pavg, log.averaged_pressure_pa(T)[keep], equal_nan=True)
+    assert np.array_equal(pavg, averaged_pressure_reference(log, T)[keep], equal_nan=True)
     assert 50 < np.isfinite(pavg).sum() < len(pavg)  # both kinds of row
     # the grid's cells (compiled) against numpy's add.at / maximum.at over the same rows
     log.fc = type("FC", (), {"grid": flank_grid(g, 16)})()

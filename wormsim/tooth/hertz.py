@@ -215,9 +215,8 @@ def _lerp_rows(a, sg, j, f):
 def _window_rows(buf, m, inwin, inv_rho, rho3, zeta, e_star, length, n):
     """PatternLog.window_rows compiled: rows 0..m-1 of the log buf (i, sigma, j, f, F_n, p_H; float32), the samples
     in the window inwin (bool per sample), (4) with l_H = length over n slices; the table's columns (i, sigma, j, f,
-    F_n, p_H, zeta, rho) of the kept rows and their averaged pressure, as PatternLog.table and
-    PatternLog.averaged_pressure_pa compute them (elementwise the same operations; the cumulative sums sequential from
-    row 0, as numpy's cumsum)."""
+    F_n, p_H, zeta, rho) of the kept rows, as PatternLog.table makes them, and their averaged pressure (4) (the
+    cumulative sums sequential from row 0)."""
     cF, cL, cK = np.zeros(m + 1), np.zeros(m + 1), np.zeros(m + 1)
     ok = np.zeros(m, dtype=np.bool_)
     first = np.zeros(m, dtype=np.int64)  # each row's line's first row
@@ -352,9 +351,10 @@ class PatternLog:
         return np.column_stack([T, self.cv.zeta[j], rho])
 
     def window_rows(self, t_s: np.ndarray, window_s) -> tuple[np.ndarray, np.ndarray]:
-        """The rows of table() with a positive F_n in samples with t in window_s, and their averaged_pressure_pa:
-        (T[keep], averaged_pressure_pa(T)[keep]) with the same floating-point operations in the same order (the
-        cumulative sums from the log's first row), compiled in one pass over the log (`_window_rows`) without the
+        """The rows of table() with a positive F_n in samples with t in window_s, and their averaged pressure (4) (the
+        line load and curvature averaged over the window of slices centred on the row, within its contact line; nan
+        for a row without a p_H of its own), computed over all rows of the log (the cumulative sums from its first
+        row) and kept for the window's rows, compiled in one pass over the log (`_window_rows`) without the
         whole table (1.5 million rows in a run that records every step of 0.3 s at 2e-5 s: about 0.25 s of numpy);
         computed once for summary and grid (rows are only appended or truncated, so the row count names the log)."""
         key = (self.m, float(window_s[0]), float(window_s[1]), len(t_s), t_s.ctypes.data)
@@ -366,37 +366,6 @@ class PatternLog:
             args = (cv.inv_rho, self.rho3, cv.zeta, float(self.e_star), length, n)
             self._rows = (key, _window_rows(self.buf, self.m, inwin, *args))
         return self._rows[1]
-
-    def averaged_pressure_pa(self, T: np.ndarray) -> np.ndarray:
-        """(4) per row of table() rows T (in the log's order: per sample, the kernel's contacts, those of one tooth
-        flank on consecutive slices): the line load and curvature averaged over the window of slices centred on the
-        row, within its contact line; nan for a row without a p_H of its own (no load, no line length)."""
-        n_rows = len(T)
-        if not n_rows:
-            return np.zeros(0)
-        cv, g = self.cv, self.geo
-        sg, j = T[:, 1].astype(np.int64), T[:, 2].astype(np.int64)
-        k = _lerp_rows(cv.inv_rho, sg, j, T[:, 3])
-        ok = np.isfinite(k) & (k > 0) & np.isfinite(T[:, 5]) & (T[:, 5] > 0) & (T[:, 4] > 0)
-        F = np.where(ok, T[:, 4], 0.0)
-        with np.errstate(divide="ignore", invalid="ignore"):  # the contact's own line length s L, from its (3)
-            L = np.where(ok, F * self.e_star * k / (math.pi * T[:, 5] ** 2), 0.0)
-        length = PRESSURE_LENGTH_MX * g.m_x
-        n = max(1, math.ceil(length / cv.slice_width - 1e-9))
-        # a new contact line where the sample, the flank or the slice run changes
-        new = np.ones(n_rows, dtype=bool)
-        new[1:] = (T[1:, 0] != T[:-1, 0]) | (sg[1:] != sg[:-1]) | (j[1:] != j[:-1] + 1)
-        start = np.flatnonzero(new)
-        gid = np.cumsum(new) - 1
-        end = np.append(start[1:], n_rows)  # one past each line's last row
-        r = np.arange(n_rows)
-        lo = np.maximum(start[gid], r - (n - 1) // 2)
-        hi = np.minimum(end[gid], r + n // 2 + 1)
-        cF, cL, cK = (np.concatenate([[0.0], np.cumsum(x)]) for x in (F, L, np.where(ok, F * k, 0.0)))
-        sF, sL, sK = cF[hi] - cF[lo], cL[hi] - cL[lo], cK[hi] - cK[lo]
-        with np.errstate(divide="ignore", invalid="ignore"):
-            p = hertz_line_pressure_pa(sF / np.maximum(sL, length), self.e_star, sK / sF)
-        return np.where(ok & (sF > 0), p, np.nan)
 
     def summary(self, t_s: np.ndarray, window_s) -> dict:
         """The summary keys of the module docstring over the samples with t in window_s."""
