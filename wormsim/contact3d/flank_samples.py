@@ -239,17 +239,9 @@ def run_samples(tables, mj, cmds, span, S, p, room, io, mrg, shaft):
         th1, th2 = qpos[p.qa1], qpos[p.qa2]
         w1, w2 = qvel[p.dof1], qvel[p.dof2]
         t = tptr[0]
+        warned = bptr[0] + bptr[ws] + bptr[2 * ws]
         event, te, turn = state_event(
-            th1,
-            th2,
-            w1,
-            w2,
-            bptr[0] + bptr[ws] + bptr[2 * ws],
-            p.dt,
-            p.overspeed_turn,
-            p.direction,
-            p.ratio,
-            p.jump_rad,
+            th1, th2, w1, w2, warned, p.dt, p.overspeed_turn, p.direction, p.ratio, p.jump_rad
         )
         if event != 0:  # Guards.state raises: the Python path
             io[IO_EVENT] = EV_GUARD
