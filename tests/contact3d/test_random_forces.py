@@ -68,6 +68,17 @@ def _scenario(gear: dict) -> Scenario:
     )
 
 
+_RUNS: dict = {}
+
+
+def _summary(gear: dict) -> dict:
+    """The gear's contact3d summary, run once per test session."""
+    key = tuple(sorted(gear.items()))
+    if key not in _RUNS:
+        _RUNS[key] = simulate(_scenario(gear)).summary
+    return _RUNS[key]
+
+
 @pytest.mark.parametrize(
     "gear",
     [
@@ -89,7 +100,7 @@ def _scenario(gear: dict) -> Scenario:
 )
 def test_random_gear_efficiency_at_the_contact_radius_and_radial_force_on_the_line_of_centres(gear):
     sc = _scenario(gear)
-    s = simulate(sc).summary
+    s = _summary(gear)
     g = derive(sc.gear)
     eta_c = float(
         gt.efficiency_at_radius(
@@ -100,3 +111,12 @@ def test_random_gear_efficiency_at_the_contact_radius_and_radial_force_on_the_li
     assert abs(s["ratio"] / s["ratio_theory"] - 1) < 1e-3
     assert abs(s["efficiency"] / eta_c - 1) < 0.03, (s["efficiency"], eta_c)
     assert abs(fr - 1) < 0.03, fr
+
+
+def test_the_steep_gear_warns_that_its_radial_force_is_not_the_pitch_point_formulas():
+    """Where contact3d's F_r2 contradicts DIN 3975-2's pitch-point formula (the steep gear, 1.427 x), the run says so
+    (wormsim.results.run_warnings.theory_warnings), and none of its other means does."""
+    s = _summary(STEEP)
+    fr = s["radial_force_mean_n"] / s["radial_force_theory_n"]
+    ws = [w for w in s["warnings"] if "x the hand formula's" in w]
+    assert abs(fr - 1) > 0.10 and len(ws) == 1 and ws[0].startswith("radial force F_r2"), (fr, s["warnings"])

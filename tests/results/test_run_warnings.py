@@ -118,3 +118,20 @@ def test_a_forward_run_whose_drive_needs_more_than_its_peak_is_warned_not_silent
     k, k4 = int(np.searchsorted(t, 0.002)), int(np.searchsorted(t, 0.004))
     assert abs(weak.series["worm_speed_rpm"][k]) < 0.99 * abs(ok.series["worm_speed_rpm"][k])
     assert weak.series["worm_speed_rpm"][k4] == pytest.approx(ok.series["worm_speed_rpm"][k4], rel=1e-3)
+
+
+def test_a_mean_more_than_ten_percent_from_its_hand_formula_warns():
+    """theory_warnings: the steep random gear's F_r2, 1.427 x DIN 3975-2's pitch-point formula
+    (tests/contact3d/test_random_forces.py), warns and names the formula's key; 1.09 x does not; the efficiency is
+    compared with the formula at the contacts' radius where the power flows from the worm, with the pitch point's
+    otherwise; a null mean (a pair that does not turn) is no contradiction."""
+    s = {"radial_force_mean_n": 1427.0, "radial_force_theory_n": 1000.0, "ratio": 10.0, "ratio_theory": 10.0}
+    (w,) = W.theory_warnings(s)
+    assert w.startswith("radial force F_r2 1427 is 1.43 x") and "`radial_force_theory_n`" in w
+    assert W.theory_warnings({**s, "radial_force_mean_n": 1090.0}) == []
+    eff = {"efficiency": 0.50, "efficiency_theory": 0.70, "efficiency_theory_at_contact_radius": 0.52}
+    assert W.theory_warnings({**eff, "power_flow": "worm to wheel"}) == []
+    (w,) = W.theory_warnings({**eff, "power_flow": "wheel to worm"})
+    assert "`efficiency_theory`" in w and "0.714 x" in w
+    assert W.theory_warnings({"ratio": None, "ratio_theory": 40.0, "efficiency": None, "efficiency_theory": 0.4}) == []
+    assert W.theory_warnings({"tangential_force_mean_n": 0.0, "tangential_force_theory_n": 0.0}) == []

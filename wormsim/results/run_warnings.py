@@ -21,7 +21,8 @@ that are computed correctly but that a user should not read as the gear's steady
   flowing from the wheel into a worm-driven pair (an overhauling load); a pair that does not turn (no ratio and no
   efficiency); a speed drive at its peak torque outside a held back-drive (the shaft follows the limit, not its
   command); a held back-drive whose worm creeps above HOLD_CREEP_SHARE of its free speed (the mesh slipped under the
-  stalled drive's torque). The root stress above its limit is the rating's warning (wormsim.rating.fe_root).
+  stalled drive's torque); a mean more than THEORY_REL from its hand formula (ratio, F_t2, F_r2, efficiency:
+  theory_warnings). The root stress above its limit is the rating's warning (wormsim.rating.fe_root).
 """
 
 from __future__ import annotations
@@ -321,6 +322,37 @@ def creep_warning(summary: dict, scenario) -> str | None:
     )
 
 
+THEORY_REL = 0.10  # a mean this far from its hand formula contradicts it (the seeds: within 1 %, docs/validation.md)
+# (mean key, formula key, what it is, the formula's name); efficiency: the formula at the contacts' radius where the
+# run has it (contact3d) and the power flows from the worm
+THEORY_PAIRS = (
+    ("ratio", "ratio_theory", "ratio", "z2 / z1"),
+    ("tangential_force_mean_n", "tangential_force_theory_n", "tangential force F_t2", "T_load / r2"),
+    ("radial_force_mean_n", "radial_force_theory_n", "radial force F_r2", "DIN 3975-2's pitch-point formula"),
+    ("efficiency", "efficiency_theory", "efficiency", "tan(gamma) / tan(gamma + rho')"),
+)
+
+
+def theory_warnings(summary: dict) -> list[str]:
+    """Each steady-window mean of THEORY_PAIRS more than THEORY_REL from its hand formula. The formulas hold at the
+    pitch point (DIN 3975-2); a pair whose contacts carry the load elsewhere (a steep lead angle, an undercut wheel,
+    flank errors), or a run that is not steady, departs from them: the run is not wrong for that, but its number
+    and the formula's must not be read as one."""
+    out = []
+    for key, ref, what, formula in THEORY_PAIRS:
+        if key == "efficiency" and summary.get("power_flow") == "worm to wheel":
+            ref = "efficiency_theory_at_contact_radius" if _num(summary, ref + "_at_contact_radius") else ref
+        m, t = _num(summary, key), _num(summary, ref)
+        if m is None or t is None or t == 0 or abs(m / t - 1) <= THEORY_REL:
+            continue
+        out.append(
+            f"{what} {m:.4g} is {m / t:.3g} x the hand formula's {t:.4g} ({formula}, `{ref}`; more than "
+            f"{100 * THEORY_REL:g} % apart): the contacts carry the load away from where the formula assumes, or the "
+            "window is not steady; read the contact pattern and the resultant keys, and lengthen the run"
+        )
+    return out
+
+
 def plausibility_warnings(result: Result, scenario) -> list[str]:
     """The results that contradict a physical limit or the run's premise (see the module docstring)."""
     s = result.summary
@@ -333,6 +365,7 @@ def plausibility_warnings(result: Result, scenario) -> list[str]:
             power_flow_warning(s, scenario),
             drive_peak_warning(result, scenario),
             creep_warning(s, scenario),
+            *theory_warnings(s),
         )
         if w
     ]

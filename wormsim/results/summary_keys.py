@@ -77,7 +77,8 @@ KEYS: dict[str, Key] = {
         "material's pitting strength (wedge, torsional: the rating's mean contact stress sigma_Hm), a runaway "
         "(1.5 x the speed command, or a torque drive still accelerating), "
         "power flowing from the wheel into a worm-driven pair (overhauling), a pair that does not turn, a held "
-        "back-drive whose worm creeps above 0.1 % of its free speed; with "
+        "back-drive whose worm creeps above 0.1 % of its free speed; a ratio, F_t2, F_r2 or efficiency more than 10 % "
+        "from its hand formula; with "
         "`rating:`, the rating's warnings follow (a root stress above its limit among them); empty when none",
     ),
     "ignored_inputs": Key(
