@@ -54,3 +54,38 @@ def test_power_source_is_the_flows_source_else_the_drive():
     assert power_source("wheel to worm", "worm") == "wheel"
     assert power_source("worm to wheel", "wheel") == "worm"
     assert power_source("none", "wheel") == "wheel" and power_source("none", "worm") == "worm"
+
+
+def test_refine_peak_is_the_continuous_spectrums_maximum():
+    """Newton's bracketed refinement finds the maximum of |Y(f)| that a bounded scalar search (scipy's, tight
+    tolerance) finds, on noisy lines with a harmonic and an offset; a maximum at the bracket's end returns the end."""
+    from scipy.optimize import minimize_scalar
+
+    from wormsim.results.metrics import _hann_dtft_amplitude, refine_peak
+
+    rng = np.random.default_rng(7)
+    for _ in range(40):
+        n, dt = int(rng.integers(64, 8000)), 1e-4
+        t = np.arange(n) * dt
+        f0 = rng.uniform(20.0, 1500.0)
+        x = rng.uniform(0.1, 10) * np.sin(2 * np.pi * f0 * t + rng.uniform(0, 6)) + 0.3 * np.sin(4 * np.pi * f0 * t)
+        x += rng.normal(0, rng.uniform(0, 1), n)
+        w = np.hanning(n)
+        y = (x - np.polyval(np.polyfit(t, x, 1), t)) * w
+        f_bin = f0 + rng.uniform(-0.1, 0.1) / (n * dt)  # the padded spectrum's bin next to the line
+        a, b = f_bin - 0.25 / (n * dt), f_bin + 0.25 / (n * dt)
+        ref = minimize_scalar(
+            lambda f: -_hann_dtft_amplitude(t, y, w.sum(), f),
+            bounds=(a, b),
+            method="bounded",
+            options={"xatol": 1e-12 * a},
+        ).x
+        got = refine_peak(t, y, a, b)
+        assert a <= got <= b
+        assert got == pytest.approx(ref, rel=1e-7)
+        assert _hann_dtft_amplitude(t, y, w.sum(), got) >= _hann_dtft_amplitude(t, y, w.sum(), ref) * (1 - 1e-12)
+    # a line above the bracket: |Y| rises to b
+    t = np.arange(2000) * 1e-4
+    y = np.sin(2 * np.pi * 100.0 * t) * np.hanning(2000)
+    assert refine_peak(t, y, 90.0, 95.0) == 95.0
+    assert refine_peak(t, y, 105.0, 110.0) == 105.0

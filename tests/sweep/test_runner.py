@@ -14,7 +14,7 @@ import pytest
 
 from wormsim import cli
 from wormsim.sweep import load_sweep, run_sweep
-from wormsim.sweep.runner import MAX_CHUNK, chunk_size
+from wormsim.sweep.runner import MAX_CHUNK, chunk_size, task_sizes
 
 ROOT = Path(__file__).resolve().parents[2]
 SWEEP = """name: chunks
@@ -37,6 +37,15 @@ def test_chunk_size():
     assert chunk_size(16, 16) == 1
 
 
+def test_task_sizes_end_in_single_points():
+    assert task_sizes(16, 2) == [2] * 5 + [1] * 6  # the workers' last tasks are single points: no wait at the end
+    assert task_sizes(8, 1) == [2, 2, 2, 1, 1] and task_sizes(15, 2) == [1] * 15 and task_sizes(0, 2) == []
+    for n, threads in [(16, 1), (100, 4), (1000, 2), (37, 3)]:
+        sizes = task_sizes(n, threads)
+        assert sum(sizes) == n and max(sizes) == chunk_size(n, threads)
+        assert sizes == sorted(sizes, reverse=True) and sizes[-2 * threads :] == [1] * (2 * threads)
+
+
 @pytest.mark.long
 def test_points_in_chunks_are_rows_of_their_own(tmp_path):
     f = tmp_path / "s.yaml"
@@ -52,7 +61,7 @@ def test_points_in_chunks_are_rows_of_their_own(tmp_path):
     doc = json.loads((tmp_path / "o" / "sweep.json").read_text())
     tim = [p["timing"] for p in doc["points"]]
     assert all(t["end"] >= t["start"] for t in tim)
-    assert len({t["submitted"] for t in tim}) == 4  # 4 tasks of 2 points
+    assert len({t["submitted"] for t in tim}) == 5  # tasks of 2, 2, 2, 1, 1 points (task_sizes)
     assert all("compile_s" in t and "jit_misses" in t for t in tim)
 
 

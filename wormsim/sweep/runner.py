@@ -136,12 +136,24 @@ def run_points(scenarios: list[dict], keep_files: bool) -> list[dict]:
 
 
 def chunk_size(n_points: int, threads: int) -> int:
-    """Points per task: 1, or up to MAX_CHUNK where there are at least 8 points per worker thread. A task's points
-    share one scheduler round trip and one hand-back (the worker waits for its next task only once per chunk);
+    """Points per task at most: 1, or up to MAX_CHUNK where there are at least 8 points per worker thread. A task's
+    points share one scheduler round trip and one hand-back (the worker waits for its next task only once per chunk);
     a worker that dies fails the points of its chunk. 16 points on 2 workers: 2 per task."""
     if n_points < 8 * threads:
         return 1
     return max(1, min(MAX_CHUNK, n_points // (4 * threads)))
+
+
+def task_sizes(n_points: int, threads: int) -> list[int]:
+    """The points of each task in the order they are handed out: chunk_size(n_points, threads) while the points left
+    fill at least two such tasks per thread, then fewer, down to one point per task for the last ones (guided
+    self-scheduling: the workers' last tasks are single points, so no worker waits at the end for another's chunk).
+    16 points on 2 workers: five tasks of 2, then six of 1."""
+    most, sizes, left = chunk_size(n_points, threads), [], n_points
+    while left > 0:
+        sizes.append(max(1, min(most, left // (2 * threads))))
+        left -= sizes[-1]
+    return sizes
 
 
 def _worker_name() -> str:
@@ -460,8 +472,9 @@ def _resume(sweep: Sweep, earlier: list[dict]) -> tuple[dict[int, dict], list[Po
 
 
 def _dispatch(client, todo: list[Point], keep_runs: bool, cluster_info: dict, on_results) -> None:
-    """Run the points of todo on the cluster in chunks (chunk_size; cluster_info gets points_per_task); each finished
-    chunk goes to on_results(points, results, submitted, received), a lost worker's chunk as failed results.
+    """Run the points of todo on the cluster in chunks (task_sizes; cluster_info gets points_per_task, the largest);
+    each finished chunk goes to on_results(points, results, submitted, received), a lost worker's chunk as failed
+    results.
     Only as many points in flight as the cluster has threads: a point waits on the scheduler, not in a worker's
     queue, so a worker that dies (segfault, OOM killer) fails the point it ran and no other."""
     from distributed import as_completed
@@ -469,29 +482,30 @@ def _dispatch(client, todo: list[Point], keep_runs: bool, cluster_info: dict, on
     futures = {}
     queue = list(todo)
     threads = _free_threads(client)
-    chunk = chunk_size(len(todo), threads)
-    cluster_info["points_per_task"] = chunk
+    sizes = task_sizes(len(todo), threads)
+    cluster_info["points_per_task"] = max(sizes, default=1)
 
     def submit_next():
-        ps = queue[:chunk]
-        del queue[:chunk]
+        n = sizes.pop(0)
+        ps = queue[:n]
+        del queue[:n]
         scs = [p.scenario.model_dump(mode="json") for p in ps]
         key = f"wormsim-point-{ps[0].index}-{ps[0].scenario_hash}"
-        if chunk == 1:
+        if n == 1:
             fut = client.submit(run_point, scs[0], keep_runs, pure=False, key=key)
         else:
             fut = client.submit(run_points, scs, keep_runs, pure=False, key=f"{key}-{len(ps)}")
         futures[fut] = (ps, time.time())
         return fut
 
-    pending = as_completed([submit_next() for _ in range(min(-(-len(queue) // chunk), threads))])
+    pending = as_completed([submit_next() for _ in range(min(len(sizes), threads))])
     for fut in pending:
         if queue:
             pending.add(submit_next())
         ps, t_submit = futures[fut]
         try:
             out_ = fut.result()
-            results = [out_] if chunk == 1 else out_
+            results = [out_] if len(ps) == 1 else out_
         except Exception as exc:  # (the worker died or the task could not run)
             results = [
                 {
