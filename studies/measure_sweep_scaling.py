@@ -27,6 +27,11 @@ fastest command (the machine is shared: the least disturbed reading) and every c
 The model (docs/sweeps.md, "Scaling"): T(N) = fixed_s + ceil(P / N) x t_point x g(N), t_point the 1-worker run's
 span per point (the point and its idle time), g(N) the step's growth with N busy cores (g(2) measured here).
 `--model-only` recomputes the model of an existing record from its runs.
+With --standing the commands run on standing clusters instead (`dask scheduler` and `dask worker --nworkers N
+--nthreads 1` on this machine, one cluster per worker count, started before the commands and kept between them, the
+local cluster's dask settings in their environment): each cluster's first command (its workers load the kernels with
+the warm-up plugin) is recorded apart (`first_command_s`) and not timed with the others; the timed commands give
+`--scheduler ADDRESS --workers N`. Writes docs/data/sweep_scaling_standing.json.
 """
 
 from __future__ import annotations
@@ -54,7 +59,7 @@ grid:
 """
 
 
-def measure(out: Path, workers: int) -> dict:
+def measure(out: Path, workers: int, scheduler: str | None = None) -> dict:
     d = out / f"workers{workers}"
     if d.exists():
         for f in d.iterdir():
@@ -63,7 +68,8 @@ def measure(out: Path, workers: int) -> dict:
     t0 = time.perf_counter()
     w0 = time.time()
     subprocess.run(
-        [str(wormsim), "sweep", str(out / "scaling.yaml"), "--out", str(d), "--workers", str(workers), "--no-progress"],
+        [str(wormsim), "sweep", str(out / "scaling.yaml"), "--out", str(d), "--workers", str(workers), "--no-progress"]
+        + (["--scheduler", scheduler] if scheduler else []),
         check=True,
     )
     command_wall = time.perf_counter() - t0
@@ -109,6 +115,43 @@ def measure(out: Path, workers: int) -> dict:
     }
 
 
+def standing_cluster(out: Path, workers: int) -> tuple[str, list[subprocess.Popen]]:
+    """A `dask scheduler` and `dask worker --nworkers workers --nthreads 1` on this machine, with the local cluster's
+    dask settings (wormsim.sweep.cluster.LOCAL_DASK_CONFIG) in their environment; returns (address, processes)."""
+    from wormsim.sweep.cluster import LOCAL_DASK_CONFIG
+
+    env = dict(os.environ, MUJOCO_GL="disable")
+    for key, value in LOCAL_DASK_CONFIG.items():
+        env["DASK_" + key.upper().replace(".", "__").replace("-", "_")] = str(value)
+    bin_dir = Path(sys.executable).parent
+    sf = out / f"scheduler{workers}.json"
+    sf.unlink(missing_ok=True)
+    log = (out / f"cluster{workers}.log").open("w")
+    procs = [
+        subprocess.Popen(
+            [str(bin_dir / "dask"), "scheduler", "--host", "127.0.0.1", "--port", "0", "--no-dashboard"]
+            + ["--scheduler-file", str(sf)],
+            env=env,
+            stdout=log,
+            stderr=log,
+        )
+    ]
+    t0 = time.perf_counter()
+    while not sf.exists() and time.perf_counter() - t0 < 60:
+        time.sleep(0.1)
+    address = json.loads(sf.read_text())["address"]
+    procs.append(
+        subprocess.Popen(
+            [str(bin_dir / "dask"), "worker", address, "--nworkers", str(workers), "--nthreads", "1"]
+            + ["--no-dashboard"],
+            env=env,
+            stdout=log,
+            stderr=log,
+        )
+    )
+    return address, procs
+
+
 def model(runs: dict, workers: int, g: float) -> float:
     """T(N) = fixed_s + ceil(P / N) x t_point x g, from the 1-worker run (module docstring)."""
     r1 = runs["1"]
@@ -133,7 +176,10 @@ def main() -> None:
     ap.add_argument("--repeats", type=int, default=1)
     ap.add_argument("--record", default=str(ROOT / "docs" / "data" / "sweep_scaling.json"))
     ap.add_argument("--model-only", action="store_true", help="recompute the model of the existing record")
+    ap.add_argument("--standing", action="store_true", help="standing clusters (module docstring)")
     args = ap.parse_args()
+    if args.standing and args.record == ap.get_default("record"):
+        args.record = str(ROOT / "docs" / "data" / "sweep_scaling_standing.json")
     if args.model_only:
         rec = json.loads(Path(args.record).read_text())
         rec["model"] = models(rec["runs"], rec["step_growth_2"])
@@ -146,24 +192,48 @@ def main() -> None:
     )
     walls: dict[str, list[float]] = {"1": [], "2": []}
     runs: dict[str, dict] = {}
-    for _ in range(args.repeats):
-        for n in (1, 2):
-            r = measure(out, n)
-            walls[str(n)].append(r["command_wall_s"])
-            if str(n) not in runs or r["command_wall_s"] < runs[str(n)]["command_wall_s"]:
-                runs[str(n)] = r
+    schedulers: dict[int, str | None] = {1: None, 2: None}
+    first: dict[str, float] = {}
+    procs: list[subprocess.Popen] = []
+    try:
+        if args.standing:
+            for n in (1, 2):
+                schedulers[n], ps = standing_cluster(out, n)
+                procs += ps
+            for n in (1, 2):
+                first[str(n)] = measure(out, n, schedulers[n])["command_wall_s"]
+        for _ in range(args.repeats):
+            for n in (1, 2):
+                r = measure(out, n, schedulers[n])
+                walls[str(n)].append(r["command_wall_s"])
+                if str(n) not in runs or r["command_wall_s"] < runs[str(n)]["command_wall_s"]:
+                    runs[str(n)] = r
+    finally:
+        for p in procs[::-1]:
+            p.terminate()
+        for p in procs:
+            p.wait(timeout=30)
     g2 = runs["2"]["step_wall_us_median"] / runs["1"]["step_wall_us_median"]
     rec = {
         "provenance": provenance(
-            "python studies/measure_sweep_scaling.py" + (f" --repeats {args.repeats}" if args.repeats > 1 else "")
+            "python studies/measure_sweep_scaling.py"
+            + (" --standing" if args.standing else "")
+            + (f" --repeats {args.repeats}" if args.repeats > 1 else "")
         ),
         "load_average_after": list(os.getloadavg()),
         "what": f"{args.points} contact3d screw-jack points ({args.duration} s, 1000-2000 rpm), `wormsim sweep` "
-        "commands on a LocalCluster of 1 then 2 workers, the kernels' cache warm"
+        + (
+            "commands with `--scheduler` on standing clusters of 1 and 2 workers (`dask scheduler`, `dask worker "
+            "--nthreads 1`; each cluster's first command not timed)"
+            if args.standing
+            else "commands on a LocalCluster of 1 then 2 workers"
+        )
+        + ", the kernels' cache warm"
         + (f", {args.repeats} times each taking turns, the fastest kept" if args.repeats > 1 else ""),
         "cpu_count": os.cpu_count(),
         "repeats": args.repeats,
         "command_walls_s": walls,
+        **({"first_command_s": first} if first else {}),
         "runs": runs,
         "speedup_command": runs["1"]["command_wall_s"] / runs["2"]["command_wall_s"],
         "speedup_span": runs["1"]["span_s"] / runs["2"]["span_s"],

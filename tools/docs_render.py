@@ -460,6 +460,15 @@ def sweep_scaling_table(name: str = "sweep_scaling") -> str:
             if r.get("command_walls_s")
             else ""
         )
+        + (
+            " Each standing cluster's first command (its workers load the kernels): "
+            + "; ".join(
+                f"{n} worker{'s' if n != '1' else ''} {v:.1f} s" for n, v in sorted(r["first_command_s"].items())
+            )
+            + "."
+            if r.get("first_command_s")
+            else ""
+        )
         + "\n\n"
         f"Model T(N) = fixed + ceil(P / N) t_point g(N), t_point = {m['t_point_s']:.1f} s the 1-worker span per "
         "point: "
@@ -1482,6 +1491,7 @@ TABLES: dict[str, Callable[[], str]] = {
     "sweep_speedup": sweep_speedup_table,
     "sweep_scaling": sweep_scaling_table,
     "sweep_fixed_cost": sweep_fixed_cost_table,
+    "sweep_scaling_standing": lambda: sweep_scaling_table("sweep_scaling_standing"),
     "core_contention": core_contention_table,
     "errors_study": errors_study_table,
     "wedge_seed000": wedge_seed000_table,
