@@ -194,11 +194,13 @@ def test_the_preload_holds_what_a_worker_needs_before_its_first_point():
     assert got["versions_cached"] > 0
 
 
-def test_the_cluster_start_thread_imports_matplotlib_before_distributed(tmp_path):
-    """One thread imports matplotlib and distributed (cluster.plot_imports, then open_client): in a fresh interpreter
-    the cluster's start thread finds matplotlib.pyplot imported and distributed not yet when it opens the client, so
-    no two threads import at once (importlib's _DeadlockError between pyparsing's `html` and tornado's
-    `html.entities`, a command's exit 1)."""
+@pytest.mark.parametrize("scheduler", [None, "tcp://127.0.0.1:1"])
+def test_the_cluster_start_thread_imports_matplotlib_before_distributed(tmp_path, scheduler):
+    """A local cluster's start thread imports matplotlib and distributed (cluster.plot_imports, then open_client): in
+    a fresh interpreter it finds matplotlib.pyplot imported and distributed not yet when it opens the client, so no
+    two threads import at once (importlib's _DeadlockError between pyparsing's `html` and tornado's `html.entities`,
+    a command's exit 1). With a scheduler's address nothing waits for a fork server: the start thread connects
+    without importing matplotlib (run_sweep imports it once the first points are out)."""
     import subprocess
     import sys
 
@@ -211,9 +213,11 @@ def test_the_cluster_start_thread_imports_matplotlib_before_distributed(tmp_path
         "                thread=threading.current_thread().name)\n"
         "    return (None, None, {})\n"
         "cluster.open_client = fake\n"
-        "cluster.ClusterStart('tcp://127.0.0.1:1', 1, warm=False).get()\n"
+        "cluster.start_fork_server = lambda warm: None\n"
+        f"cluster.ClusterStart({scheduler!r}, 1, warm=False).get()\n"
         "print(seen['mpl'], seen['dist'], seen['thread'], 'matplotlib.pyplot' in sys.modules)\n"
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=tmp_path, timeout=120)
     assert out.returncode == 0, out.stderr
-    assert out.stdout.split() == ["True", "False", "wormsim-cluster-start", "True"], out.stdout
+    mpl = str(scheduler is None)
+    assert out.stdout.split() == [mpl, "False", "wormsim-cluster-start", mpl], out.stdout

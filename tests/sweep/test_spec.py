@@ -276,6 +276,7 @@ def test_external_scheduler_gives_the_same_table(local_run, tmp_path, capsys):
                 _stop(p)
     doc = json.loads((out / "sweep.json").read_text())
     assert doc["cluster"]["kind"] == "existing scheduler" and doc["cluster"]["scheduler"] == address
+    assert (out / "sweep.png").stat().st_size > 10_000  # (matplotlib imported while the points ran)
     a, b = _rows(local), _rows(out)
     assert _header(local) == _header(out)
     for ra, rb in zip(a, b, strict=True):

@@ -238,12 +238,14 @@ def warm_workers(client, info: dict) -> None:
 
 
 def plot_imports() -> None:
-    """matplotlib's import (pyplot on the Agg backend, what sweep.png needs), in the cluster's start thread before
-    distributed's: one thread imports both. Two threads that import them at once can stop the command with
-    importlib's _DeadlockError (CPython's per-module locks taken in opposite orders for a package and its submodule:
-    pyparsing imports `html`, whose __init__ imports `html.entities`, which tornado imports directly). The start waits
-    for the fork server's preload on another core, so the import costs it no time; a failure is dropped (the figure
-    imports for itself)."""
+    """matplotlib's import (pyplot on the Agg backend, what sweep.png needs). A local cluster's start thread runs it
+    before distributed's import: one thread imports both. Two threads that import them at once can stop the command
+    with importlib's _DeadlockError (CPython's per-module locks taken in opposite orders for a package and its
+    submodule: pyparsing imports `html`, whose __init__ imports `html.entities`, which tornado imports directly). That
+    start waits for the fork server's preload on another core, so the import costs it no time. On a cluster given by
+    address nothing waits for a preload: the client connects first and imports matplotlib in its main thread once
+    the first points are out (runner.run_sweep; distributed is imported and connected by then), while the workers
+    run them. A failure is dropped (the figure imports for itself)."""
     try:
         import matplotlib
 
@@ -273,7 +275,8 @@ class ClusterStart:
         self._thread.start()
 
     def _run(self, scheduler, workers, warm) -> None:
-        plot_imports()
+        if scheduler is None:  # (beside the fork server's preload; with a scheduler the points run first: run_sweep)
+            plot_imports()
         try:
             self._result = open_client(scheduler, workers, warm)
         except BaseException as exc:  # (re-raised by get in the main thread)

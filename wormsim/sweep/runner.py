@@ -35,6 +35,7 @@ from wormsim.sweep.cluster import (  # noqa: F401  (the cluster's names, as they
     close_cluster,
     default_workers,
     open_client,
+    plot_imports,
     start_fork_server,
     warm_workers,
 )
@@ -416,7 +417,8 @@ def run_sweep(
                     bar.point_done(summary.get("status") != "ok")
                 flush_csv()
 
-            _dispatch(client, todo, keep_runs, cluster_info, on_results)
+            # on a cluster given by address the figure's imports wait until the first points are out (plot_imports)
+            _dispatch(client, todo, keep_runs, cluster_info, on_results, plot_imports if cluster is None else None)
     except KeyboardInterrupt:
         interrupted = True
     finally:
@@ -471,12 +473,13 @@ def _resume(sweep: Sweep, earlier: list[dict]) -> tuple[dict[int, dict], list[Po
     return rows, todo
 
 
-def _dispatch(client, todo: list[Point], keep_runs: bool, cluster_info: dict, on_results) -> None:
+def _dispatch(client, todo: list[Point], keep_runs: bool, cluster_info: dict, on_results, after_submit=None) -> None:
     """Run the points of todo on the cluster in chunks (task_sizes; cluster_info gets points_per_task, the largest);
     each finished chunk goes to on_results(points, results, submitted, received), a lost worker's chunk as failed
     results.
     Only as many points in flight as the cluster has threads: a point waits on the scheduler, not in a worker's
-    queue, so a worker that dies (segfault, OOM killer) fails the point it ran and no other."""
+    queue, so a worker that dies (segfault, OOM killer) fails the point it ran and no other. after_submit (if given)
+    runs once, after the first tasks are submitted."""
     from distributed import as_completed
 
     futures = {}
@@ -499,6 +502,8 @@ def _dispatch(client, todo: list[Point], keep_runs: bool, cluster_info: dict, on
         return fut
 
     pending = as_completed([submit_next() for _ in range(min(len(sizes), threads))])
+    if after_submit is not None:
+        after_submit()
     for fut in pending:
         if queue:
             pending.add(submit_next())
