@@ -122,12 +122,7 @@ def refine_peak(tt: np.ndarray, y: np.ndarray, a: float, b: float, rtol: float =
     d_lo, _ = _power_slope(tt, y, lo)
     d_hi, _ = _power_slope(tt, y, hi)
     if d_lo <= 0.0:  # |Y| falls from a: the largest value is at an end
-        return (
-            a
-            if d_hi <= 0.0
-            or abs(np.dot(y, np.exp(-2j * np.pi * a * tt))) >= abs(np.dot(y, np.exp(-2j * np.pi * b * tt)))
-            else b
-        )
+        return a if d_hi <= 0.0 or _hann_dtft_amplitude(tt, y, 1.0, a) >= _hann_dtft_amplitude(tt, y, 1.0, b) else b
     if d_hi >= 0.0:
         return b
     f = 0.5 * (lo + hi)

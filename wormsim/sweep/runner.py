@@ -476,10 +476,9 @@ def _resume(sweep: Sweep, earlier: list[dict]) -> tuple[dict[int, dict], list[Po
 def _dispatch(client, todo: list[Point], keep_runs: bool, cluster_info: dict, on_results, after_submit=None) -> None:
     """Run the points of todo on the cluster in chunks (task_sizes; cluster_info gets points_per_task, the largest);
     each finished chunk goes to on_results(points, results, submitted, received), a lost worker's chunk as failed
-    results.
-    Only as many points in flight as the cluster has threads: a point waits on the scheduler, not in a worker's
-    queue, so a worker that dies (segfault, OOM killer) fails the point it ran and no other. after_submit (if given)
-    runs once, after the first tasks are submitted."""
+    results. Only as many points in flight as the cluster has threads: a point waits on the scheduler, not in a
+    worker's queue, so a worker that dies (segfault, OOM killer) fails the point it ran and no other. after_submit
+    (if given) runs once, after the first tasks are submitted."""
     from distributed import as_completed
 
     futures = {}
