@@ -34,7 +34,10 @@ LONG_TESTS: dict[str, set[str] | None] = {
         "test_left_q6_4start_at_1400_rpm_f_t_p2p_converged_in_slices"
     },  # four random gears' contact3d runs (issue 31), ~10 s each
     # a set may also name tests (their function names): WormPair against a contact3d run of the same gear (~20 s)
-    "test_pair.py": {"test_pair_forces_and_efficiency_match_contact3d_on_the_same_gear"},
+    "test_pair.py": {
+        "test_pair_forces_and_efficiency_match_contact3d_on_the_same_gear",
+        "test_pair_axial_force_against_din_3975",
+    },
     "contact3d/test_flank_samples.py": {
         "test_held_run_ends_alike_on_the_compiled_and_the_python_path"
     },  # two held runs  # F_t sidebands of a wheel runout over a wheel revolution (~1 min)
