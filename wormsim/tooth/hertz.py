@@ -188,6 +188,13 @@ def hertz_line_pressure_pa(line_load_n_per_m, e_star_pa: float, inv_rho_per_m):
 
 
 @numba.njit(cache=True, inline="always")
+def _line_pressure(w, e_star, inv_rho):
+    """(3) for one contact, compiled (pattern_rows, _window_rows): hertz_line_pressure_pa's formula, its operations
+    in its order."""
+    return math.sqrt(max(w, 0.0) * e_star * max(inv_rho, 0.0) / math.pi)
+
+
+@numba.njit(cache=True, inline="always")
 def _lerp(a, sg, j, f):
     """a[sg, j, f] linear in the fractional profile index f; a nan neighbour gives the other one."""
     N = a.shape[2]
@@ -261,7 +268,7 @@ def _window_rows(buf, m, inwin, inv_rho, rho3, zeta, e_star, length, n):
         sF, sL, sK = cF[hi] - cF[lo], cL[hi] - cL[lo], cK[hi] - cK[lo]
         if ok[r] and sF > 0:
             w = sF / max(sL, length)
-            pavg[q] = math.sqrt(max(w, 0.0) * e_star * max(sK / sF, 0.0) / math.pi)
+            pavg[q] = _line_pressure(w, e_star, sK / sF)
         else:
             pavg[q] = math.nan
     return sel, pavg
@@ -297,7 +304,7 @@ def pattern_rows(i, adr, efc_force, meta, weight, inv_rho, line_len, e_star, out
         o[0], o[1], o[2], o[3], o[4] = i, sg, j, f, fn
         # a contact whose slice has no contact-line length left (L = 0: a steep flank's slice at the active profile's
         # end) has no line load: its p_H is nan, left out of the pressure keys
-        o[5] = math.sqrt(max(fn, 0.0) / L * e_star * max(k, 0.0) / math.pi) if L > 0.0 else math.nan
+        o[5] = _line_pressure(fn / L, e_star, k) if L > 0.0 else math.nan
         m += 1
     return m
 
@@ -314,11 +321,11 @@ class PatternLog:
         self.e_star = e_star_pa
         self.buf = np.zeros((4096, 6), dtype=np.float32)  # 24 bytes per contact and sample
         self.m = 0
-        self._rows: tuple | None = None  # (key, window_rows' result): `window_rows`
+        self._rows: tuple | None = None  # (row count, samples in the window, window_rows' result): `window_rows`
 
     def record(self, i: int, d) -> None:
         """The kernel's contacts (d.contact's last fc.n entries) at sample i: (i, sigma, j, f, F_n, p_H);
-        p_H by (3) (in `pattern_rows`, compiled: the same formula as hertz_line_pressure_pa)."""
+        p_H by (3) (in `pattern_rows`, compiled: `_line_pressure`)."""
         fc = self.fc
         n = fc.n if fc.merge else min(fc.n, d.ncon)
         if n == 0:
@@ -357,15 +364,14 @@ class PatternLog:
         row) and kept for the window's rows, compiled in one pass over the log (`_window_rows`) without the
         whole table (1.5 million rows in a run that records every step of 0.3 s at 2e-5 s: about 0.25 s of numpy);
         computed once for summary and grid (rows are only appended or truncated, so the row count names the log)."""
-        key = (self.m, float(window_s[0]), float(window_s[1]), len(t_s), t_s.ctypes.data)
-        if self._rows is None or self._rows[0] != key:
-            inwin = (t_s >= window_s[0]) & (t_s <= window_s[1])
+        inwin = (t_s >= window_s[0]) & (t_s <= window_s[1])
+        if self._rows is None or self._rows[0] != self.m or not np.array_equal(self._rows[1], inwin):
             cv = self.cv
             length = PRESSURE_LENGTH_MX * self.geo.m_x
             n = max(1, math.ceil(length / cv.slice_width - 1e-9))
             args = (cv.inv_rho, self.rho3, cv.zeta, float(self.e_star), length, n)
-            self._rows = (key, _window_rows(self.buf, self.m, inwin, *args))
-        return self._rows[1]
+            self._rows = (self.m, inwin, _window_rows(self.buf, self.m, inwin, *args))
+        return self._rows[2]
 
     def summary(self, t_s: np.ndarray, window_s) -> dict:
         """The summary keys of the module docstring over the samples with t in window_s."""
